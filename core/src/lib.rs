@@ -1,0 +1,102 @@
+//! # Footprint
+//!
+//! A `no_std`, allocation-free implementation of Lee Westover's footprint-evaluation splatting
+//! ("Footprint Evaluation for Volume Rendering", SIGGRAPH 1990).
+//!
+//! Every voxel is projected to the screen and its reconstruction kernel's *footprint* (the kernel
+//! integrated along the view direction) is spread over the pixels it covers. The footprint is
+//! precomputed once per kernel as a [`GenericTable`]; per view, the projected kernel ellipse is
+//! mapped back onto the unit circle ([`Footprint`]) and the generic table resampled into a
+//! [`ViewTable`], which every voxel then reuses.
+//!
+//! ## Where things live
+//! - [`math`]: the one door to float functions (`libm` or `micromath` backend).
+//! - [`kernel`]: kernels, their footprints, specs like `gaussian:spread=1.6,sigmas=2.5`.
+//! - [`geometry`]: grid, view, the screen ellipse, its extent and its map to the unit circle.
+//! - [`table`]: generic and view tables, lookup, the table byte format.
+//! - [`splat`]: spreading one voxel into a caller-owned image.
+//!
+//! ## Conventions (kept everywhere)
+//! - world = G·(i, j, k), G the grid-to-world matrix (diagonal = spacing, world units such as mm);
+//! - screen = V·world + (W/2, H/2, 0), V the world-to-screen linear map, in pixels; x right,
+//!   y down, z away from the viewer; pixel (x, y) has its centre at (x + 0.5, y + 0.5);
+//! - a footprint weight is a density in px⁻² that integrates to one over the screen plane.
+//!
+//! ## Example
+//! ```
+//! use footprint::{geometry::*, kernel::Kernel, splat::*, table::*};
+//! let kernel = Kernel::parse("gaussian:spread=1.6,sigmas=2.5").unwrap();
+//! let generic = GenericTable::<33>::build(kernel);
+//! let grid = Grid::from_spacing([4.0, 2.0, 2.0]).unwrap();
+//! let view = View::new(glam::Mat3::IDENTITY).unwrap();
+//! let fp = Footprint::new(&kernel, &view.grid_to_screen(&grid), FootprintOptions::default()).unwrap();
+//! let table = ViewTable::<33>::build(&fp, &generic, Lookup::Bilinear, Lookup::Bilinear);
+//! let mut pixels = [0.0f32; 32 * 32];
+//! let mut image = ImageMut::new(&mut pixels, 32, 32, 32).unwrap();
+//! splat(&table, [16.0, 16.0], &1.0f32, &mut image).unwrap();
+//! let total: f32 = pixels.iter().sum();
+//! assert!((total - 1.0).abs() < 0.01, "a splat deposits one unit, got {total}");
+//! ```
+#![no_std]
+#![forbid(unsafe_code)]
+#![deny(missing_docs, rustdoc::broken_intra_doc_links)]
+
+pub mod geometry;
+pub mod kernel;
+pub mod math;
+pub mod splat;
+pub mod table;
+
+pub use geometry::{Footprint, FootprintOptions, GeometryError, Grid, Mapping, View};
+pub use kernel::{Kernel, KernelSpecError};
+pub use splat::{splat, BufferError, ImageMut, Sampler};
+pub use table::{GenericTable, Lookup, TableError, ViewTable};
+
+use core::fmt;
+
+/// Any error the core can return, for callers that want one type.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum Error {
+    /// A bad kernel spec.
+    Kernel(KernelSpecError),
+    /// Bad grid or view geometry.
+    Geometry(GeometryError),
+    /// A table that cannot be loaded or saved.
+    Table(TableError),
+    /// A caller buffer of the wrong size, or a bad splat position.
+    Buffer(BufferError),
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Error::Kernel(e) => e.fmt(f),
+            Error::Geometry(e) => e.fmt(f),
+            Error::Table(e) => e.fmt(f),
+            Error::Buffer(e) => e.fmt(f),
+        }
+    }
+}
+
+impl core::error::Error for Error {
+    fn source(&self) -> Option<&(dyn core::error::Error + 'static)> {
+        match self {
+            Error::Kernel(e) => Some(e),
+            Error::Geometry(e) => Some(e),
+            Error::Table(e) => Some(e),
+            Error::Buffer(e) => Some(e),
+        }
+    }
+}
+
+macro_rules! from_error {
+    ($($variant:ident($ty:ty)),*) => {$(
+        impl From<$ty> for Error {
+            fn from(e: $ty) -> Self {
+                Error::$variant(e)
+            }
+        }
+    )*};
+}
+from_error!(Kernel(KernelSpecError), Geometry(GeometryError), Table(TableError), Buffer(BufferError));

@@ -1,0 +1,78 @@
+//! `micromath` backend: fast approximations for small cores.
+//!
+//! | function | method | worst-case error |
+//! |---|---|---|
+//! | `sqrt` | micromath's bit-trick seed (5 %), then two Newton–Raphson steps | relative 2e-6 |
+//! | `exp` | micromath (`exp_ln2_approx`) | relative 1e-3 (micromath's `MAX_ERROR`) |
+//! | `sin`, `cos` | micromath's parabolic approximation | absolute 2e-3 |
+//! | `atan` | micromath | absolute 2.9e-3 rad (0.162°) |
+//! | `erf` | Abramowitz & Stegun 7.1.26 on top of this `exp` | absolute 1.5e-7 + 1e-3 × e^(−x²) ≤ 1.1e-3 |
+//! | `floor` | micromath | exact |
+//!
+//! `sqrt` is refined because a 5 % error in an ellipse axis would move every footprint edge by
+//! 5 %; the other bounds are what micromath states. The table in `tests/math_backends.rs` measures
+//! them against f64 references.
+
+use super::ErrorBounds;
+use micromath::F32Ext as _;
+
+pub const NAME: &str = "micromath";
+
+/// This backend's bounds (see the table above).
+pub const ERROR_BOUNDS: ErrorBounds = ErrorBounds {
+    sqrt_rel: 2.0e-6,
+    exp_rel: 1.0e-3,
+    sin_cos_abs: 2.0e-3,
+    atan_abs: 2.9e-3,
+    erf_abs: 1.1e-3,
+};
+
+#[inline]
+pub fn sqrt(x: f32) -> f32 {
+    if !(x > 0.0) {
+        // 0 → 0, negative or NaN → NaN, matching libm.
+        return if x == 0.0 { x } else { f32::NAN };
+    }
+    if x == f32::INFINITY {
+        return x;
+    }
+    let mut y = micromath::F32(x).sqrt().0;
+    y = 0.5 * (y + x / y);
+    0.5 * (y + x / y)
+}
+#[inline]
+pub fn exp(x: f32) -> f32 {
+    x.exp()
+}
+/// Abramowitz & Stegun 7.1.26: erf(x) = 1 − (a₁t + a₂t² + … + a₅t⁵)e^(−x²), t = 1/(1+px),
+/// |error| ≤ 1.5e-7 with an exact exponential; the `exp` error adds at most 1e-3·e^(−x²).
+#[inline]
+pub fn erf(x: f32) -> f32 {
+    const P: f32 = 0.327_591_1;
+    const A: [f32; 5] = [0.254_829_6, -0.284_496_74, 1.421_413_8, -1.453_152_1, 1.061_405_4];
+    let ax = super::abs(x);
+    let t = 1.0 / (1.0 + P * ax);
+    let poly = t * (A[0] + t * (A[1] + t * (A[2] + t * (A[3] + t * A[4]))));
+    let y = 1.0 - poly * exp(-ax * ax);
+    if x < 0.0 {
+        -y
+    } else {
+        y
+    }
+}
+#[inline]
+pub fn sin(x: f32) -> f32 {
+    x.sin()
+}
+#[inline]
+pub fn cos(x: f32) -> f32 {
+    x.cos()
+}
+#[inline]
+pub fn atan(x: f32) -> f32 {
+    x.atan()
+}
+#[inline]
+pub fn floor(x: f32) -> f32 {
+    x.floor()
+}

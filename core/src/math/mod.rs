@@ -1,0 +1,106 @@
+//! The one door to floating-point functions in the core.
+//!
+//! Every transcendental or rounding function the core uses is a free function here; nothing else in
+//! the crate calls `f32::sqrt` and friends (with `std` linked, as in unit tests, inherent `f32`
+//! methods would silently replace the no_std functions, so a test would measure code the embedded
+//! build never runs).
+//!
+//! Two backends, chosen by cargo feature:
+//! - `libm` (default): correctly rounded or nearly so (libm's `f32` functions are accurate to
+//!   about 1 ulp). See [`libm_backend`](self) for the per-function bound.
+//! - `micromath`: small, fast approximations for cores without an FPU or with a single-precision
+//!   one. `micromath` is used for the seeds; where its raw error would break the geometry (its
+//!   `sqrt` is only good to 5 %), this module refines the result. The bounds are stated in the
+//!   backend's doc comment and checked against `libm` in `tests/math_backends.rs`.
+//!
+//! If both features are enabled, `micromath` wins: `libm` is the default, so asking for
+//! `micromath` is the explicit choice.
+
+#[cfg(not(any(feature = "libm", feature = "micromath")))]
+compile_error!("footprint needs a float backend: enable the `libm` (default) or `micromath` feature");
+
+#[cfg(all(feature = "libm", not(feature = "micromath")))]
+mod libm_backend;
+#[cfg(all(feature = "libm", not(feature = "micromath")))]
+use libm_backend as backend;
+
+#[cfg(feature = "micromath")]
+mod micromath_backend;
+#[cfg(feature = "micromath")]
+use micromath_backend as backend;
+
+/// Name of the active backend (`"libm"` or `"micromath"`), for reports and benchmark labels.
+pub const BACKEND: &str = backend::NAME;
+
+/// Documented worst-case errors of the active backend, checked in `tests/math_backends.rs`.
+pub use backend::ERROR_BOUNDS;
+
+/// Worst-case error bounds of one backend: relative error for `sqrt` and `exp`, absolute error for
+/// the others (`sin`/`cos` over |x| ≤ 2π, `atan` in radians, `erf` over all x).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ErrorBounds {
+    /// Relative error of [`sqrt`].
+    pub sqrt_rel: f32,
+    /// Relative error of [`exp`] for results in the normal range.
+    pub exp_rel: f32,
+    /// Absolute error of [`sin`] and [`cos`] for |x| ≤ 2π.
+    pub sin_cos_abs: f32,
+    /// Absolute error of [`atan`], radians.
+    pub atan_abs: f32,
+    /// Absolute error of [`erf`].
+    pub erf_abs: f32,
+}
+
+/// Square root. NaN for negative input.
+#[inline]
+pub fn sqrt(x: f32) -> f32 {
+    backend::sqrt(x)
+}
+
+/// e^x.
+#[inline]
+pub fn exp(x: f32) -> f32 {
+    backend::exp(x)
+}
+
+/// The error function erf(x) = 2/√π ∫₀ˣ e^(−t²) dt.
+#[inline]
+pub fn erf(x: f32) -> f32 {
+    backend::erf(x)
+}
+
+/// Sine of an angle in radians.
+#[inline]
+pub fn sin(x: f32) -> f32 {
+    backend::sin(x)
+}
+
+/// Cosine of an angle in radians.
+#[inline]
+pub fn cos(x: f32) -> f32 {
+    backend::cos(x)
+}
+
+/// Arctangent in radians, in (−π/2, π/2).
+#[inline]
+pub fn atan(x: f32) -> f32 {
+    backend::atan(x)
+}
+
+/// Largest integer value not greater than `x`.
+#[inline]
+pub fn floor(x: f32) -> f32 {
+    backend::floor(x)
+}
+
+/// |x|, by clearing the sign bit (exact, no backend needed).
+#[inline]
+pub fn abs(x: f32) -> f32 {
+    f32::from_bits(x.to_bits() & 0x7fff_ffff)
+}
+
+/// x², spelled out so call sites read like the formulas they implement.
+#[inline]
+pub fn sq(x: f32) -> f32 {
+    x * x
+}
