@@ -111,7 +111,10 @@ impl fmt::Display for GeometryError {
         match *self {
             Self::NonFinite => f.write_str("matrix or spacing contains NaN or infinity"),
             Self::NonPositiveSpacing { axis, value } => {
-                write!(f, "spacing along grid axis {axis} must be positive, got {value}")
+                write!(
+                    f,
+                    "spacing along grid axis {axis} must be positive, got {value}"
+                )
             }
             Self::SingularGrid => f.write_str("grid-to-world matrix is singular"),
             Self::SingularView => f.write_str("world-to-screen matrix is singular"),
@@ -120,7 +123,10 @@ impl fmt::Display for GeometryError {
                 "footprint half-extent {half_extent_px} px exceeds {MAX_HALF_EXTENT_PX} px"
             ),
             Self::BadMinRadius { value } => {
-                write!(f, "minimum footprint radius must be >= {MIN_MIN_RADIUS_PX} px, got {value}")
+                write!(
+                    f,
+                    "minimum footprint radius must be >= {MIN_MIN_RADIUS_PX} px, got {value}"
+                )
             }
             Self::PaperSingular { theta_deg } => {
                 write!(f, "paper θ decomposition is singular at θ = {theta_deg}°")
@@ -157,10 +163,15 @@ impl Grid {
                 return Err(GeometryError::NonFinite);
             }
             if value <= 0.0 {
-                return Err(GeometryError::NonPositiveSpacing { axis: axis as u8, value });
+                return Err(GeometryError::NonPositiveSpacing {
+                    axis: axis as u8,
+                    value,
+                });
             }
         }
-        Ok(Grid { to_world: Mat3::from_diagonal(Vec3::from_array(spacing)) })
+        Ok(Grid {
+            to_world: Mat3::from_diagonal(Vec3::from_array(spacing)),
+        })
     }
 
     /// A general grid (sheared or rotated, e.g. from NRRD `space directions`). Column c is the
@@ -172,7 +183,9 @@ impl Grid {
         if !well_conditioned(&grid_to_world) {
             return Err(GeometryError::SingularGrid);
         }
-        Ok(Grid { to_world: grid_to_world })
+        Ok(Grid {
+            to_world: grid_to_world,
+        })
     }
 
     /// The grid-to-world matrix.
@@ -197,7 +210,9 @@ impl View {
         if !well_conditioned(&world_to_screen) {
             return Err(GeometryError::SingularView);
         }
-        Ok(View { to_screen: world_to_screen })
+        Ok(View {
+            to_screen: world_to_screen,
+        })
     }
 
     /// From nine entries in row-major order (m00, m01, m02, m10, …), as the CLI's `--view-matrix`.
@@ -220,7 +235,11 @@ impl View {
 /// plane: the one whose in-sheet axes span a plane with the largest |cos| to the screen's xy plane.
 /// Ties go to the lower axis. `grid_to_screen` is V·G.
 pub fn sheet_axis(grid_to_screen: &Mat3) -> usize {
-    let cols = [grid_to_screen.x_axis, grid_to_screen.y_axis, grid_to_screen.z_axis];
+    let cols = [
+        grid_to_screen.x_axis,
+        grid_to_screen.y_axis,
+        grid_to_screen.z_axis,
+    ];
     let mut best = (0, -1.0f32);
     for k in 0..3 {
         let (a, b) = in_sheet_axes(k);
@@ -272,7 +291,10 @@ pub struct FootprintOptions {
 
 impl Default for FootprintOptions {
     fn default() -> Self {
-        FootprintOptions { mapping: Mapping::Robust, min_radius_px: DEFAULT_MIN_RADIUS_PX }
+        FootprintOptions {
+            mapping: Mapping::Robust,
+            min_radius_px: DEFAULT_MIN_RADIUS_PX,
+        }
     }
 }
 
@@ -293,13 +315,22 @@ pub type Mat2 = [[f32; 2]; 2];
 /// m · v.
 #[inline]
 pub fn mul2(m: &Mat2, v: [f32; 2]) -> [f32; 2] {
-    [m[0][0] * v[0] + m[0][1] * v[1], m[1][0] * v[0] + m[1][1] * v[1]]
+    [
+        m[0][0] * v[0] + m[0][1] * v[1],
+        m[1][0] * v[0] + m[1][1] * v[1],
+    ]
 }
 
 fn inverse2(m: &Mat2) -> (Mat2, f32) {
     let det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
     let inv = 1.0 / det;
-    ([[m[1][1] * inv, -m[0][1] * inv], [-m[1][0] * inv, m[0][0] * inv]], det)
+    (
+        [
+            [m[1][1] * inv, -m[0][1] * inv],
+            [-m[1][0] * inv, m[0][0] * inv],
+        ],
+        det,
+    )
 }
 
 /// One view's footprint: where it reaches on screen and how a screen offset maps into the generic
@@ -324,6 +355,8 @@ pub struct Footprint {
     pub covariance: Sym2,
     /// The sheet axis this footprint was oriented for (used by separable kernels).
     pub sheet_axis: usize,
+    /// Radial (ellipse support) or separable (parallelogram support).
+    pub shape: Shape,
 }
 
 impl Footprint {
@@ -345,7 +378,11 @@ impl Footprint {
         }
         let axis = sheet_axis(grid_to_screen);
         let r = kernel.spread();
-        let cols = [grid_to_screen.x_axis, grid_to_screen.y_axis, grid_to_screen.z_axis];
+        let cols = [
+            grid_to_screen.x_axis,
+            grid_to_screen.y_axis,
+            grid_to_screen.z_axis,
+        ];
         // N: 2×3 (radial) or B: 2×2 (separable), rows = screen x and y, scaled by R.
         let mut n = [[0.0f32; 3]; 2];
         match kernel.shape() {
@@ -358,7 +395,10 @@ impl Footprint {
             Shape::Separable => {
                 // Third column zero: the same formulas then give B Bᵀ and det(B)².
                 let (a, b) = in_sheet_axes(axis);
-                n = [[r * cols[a].x, r * cols[b].x, 0.0], [r * cols[a].y, r * cols[b].y, 0.0]];
+                n = [
+                    [r * cols[a].x, r * cols[b].x, 0.0],
+                    [r * cols[a].y, r * cols[b].y, 0.0],
+                ];
             }
         }
         let clamped = clamp_min_radius(&mut n, mr * mr);
@@ -399,11 +439,15 @@ impl Footprint {
             && scale.is_finite()
             && scale > 0.0;
         if !finite {
-            return Err(GeometryError::PaperSingular { theta_deg: f32::NAN });
+            return Err(GeometryError::PaperSingular {
+                theta_deg: f32::NAN,
+            });
         }
         let largest = half_extent[0].max(half_extent[1]);
         if largest > MAX_HALF_EXTENT_PX {
-            return Err(GeometryError::TooLarge { half_extent_px: largest });
+            return Err(GeometryError::TooLarge {
+                half_extent_px: largest,
+            });
         }
         Ok(Footprint {
             to_unit,
@@ -414,14 +458,61 @@ impl Footprint {
             cheated,
             covariance: cov,
             sheet_axis: axis,
+            shape: kernel.shape(),
         })
+    }
+
+    /// The range of screen x offsets (pixels, relative to the voxel's projected centre) where the
+    /// footprint's support meets the row at y offset `qy`: the ellipse `|A q| ≤ 1` (radial) or
+    /// the parallelogram `|A q|∞ ≤ 1` (separable), A = [`Footprint::to_unit`]. `None` if the row
+    /// misses it. Splatting visits only these pixels, so table interpolation never leaks weight
+    /// past the support, and a quarter of an ellipse's bounding box is never touched.
+    #[inline]
+    pub fn row_span(&self, qy: f32) -> Option<(f32, f32)> {
+        let a = &self.to_unit;
+        match self.shape {
+            Shape::Radial => {
+                // |A q|² = P_xx qx² + 2 P_xy qx qy + P_yy qy² ≤ 1 with P = AᵀA: solve for qx.
+                let pxx = sq(a[0][0]) + sq(a[1][0]);
+                let pxy = a[0][0] * a[0][1] + a[1][0] * a[1][1];
+                let pyy = sq(a[0][1]) + sq(a[1][1]);
+                let mid = -pxy * qy / pxx;
+                let disc = sq(pxy * qy) - pxx * (pyy * qy * qy - 1.0);
+                if !(disc > 0.0) {
+                    return None;
+                }
+                let half = math::sqrt(disc) / pxx;
+                Some((mid - half, mid + half))
+            }
+            Shape::Separable => {
+                // |a_r0 qx + a_r1 qy| ≤ 1 for both rows r: intersect two slabs.
+                let (mut lo, mut hi) = (f32::NEG_INFINITY, f32::INFINITY);
+                for row in a {
+                    let rest = row[1] * qy;
+                    if row[0] == 0.0 {
+                        if !(math::abs(rest) < 1.0) {
+                            return None;
+                        }
+                    } else {
+                        let (p, q) = ((-1.0 - rest) / row[0], (1.0 - rest) / row[0]);
+                        lo = lo.max(p.min(q));
+                        hi = hi.min(p.max(q));
+                    }
+                }
+                (lo < hi).then_some((lo, hi))
+            }
+        }
     }
 }
 
 /// Σ = N Nᵀ for a 2×3 N.
 pub fn covariance(n: &[[f32; 3]; 2]) -> Sym2 {
     let dot = |a: &[f32; 3], b: &[f32; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-    Sym2 { xx: dot(&n[0], &n[0]), xy: dot(&n[0], &n[1]), yy: dot(&n[1], &n[1]) }
+    Sym2 {
+        xx: dot(&n[0], &n[0]),
+        xy: dot(&n[0], &n[1]),
+        yy: dot(&n[1], &n[1]),
+    }
 }
 
 /// det(N Nᵀ) by Cauchy–Binet: the sum of the squares of N's three 2×2 minors. No cancellation.
@@ -432,7 +523,11 @@ pub fn cauchy_binet_det(n: &[[f32; 3]; 2]) -> f32 {
 
 /// The conic Σ⁻¹ of the footprint ellipse `qᵀ Σ⁻¹ q = 1` (px⁻²).
 pub fn conic_of(cov: &Sym2, det: f32) -> Sym2 {
-    Sym2 { xx: cov.yy / det, xy: -cov.xy / det, yy: cov.xx / det }
+    Sym2 {
+        xx: cov.yy / det,
+        xy: -cov.xy / det,
+        yy: cov.xx / det,
+    }
 }
 
 /// A = C⁻¹ for Σ = C Cᵀ (C lower-triangular), so AᵀA = Σ⁻¹. Defined for every positive-definite Σ:
@@ -462,10 +557,22 @@ fn clamp_min_radius(n: &mut [[f32; 3]; 2], min_r2: f32) -> bool {
         return false;
     }
     // Unit eigenvector of l1; for a circle any direction will do.
-    let (vx, vy) = if cov.xx >= cov.yy { (l1 - cov.yy, cov.xy) } else { (cov.xy, l1 - cov.xx) };
+    let (vx, vy) = if cov.xx >= cov.yy {
+        (l1 - cov.yy, cov.xy)
+    } else {
+        (cov.xy, l1 - cov.xx)
+    };
     let len = math::sqrt(vx * vx + vy * vy);
-    let (vx, vy) = if len > 0.0 { (vx / len, vy / len) } else { (1.0, 0.0) };
-    let k1 = if l1 < min_r2 { math::sqrt(min_r2 / l1) } else { 1.0 };
+    let (vx, vy) = if len > 0.0 {
+        (vx / len, vy / len)
+    } else {
+        (1.0, 0.0)
+    };
+    let k1 = if l1 < min_r2 {
+        math::sqrt(min_r2 / l1)
+    } else {
+        1.0
+    };
     let k2 = math::sqrt(min_r2 / l2);
     // K = k1 v vᵀ + k2 w wᵀ with w = (−vy, vx).
     let k = [
@@ -507,7 +614,10 @@ pub const PAPER_SINGULAR_COS2: f32 = 1e-6;
 ///
 /// Computed in f32 exactly as written, including its cancellations; use the robust map for
 /// rendering.
-pub fn paper_decomposition(conic: &Sym2, cheat_deg: f32) -> Result<PaperDecomposition, GeometryError> {
+pub fn paper_decomposition(
+    conic: &Sym2,
+    cheat_deg: f32,
+) -> Result<PaperDecomposition, GeometryError> {
     let attempt = |p: &Sym2| -> (f32, f32, f32, f32) {
         if p.xy == 0.0 {
             return (0.0, math::sqrt(p.xx), math::sqrt(p.yy), 1.0);
@@ -537,10 +647,17 @@ pub fn paper_decomposition(conic: &Sym2, cheat_deg: f32) -> Result<PaperDecompos
         cheated = true;
     }
     if !(sx > 0.0 && sy > 0.0 && sx.is_finite() && sy.is_finite() && theta.is_finite()) {
-        return Err(GeometryError::PaperSingular { theta_deg: theta * (180.0 / core::f32::consts::PI) });
+        return Err(GeometryError::PaperSingular {
+            theta_deg: theta * (180.0 / core::f32::consts::PI),
+        });
     }
     let (s, c) = (math::sin(theta), math::cos(theta));
     // Tᵀ = diag(Sx, Sy)·R(θ)ᵀ.
     let to_unit = [[sx * c, sx * s], [-sy * s, sy * c]];
-    Ok(PaperDecomposition { theta, scales: [sx, sy], to_unit, cheated })
+    Ok(PaperDecomposition {
+        theta,
+        scales: [sx, sy],
+        to_unit,
+        cheated,
+    })
 }

@@ -112,7 +112,10 @@ impl fmt::Display for KernelSpecError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match *self {
             Self::BadLength { len } => {
-                write!(f, "kernel spec must be 1 to {MAX_SPEC_LEN} bytes, got {len}")
+                write!(
+                    f,
+                    "kernel spec must be 1 to {MAX_SPEC_LEN} bytes, got {len}"
+                )
             }
             Self::UnknownKernel => {
                 f.write_str("unknown kernel (expected gaussian, cone, sinc or bilinear)")
@@ -123,7 +126,9 @@ impl fmt::Display for KernelSpecError {
             Self::OutOfRange { param, min, max } => {
                 write!(f, "kernel parameter {param} must be in [{min}, {max}]")
             }
-            Self::EvenLobes => f.write_str("sinc lobes must be odd (an even count integrates to zero)"),
+            Self::EvenLobes => {
+                f.write_str("sinc lobes must be odd (an even count integrates to zero)")
+            }
         }
     }
 }
@@ -144,7 +149,10 @@ fn check(param: &'static str, v: f32, (min, max): (f32, f32)) -> Result<f32, Ker
 
 impl Kernel {
     /// The paper's Gaussian: spread 160 %, 2.5 standard deviations in the radius.
-    pub const PAPER_GAUSSIAN: Kernel = Kernel::Gaussian { spread: 1.6, sigmas: 2.5 };
+    pub const PAPER_GAUSSIAN: Kernel = Kernel::Gaussian {
+        spread: 1.6,
+        sigmas: 2.5,
+    };
 
     /// A validated Gaussian (`spread` in voxel spacings, 0.05–64; `sigmas` 0.1–10).
     pub fn gaussian(spread: f32, sigmas: f32) -> Result<Self, KernelSpecError> {
@@ -156,21 +164,28 @@ impl Kernel {
 
     /// A validated cone model.
     pub fn cone(spread: f32) -> Result<Self, KernelSpecError> {
-        Ok(Kernel::Cone { spread: check("spread", spread, SPREAD_RANGE)? })
+        Ok(Kernel::Cone {
+            spread: check("spread", spread, SPREAD_RANGE)?,
+        })
     }
 
     /// A validated sinc model (`lobes` odd, 1–15).
     pub fn sinc(spread: f32, lobes: u8) -> Result<Self, KernelSpecError> {
         check("lobes", f32::from(lobes), LOBES_RANGE)?;
-        if lobes % 2 == 0 {
+        if lobes.is_multiple_of(2) {
             return Err(KernelSpecError::EvenLobes);
         }
-        Ok(Kernel::Sinc { spread: check("spread", spread, SPREAD_RANGE)?, lobes })
+        Ok(Kernel::Sinc {
+            spread: check("spread", spread, SPREAD_RANGE)?,
+            lobes,
+        })
     }
 
     /// A validated bilinear model.
     pub fn bilinear(spread: f32) -> Result<Self, KernelSpecError> {
-        Ok(Kernel::Bilinear { spread: check("spread", spread, SPREAD_RANGE)? })
+        Ok(Kernel::Bilinear {
+            spread: check("spread", spread, SPREAD_RANGE)?,
+        })
     }
 
     /// Parses `name[:key=value[,key=value…]]`, e.g. `gaussian:spread=1.6,sigmas=2.5`.
@@ -196,7 +211,9 @@ impl Kernel {
         let mut values: [Option<f32>; 2] = [None, None];
         if let Some((mut offset, list)) = params {
             for item in list.split(',') {
-                let eq = item.find('=').ok_or(KernelSpecError::BadNumber { at: offset })?;
+                let eq = item
+                    .find('=')
+                    .ok_or(KernelSpecError::BadNumber { at: offset })?;
                 let (key, value) = (&item[..eq], &item[eq + 1..]);
                 let slot = keys
                     .iter()
@@ -205,9 +222,9 @@ impl Kernel {
                 if values[slot].is_some() {
                     return Err(KernelSpecError::DuplicateParameter { at: offset });
                 }
-                let v: f32 = value
-                    .parse()
-                    .map_err(|_| KernelSpecError::BadNumber { at: offset + eq + 1 })?;
+                let v: f32 = value.parse().map_err(|_| KernelSpecError::BadNumber {
+                    at: offset + eq + 1,
+                })?;
                 values[slot] = Some(v);
                 offset += item.len() + 1;
             }

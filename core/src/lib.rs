@@ -40,6 +40,8 @@
 #![no_std]
 #![forbid(unsafe_code)]
 #![deny(missing_docs, rustdoc::broken_intra_doc_links)]
+// `!(x > 0.0)` is how this crate sends NaN down the rejecting branch; `x <= 0.0` would let it through.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod geometry;
 pub mod kernel;
@@ -99,4 +101,9 @@ macro_rules! from_error {
         }
     )*};
 }
-from_error!(Kernel(KernelSpecError), Geometry(GeometryError), Table(TableError), Buffer(BufferError));
+from_error!(
+    Kernel(KernelSpecError),
+    Geometry(GeometryError),
+    Table(TableError),
+    Buffer(BufferError)
+);

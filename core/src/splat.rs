@@ -49,7 +49,10 @@ impl<const N: usize> Sampler for Direct<'_, N> {
     }
     #[inline]
     fn weight(&self, q: [f32; 2]) -> f32 {
-        self.footprint.scale * self.table.sample(mul2(&self.footprint.to_unit, q), self.lookup)
+        self.footprint.scale
+            * self
+                .table
+                .sample(mul2(&self.footprint.to_unit, q), self.lookup)
     }
 }
 
@@ -115,7 +118,10 @@ impl fmt::Display for BufferError {
                 write!(f, "buffer holds {got} pixels, needs {needed}")
             }
             Self::TooLarge { width, height } => {
-                write!(f, "image {width}x{height} is too large (max side {MAX_IMAGE_SIDE})")
+                write!(
+                    f,
+                    "image {width}x{height} is too large (max side {MAX_IMAGE_SIDE})"
+                )
             }
             Self::NonFiniteCenter => f.write_str("voxel centre is not finite"),
         }
@@ -139,7 +145,12 @@ pub struct ImageMut<'a, P> {
 impl<'a, P> ImageMut<'a, P> {
     /// Wraps `data` after checking it is large enough: `stride ≥ width` and
     /// `data.len() ≥ stride × (height − 1) + width`.
-    pub fn new(data: &'a mut [P], width: usize, height: usize, stride: usize) -> Result<Self, BufferError> {
+    pub fn new(
+        data: &'a mut [P],
+        width: usize,
+        height: usize,
+        stride: usize,
+    ) -> Result<Self, BufferError> {
         if width > MAX_IMAGE_SIDE || height > MAX_IMAGE_SIDE {
             return Err(BufferError::TooLarge { width, height });
         }
@@ -155,9 +166,17 @@ impl<'a, P> ImageMut<'a, P> {
                 .ok_or(BufferError::TooLarge { width, height })?
         };
         if data.len() < needed {
-            return Err(BufferError::TooSmall { needed, got: data.len() });
+            return Err(BufferError::TooSmall {
+                needed,
+                got: data.len(),
+            });
         }
-        Ok(ImageMut { data, width, height, stride })
+        Ok(ImageMut {
+            data,
+            width,
+            height,
+            stride,
+        })
     }
 
     /// Width, pixels.
@@ -191,17 +210,15 @@ pub struct SplatStats {
     pub pixels_updated: u32,
 }
 
-/// Inclusive pixel index range whose centres lie within [c − e, c + e], unclipped. Values are
-/// clamped to ±2³¹ so later clipping stays exact.
+/// Inclusive pixel index range whose centres lie within [c − e, c + e], unclipped, clamped to
+/// ±2³¹ so later clipping stays exact.
 fn pixel_span(c: f32, e: f32) -> (i64, i64) {
-    let lo = -math::floor(-(c - e - 0.5)); // ceil
-    let hi = math::floor(c + e - 0.5);
-    let clamp = |v: f32| v.clamp(-2_147_483_648.0, 2_147_483_647.0) as i64;
-    (clamp(lo), clamp(hi))
+    pixel_range(c - e, c + e)
 }
 
 /// Spreads `value` (e.g. premultiplied RGBA) of a voxel projected to screen position `center`
-/// (pixels, absolute) into `image`, using `sampler`'s footprint. See the module docs.
+/// (pixels, absolute) into `image`, using `sampler`'s footprint. Only pixels whose centres lie
+/// inside the footprint's support ([`Footprint::row_span`]) are visited. See the module docs.
 pub fn splat<S: Sampler + ?Sized, P: Pixel>(
     sampler: &S,
     center: [f32; 2],
@@ -212,17 +229,15 @@ pub fn splat<S: Sampler + ?Sized, P: Pixel>(
         return Err(BufferError::NonFiniteCenter);
     }
     let fp = sampler.footprint();
-    let (x0, x1) = pixel_span(center[0], fp.half_extent[0]);
     let (y0, y1) = pixel_span(center[1], fp.half_extent[1]);
     let mut factor = 1.0;
     if fp.renormalise {
+        // Small footprint (at most 9×9 pixels): sum its sampled weights over the unclipped
+        // support so the voxel deposits exactly one unit, less what falls off-screen.
         let mut sum = 0.0f32;
-        for y in y0..=y1 {
-            let qy = y as f32 + 0.5 - center[1];
-            for x in x0..=x1 {
-                sum += sampler.weight([x as f32 + 0.5 - center[0], qy]);
-            }
-        }
+        for_each_in_support(fp, center, y0, y1, i64::MIN, i64::MAX, |_, _, q| {
+            sum += sampler.weight(q)
+        });
         if sum > 0.0 {
             factor = 1.0 / sum;
         } else {
@@ -233,32 +248,60 @@ pub fn splat<S: Sampler + ?Sized, P: Pixel>(
     }
     let mut stats = SplatStats::default();
     let (w, h) = (image.width as i64, image.height as i64);
-    let (cx0, cx1) = (x0.max(0), x1.min(w - 1));
-    let (cy0, cy1) = (y0.max(0), y1.min(h - 1));
-    if cx0 > cx1 || cy0 > cy1 {
-        return Ok(stats);
-    }
-    for y in cy0..=cy1 {
+    let stride = image.stride;
+    let data = &mut *image.data;
+    for_each_in_support(fp, center, y0.max(0), y1.min(h - 1), 0, w - 1, |x, y, q| {
+        stats.pixels_visited += 1;
+        let weight = sampler.weight(q);
+        if weight != 0.0 {
+            // x, y are within the clipped image, so the index is in the buffer ImageMut checked.
+            data[y as usize * stride + x as usize].add_weighted(value, weight * factor);
+            stats.pixels_updated += 1;
+        }
+    });
+    Ok(stats)
+}
+
+/// Calls `f(x, y, q)` for every pixel (x, y) with y in `y0..=y1`, x in `xmin..=xmax`, whose centre
+/// lies inside the footprint's support; q is the centre's offset from `center`, pixels.
+#[inline]
+fn for_each_in_support(
+    fp: &Footprint,
+    center: [f32; 2],
+    y0: i64,
+    y1: i64,
+    xmin: i64,
+    xmax: i64,
+    mut f: impl FnMut(i64, i64, [f32; 2]),
+) {
+    for y in y0..=y1 {
         let qy = y as f32 + 0.5 - center[1];
-        // In range by the clipping above.
-        let row = &mut image.data[y as usize * image.stride..][..image.width];
-        for x in cx0..=cx1 {
-            let weight = sampler.weight([x as f32 + 0.5 - center[0], qy]);
-            if weight != 0.0 {
-                row[x as usize].add_weighted(value, weight * factor);
-                stats.pixels_updated += 1;
-            }
+        let Some((lo, hi)) = fp.row_span(qy) else {
+            continue;
+        };
+        let (x0, x1) = pixel_range(center[0] + lo, center[0] + hi);
+        for x in x0.max(xmin)..=x1.min(xmax) {
+            f(x, y, [x as f32 + 0.5 - center[0], qy]);
         }
     }
-    stats.pixels_visited = ((cx1 - cx0 + 1) * (cy1 - cy0 + 1)) as u32;
-    Ok(stats)
+}
+
+/// Inclusive range of pixel indices whose centres lie in [lo, hi] (screen pixels).
+fn pixel_range(lo: f32, hi: f32) -> (i64, i64) {
+    let first = -math::floor(-(lo - 0.5)); // ceil
+    let last = math::floor(hi - 0.5);
+    let clamp = |v: f32| v.clamp(-2_147_483_648.0, 2_147_483_647.0) as i64;
+    (clamp(first), clamp(last))
 }
 
 fn deposit_whole<P: Pixel>(center: [f32; 2], value: &P, image: &mut ImageMut<'_, P>) -> SplatStats {
     let (x, y) = (math::floor(center[0]), math::floor(center[1]));
     if x >= 0.0 && y >= 0.0 && (x as usize) < image.width && (y as usize) < image.height {
         image.data[y as usize * image.stride + x as usize].add_weighted(value, 1.0);
-        SplatStats { pixels_visited: 1, pixels_updated: 1 }
+        SplatStats {
+            pixels_visited: 1,
+            pixels_updated: 1,
+        }
     } else {
         SplatStats::default()
     }

@@ -17,7 +17,9 @@
 //! `micromath` is the explicit choice.
 
 #[cfg(not(any(feature = "libm", feature = "micromath")))]
-compile_error!("footprint needs a float backend: enable the `libm` (default) or `micromath` feature");
+compile_error!(
+    "footprint needs a float backend: enable the `libm` (default) or `micromath` feature"
+);
 
 #[cfg(all(feature = "libm", not(feature = "micromath")))]
 mod libm_backend;

@@ -88,17 +88,29 @@ impl fmt::Display for TableError {
                 write!(f, "table truncated: need {needed} bytes, got {got}")
             }
             Self::TrailingBytes { expected, got } => {
-                write!(f, "table has trailing bytes: expected {expected}, got {got}")
+                write!(
+                    f,
+                    "table has trailing bytes: expected {expected}, got {got}"
+                )
             }
             Self::BadMagic => f.write_str("not a footprint table (bad magic)"),
             Self::UnsupportedVersion { found } => {
-                write!(f, "unsupported table format version {found} (this build reads {FORMAT_VERSION})")
+                write!(
+                    f,
+                    "unsupported table format version {found} (this build reads {FORMAT_VERSION})"
+                )
             }
             Self::SizeMismatch { expected, found } => {
-                write!(f, "table is {found}x{found}, expected {expected}x{expected}")
+                write!(
+                    f,
+                    "table is {found}x{found}, expected {expected}x{expected}"
+                )
             }
             Self::ChecksumMismatch { stored, computed } => {
-                write!(f, "table checksum mismatch: stored {stored:08x}, computed {computed:08x}")
+                write!(
+                    f,
+                    "table checksum mismatch: stored {stored:08x}, computed {computed:08x}"
+                )
             }
             Self::BadSpec(e) => write!(f, "table kernel spec: {e}"),
             Self::NonFinite { index } => write!(f, "table sample {index} is not finite"),
@@ -147,7 +159,10 @@ impl<const N: usize> GenericTable<N> {
         let spec = self.kernel.spec();
         let len = self.serialized_len();
         if out.len() < len {
-            return Err(TableError::BufferTooSmall { needed: len, got: out.len() });
+            return Err(TableError::BufferTooSmall {
+                needed: len,
+                got: out.len(),
+            });
         }
         out[0..4].copy_from_slice(&MAGIC);
         out[4..6].copy_from_slice(&FORMAT_VERSION.to_le_bytes());
@@ -190,7 +205,10 @@ impl<const N: usize> GenericTable<N> {
 /// Checks everything about `bytes` before a sample is copied; returns the parsed kernel.
 fn validate<const N: usize>(bytes: &[u8]) -> Result<Kernel, TableError> {
     if bytes.len() < HEADER {
-        return Err(TableError::Truncated { needed: HEADER, got: bytes.len() });
+        return Err(TableError::Truncated {
+            needed: HEADER,
+            got: bytes.len(),
+        });
     }
     if bytes[0..4] != MAGIC {
         return Err(TableError::BadMagic);
@@ -202,17 +220,28 @@ fn validate<const N: usize>(bytes: &[u8]) -> Result<Kernel, TableError> {
     let spec_len = usize::from(read_u16(bytes, 6));
     let n = read_u32(bytes, 8);
     if n as usize != N {
-        return Err(TableError::SizeMismatch { expected: N as u32, found: n });
+        return Err(TableError::SizeMismatch {
+            expected: N as u32,
+            found: n,
+        });
     }
     if spec_len == 0 || spec_len > MAX_SPEC_LEN {
-        return Err(TableError::BadSpec(KernelSpecError::BadLength { len: spec_len }));
+        return Err(TableError::BadSpec(KernelSpecError::BadLength {
+            len: spec_len,
+        }));
     }
     let total = HEADER + spec_len + 4 * N * N + 4;
     if bytes.len() < total {
-        return Err(TableError::Truncated { needed: total, got: bytes.len() });
+        return Err(TableError::Truncated {
+            needed: total,
+            got: bytes.len(),
+        });
     }
     if bytes.len() > total {
-        return Err(TableError::TrailingBytes { expected: total, got: bytes.len() });
+        return Err(TableError::TrailingBytes {
+            expected: total,
+            got: bytes.len(),
+        });
     }
     let stored = read_u32(bytes, total - 4);
     let computed = crc32(&bytes[..total - 4]);

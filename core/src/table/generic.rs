@@ -21,7 +21,10 @@ impl<const N: usize> GenericTable<N> {
     pub const fn zeroed(kernel: Kernel) -> Self {
         #[allow(clippy::let_unit_value)]
         let () = Self::VALID;
-        GenericTable { kernel, data: [[0.0; N]; N] }
+        GenericTable {
+            kernel,
+            data: [[0.0; N]; N],
+        }
     }
 
     /// Builds the table for `kernel` (the paper's preprocessor; N² footprint evaluations).
@@ -59,6 +62,11 @@ impl<const N: usize> GenericTable<N> {
     #[inline]
     pub fn sample(&self, u: [f32; 2], lookup: Lookup) -> f32 {
         let half = 0.5 * (N - 1) as f32;
-        sample_nodes(self.as_slice(), N, [(u[0] + 1.0) * half, (u[1] + 1.0) * half], lookup)
+        sample_nodes(
+            self.as_slice(),
+            N,
+            [(u[0] + 1.0) * half, (u[1] + 1.0) * half],
+            lookup,
+        )
     }
 }

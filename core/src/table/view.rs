@@ -22,7 +22,12 @@ impl<const M: usize> ViewTable<M> {
     pub const fn zeroed(footprint: Footprint) -> Self {
         #[allow(clippy::let_unit_value)]
         let () = Self::VALID;
-        ViewTable { data: [[0.0; M]; M], footprint, nodes_per_px: [0.0; 2], lookup: Lookup::Nearest }
+        ViewTable {
+            data: [[0.0; M]; M],
+            footprint,
+            nodes_per_px: [0.0; 2],
+            lookup: Lookup::Nearest,
+        }
     }
 
     /// Builds the view table for `footprint` from `generic`: each node q is mapped to
@@ -76,7 +81,10 @@ impl<const M: usize> ViewTable<M> {
     #[inline]
     pub fn weight(&self, q: [f32; 2]) -> f32 {
         let [ex, ey] = self.footprint.half_extent;
-        let t = [(q[0] + ex) * self.nodes_per_px[0], (q[1] + ey) * self.nodes_per_px[1]];
+        let t = [
+            (q[0] + ex) * self.nodes_per_px[0],
+            (q[1] + ey) * self.nodes_per_px[1],
+        ];
         sample_nodes(self.as_slice(), M, t, self.lookup)
     }
 }

@@ -1,0 +1,121 @@
+//! Command-line parsing. Value formats: lists are comma-separated (`60,30,30`), sizes `WxH`,
+//! angles in degrees, matrices nine numbers in row-major order.
+
+use crate::commands;
+use clap::{Parser, Subcommand, ValueEnum};
+use std::ffi::OsString;
+
+/// Footprint: Westover footprint-evaluation splatting.
+#[derive(Parser, Debug)]
+#[command(name = "footprint", version, about)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Render one voxel (value 1) and write its raw footprint weights (px⁻²).
+    Splat(commands::splat::SplatArgs),
+    /// Precompute a generic footprint table and save it (the paper's preprocessor).
+    Tables(commands::tables::TablesArgs),
+    /// Compare two single-channel PFM images: max |A − B| relative to B's peak.
+    Compare(commands::compare::CompareArgs),
+}
+
+/// Table lookup, as on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum LookupArg {
+    Nearest,
+    Bilinear,
+}
+
+impl From<LookupArg> for footprint::Lookup {
+    fn from(l: LookupArg) -> Self {
+        match l {
+            LookupArg::Nearest => footprint::Lookup::Nearest,
+            LookupArg::Bilinear => footprint::Lookup::Bilinear,
+        }
+    }
+}
+
+/// How the footprint is evaluated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum MethodArg {
+    /// View table built through the Cholesky (or sheet-parallelogram) map: no singular angle.
+    Robust,
+    /// View table built through the paper's θ/Sx/Sy decomposition with its 0.01° cheat.
+    Paper,
+    /// No view table: each pixel is mapped straight into the generic table.
+    Direct,
+    /// f64, no tables: the exact line integral (the float reference).
+    Reference,
+}
+
+/// Parses `a,b,c,…` into exactly `n` finite numbers.
+pub fn parse_list<const N: usize>(s: &str) -> Result<[f32; N], String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    if parts.len() != N {
+        return Err(format!(
+            "expected {N} comma-separated numbers, got {}",
+            parts.len()
+        ));
+    }
+    let mut out = [0.0f32; N];
+    for (o, p) in out.iter_mut().zip(parts) {
+        *o = p
+            .trim()
+            .parse()
+            .map_err(|_| format!("'{p}' is not a number"))?;
+        if !o.is_finite() {
+            return Err(format!("'{p}' is not finite"));
+        }
+    }
+    Ok(out)
+}
+
+/// Parses `WxH` (each 1 … 16384).
+pub fn parse_size(s: &str) -> Result<(usize, usize), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("'{s}' is not WxH"))?;
+    let parse = |v: &str| -> Result<usize, String> {
+        let n: usize = v
+            .parse()
+            .map_err(|_| format!("'{v}' is not a whole number"))?;
+        if !(1..=16384).contains(&n) {
+            return Err(format!("image side {n} is outside 1..=16384"));
+        }
+        Ok(n)
+    };
+    Ok((parse(w)?, parse(h)?))
+}
+
+/// Runs the command line `args` (program name first); returns the process exit code: 0 success,
+/// 1 a check failed, 2 bad input or I/O error. Errors are printed to stderr as one line.
+pub fn run<I, T>(args: I) -> i32
+where
+    I: IntoIterator<Item = T>,
+    T: Into<OsString> + Clone,
+{
+    let cli = match Cli::try_parse_from(args) {
+        Ok(cli) => cli,
+        Err(e) => {
+            let code = if e.use_stderr() { 2 } else { 0 };
+            let _ = e.print();
+            return code;
+        }
+    };
+    let result = match cli.command {
+        Command::Splat(a) => commands::splat::run(&a),
+        Command::Tables(a) => commands::tables::run(&a),
+        Command::Compare(a) => commands::compare::run(&a),
+    };
+    match result {
+        Ok(()) => 0,
+        Err(e) => {
+            eprintln!("footprint: {e}");
+            e.code
+        }
+    }
+}

@@ -1,0 +1,60 @@
+//! `footprint tables`: precompute a generic table and save it in the core's byte format.
+
+use crate::{io, with_table_size, CliError};
+use clap::Args;
+use footprint::{GenericTable, Kernel};
+use std::path::PathBuf;
+
+#[derive(Args, Debug)]
+pub struct TablesArgs {
+    /// Kernel spec, e.g. gaussian:spread=1.6,sigmas=2.5.
+    #[arg(long, default_value = "gaussian:spread=1.6,sigmas=2.5")]
+    pub kernel: String,
+    /// Table size N (N×N samples over [-1,1]²).
+    #[arg(long, default_value_t = 65)]
+    pub size: usize,
+    /// Output file.
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+/// Builds a table and returns its serialised bytes.
+pub fn table_bytes(kernel: &Kernel, size: usize) -> Result<Vec<u8>, CliError> {
+    with_table_size!(size, N => {
+        let table = Box::new(GenericTable::<N>::build(*kernel));
+        let mut bytes = vec![0u8; table.serialized_len()];
+        let len = table.write_bytes(&mut bytes)?;
+        bytes.truncate(len);
+        bytes
+    })
+}
+
+/// Loads a table file for a `GenericTable<N>`, with the path in any error.
+pub fn load_table<const N: usize>(
+    path: &std::path::Path,
+) -> Result<Box<GenericTable<N>>, CliError> {
+    let bytes = io::read_file(path)?;
+    let mut table = Box::new(GenericTable::<N>::zeroed(Kernel::PAPER_GAUSSIAN));
+    table
+        .load_into(&bytes)
+        .map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
+    Ok(table)
+}
+
+pub fn run(args: &TablesArgs) -> Result<(), CliError> {
+    let kernel = Kernel::parse(&args.kernel)
+        .map_err(|e| CliError::input(format!("--kernel '{}': {e}", args.kernel)))?;
+    let start = std::time::Instant::now();
+    let bytes = table_bytes(&kernel, args.size)?;
+    io::write_atomic(&args.out, &bytes)?;
+    println!(
+        "wrote {} ({}x{} table, kernel {kernel}, {} bytes, crc32 {:08x}) in {:.1} ms",
+        args.out.display(),
+        args.size,
+        args.size,
+        bytes.len(),
+        u32::from_le_bytes(bytes[bytes.len() - 4..].try_into().expect("4 bytes")),
+        start.elapsed().as_secs_f64() * 1e3
+    );
+    Ok(())
+}

@@ -1,0 +1,138 @@
+//! Single-channel float images: PFM (float32, exact) and PNG (8-bit view).
+
+use crate::CliError;
+use std::path::Path;
+
+/// A single-channel f32 image, rows top to bottom (screen y down).
+#[derive(Clone, Debug, PartialEq)]
+pub struct GreyImage {
+    /// Width, pixels.
+    pub width: usize,
+    /// Height, pixels.
+    pub height: usize,
+    /// `width × height` values, row-major, top row first.
+    pub data: Vec<f32>,
+}
+
+impl GreyImage {
+    /// Largest value (0 for an empty or all-negative image).
+    pub fn peak(&self) -> f32 {
+        self.data.iter().copied().fold(0.0, f32::max)
+    }
+}
+
+/// Encodes a PFM: `Pf`, `W H`, scale −1 (little-endian), then rows **bottom to top** as PFM
+/// requires.
+pub fn encode_pfm(img: &GreyImage) -> Vec<u8> {
+    let mut out = format!("Pf\n{} {}\n-1.0\n", img.width, img.height).into_bytes();
+    out.reserve(img.data.len() * 4);
+    for row in img.data.chunks(img.width.max(1)).rev() {
+        for v in row {
+            out.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    out
+}
+
+/// Decodes a single-channel PFM (either endianness).
+pub fn decode_pfm(bytes: &[u8], name: &str) -> Result<GreyImage, CliError> {
+    let bad = |what: &str| CliError::input(format!("{name}: not a greyscale PFM: {what}"));
+    // Header: three whitespace-separated lines.
+    let mut fields = Vec::new();
+    let mut at = 0;
+    while fields.len() < 4 {
+        while at < bytes.len() && bytes[at].is_ascii_whitespace() {
+            at += 1;
+        }
+        let start = at;
+        while at < bytes.len() && !bytes[at].is_ascii_whitespace() {
+            at += 1;
+        }
+        if start == at {
+            return Err(bad("header ends early"));
+        }
+        fields.push(std::str::from_utf8(&bytes[start..at]).map_err(|_| bad("header is not text"))?);
+    }
+    at += 1; // the single whitespace byte after the scale
+    if fields[0] != "Pf" {
+        return Err(bad("magic is not Pf (colour PFM is not supported)"));
+    }
+    let parse = |s: &str, what: &str| s.parse::<usize>().map_err(|_| bad(what));
+    let width = parse(fields[1], "bad width")?;
+    let height = parse(fields[2], "bad height")?;
+    let scale: f32 = fields[3].parse().map_err(|_| bad("bad scale"))?;
+    let n = width
+        .checked_mul(height)
+        .ok_or_else(|| bad("size overflows"))?;
+    let need = n
+        .checked_mul(4)
+        .and_then(|b| b.checked_add(at))
+        .ok_or_else(|| bad("size overflows"))?;
+    if bytes.len() != need {
+        return Err(bad(&format!(
+            "expected {need} bytes for {width}x{height}, got {}",
+            bytes.len()
+        )));
+    }
+    let little = scale < 0.0;
+    let mut data = vec![0.0f32; n];
+    for (i, chunk) in bytes[at..].chunks_exact(4).enumerate() {
+        let b = [chunk[0], chunk[1], chunk[2], chunk[3]];
+        let v = if little {
+            f32::from_le_bytes(b)
+        } else {
+            f32::from_be_bytes(b)
+        };
+        // File row r (from the bottom) is image row height−1−r.
+        let (r, c) = (i / width, i % width);
+        data[(height - 1 - r) * width + c] = v;
+    }
+    Ok(GreyImage {
+        width,
+        height,
+        data,
+    })
+}
+
+/// Encodes an 8-bit greyscale PNG, mapping [0, `white`] linearly to [0, 255] (clamped).
+pub fn encode_png_grey(img: &GreyImage, white: f32) -> Result<Vec<u8>, CliError> {
+    let scale = if white > 0.0 { 255.0 / white } else { 0.0 };
+    let pixels: Vec<u8> = img
+        .data
+        .iter()
+        .map(|v| (v * scale).round().clamp(0.0, 255.0) as u8)
+        .collect();
+    let mut out = Vec::new();
+    let mut enc = png::Encoder::new(&mut out, img.width as u32, img.height as u32);
+    enc.set_color(png::ColorType::Grayscale);
+    enc.set_depth(png::BitDepth::Eight);
+    let mut writer = enc
+        .write_header()
+        .map_err(|e| CliError::input(format!("PNG encoder: {e}")))?;
+    writer
+        .write_image_data(&pixels)
+        .map_err(|e| CliError::input(format!("PNG encoder: {e}")))?;
+    writer
+        .finish()
+        .map_err(|e| CliError::input(format!("PNG encoder: {e}")))?;
+    Ok(out)
+}
+
+/// Writes `img` to `path` as PFM (`.pfm`) or as an 8-bit PNG normalised to its peak (`.png`).
+pub fn save_grey(img: &GreyImage, path: &Path) -> Result<(), CliError> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let bytes = match ext.as_deref() {
+        Some("pfm") => encode_pfm(img),
+        Some("png") => encode_png_grey(img, img.peak())?,
+        _ => {
+            return Err(CliError::input(format!(
+                "{}: unknown output type (use .pfm or .png)",
+                path.display()
+            )))
+        }
+    };
+    super::write_atomic(path, &bytes)
+}
