@@ -1,1 +1,132 @@
-//! Test support.
+//! Shared helpers for the integration tests and benches: brute-force integrals (no closed forms),
+//! view construction, single-sample renders through the harness, and tolerance checks that say
+//! what they found.
+
+use footprint::Kernel;
+use footprint_harness::cli::{LookupArg, MethodArg};
+use footprint_harness::commands::splat::{splat_image, SplatArgs};
+use footprint_harness::io::image::GreyImage;
+use glam::{DMat3, Mat3};
+use std::path::PathBuf;
+
+/// Brute-force footprint of a radial 3D kernel: ∫ h(√(ρ² + s²)) ds over the chord through the
+/// unit ball, composite Simpson with `steps` (even) intervals. `h` takes r in unit coordinates.
+pub fn line_integral(h: impl Fn(f64) -> f64, rho: f64, steps: usize) -> f64 {
+    if rho >= 1.0 {
+        return 0.0;
+    }
+    let half = (1.0 - rho * rho).sqrt();
+    let dx = 2.0 * half / steps as f64;
+    let mut sum = 0.0;
+    for i in 0..=steps {
+        let s = -half + dx * i as f64;
+        let w = if i == 0 || i == steps {
+            1.0
+        } else if i % 2 == 1 {
+            4.0
+        } else {
+            2.0
+        };
+        sum += w * h((rho * rho + s * s).sqrt());
+    }
+    sum * dx / 3.0
+}
+
+/// The truncated 3D Gaussian h(r) = e^(−r²·sigmas²/2) for r ≤ 1, in unit coordinates. The
+/// support is closed so that Simpson's end points, which sit exactly on the sphere, take the
+/// kernel's value there rather than zero (a rounding margin of 1e-12 keeps them inside).
+pub fn gaussian_3d(sigmas: f64) -> impl Fn(f64) -> f64 {
+    move |r| {
+        if r <= 1.0 + 1e-12 {
+            (-0.5 * r * r * sigmas * sigmas).exp()
+        } else {
+            0.0
+        }
+    }
+}
+
+/// ∫_ball h d³u by Simpson on the radial integral 4π∫r²h(r)dr.
+pub fn ball_integral(h: impl Fn(f64) -> f64, steps: usize) -> f64 {
+    let dr = 1.0 / steps as f64;
+    let mut sum = 0.0;
+    for i in 0..=steps {
+        let r = dr * i as f64;
+        let w = if i == 0 || i == steps {
+            1.0
+        } else if i % 2 == 1 {
+            4.0
+        } else {
+            2.0
+        };
+        sum += w * r * r * h(r);
+    }
+    4.0 * std::f64::consts::PI * sum * dr / 3.0
+}
+
+/// A world-to-screen matrix: rotation by Euler angles (degrees, applied x then y then z) times a
+/// uniform zoom (pixels per world unit).
+pub fn view(rx: f32, ry: f32, rz: f32, zoom: f32) -> Mat3 {
+    Mat3::from_rotation_z(rz.to_radians())
+        * Mat3::from_rotation_y(ry.to_radians())
+        * Mat3::from_rotation_x(rx.to_radians())
+        * zoom
+}
+
+/// Row-major nine numbers of a matrix, as `--view-matrix` takes them.
+pub fn rows(m: &Mat3) -> [f32; 9] {
+    m.transpose().to_cols_array()
+}
+
+/// Default `footprint splat` arguments (paper Gaussian, spacing 60,30,30, 256×256, table 65,
+/// bilinear, robust) for tests to modify.
+pub fn splat_args() -> SplatArgs {
+    SplatArgs {
+        kernel: "gaussian:spread=1.6,sigmas=2.5".into(),
+        spacing: [60.0, 30.0, 30.0],
+        grid_matrix: None,
+        view_matrix: None,
+        rotate_x: 0.0,
+        rotate_y: 0.0,
+        rotate_z: 0.0,
+        size: (256, 256),
+        table: 65,
+        table_file: None,
+        lookup: LookupArg::Bilinear,
+        method: MethodArg::Robust,
+        min_radius: footprint::geometry::DEFAULT_MIN_RADIUS_PX,
+        center: None,
+        out: PathBuf::from("unused.pfm"),
+    }
+}
+
+/// Renders `args` with its method and with `--method reference`; returns (core, reference).
+pub fn with_reference(args: &SplatArgs) -> (GreyImage, GreyImage) {
+    let core = splat_image(args).expect("core splat").0;
+    let mut r = args.clone();
+    r.method = MethodArg::Reference;
+    (core, splat_image(&r).expect("reference splat").0)
+}
+
+/// max |a − b| / max(b): the footprint difference relative to the reference's peak.
+pub fn max_rel_diff(a: &GreyImage, b: &GreyImage) -> f64 {
+    footprint_harness::commands::compare::max_rel_diff(a, b).expect("comparable images")
+}
+
+/// Asserts `value <= bound`, printing both and the context.
+#[track_caller]
+pub fn assert_le(value: f64, bound: f64, what: &str) {
+    assert!(
+        value.is_finite() && value <= bound,
+        "{what}: got {value:.6e}, bound {bound:.6e}"
+    );
+}
+
+/// f64 copy of an f32 matrix.
+pub fn dmat(m: &Mat3) -> DMat3 {
+    m.as_dmat3()
+}
+
+/// The four kernels at their defaults, by spec.
+pub fn default_kernels() -> [Kernel; 4] {
+    ["gaussian", "cone", "sinc", "bilinear"].map(|s| Kernel::parse(s).expect("default spec"))
+}
