@@ -64,7 +64,7 @@ fn check_geometry(
     );
     // The map sends every projected surface point into the unit disc, and the silhouette onto its rim.
     prop_assert!(
-        max_r <= 1.0 + 1e-4 && max_r >= 1.0 - 2e-3,
+        (1.0 - 2e-3..=1.0 + 1e-4).contains(&max_r),
         "max |A q| over the surface = {max_r}"
     );
     // AᵀA equals the conic (N Nᵀ)⁻¹ computed in f64.
@@ -91,7 +91,7 @@ fn check_geometry(
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 200, ..ProptestConfig::default() })]
+    #![proptest_config(footprint_suite::proptest_config(200))]
 
     #[test]
     fn extent_and_map_match_projected_ellipsoid(

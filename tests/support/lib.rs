@@ -130,3 +130,14 @@ pub fn dmat(m: &Mat3) -> DMat3 {
 pub fn default_kernels() -> [Kernel; 4] {
     ["gaussian", "cone", "sinc", "bilinear"].map(|s| Kernel::parse(s).expect("default spec"))
 }
+
+/// Proptest settings for this suite: `cases` random cases, no regression files (the suite's lib
+/// lives at `tests/support/lib.rs`, where proptest cannot find a source root to store them; a
+/// failure prints its minimal input, which a test can then pin).
+pub fn proptest_config(cases: u32) -> proptest::test_runner::Config {
+    proptest::test_runner::Config {
+        cases,
+        failure_persistence: None,
+        ..Default::default()
+    }
+}
