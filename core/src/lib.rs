@@ -37,7 +37,7 @@
 //! let total: f32 = pixels.iter().sum();
 //! assert!((total - 1.0).abs() < 0.01, "a splat deposits one unit, got {total}");
 //! ```
-#![no_std]
+#![cfg_attr(not(test), no_std)]
 #![forbid(unsafe_code)]
 #![deny(missing_docs, rustdoc::broken_intra_doc_links)]
 // `!(x > 0.0)` is how this crate sends NaN down the rejecting branch; `x <= 0.0` would let it through.

@@ -3,10 +3,10 @@
 //! | function | method | worst-case error |
 //! |---|---|---|
 //! | `sqrt` | micromath's bit-trick seed (5 %), then two Newton–Raphson steps | relative 2e-6 |
-//! | `exp` | micromath (`exp_ln2_approx`) | relative 1e-3 (micromath's `MAX_ERROR`) |
-//! | `sin`, `cos` | micromath's parabolic approximation | absolute 2e-3 |
-//! | `atan` | micromath | absolute 2.9e-3 rad (0.162°) |
-//! | `erf` | Abramowitz & Stegun 7.1.26 on top of this `exp` | absolute 1.5e-7 + 1e-3 × e^(−x²) ≤ 1.1e-3 |
+//! | `exp` | micromath (`exp_ln2_approx`) | relative 3e-3 (micromath states 1e-3 for its test vectors; measured 2.4e-3 over [−80, 80]) |
+//! | `sin`, `cos` | micromath's parabolic approximation | absolute 2e-3 (measured 1.1e-3 on ±2π) |
+//! | `atan` | micromath | absolute 2.9e-3 rad, 0.162° (measured 2.8e-3) |
+//! | `erf` | Abramowitz & Stegun 7.1.26 on top of this `exp` | absolute 1.5e-7 + 3e-3 × p(t)e^(−x²) ≤ 3e-3, since p(t)e^(−x²) ≤ 1 (measured 5.7e-4 on ±6) |
 //! | `floor` | micromath | exact |
 //!
 //! `sqrt` is refined because a 5 % error in an ellipse axis would move every footprint edge by
@@ -14,17 +14,19 @@
 //! them against f64 references.
 
 use super::ErrorBounds;
-use micromath::F32Ext as _;
+// Every call goes through micromath's `F32` wrapper: `x.exp()` on a plain f32 would silently
+// resolve to std's inherent method whenever std is linked (as in unit tests).
+use micromath::F32;
 
 pub const NAME: &str = "micromath";
 
 /// This backend's bounds (see the table above).
 pub const ERROR_BOUNDS: ErrorBounds = ErrorBounds {
     sqrt_rel: 2.0e-6,
-    exp_rel: 1.0e-3,
+    exp_rel: 3.0e-3,
     sin_cos_abs: 2.0e-3,
     atan_abs: 2.9e-3,
-    erf_abs: 1.1e-3,
+    erf_abs: 3.0e-3,
 };
 
 #[inline]
@@ -36,16 +38,17 @@ pub fn sqrt(x: f32) -> f32 {
     if x == f32::INFINITY {
         return x;
     }
-    let mut y = micromath::F32(x).sqrt().0;
+    let mut y = F32(x).sqrt().0;
     y = 0.5 * (y + x / y);
     0.5 * (y + x / y)
 }
 #[inline]
 pub fn exp(x: f32) -> f32 {
-    x.exp()
+    F32(x).exp().0
 }
 /// Abramowitz & Stegun 7.1.26: erf(x) = 1 − (a₁t + a₂t² + … + a₅t⁵)e^(−x²), t = 1/(1+px),
-/// |error| ≤ 1.5e-7 with an exact exponential; the `exp` error adds at most 1e-3·e^(−x²).
+/// |error| ≤ 1.5e-7 with an exact exponential; the `exp` error adds at most 3e-3 × p(t)e^(−x²),
+/// and p(t)e^(−x²) = 1 − erf(|x|) ≤ 1.
 #[inline]
 pub fn erf(x: f32) -> f32 {
     const P: f32 = 0.327_591_1;
@@ -68,17 +71,17 @@ pub fn erf(x: f32) -> f32 {
 }
 #[inline]
 pub fn sin(x: f32) -> f32 {
-    x.sin()
+    F32(x).sin().0
 }
 #[inline]
 pub fn cos(x: f32) -> f32 {
-    x.cos()
+    F32(x).cos().0
 }
 #[inline]
 pub fn atan(x: f32) -> f32 {
-    x.atan()
+    F32(x).atan().0
 }
 #[inline]
 pub fn floor(x: f32) -> f32 {
-    x.floor()
+    F32(x).floor().0
 }

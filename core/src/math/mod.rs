@@ -106,3 +106,55 @@ pub fn abs(x: f32) -> f32 {
 pub fn sq(x: f32) -> f32 {
     x * x
 }
+
+#[cfg(test)]
+mod tests {
+    //! Each backend against f64 references (`libm`'s f64 functions), at its stated bounds. Run for
+    //! both: `cargo test -p footprint --lib` and
+    //! `cargo test -p footprint --lib --no-default-features --features micromath`.
+    use super::*;
+
+    fn worst(points: impl Iterator<Item = f32>, f: fn(f32) -> f32, r: fn(f64) -> f64, rel: bool) -> f64 {
+        points
+            .map(|x| {
+                let (got, want) = (f64::from(f(x)), r(f64::from(x)));
+                let err = (got - want).abs();
+                if rel {
+                    err / want.abs()
+                } else {
+                    err
+                }
+            })
+            .fold(0.0, f64::max)
+    }
+
+    fn grid(lo: f32, hi: f32, n: usize) -> impl Iterator<Item = f32> {
+        (0..=n).map(move |i| lo + (hi - lo) * i as f32 / n as f32)
+    }
+
+    #[test]
+    fn backend_meets_its_stated_bounds() {
+        let b = ERROR_BOUNDS;
+        let sqrt_e = worst(grid(1e-6, 1e6, 100_000), sqrt, libm::sqrt, true);
+        let exp_e = worst(grid(-80.0, 80.0, 100_000), exp, libm::exp, true);
+        let sin_e = worst(grid(-6.283, 6.283, 100_000), sin, libm::sin, false);
+        let cos_e = worst(grid(-6.283, 6.283, 100_000), cos, libm::cos, false);
+        let atan_e = worst(grid(-1e3, 1e3, 100_000), atan, libm::atan, false);
+        let erf_e = worst(grid(-6.0, 6.0, 100_000), erf, libm::erf, false);
+        // Printed with --nocapture; the README's backend table quotes these.
+        std::println!(
+            "{BACKEND}: sqrt {sqrt_e:.2e} rel, exp {exp_e:.2e} rel, sin {sin_e:.2e}, cos {cos_e:.2e}, atan {atan_e:.2e}, erf {erf_e:.2e}"
+        );
+        assert!(sqrt_e <= f64::from(b.sqrt_rel), "sqrt {sqrt_e:e}");
+        assert!(exp_e <= f64::from(b.exp_rel), "exp {exp_e:e}");
+        assert!(sin_e <= f64::from(b.sin_cos_abs), "sin {sin_e:e}");
+        assert!(cos_e <= f64::from(b.sin_cos_abs), "cos {cos_e:e}");
+        assert!(atan_e <= f64::from(b.atan_abs), "atan {atan_e:e}");
+        assert!(erf_e <= f64::from(b.erf_abs), "erf {erf_e:e}");
+        assert_eq!(floor(-2.5), -3.0);
+        assert_eq!(floor(2.5), 2.0);
+        assert_eq!(abs(-0.0f32).to_bits(), 0);
+        assert!(sqrt(-1.0).is_nan());
+        assert_eq!(sqrt(0.0), 0.0);
+    }
+}
