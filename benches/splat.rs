@@ -16,7 +16,10 @@ use std::hint::black_box;
 /// oblique view with 2:1 anisotropy.
 fn g2s(across: f32) -> Mat3 {
     let zoom = across / (2.0 * 1.6 * 2.0);
-    Mat3::from_rotation_z(0.5) * Mat3::from_rotation_x(0.3) * Mat3::from_diagonal(glam::Vec3::new(2.0, 1.0, 1.0)) * zoom
+    Mat3::from_rotation_z(0.5)
+        * Mat3::from_rotation_x(0.3)
+        * Mat3::from_diagonal(glam::Vec3::new(2.0, 1.0, 1.0))
+        * zoom
 }
 
 fn bench_splat_n<const N: usize>(c: &mut Criterion) {
@@ -27,10 +30,17 @@ fn bench_splat_n<const N: usize>(c: &mut Criterion) {
         let fp = Footprint::new(&kernel, &g2s(across), FootprintOptions::default()).unwrap();
         for (lookup, lname) in [(Lookup::Nearest, "nearest"), (Lookup::Bilinear, "bilinear")] {
             let table = Box::new(ViewTable::<N>::build(&fp, &generic, lookup, lookup));
-            let direct = Direct { footprint: fp, table: &*generic, lookup };
+            let direct = Direct {
+                footprint: fp,
+                table: &*generic,
+                lookup,
+            };
             let samplers: [(&dyn Sampler, &str); 2] = [(&*table, "robust"), (&direct, "direct")];
             for (sampler, method) in samplers {
-                let name = format!("n={N}/{lname}/{method}/float/{}/fp={across}px", math::BACKEND);
+                let name = format!(
+                    "n={N}/{lname}/{method}/float/{}/fp={across}px",
+                    math::BACKEND
+                );
                 let mut px = vec![0.0f32; 128 * 128];
                 group.bench_function(BenchmarkId::from_parameter(name), |b| {
                     let mut img = ImageMut::new(&mut px, 128, 128, 128).unwrap();

@@ -11,6 +11,10 @@ mod scene {
 fn freestanding_scene_on_the_host() {
     let mut pixels = vec![0.0f32; scene::SIDE * scene::SIDE];
     let sum = scene::render(&mut pixels).unwrap();
-    println!("host: checksum 0x{:08x}, sum of weights bits 0x{:08x}", scene::checksum(&pixels), sum.to_bits());
+    println!(
+        "host: checksum 0x{:08x}, sum of weights bits 0x{:08x}",
+        scene::checksum(&pixels),
+        sum.to_bits()
+    );
     assert!((sum - 1.0).abs() < 0.01, "sum of weights {sum}");
 }

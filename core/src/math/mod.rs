@@ -114,7 +114,12 @@ mod tests {
     //! `cargo test -p footprint --lib --no-default-features --features micromath`.
     use super::*;
 
-    fn worst(points: impl Iterator<Item = f32>, f: fn(f32) -> f32, r: fn(f64) -> f64, rel: bool) -> f64 {
+    fn worst(
+        points: impl Iterator<Item = f32>,
+        f: fn(f32) -> f32,
+        r: fn(f64) -> f64,
+        rel: bool,
+    ) -> f64 {
         points
             .map(|x| {
                 let (got, want) = (f64::from(f(x)), r(f64::from(x)));
