@@ -142,8 +142,18 @@ mod tests {
         let b = ERROR_BOUNDS;
         let sqrt_e = worst(grid(1e-6, 1e6, 100_000), sqrt, libm::sqrt, true);
         let exp_e = worst(grid(-80.0, 80.0, 100_000), exp, libm::exp, true);
-        let sin_e = worst(grid(-6.283, 6.283, 100_000), sin, libm::sin, false);
-        let cos_e = worst(grid(-6.283, 6.283, 100_000), cos, libm::cos, false);
+        let sin_e = worst(
+            grid(-core::f32::consts::TAU, core::f32::consts::TAU, 100_000),
+            sin,
+            libm::sin,
+            false,
+        );
+        let cos_e = worst(
+            grid(-core::f32::consts::TAU, core::f32::consts::TAU, 100_000),
+            cos,
+            libm::cos,
+            false,
+        );
         let atan_e = worst(grid(-1e3, 1e3, 100_000), atan, libm::atan, false);
         let erf_e = worst(grid(-6.0, 6.0, 100_000), erf, libm::erf, false);
         // Printed with --nocapture; the README's backend table quotes these.
