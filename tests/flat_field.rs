@@ -154,24 +154,11 @@ fn flat_field_ripple_per_kernel_and_table() {
 fn fourier_ripple_bound(kernel: Kernel) -> f64 {
     let r = f64::from(kernel.spread());
     let hankel = |nu: f64| {
-        let steps = 4000;
-        let h = r / steps as f64;
-        (0..=steps)
-            .map(|i| {
-                let rho = h * i as f64;
-                let w = if i == 0 || i == steps {
-                    1.0
-                } else if i % 2 == 1 {
-                    4.0
-                } else {
-                    2.0
-                };
-                let f = footprint_harness::reference::footprint_f64(&kernel, [rho / r, 0.0]);
-                w * f * libm::j0(2.0 * std::f64::consts::PI * nu * rho) * rho
-            })
-            .sum::<f64>()
-            * h
-            / 3.0
+        let f = |rho: f64| {
+            let fp = footprint_harness::reference::footprint_f64(&kernel, [rho / r, 0.0]);
+            fp * libm::j0(2.0 * std::f64::consts::PI * nu * rho) * rho
+        };
+        footprint_suite::simpson(f, 0.0, r, 4000)
     };
     let f0 = hankel(0.0);
     let mut sum = 0.0;

@@ -9,27 +9,23 @@ use footprint_harness::io::image::GreyImage;
 use glam::{DMat3, Mat3};
 use std::path::PathBuf;
 
+/// Composite Simpson's rule for ∫ₐᵇ f, with `steps` (even) intervals.
+pub fn simpson(f: impl Fn(f64) -> f64, a: f64, b: f64, steps: usize) -> f64 {
+    let h = (b - a) / steps as f64;
+    let inner: f64 = (1..steps)
+        .map(|i| f(a + h * i as f64) * if i % 2 == 1 { 4.0 } else { 2.0 })
+        .sum();
+    (f(a) + inner + f(b)) * h / 3.0
+}
+
 /// Brute-force footprint of a radial 3D kernel: ∫ h(√(ρ² + s²)) ds over the chord through the
-/// unit ball, composite Simpson with `steps` (even) intervals. `h` takes r in unit coordinates.
+/// unit ball, by Simpson's rule with `steps` intervals. `h` takes r in unit coordinates.
 pub fn line_integral(h: impl Fn(f64) -> f64, rho: f64, steps: usize) -> f64 {
     if rho >= 1.0 {
         return 0.0;
     }
     let half = (1.0 - rho * rho).sqrt();
-    let dx = 2.0 * half / steps as f64;
-    let mut sum = 0.0;
-    for i in 0..=steps {
-        let s = -half + dx * i as f64;
-        let w = if i == 0 || i == steps {
-            1.0
-        } else if i % 2 == 1 {
-            4.0
-        } else {
-            2.0
-        };
-        sum += w * h((rho * rho + s * s).sqrt());
-    }
-    sum * dx / 3.0
+    simpson(|s| h((rho * rho + s * s).sqrt()), -half, half, steps)
 }
 
 /// The truncated 3D Gaussian h(r) = e^(−r²·sigmas²/2) for r ≤ 1, in unit coordinates. The
@@ -47,20 +43,7 @@ pub fn gaussian_3d(sigmas: f64) -> impl Fn(f64) -> f64 {
 
 /// ∫_ball h d³u by Simpson on the radial integral 4π∫r²h(r)dr.
 pub fn ball_integral(h: impl Fn(f64) -> f64, steps: usize) -> f64 {
-    let dr = 1.0 / steps as f64;
-    let mut sum = 0.0;
-    for i in 0..=steps {
-        let r = dr * i as f64;
-        let w = if i == 0 || i == steps {
-            1.0
-        } else if i % 2 == 1 {
-            4.0
-        } else {
-            2.0
-        };
-        sum += w * r * r * h(r);
-    }
-    4.0 * std::f64::consts::PI * sum * dr / 3.0
+    4.0 * std::f64::consts::PI * simpson(|r| r * r * h(r), 0.0, 1.0, steps)
 }
 
 /// A world-to-screen matrix: rotation by Euler angles (degrees, applied x then y then z) times a
