@@ -14,6 +14,7 @@ pub const ERROR_BOUNDS: ErrorBounds = ErrorBounds {
     sin_cos_abs: 4.0e-7,
     atan_abs: 4.0e-7,
     erf_abs: 4.0e-7,
+    powf_unit_abs: 4.0e-7,
 };
 
 #[inline]
@@ -43,4 +44,8 @@ pub fn atan(x: f32) -> f32 {
 #[inline]
 pub fn floor(x: f32) -> f32 {
     libm::floorf(x)
+}
+#[inline]
+pub fn powf(x: f32, y: f32) -> f32 {
+    libm::powf(x, y)
 }

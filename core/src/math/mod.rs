@@ -51,6 +51,9 @@ pub struct ErrorBounds {
     pub atan_abs: f32,
     /// Absolute error of [`erf`].
     pub erf_abs: f32,
+    /// Absolute error of [`powf`] for x in (0, 1] and y in [0, 64] (the range opacity correction
+    /// and specular highlights use).
+    pub powf_unit_abs: f32,
 }
 
 /// Square root. NaN for negative input.
@@ -87,6 +90,12 @@ pub fn cos(x: f32) -> f32 {
 #[inline]
 pub fn atan(x: f32) -> f32 {
     backend::atan(x)
+}
+
+/// xʸ for x > 0 (NaN for x < 0, as libm).
+#[inline]
+pub fn powf(x: f32, y: f32) -> f32 {
+    backend::powf(x, y)
 }
 
 /// Largest integer value not greater than `x`.
@@ -142,6 +151,8 @@ mod tests {
         let b = ERROR_BOUNDS;
         let sqrt_e = worst(grid(1e-6, 1e6, 100_000), sqrt, libm::sqrt, true);
         let exp_e = worst(grid(-80.0, 80.0, 100_000), exp, libm::exp, true);
+        // Underflow and overflow are exact limits, not approximations.
+        assert!(exp(-100.0) == 0.0 && exp(-500.0) == 0.0 && exp(100.0) == f32::INFINITY);
         let sin_e = worst(
             grid(-core::f32::consts::TAU, core::f32::consts::TAU, 100_000),
             sin,
@@ -156,9 +167,15 @@ mod tests {
         );
         let atan_e = worst(grid(-1e3, 1e3, 100_000), atan, libm::atan, false);
         let erf_e = worst(grid(-6.0, 6.0, 100_000), erf, libm::erf, false);
+        let mut pow_e = 0.0f64;
+        for x in grid(1e-3, 1.0, 400) {
+            for y in grid(0.0, 64.0, 400) {
+                pow_e = pow_e.max((f64::from(powf(x, y)) - libm::pow(f64::from(x), f64::from(y))).abs());
+            }
+        }
         // Printed with --nocapture; the README's backend table quotes these.
         std::println!(
-            "{BACKEND}: sqrt {sqrt_e:.2e} rel, exp {exp_e:.2e} rel, sin {sin_e:.2e}, cos {cos_e:.2e}, atan {atan_e:.2e}, erf {erf_e:.2e}"
+            "{BACKEND}: sqrt {sqrt_e:.2e} rel, exp {exp_e:.2e} rel, sin {sin_e:.2e}, cos {cos_e:.2e}, atan {atan_e:.2e}, erf {erf_e:.2e}, powf {pow_e:.2e}"
         );
         assert!(sqrt_e <= f64::from(b.sqrt_rel), "sqrt {sqrt_e:e}");
         assert!(exp_e <= f64::from(b.exp_rel), "exp {exp_e:e}");
@@ -166,6 +183,7 @@ mod tests {
         assert!(cos_e <= f64::from(b.sin_cos_abs), "cos {cos_e:e}");
         assert!(atan_e <= f64::from(b.atan_abs), "atan {atan_e:e}");
         assert!(erf_e <= f64::from(b.erf_abs), "erf {erf_e:e}");
+        assert!(pow_e <= f64::from(b.powf_unit_abs), "powf {pow_e:e}");
         assert_eq!(floor(-2.5), -3.0);
         assert_eq!(floor(2.5), 2.0);
         assert_eq!(abs(-0.0f32).to_bits(), 0);
