@@ -15,6 +15,10 @@
 //! - [`geometry`]: grid, view, the screen ellipse, its extent and its map to the unit circle.
 //! - [`table`]: generic and view tables, lookup, the table byte format.
 //! - [`splat`]: spreading one voxel into a caller-owned image.
+//! - [`frame`]: one view of one volume: placement, sheet axis and order, buffer sizes.
+//! - [`shade`]: transfer functions, Phong, Levoy iso-surfaces, grid-coordinate texture.
+//! - [`composite`]: Porter–Duff over/under of premultiplied RGBA.
+//! - [`render`]: the sheet renderer and the three-sheet ring for sources that cannot seek.
 //!
 //! ## Conventions (kept everywhere)
 //! - world = G·(i, j, k), G the grid-to-world matrix (diagonal = spacing, world units such as mm);
@@ -43,9 +47,13 @@
 // `!(x > 0.0)` is how this crate sends NaN down the rejecting branch; `x <= 0.0` would let it through.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod composite;
+pub mod frame;
 pub mod geometry;
 pub mod kernel;
 pub mod math;
+pub mod render;
+pub mod shade;
 pub mod splat;
 pub mod table;
 
@@ -68,6 +76,10 @@ pub enum Error {
     Table(TableError),
     /// A caller buffer of the wrong size, or a bad splat position.
     Buffer(BufferError),
+    /// A frame that cannot be set up.
+    Frame(frame::FrameError),
+    /// A sheet the renderer refused.
+    Render(render::RenderError),
 }
 
 impl fmt::Display for Error {
@@ -77,6 +89,8 @@ impl fmt::Display for Error {
             Error::Geometry(e) => e.fmt(f),
             Error::Table(e) => e.fmt(f),
             Error::Buffer(e) => e.fmt(f),
+            Error::Frame(e) => e.fmt(f),
+            Error::Render(e) => e.fmt(f),
         }
     }
 }
@@ -88,6 +102,8 @@ impl core::error::Error for Error {
             Error::Geometry(e) => Some(e),
             Error::Table(e) => Some(e),
             Error::Buffer(e) => Some(e),
+            Error::Frame(e) => Some(e),
+            Error::Render(e) => Some(e),
         }
     }
 }

@@ -225,6 +225,18 @@ pub fn splat<S: Sampler + ?Sized, P: Pixel>(
     value: &P,
     image: &mut ImageMut<'_, P>,
 ) -> Result<SplatStats, BufferError> {
+    splat_rows(sampler, center, value, image, |_, _, _| {})
+}
+
+/// [`splat`], also calling `touched(y, x0, x1)` for every image row it visits with the inclusive
+/// pixel range it visited there (so a caller can composite only what a sheet covered).
+pub fn splat_rows<S: Sampler + ?Sized, P: Pixel>(
+    sampler: &S,
+    center: [f32; 2],
+    value: &P,
+    image: &mut ImageMut<'_, P>,
+    mut touched: impl FnMut(usize, usize, usize),
+) -> Result<SplatStats, BufferError> {
     if !(center[0].is_finite() && center[1].is_finite()) {
         return Err(BufferError::NonFiniteCenter);
     }
@@ -243,15 +255,23 @@ pub fn splat<S: Sampler + ?Sized, P: Pixel>(
         } else {
             // No pixel centre saw the footprint (a table too coarse to resolve it): put the whole
             // voxel in the pixel that contains its centre rather than lose it.
-            return Ok(deposit_whole(center, value, image));
+            return Ok(deposit_whole(center, value, image, touched));
         }
     }
     let mut stats = SplatStats::default();
     let (w, h) = (image.width as i64, image.height as i64);
     let stride = image.stride;
     let data = &mut *image.data;
+    let mut row = (-1i64, 0i64, 0i64);
     for_each_in_support(fp, center, y0.max(0), y1.min(h - 1), 0, w - 1, |x, y, q| {
         stats.pixels_visited += 1;
+        if y != row.0 {
+            if row.0 >= 0 {
+                touched(row.0 as usize, row.1 as usize, row.2 as usize);
+            }
+            row = (y, x, x);
+        }
+        row.2 = x;
         let weight = sampler.weight(q);
         if weight != 0.0 {
             // x, y are within the clipped image, so the index is in the buffer ImageMut checked.
@@ -259,6 +279,9 @@ pub fn splat<S: Sampler + ?Sized, P: Pixel>(
             stats.pixels_updated += 1;
         }
     });
+    if row.0 >= 0 {
+        touched(row.0 as usize, row.1 as usize, row.2 as usize);
+    }
     Ok(stats)
 }
 
@@ -294,10 +317,16 @@ fn pixel_range(lo: f32, hi: f32) -> (i64, i64) {
     (clamp(first), clamp(last))
 }
 
-fn deposit_whole<P: Pixel>(center: [f32; 2], value: &P, image: &mut ImageMut<'_, P>) -> SplatStats {
+fn deposit_whole<P: Pixel>(
+    center: [f32; 2],
+    value: &P,
+    image: &mut ImageMut<'_, P>,
+    mut touched: impl FnMut(usize, usize, usize),
+) -> SplatStats {
     let (x, y) = (math::floor(center[0]), math::floor(center[1]));
     if x >= 0.0 && y >= 0.0 && (x as usize) < image.width && (y as usize) < image.height {
         image.data[y as usize * image.stride + x as usize].add_weighted(value, 1.0);
+        touched(y as usize, x as usize, x as usize);
         SplatStats {
             pixels_visited: 1,
             pixels_updated: 1,

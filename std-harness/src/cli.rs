@@ -15,8 +15,13 @@ pub struct Cli {
 
 #[derive(Subcommand, Debug)]
 pub enum Command {
+    /// Render a volume (or, with no volume, the built-in scene) to a PNG.
+    Render(commands::render::RenderArgs),
     /// Render one voxel (value 1) and write its raw footprint weights (px⁻²).
     Splat(commands::splat::SplatArgs),
+    /// Render with the core and with the f64 reference (no tables) and report PSNR, RMSE and max
+    /// error; exit 1 below --min-psnr.
+    Verify(commands::verify::VerifyArgs),
     /// Precompute a generic footprint table and save it (the paper's preprocessor).
     Tables(commands::tables::TablesArgs),
     /// Compare two single-channel PFM images: max |A − B| relative to B's peak.
@@ -107,14 +112,17 @@ where
         }
     };
     let result = match cli.command {
+        Command::Render(a) => commands::render::run(&a),
         Command::Splat(a) => commands::splat::run(&a),
+        Command::Verify(a) => commands::verify::run(&a),
         Command::Tables(a) => commands::tables::run(&a),
         Command::Compare(a) => commands::compare::run(&a),
     };
     match result {
         Ok(()) => 0,
         Err(e) => {
-            eprintln!("footprint: {e}");
+            use std::io::Write as _;
+            let _ = writeln!(std::io::stderr().lock(), "footprint: {e}");
             e.code
         }
     }

@@ -7,11 +7,26 @@
 //! - [`io`]: image and table files (always written atomically: temporary file, then rename).
 //! - [`dispatch`]: runtime table size → const generic.
 
+// `!(x > y)` sends NaN down the rejecting branch, on purpose (as in the core).
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+/// `println!` that never panics: a closed stdout (`footprint … | head`) is not an error worth a
+/// crash, and the output files are already written by then.
+#[macro_export]
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout().lock(), $($arg)*);
+    }};
+}
+
 pub mod cli;
 pub mod commands;
 pub mod dispatch;
 pub mod io;
 pub mod reference;
+pub mod scene;
+pub mod tf;
 
 pub use cli::run;
 
@@ -70,5 +85,7 @@ from_core_error!(
     footprint::KernelSpecError,
     footprint::GeometryError,
     footprint::TableError,
-    footprint::BufferError
+    footprint::BufferError,
+    footprint::frame::FrameError,
+    footprint::render::RenderError
 );

@@ -41,7 +41,7 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
     let load = |p: &PathBuf| decode_pfm(&io::read_file(p)?, &p.display().to_string());
     let (a, b) = (load(&args.a)?, load(&args.b)?);
     let d = max_rel_diff(&a, &b)?;
-    println!("max |A-B| / peak(B) = {d:.6} ({:.4} %)", d * 100.0);
+    crate::say!("max |A-B| / peak(B) = {d:.6} ({:.4} %)", d * 100.0);
     match args.max_diff {
         Some(limit) if d.is_nan() || d > limit => Err(CliError::check(format!(
             "difference {d:.6} exceeds --max-diff {limit}"

@@ -1,5 +1,7 @@
 //! One module per subcommand.
 
 pub mod compare;
+pub mod render;
 pub mod splat;
 pub mod tables;
+pub mod verify;

@@ -206,7 +206,7 @@ pub fn splat_image(args: &SplatArgs) -> Result<(GreyImage, SplatReport), CliErro
 pub fn run(args: &SplatArgs) -> Result<(), CliError> {
     let (img, r) = splat_image(args)?;
     save_grey(&img, &args.out)?;
-    println!(
+    crate::say!(
         "{}: {:?} {}x{} table, footprint half-extent {:.3} x {:.3} px, sheet axis {}, \
          sum of weights {:.6}, peak {:.6e} px^-2{}{}, {:.3} ms",
         args.out.display(),

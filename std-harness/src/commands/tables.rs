@@ -47,7 +47,7 @@ pub fn run(args: &TablesArgs) -> Result<(), CliError> {
     let start = std::time::Instant::now();
     let bytes = table_bytes(&kernel, args.size)?;
     io::write_atomic(&args.out, &bytes)?;
-    println!(
+    crate::say!(
         "wrote {} ({}x{} table, kernel {kernel}, {} bytes, crc32 {:08x}) in {:.1} ms",
         args.out.display(),
         args.size,

@@ -136,3 +136,65 @@ pub fn save_grey(img: &GreyImage, path: &Path) -> Result<(), CliError> {
     };
     super::write_atomic(path, &bytes)
 }
+
+/// Encodes premultiplied RGBA (composited over black, i.e. the colour channels as they are) as an
+/// 8-bit RGB PNG. Values are linear and written without a gamma curve, clamped to [0, 1].
+pub fn encode_png_rgb(rgba: &[[f32; 4]], width: usize, height: usize) -> Result<Vec<u8>, CliError> {
+    let pixels: Vec<u8> = rgba
+        .iter()
+        .flat_map(|p| [p[0], p[1], p[2]])
+        .map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8)
+        .collect();
+    let mut out = Vec::new();
+    let mut enc = png::Encoder::new(&mut out, width as u32, height as u32);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    let err = |e: png::EncodingError| CliError::input(format!("PNG encoder: {e}"));
+    let mut writer = enc.write_header().map_err(err)?;
+    writer.write_image_data(&pixels).map_err(err)?;
+    writer.finish().map_err(err)?;
+    Ok(out)
+}
+
+/// Decodes an 8-bit grey, grey+alpha, RGB or RGBA PNG into premultiplied RGBA f32 (linear, as
+/// stored). Returns (width, height, pixels).
+pub fn decode_png_rgba(
+    bytes: &[u8],
+    name: &str,
+) -> Result<(usize, usize, Vec<[f32; 4]>), CliError> {
+    let bad = |e: String| CliError::input(format!("{name}: {e}"));
+    let mut decoder = png::Decoder::new(std::io::Cursor::new(bytes));
+    decoder.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
+    let mut reader = decoder
+        .read_info()
+        .map_err(|e| bad(format!("not a readable PNG: {e}")))?;
+    let size = reader
+        .output_buffer_size()
+        .ok_or_else(|| bad("PNG too large".into()))?;
+    let mut buf = vec![0u8; size];
+    let info = reader
+        .next_frame(&mut buf)
+        .map_err(|e| bad(format!("corrupt PNG: {e}")))?;
+    let (w, h) = (info.width as usize, info.height as usize);
+    let channels = match info.color_type {
+        png::ColorType::Grayscale => 1,
+        png::ColorType::GrayscaleAlpha => 2,
+        png::ColorType::Rgb => 3,
+        png::ColorType::Rgba => 4,
+        other => return Err(bad(format!("unsupported PNG colour type {other:?}"))),
+    };
+    let px = buf[..w * h * channels]
+        .chunks_exact(channels)
+        .map(|c| {
+            let f = |v: u8| f32::from(v) / 255.0;
+            let (r, g, b, a) = match channels {
+                1 => (f(c[0]), f(c[0]), f(c[0]), 1.0),
+                2 => (f(c[0]), f(c[0]), f(c[0]), f(c[1])),
+                3 => (f(c[0]), f(c[1]), f(c[2]), 1.0),
+                _ => (f(c[0]), f(c[1]), f(c[2]), f(c[3])),
+            };
+            [r * a, g * a, b * a, a]
+        })
+        .collect();
+    Ok((w, h, px))
+}

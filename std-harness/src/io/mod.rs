@@ -2,6 +2,8 @@
 //! target and is renamed into place, so a failure never leaves a half-written output.
 
 pub mod image;
+pub mod json;
+pub mod volume;
 
 use crate::CliError;
 use std::io::Write;

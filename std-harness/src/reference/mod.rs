@@ -13,6 +13,8 @@
 //! exactly (f64) at the mapped point. Small footprints are renormalised to sum to one, as in the
 //! core: that is part of the model, not an approximation.
 
+pub mod render;
+
 use footprint::geometry::{in_sheet_axes, sheet_axis, RENORMALISE_BELOW_PX};
 use footprint::{GeometryError, Kernel};
 use glam::{DMat3, DVec3};
@@ -196,29 +198,85 @@ impl ReferenceFootprint {
         }
     }
 
-    /// Splats one voxel of value 1 at screen position `center` (pixels) into a `width × height`
-    /// image (row-major, top row first), with the core's pixel-centre and renormalisation rules.
-    pub fn splat(&self, center: [f64; 2], width: usize, height: usize, out: &mut [f64]) {
-        let span = |c: f64, e: f64| ((c - e - 0.5).ceil() as i64, (c + e - 0.5).floor() as i64);
-        let (x0, x1) = span(center[0], self.half_extent[0]);
-        let (y0, y1) = span(center[1], self.half_extent[1]);
-        let at =
-            |x: i64, y: i64| self.weight([x as f64 + 0.5 - center[0], y as f64 + 0.5 - center[1]]);
+    /// The x offsets (pixels from the centre) where the support meets the row at y offset `qy`:
+    /// the ellipse |A q| ≤ 1 or the parallelogram |A q|∞ ≤ 1 (exact, f64). `None` if it misses.
+    fn row_span(&self, qy: f64) -> Option<(f64, f64)> {
+        let a = &self.to_unit;
+        if matches!(self.kernel, Kernel::Bilinear { .. }) {
+            let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
+            for row in a {
+                let rest = row[1] * qy;
+                if row[0] == 0.0 {
+                    if rest.abs() >= 1.0 {
+                        return None;
+                    }
+                } else {
+                    let (p, q) = ((-1.0 - rest) / row[0], (1.0 - rest) / row[0]);
+                    lo = lo.max(p.min(q));
+                    hi = hi.min(p.max(q));
+                }
+            }
+            return (lo < hi).then_some((lo, hi));
+        }
+        let pxx = a[0][0] * a[0][0] + a[1][0] * a[1][0];
+        let pxy = a[0][0] * a[0][1] + a[1][0] * a[1][1];
+        let pyy = a[0][1] * a[0][1] + a[1][1] * a[1][1];
+        let disc = (pxy * qy).powi(2) - pxx * (pyy * qy * qy - 1.0);
+        if disc <= 0.0 {
+            return None;
+        }
+        let (mid, half) = (-pxy * qy / pxx, disc.sqrt() / pxx);
+        Some((mid - half, mid + half))
+    }
+
+    /// Calls `f(pixel index, weight)` for every pixel with row in `rows` of a `width × height` image
+    /// (row-major, top row first) that a voxel at screen position `center` (pixels) reaches, with
+    /// the core's pixel-centre and renormalisation rules; weights are already renormalised.
+    /// Pixels outside the support (where every weight is exactly zero) are not visited.
+    pub fn for_each_weight(
+        &self,
+        center: [f64; 2],
+        width: usize,
+        rows: std::ops::Range<usize>,
+        mut f: impl FnMut(usize, f64),
+    ) {
+        let span = |lo: f64, hi: f64| ((lo - 0.5).ceil() as i64, (hi - 0.5).floor() as i64);
+        let (y0, y1) = span(
+            center[1] - self.half_extent[1],
+            center[1] + self.half_extent[1],
+        );
+        let each = |ylo: i64, yhi: i64, xmin: i64, xmax: i64, f: &mut dyn FnMut(i64, i64, f64)| {
+            for y in ylo..=yhi {
+                let qy = y as f64 + 0.5 - center[1];
+                let Some((lo, hi)) = self.row_span(qy) else {
+                    continue;
+                };
+                let (x0, x1) = span(center[0] + lo, center[0] + hi);
+                for x in x0.max(xmin)..=x1.min(xmax) {
+                    f(x, y, self.weight([x as f64 + 0.5 - center[0], qy]));
+                }
+            }
+        };
         let mut factor = 1.0;
         if self.renormalise {
-            let sum: f64 = (y0..=y1)
-                .flat_map(|y| (x0..=x1).map(move |x| (x, y)))
-                .map(|(x, y)| at(x, y))
-                .sum();
+            let mut sum = 0.0;
+            each(y0, y1, i64::MIN, i64::MAX, &mut |_, _, w| sum += w);
             if sum > 0.0 {
                 factor = 1.0 / sum;
             }
         }
-        for y in y0.max(0)..=y1.min(height as i64 - 1) {
-            for x in x0.max(0)..=x1.min(width as i64 - 1) {
-                out[y as usize * width + x as usize] += at(x, y) * factor;
+        let (ylo, yhi) = (y0.max(rows.start as i64), y1.min(rows.end as i64 - 1));
+        each(ylo, yhi, 0, width as i64 - 1, &mut |x, y, w| {
+            if w != 0.0 {
+                f(y as usize * width + x as usize, w * factor);
             }
-        }
+        });
+    }
+
+    /// Splats one voxel of value 1 at screen position `center` (pixels) into a `width × height`
+    /// image (row-major, top row first).
+    pub fn splat(&self, center: [f64; 2], width: usize, height: usize, out: &mut [f64]) {
+        self.for_each_weight(center, width, 0..height, |i, w| out[i] += w);
     }
 }
 

@@ -1,0 +1,531 @@
+//! `footprint render`: a volume (or the built-in scene) rendered by the core, sheet by sheet.
+//!
+//! View: `--view AZ,EL,ROLL` (degrees) builds V = zoom · Rz(roll) · Rx(el) · Ry(az): azimuth turns
+//! the volume about the screen's vertical axis, elevation about its horizontal axis, roll about
+//! the view direction. With AZ = EL = ROLL = 0 the viewer looks along +k with +i to the right and
+//! +j down. The zoom that fits the volume's bounding box into 90 % of the image is multiplied by
+//! `--zoom`. `--view-matrix` gives V (world → screen, pixels per world unit) explicitly instead.
+
+use crate::cli::{parse_list, parse_size, LookupArg, MethodArg};
+use crate::io::image::encode_png_rgb;
+use crate::io::volume::{load_nrrd, load_raw, SampleType, Volume};
+use crate::io::{self, json::Json};
+use crate::reference::render::{render_reference, ReferenceScene};
+use crate::{scene, tf, with_table_size, CliError};
+use clap::{Args, ValueEnum};
+use footprint::frame::{FrameSetup, Order};
+use footprint::geometry::{FootprintOptions, Mapping, DEFAULT_MIN_RADIUS_PX};
+use footprint::render::{RenderBuffers, RenderStats, SheetRenderer, SheetRing};
+use footprint::shade::{Phong, Shader, Shading, TransferFunction};
+use footprint::splat::{Direct, Sampler};
+use footprint::{composite::RowSpan, GenericTable, Grid, Kernel, Lookup, View, ViewTable};
+use glam::{Mat3, Vec3};
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Compositing direction on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum OrderArg {
+    /// Farthest sheet first, composited over (the paper's order).
+    BackToFront,
+    /// Nearest sheet first, composited under.
+    FrontToBack,
+}
+
+impl From<OrderArg> for Order {
+    fn from(o: OrderArg) -> Self {
+        match o {
+            OrderArg::BackToFront => Order::BackToFront,
+            OrderArg::FrontToBack => Order::FrontToBack,
+        }
+    }
+}
+
+/// Every flag of `render` (and of `verify`, which takes them all).
+#[derive(Args, Debug, Clone)]
+pub struct RenderArgs {
+    /// Volume: .nrrd / .nhdr, or headerless raw with --dims and --type. Omitted: the built-in
+    /// electron-density scene.
+    pub volume: Option<PathBuf>,
+    /// Image size, WxH pixels.
+    #[arg(long, default_value = "512x512", value_parser = parse_size)]
+    pub size: (usize, usize),
+    /// View angles AZ,EL,ROLL in degrees (see the module docs).
+    #[arg(long, default_value = "0,0,0", value_parser = parse_list::<3>, allow_hyphen_values = true)]
+    pub view: [f32; 3],
+    /// Multiplies the zoom that fits the volume into the image.
+    #[arg(long, default_value_t = 1.0)]
+    pub zoom: f32,
+    /// Explicit world-to-screen matrix, nine numbers row-major, pixels per world unit (overrides
+    /// --view and --zoom).
+    #[arg(long, value_parser = parse_list::<9>, allow_hyphen_values = true)]
+    pub view_matrix: Option<[f32; 9]>,
+    /// Kernel spec.
+    #[arg(long, default_value = "gaussian:spread=1.6,sigmas=2.5")]
+    pub kernel: String,
+    /// Generic and view table size N.
+    #[arg(long, default_value_t = 65)]
+    pub table: usize,
+    /// Load the generic table from a file written by `footprint tables`.
+    #[arg(long)]
+    pub table_file: Option<PathBuf>,
+    /// Table lookup, for building the view table and for sampling it.
+    #[arg(long, value_enum, default_value_t = LookupArg::Bilinear)]
+    pub lookup: LookupArg,
+    /// Footprint method (`reference` renders with the f64 reference, no tables).
+    #[arg(long, value_enum, default_value_t = MethodArg::Robust)]
+    pub method: MethodArg,
+    /// Smallest footprint semi-axis, pixels.
+    #[arg(long, default_value_t = DEFAULT_MIN_RADIUS_PX)]
+    pub min_radius: f32,
+    /// Transfer function: a preset (grey, ct-bone-skin, density) or a file of `t r g b a` lines.
+    /// Default: density for the built-in scene, grey otherwise.
+    #[arg(long)]
+    pub tf: Option<String>,
+    /// Value window LO,HI mapped onto the transfer function (default: the data's range).
+    #[arg(long, value_parser = parse_list::<2>, allow_hyphen_values = true)]
+    pub window: Option<[f32; 2]>,
+    /// Shading: emission, phong, iso:VALUE (Levoy iso-surface at VALUE, data units), texture.
+    #[arg(long, default_value = "emission")]
+    pub shading: String,
+    /// Starting working image (PNG of the output size), composited behind the volume.
+    #[arg(long)]
+    pub background: Option<PathBuf>,
+    /// Compositing direction.
+    #[arg(long, value_enum, default_value_t = OrderArg::BackToFront)]
+    pub order: OrderArg,
+    /// Write a JSON summary here.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+    /// Raw volumes: dimensions X,Y,Z.
+    #[arg(long, value_parser = parse_dims)]
+    pub dims: Option<[usize; 3]>,
+    /// Raw volumes: sample type (u8, i8, u16, i16, u32, i32, f32, f64).
+    #[arg(long = "type")]
+    pub sample_type: Option<String>,
+    /// Raw volumes: byte order.
+    #[arg(long, default_value = "little")]
+    pub endian: String,
+    /// Raw volumes: spacing X,Y,Z in world units.
+    #[arg(long, default_value = "1,1,1", value_parser = parse_list::<3>)]
+    pub spacing: [f32; 3],
+    /// Output image (PNG). `render` defaults to footprint.png; `verify` writes one only if asked.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
+fn parse_dims(s: &str) -> Result<[usize; 3], String> {
+    let v: Vec<&str> = s.split(',').collect();
+    if v.len() != 3 {
+        return Err("expected X,Y,Z".into());
+    }
+    let mut out = [0usize; 3];
+    for (o, p) in out.iter_mut().zip(v) {
+        *o = p
+            .trim()
+            .parse()
+            .map_err(|_| format!("'{p}' is not a whole number"))?;
+    }
+    Ok(out)
+}
+
+/// Parses `--shading`; iso-surfaces are `1.5 × min_spacing` thick (world units).
+pub fn parse_shading(s: &str, min_spacing: f32) -> Result<Shading, CliError> {
+    let phong = Phong::default();
+    Ok(match s {
+        "emission" => Shading::Emission,
+        "phong" => Shading::Phong(phong),
+        "texture" => Shading::Texture(phong),
+        _ => match s.strip_prefix("iso:").map(str::parse::<f32>) {
+            Some(Ok(value)) if value.is_finite() => Shading::Iso {
+                value,
+                opacity: 0.9,
+                thickness: 1.5 * min_spacing,
+                phong,
+            },
+            _ => {
+                return Err(CliError::input(format!(
+                    "--shading '{s}': expected emission, phong, iso:VALUE or texture"
+                )))
+            }
+        },
+    })
+}
+
+/// A render, set up and ready to run: the volume, the frame, the shading.
+pub struct Prepared {
+    pub volume: Volume,
+    pub name: String,
+    pub kernel: Kernel,
+    pub frame: FrameSetup,
+    pub lut: Vec<[f32; 4]>,
+    pub window: [f32; 2],
+    pub shading: Shading,
+    pub tf_name: String,
+    pub background: Option<Vec<[f32; 4]>>,
+    pub order: Order,
+    pub options: FootprintOptions,
+}
+
+impl Prepared {
+    /// The shader over this render's lookup table.
+    pub fn shader(&self) -> Shader<'_> {
+        Shader {
+            tf: TransferFunction {
+                lut: &self.lut,
+                lo: self.window[0],
+                hi: self.window[1],
+            },
+            shading: self.shading,
+        }
+    }
+
+    /// Copies sheet `s` (along the frame's sheet axis) into `out`.
+    pub fn sheet(&self, s: usize, out: &mut [f32]) {
+        self.volume.sheet_into(self.frame.sheet_axis, s, out);
+    }
+}
+
+/// V for `--view`/`--zoom` (fitted to the volume) or `--view-matrix`.
+pub fn view_matrix(args: &RenderArgs, volume: &Volume) -> Mat3 {
+    if let Some(m) = args.view_matrix {
+        return Mat3::from_cols_array(&m).transpose();
+    }
+    let [az, el, roll] = args.view.map(f32::to_radians);
+    let r = Mat3::from_rotation_z(roll) * Mat3::from_rotation_x(el) * Mat3::from_rotation_y(az);
+    // Half-extents on screen of the volume's bounding box (voxel centres ± half a voxel).
+    let half = Vec3::new(
+        volume.dims[0] as f32 * volume.spacing[0],
+        volume.dims[1] as f32 * volume.spacing[1],
+        volume.dims[2] as f32 * volume.spacing[2],
+    ) * 0.5;
+    let mut ext = Vec3::ZERO;
+    for corner in 0..8 {
+        let c = Vec3::new(
+            if corner & 1 == 0 { -half.x } else { half.x },
+            if corner & 2 == 0 { -half.y } else { half.y },
+            if corner & 4 == 0 { -half.z } else { half.z },
+        );
+        ext = ext.max((r * c).abs());
+    }
+    let (w, h) = (args.size.0 as f32, args.size.1 as f32);
+    let fit = 0.9 * (w / (2.0 * ext.x)).min(h / (2.0 * ext.y));
+    r * (fit * args.zoom)
+}
+
+fn load_volume(args: &RenderArgs) -> Result<(Volume, String), CliError> {
+    let Some(path) = &args.volume else {
+        return Ok((
+            scene::default_volume(),
+            "built-in electron-density scene".into(),
+        ));
+    };
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let volume = match (ext.as_deref(), args.dims) {
+        (Some("nrrd" | "nhdr"), _) => load_nrrd(path)?,
+        (_, Some(dims)) => {
+            let ty = args
+                .sample_type
+                .as_deref()
+                .ok_or_else(|| CliError::input("raw volumes need --type"))?;
+            let ty = SampleType::parse(ty)
+                .ok_or_else(|| CliError::input(format!("--type '{ty}' is not a sample type")))?;
+            let big = match args.endian.as_str() {
+                "little" => false,
+                "big" => true,
+                e => {
+                    return Err(CliError::input(format!(
+                        "--endian '{e}': expected little or big"
+                    )))
+                }
+            };
+            load_raw(path, dims, ty, big, args.spacing)?
+        }
+        _ => {
+            return Err(CliError::input(format!(
+                "{}: unknown volume format (use .nrrd/.nhdr, or --dims and --type for raw)",
+                path.display()
+            )))
+        }
+    };
+    Ok((volume, path.display().to_string()))
+}
+
+fn load_background(
+    path: &std::path::Path,
+    size: (usize, usize),
+) -> Result<Vec<[f32; 4]>, CliError> {
+    let bytes = io::read_file(path)?;
+    let img = crate::io::image::decode_png_rgba(&bytes, &path.display().to_string())?;
+    if (img.0, img.1) != size {
+        return Err(CliError::input(format!(
+            "{}: background is {}x{}, the image is {}x{}",
+            path.display(),
+            img.0,
+            img.1,
+            size.0,
+            size.1
+        )));
+    }
+    Ok(img.2)
+}
+
+/// Loads and sets up everything `args` describes.
+pub fn prepare(args: &RenderArgs) -> Result<Prepared, CliError> {
+    let kernel = Kernel::parse(&args.kernel)
+        .map_err(|e| CliError::input(format!("--kernel '{}': {e}", args.kernel)))?;
+    let (volume, name) = load_volume(args)?;
+    let grid =
+        Grid::from_spacing(volume.spacing).map_err(|e| CliError::input(format!("{name}: {e}")))?;
+    let view =
+        View::new(view_matrix(args, &volume)).map_err(|e| CliError::input(format!("view: {e}")))?;
+    let mapping = if args.method == MethodArg::Paper {
+        Mapping::PAPER
+    } else {
+        Mapping::Robust
+    };
+    let options = FootprintOptions {
+        mapping,
+        min_radius_px: args.min_radius,
+    };
+    let frame = FrameSetup::new(
+        volume.dims,
+        &grid,
+        &view,
+        &kernel,
+        options,
+        [args.size.0, args.size.1],
+    )?;
+    let tf_name = args.tf.clone().unwrap_or_else(|| {
+        if args.volume.is_none() {
+            "density"
+        } else {
+            "grey"
+        }
+        .into()
+    });
+    let lut = tf::lut(&tf::load(&tf_name)?);
+    let window = match args.window {
+        Some(w) => w,
+        None => {
+            let (lo, hi) = volume.range();
+            if !(hi > lo) {
+                return Err(CliError::input(format!(
+                    "{name}: the data are constant ({lo}); give --window"
+                )));
+            }
+            [lo, hi]
+        }
+    };
+    if !(window[1] > window[0]) {
+        return Err(CliError::input(format!(
+            "--window {},{}: HI must exceed LO",
+            window[0], window[1]
+        )));
+    }
+    let shading = parse_shading(
+        &args.shading,
+        frame.spacing.iter().copied().fold(f32::INFINITY, f32::min),
+    )?;
+    let background = args
+        .background
+        .as_ref()
+        .map(|p| load_background(p, args.size))
+        .transpose()?;
+    Ok(Prepared {
+        volume,
+        name,
+        kernel,
+        frame,
+        lut,
+        window,
+        shading,
+        tf_name,
+        background,
+        order: args.order.into(),
+        options,
+    })
+}
+
+/// Shows `sheet n/N` on stderr when it is a terminal.
+pub fn progress(label: &'static str) -> impl FnMut(usize, usize) {
+    let tty = std::io::stderr().is_terminal();
+    move |n, total| {
+        if tty {
+            use std::io::Write as _;
+            let end = if n == total { "\n" } else { "" };
+            let _ = write!(
+                std::io::stderr().lock(),
+                "\r{label}: sheet {n}/{total}{end}"
+            );
+        }
+    }
+}
+
+/// The core's render of `p`: premultiplied RGBA, counts, seconds.
+pub fn render_core(
+    p: &Prepared,
+    args: &RenderArgs,
+) -> Result<(Vec<[f32; 4]>, RenderStats, f64), CliError> {
+    let lookup = Lookup::from(args.lookup);
+    with_table_size!(args.table, N => {
+        let generic = match &args.table_file {
+            Some(path) => {
+                let t = super::tables::load_table::<N>(path)?;
+                if *t.kernel() != p.kernel {
+                    return Err(CliError::input(format!(
+                        "{}: table is for kernel {}, but --kernel is {}",
+                        path.display(), t.kernel(), p.kernel
+                    )));
+                }
+                t
+            }
+            None => Box::new(GenericTable::<N>::build(p.kernel)),
+        };
+        let start = Instant::now();
+        let sampler: Box<dyn Sampler + '_> = match args.method {
+            MethodArg::Direct => Box::new(Direct { footprint: p.frame.footprint, table: &*generic, lookup }),
+            _ => Box::new(ViewTable::<N>::build(&p.frame.footprint, &generic, lookup, lookup)),
+        };
+        let (image, stats) = run_sheets(p, &*sampler)?;
+        (image, stats, start.elapsed().as_secs_f64())
+    })
+}
+
+/// Drives the core renderer through a [`SheetRing`], as a streaming source would.
+fn run_sheets(
+    p: &Prepared,
+    sampler: &dyn Sampler,
+) -> Result<(Vec<[f32; 4]>, RenderStats), CliError> {
+    let f = &p.frame;
+    let n = f.image_len();
+    let (mut accum, mut image, mut rows) = (
+        vec![[0.0f32; 4]; n],
+        vec![[0.0f32; 4]; n],
+        vec![RowSpan::EMPTY; f.size[1]],
+    );
+    let buffers = RenderBuffers {
+        accumulator: &mut accum,
+        image: &mut image,
+        rows: &mut rows,
+    };
+    let mut renderer = SheetRenderer::new(
+        f,
+        sampler,
+        p.shader(),
+        p.order,
+        buffers,
+        p.background.as_deref(),
+    )?;
+    let mut storage = vec![0.0f32; 3 * f.sheet_shape().0];
+    let mut ring = SheetRing::new(&mut storage, f, p.order)?;
+    let mut show = progress("render");
+    let count = f.sheet_count();
+    for step in 0..count {
+        let s = ring.sheet_index(step);
+        if let Some(done) = ring.push_with(|slot| {
+            p.sheet(s, slot);
+            Ok::<(), footprint::render::RenderError>(())
+        })? {
+            renderer.render_sheet(ring.sheet_index(done), ring.window(done))?;
+            show(done + 1, count);
+        }
+    }
+    if let Some(last) = ring.last() {
+        renderer.render_sheet(ring.sheet_index(last), ring.window(last))?;
+        show(count, count);
+    }
+    let stats = renderer.finish();
+    Ok((image, stats))
+}
+
+/// The f64 reference render of `p` and its seconds.
+pub fn render_ref(p: &Prepared) -> Result<(Vec<[f64; 4]>, f64), CliError> {
+    let start = Instant::now();
+    let scene = ReferenceScene {
+        frame: &p.frame,
+        kernel: &p.kernel,
+        min_radius_px: p.options.min_radius_px,
+        shader: p.shader(),
+        order: p.order,
+        background: p.background.as_deref(),
+    };
+    let img = render_reference(&scene, |s, out| p.sheet(s, out), progress("reference"))?;
+    Ok((img, start.elapsed().as_secs_f64()))
+}
+
+/// The JSON fields every render and verify summary share.
+pub fn describe(p: &Prepared, args: &RenderArgs) -> Json {
+    let f = &p.frame;
+    Json::object()
+        .str("volume", &p.name)
+        .arr_usize("dims", &p.volume.dims)
+        .arr_f64("spacing", &p.volume.spacing.map(f64::from))
+        .arr_usize("size", &[args.size.0, args.size.1])
+        .str("kernel", &p.kernel.to_string())
+        .num("table", args.table as f64)
+        .str("lookup", &format!("{:?}", args.lookup).to_lowercase())
+        .str("method", &format!("{:?}", args.method).to_lowercase())
+        .str("order", &format!("{:?}", args.order).to_lowercase())
+        .str("shading", &args.shading)
+        .str("tf", &p.tf_name)
+        .arr_f64("window", &p.window.map(f64::from))
+        .str("sheet_axis", ["i", "j", "k"][f.sheet_axis])
+        .arr_f64(
+            "footprint_half_extent_px",
+            &f.footprint.half_extent.map(f64::from),
+        )
+}
+
+pub fn run(args: &RenderArgs) -> Result<(), CliError> {
+    let p = prepare(args)?;
+    let (rgb, summary) = if args.method == MethodArg::Reference {
+        let (img, secs) = render_ref(&p)?;
+        let rgb: Vec<[f32; 4]> = img.iter().map(|c| c.map(|x| x as f32)).collect();
+        crate::say!("{}: f64 reference render in {:.3} s", p.name, secs);
+        (rgb, describe(&p, args).num("seconds", secs))
+    } else {
+        let (img, stats, secs) = render_core(&p, args)?;
+        crate::say!(
+            "{}: {}x{} in {:.3} s; {} sheets along {}, {} voxels ({} splatted), {} pixel updates, {} composites",
+            p.name,
+            args.size.0,
+            args.size.1,
+            secs,
+            stats.sheets,
+            ["i", "j", "k"][p.frame.sheet_axis],
+            stats.voxels,
+            stats.voxels_splatted,
+            stats.pixel_updates,
+            stats.pixels_composited
+        );
+        let j = describe(&p, args)
+            .num("seconds", secs)
+            .num("voxels", stats.voxels as f64)
+            .num("voxels_splatted", stats.voxels_splatted as f64)
+            .num("pixel_updates", stats.pixel_updates as f64)
+            .num("pixels_composited", stats.pixels_composited as f64);
+        (img, j)
+    };
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("footprint.png"));
+    let png = encode_png_rgb(&rgb, args.size.0, args.size.1)?;
+    io::write_atomic(&out, &png)?;
+    if let Some(j) = &args.json {
+        io::write_atomic(
+            j,
+            summary
+                .str("out", &out.display().to_string())
+                .finish()
+                .as_bytes(),
+        )?;
+    }
+    crate::say!("wrote {}", out.display());
+    Ok(())
+}

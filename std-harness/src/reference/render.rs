@@ -1,0 +1,151 @@
+//! The f64 reference renderer: the same frame, sheets, shading and compositing as the core, but
+//! every footprint weight is the exact kernel integral ([`super::ReferenceFootprint`]) and every
+//! accumulation and composite is in f64. Shading uses the core's shader (f32), so the difference
+//! between the two renders isolates the tables and the f32 accumulation.
+
+use super::ReferenceFootprint;
+use crate::CliError;
+use footprint::frame::{FrameSetup, Order};
+use footprint::render::{gradient, SheetWindow};
+use footprint::shade::{Lighting, Shader};
+use footprint::Kernel;
+
+/// What the reference renders: the core's frame and shading, the kernel, the compositing order
+/// and the background (as in the core renderer).
+#[derive(Clone, Copy, Debug)]
+pub struct ReferenceScene<'a> {
+    pub frame: &'a FrameSetup,
+    pub kernel: &'a Kernel,
+    pub min_radius_px: f32,
+    pub shader: Shader<'a>,
+    pub order: Order,
+    pub background: Option<&'a [[f32; 4]]>,
+}
+
+/// Renders the sheets `sheet(s, buffer)` supplies and returns the premultiplied RGBA image (f64,
+/// row-major, top row first); `progress(done, total)` after each sheet.
+pub fn render_reference(
+    scene: &ReferenceScene<'_>,
+    mut sheet: impl FnMut(usize, &mut [f32]),
+    mut progress: impl FnMut(usize, usize),
+) -> Result<Vec<[f64; 4]>, CliError> {
+    let ReferenceScene {
+        frame,
+        kernel,
+        min_radius_px,
+        shader,
+        order,
+        background,
+    } = *scene;
+    let g2s = frame.grid_to_screen.as_dmat3();
+    let fp = ReferenceFootprint::new(kernel, &g2s, f64::from(min_radius_px))?;
+    let (w, h) = (frame.size[0], frame.size[1]);
+    let n = w * h;
+    let bg: Vec<[f64; 4]> = match background {
+        Some(b) => b.iter().map(|p| p.map(f64::from)).collect(),
+        None => vec![[0.0; 4]; n],
+    };
+    let mut image = if order == Order::BackToFront {
+        bg.clone()
+    } else {
+        vec![[0.0; 4]; n]
+    };
+    let mut accum = vec![[0.0f64; 4]; n];
+    let lighting = Lighting::new(frame);
+    let (len, na, nb) = frame.sheet_shape();
+    let count = frame.sheet_count();
+    let (k, (a, b)) = (frame.sheet_axis, frame.in_sheet);
+    let origin = frame.origin.as_dvec3();
+    let (ck, ca, cb) = (g2s.col(k), g2s.col(a), g2s.col(b));
+    let area = f64::from(frame.cell_area);
+    let mut bufs = [vec![0.0f32; len], vec![0.0f32; len], vec![0.0f32; len]];
+    let load =
+        |s: usize, buf: &mut Vec<f32>, sheet: &mut dyn FnMut(usize, &mut [f32])| sheet(s, buf);
+    for step in 0..count {
+        let s = frame.sheet_at(order, step);
+        // Sheets s−1, s, s+1 (read directly: the reference does not need to stream).
+        let have_lo = s > 0;
+        let have_hi = s + 1 < count;
+        if have_lo {
+            load(s - 1, &mut bufs[0], &mut sheet);
+        }
+        load(s, &mut bufs[1], &mut sheet);
+        if have_hi {
+            load(s + 1, &mut bufs[2], &mut sheet);
+        }
+        let window = SheetWindow {
+            lower: have_lo.then_some(&bufs[0][..]),
+            current: &bufs[1][..],
+            upper: have_hi.then_some(&bufs[2][..]),
+        };
+        // The image's rows are split between threads; each shades every voxel (cheap) and
+        // evaluates footprints only on its own rows (the expensive part), so the sum is the same
+        // as a single pass.
+        let threads = std::thread::available_parallelism()
+            .map_or(1, |n| n.get())
+            .clamp(1, 8);
+        let band = h.div_ceil(threads);
+        std::thread::scope(|scope| {
+            for (t, chunk) in accum.chunks_mut(band * w).enumerate() {
+                let window = &window;
+                let fp = &fp;
+                let lighting = &lighting;
+                scope.spawn(move || {
+                    let rows = t * band..(t * band + chunk.len() / w);
+                    let first = rows.start * w;
+                    for v in 0..nb {
+                        for u in 0..na {
+                            let value = window.current[v * na + u];
+                            let rgba = shader.shade(
+                                lighting,
+                                value,
+                                || gradient(frame, window, u, v),
+                                frame.grid_index(s, u, v),
+                                frame.dims,
+                            );
+                            if !(rgba[3] > 0.0) {
+                                continue;
+                            }
+                            let p = origin + ck * s as f64 + ca * u as f64 + cb * v as f64;
+                            let c = rgba.map(|x| f64::from(x) * area);
+                            fp.for_each_weight([p.x, p.y], w, rows.clone(), |i, wt| {
+                                let px = &mut chunk[i - first];
+                                for ch in 0..4 {
+                                    px[ch] += c[ch] * wt;
+                                }
+                            });
+                        }
+                    }
+                });
+            }
+        });
+        for (acc, img) in accum.iter_mut().zip(image.iter_mut()) {
+            if *acc == [0.0; 4] {
+                continue;
+            }
+            let src = acc.map(|x| x.clamp(0.0, 1.0));
+            *img = match order {
+                Order::BackToFront => over64(src, *img),
+                Order::FrontToBack => over64(*img, src),
+            };
+            *acc = [0.0; 4];
+        }
+        progress(step + 1, count);
+    }
+    if order == Order::FrontToBack {
+        for (img, b) in image.iter_mut().zip(&bg) {
+            *img = over64(*img, *b);
+        }
+    }
+    Ok(image)
+}
+
+fn over64(front: [f64; 4], back: [f64; 4]) -> [f64; 4] {
+    let k = 1.0 - front[3];
+    [
+        front[0] + k * back[0],
+        front[1] + k * back[1],
+        front[2] + k * back[2],
+        front[3] + k * back[3],
+    ]
+}
