@@ -476,3 +476,77 @@ fn renderer_errors_are_typed() {
     )
     .is_err());
 }
+
+/// Pre-shaded RGBA sheets render exactly like the same colours produced by a transfer function
+/// (spacing 1 along the view, so the opacity correction is the identity).
+#[test]
+fn pre_shaded_sheets_match_classified_sheets() {
+    let scene = blob([12, 10, 8], [1.0, 1.0, 1.0]);
+    let lut = ramp(0.5);
+    let view = Mat3::IDENTITY * 4.0;
+    let classified = render(
+        &scene,
+        view,
+        64,
+        Shading::Emission,
+        Order::BackToFront,
+        &lut,
+        None,
+    );
+    let frame = classified.frame;
+    let shader = Shader {
+        tf: TransferFunction {
+            lut: &lut,
+            lo: 0.0,
+            hi: 1.0,
+        },
+        shading: Shading::Emission,
+    };
+    let generic = GenericTable::<65>::build(Kernel::PAPER_GAUSSIAN);
+    let table = ViewTable::<65>::build(
+        &frame.footprint,
+        &generic,
+        Lookup::Bilinear,
+        Lookup::Bilinear,
+    );
+    let n = frame.image_len();
+    let (mut acc, mut img, mut rows) = (
+        vec![[0.0f32; 4]; n],
+        vec![[0.0f32; 4]; n],
+        vec![RowSpan::EMPTY; 64],
+    );
+    let buffers = RenderBuffers {
+        accumulator: &mut acc,
+        image: &mut img,
+        rows: &mut rows,
+    };
+    let mut r =
+        SheetRenderer::new(&frame, &table, shader, Order::BackToFront, buffers, None).unwrap();
+    let (len, _, _) = frame.sheet_shape();
+    let mut values = vec![0.0f32; len];
+    for step in 0..frame.sheet_count() {
+        let s = frame.sheet_at(Order::BackToFront, step);
+        scene.sheet(&frame, s, &mut values);
+        let rgba: Vec<[f32; 4]> = values
+            .iter()
+            .map(|&v| {
+                let c = shader.tf.lookup(v);
+                [c[0] * c[3], c[1] * c[3], c[2] * c[3], c[3]]
+            })
+            .collect();
+        r.render_shaded_sheet(s, &rgba).unwrap();
+    }
+    assert_eq!(
+        r.render_shaded_sheet(0, &[[0.0; 4]; 3]),
+        Err(RenderError::SheetLength {
+            expected: len,
+            got: 3
+        })
+    );
+    r.finish();
+    assert_le(
+        f64::from(max_diff(&img, &classified.image)),
+        1e-6,
+        "pre-shaded vs classified",
+    );
+}

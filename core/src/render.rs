@@ -248,6 +248,55 @@ impl<'a, S: Sampler + ?Sized> SheetRenderer<'a, S> {
         Ok(())
     }
 
+    /// Splats and composites sheet `index` of voxels the caller has already shaded: premultiplied
+    /// RGBA per voxel (`dims[a] × dims[b]`, the sheet layout), each the colour and opacity of that
+    /// voxel's slab of this sheet (no transfer function, lighting or opacity correction is
+    /// applied). Voxels with α = 0 are skipped.
+    pub fn render_shaded_sheet(
+        &mut self,
+        index: usize,
+        rgba: &[[f32; 4]],
+    ) -> Result<(), RenderError> {
+        let f = self.frame;
+        let count = f.sheet_count();
+        if index >= count {
+            return Err(RenderError::SheetIndex { index, count });
+        }
+        let (len, na, _) = f.sheet_shape();
+        if rgba.len() != len {
+            return Err(RenderError::SheetLength {
+                expected: len,
+                got: rgba.len(),
+            });
+        }
+        let (k, (a, b)) = (f.sheet_axis, f.in_sheet);
+        let cols = f.grid_to_screen;
+        let base = f.origin + cols.col(k) * index as f32;
+        let mut image = ImageMut::new(
+            &mut *self.buffers.accumulator,
+            f.size[0],
+            f.size[1],
+            f.size[0],
+        )?;
+        let rows = &mut *self.buffers.rows;
+        for (n, c) in rgba.iter().enumerate() {
+            self.stats.voxels += 1;
+            if !(c[3] > 0.0) {
+                continue;
+            }
+            let p = base + cols.col(a) * (n % na) as f32 + cols.col(b) * (n / na) as f32;
+            let value = c.map(|x| x * f.cell_area);
+            let s = splat_rows(self.sampler, [p.x, p.y], &value, &mut image, |y, x0, x1| {
+                rows[y].include(x0, x1)
+            })?;
+            self.stats.voxels_splatted += 1;
+            self.stats.pixel_updates += u64::from(s.pixels_updated);
+        }
+        self.composite_sheet();
+        self.stats.sheets += 1;
+        Ok(())
+    }
+
     /// Composites the accumulated sheet into the working image over the rows it touched, and
     /// clears what it used.
     fn composite_sheet(&mut self) {
