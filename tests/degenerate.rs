@@ -219,7 +219,7 @@ fn footprint_of_a_thousandth_of_a_pixel_keeps_its_weight() {
             a.spacing = [1.0, 1.0, 1.0];
             a.view_matrix = Some(rows(&(Mat3::IDENTITY * (1e-3 / 1.6))));
             a.center = Some(center);
-            a.method = method;
+            a.footprint.method = method;
             let (img, r) = with_reference(&a);
             assert!(img.data.iter().all(|v| v.is_finite() && *v >= 0.0));
             let sum: f64 = img.data.iter().map(|&v| f64::from(v)).sum();
@@ -245,7 +245,7 @@ fn footprint_of_ten_thousand_pixels_is_right_on_screen() {
         a.spacing = [1.0, 1.0, 1.0];
         a.view_matrix = Some(rows(&(Mat3::from_rotation_z(0.3) * (1e4 / 1.6))));
         a.center = Some([100.0, 40.0]);
-        a.method = method;
+        a.footprint.method = method;
         let (img, r) = with_reference(&a);
         assert!(img.data.iter().all(|v| v.is_finite()));
         assert_le(

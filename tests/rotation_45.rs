@@ -182,9 +182,9 @@ fn paper_map_near_45_degrees_is_measured() {
     // The image is still within 1 % with the cheat at 45° (it turns the footprint by 0.01°).
     let mut args = splat_args();
     args.rotate_z = 45.0;
-    args.method = MethodArg::Paper;
+    args.footprint.method = MethodArg::Paper;
     let img = splat_image(&args).unwrap().0;
-    args.method = MethodArg::Reference;
+    args.footprint.method = MethodArg::Reference;
     let r = splat_image(&args).unwrap().0;
     assert_le(
         max_rel_diff(&img, &r),

@@ -35,9 +35,10 @@ fn methods_and_kernels_against_reference() {
                 let mut errs = Vec::new();
                 for n in [11, 33, 65] {
                     let mut a = splat_args();
-                    a.kernel = kernel.into();
+                    a.footprint.kernel = kernel.into();
                     (a.rotate_x, a.rotate_y, a.rotate_z) = (20.0, 10.0, 30.0);
-                    (a.table, a.lookup, a.method) = (n, lookup, method);
+                    (a.footprint.table, a.footprint.lookup, a.footprint.method) =
+                        (n, lookup, method);
                     if kernel == "sinc" {
                         a.spacing = [20.0, 10.0, 10.0]; // spread 5: keep it on the 256² image
                     }
@@ -92,9 +93,9 @@ fn methods_and_kernels_against_reference() {
 fn bilinear_model_needs_the_grid_orientation() {
     let run = |rx: f32, ry: f32, method: MethodArg| {
         let mut a = splat_args();
-        a.kernel = "bilinear".into();
+        a.footprint.kernel = "bilinear".into();
         a.spacing = [40.0, 40.0, 40.0];
-        (a.rotate_x, a.rotate_y, a.method) = (rx, ry, method);
+        (a.rotate_x, a.rotate_y, a.footprint.method) = (rx, ry, method);
         let (img, r) = with_reference(&a);
         max_rel_diff(&img, &r)
     };

@@ -132,15 +132,15 @@ fn tables_command_output_loads_in_splat() {
     let built = footprint_harness::commands::splat::splat_image(&a)
         .unwrap()
         .0;
-    a.table_file = Some(file.clone());
+    a.footprint.table_file = Some(file.clone());
     let loaded = footprint_harness::commands::splat::splat_image(&a)
         .unwrap()
         .0;
     assert_eq!(max_rel_diff(&loaded, &built), 0.0);
-    a.kernel = "cone".into();
+    a.footprint.kernel = "cone".into();
     assert!(footprint_harness::commands::splat::splat_image(&a).is_err());
-    a.kernel = "gaussian".into();
-    a.table = 33;
+    a.footprint.kernel = "gaussian".into();
+    a.footprint.table = 33;
     let err = footprint_harness::commands::splat::splat_image(&a).unwrap_err();
     assert!(
         err.message.contains("65x65") && err.message.contains("33x33"),

@@ -184,22 +184,56 @@ impl<'a, S: Sampler + ?Sized> SheetRenderer<'a, S> {
         index: usize,
         window: SheetWindow<'_, T>,
     ) -> Result<(), RenderError> {
+        let (f, shader, lighting) = (self.frame, self.shader, self.lighting);
+        let na = f.sheet_shape().1;
+        let lengths = [
+            Some(window.current.len()),
+            window.lower.map(<[T]>::len),
+            window.upper.map(<[T]>::len),
+        ];
+        self.splat_sheet(index, lengths, |u, v| {
+            let value = window.current[v * na + u].to_f32();
+            shader.shade(
+                &lighting,
+                value,
+                || gradient(f, &window, u, v),
+                f.grid_index(index, u, v),
+                f.dims,
+            )
+        })
+    }
+
+    /// Splats and composites sheet `index` of voxels the caller has already shaded: premultiplied
+    /// RGBA per voxel (`dims[a] × dims[b]`, the sheet layout), each the colour and opacity of that
+    /// voxel's slab of this sheet (no transfer function, lighting or opacity correction is
+    /// applied). Voxels with α = 0 are skipped.
+    pub fn render_shaded_sheet(
+        &mut self,
+        index: usize,
+        rgba: &[[f32; 4]],
+    ) -> Result<(), RenderError> {
+        let na = self.frame.sheet_shape().1;
+        self.splat_sheet(index, [Some(rgba.len()), None, None], |u, v| {
+            rgba[v * na + u]
+        })
+    }
+
+    /// Checks sheet `index` and the given sheet `lengths`, then splats the premultiplied RGBA that
+    /// `shade(u, v)` gives for every voxel (skipping α = 0) and composites the sheet.
+    fn splat_sheet(
+        &mut self,
+        index: usize,
+        lengths: [Option<usize>; 3],
+        mut shade: impl FnMut(usize, usize) -> [f32; 4],
+    ) -> Result<(), RenderError> {
         let f = self.frame;
         let count = f.sheet_count();
         if index >= count {
             return Err(RenderError::SheetIndex { index, count });
         }
         let (len, na, nb) = f.sheet_shape();
-        for sheet in [Some(window.current), window.lower, window.upper]
-            .into_iter()
-            .flatten()
-        {
-            if sheet.len() != len {
-                return Err(RenderError::SheetLength {
-                    expected: len,
-                    got: sheet.len(),
-                });
-            }
+        if let Some(got) = lengths.into_iter().flatten().find(|&l| l != len) {
+            return Err(RenderError::SheetLength { expected: len, got });
         }
         let (k, (a, b)) = (f.sheet_axis, f.in_sheet);
         let cols = f.grid_to_screen;
@@ -212,85 +246,21 @@ impl<'a, S: Sampler + ?Sized> SheetRenderer<'a, S> {
             f.size[0],
         )?;
         let rows = &mut *self.buffers.rows;
-        let cur = window.current;
         for v in 0..nb {
             for u in 0..na {
-                let value = cur[v * na + u].to_f32();
                 self.stats.voxels += 1;
-                let gradient = || gradient(f, &window, u, v);
-                let rgba = self.shader.shade(
-                    &self.lighting,
-                    value,
-                    gradient,
-                    f.grid_index(index, u, v),
-                    f.dims,
-                );
+                let rgba = shade(u, v);
                 if !(rgba[3] > 0.0) {
                     continue;
                 }
                 let p = base + ca * u as f32 + cb * v as f32;
-                let area = f.cell_area;
-                let value = [
-                    rgba[0] * area,
-                    rgba[1] * area,
-                    rgba[2] * area,
-                    rgba[3] * area,
-                ];
+                let value = rgba.map(|c| c * f.cell_area);
                 let s = splat_rows(self.sampler, [p.x, p.y], &value, &mut image, |y, x0, x1| {
                     rows[y].include(x0, x1)
                 })?;
                 self.stats.voxels_splatted += 1;
                 self.stats.pixel_updates += u64::from(s.pixels_updated);
             }
-        }
-        self.composite_sheet();
-        self.stats.sheets += 1;
-        Ok(())
-    }
-
-    /// Splats and composites sheet `index` of voxels the caller has already shaded: premultiplied
-    /// RGBA per voxel (`dims[a] × dims[b]`, the sheet layout), each the colour and opacity of that
-    /// voxel's slab of this sheet (no transfer function, lighting or opacity correction is
-    /// applied). Voxels with α = 0 are skipped.
-    pub fn render_shaded_sheet(
-        &mut self,
-        index: usize,
-        rgba: &[[f32; 4]],
-    ) -> Result<(), RenderError> {
-        let f = self.frame;
-        let count = f.sheet_count();
-        if index >= count {
-            return Err(RenderError::SheetIndex { index, count });
-        }
-        let (len, na, _) = f.sheet_shape();
-        if rgba.len() != len {
-            return Err(RenderError::SheetLength {
-                expected: len,
-                got: rgba.len(),
-            });
-        }
-        let (k, (a, b)) = (f.sheet_axis, f.in_sheet);
-        let cols = f.grid_to_screen;
-        let base = f.origin + cols.col(k) * index as f32;
-        let mut image = ImageMut::new(
-            &mut *self.buffers.accumulator,
-            f.size[0],
-            f.size[1],
-            f.size[0],
-        )?;
-        let rows = &mut *self.buffers.rows;
-        for (n, c) in rgba.iter().enumerate() {
-            self.stats.voxels += 1;
-            if !(c[3] > 0.0) {
-                continue;
-            }
-            let p = base + cols.col(a) * (n % na) as f32 + cols.col(b) * (n / na) as f32;
-            let value = c.map(|x| x * f.cell_area);
-            let s = splat_rows(self.sampler, [p.x, p.y], &value, &mut image, |y, x0, x1| {
-                rows[y].include(x0, x1)
-            })?;
-            self.stats.voxels_splatted += 1;
-            self.stats.pixel_updates += u64::from(s.pixels_updated);
         }
         self.composite_sheet();
         self.stats.sheets += 1;

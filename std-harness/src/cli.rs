@@ -2,6 +2,7 @@
 //! angles in degrees, matrices nine numbers in row-major order.
 
 use crate::commands;
+use crate::CliError;
 use clap::{Parser, Subcommand, ValueEnum};
 use std::ffi::OsString;
 
@@ -55,6 +56,57 @@ pub enum MethodArg {
     Direct,
     /// f64, no tables: the exact line integral (the float reference).
     Reference,
+}
+
+/// The footprint flags `splat`, `render` and `verify` share.
+#[derive(clap::Args, Debug, Clone)]
+pub struct FootprintArgs {
+    /// Kernel spec, e.g. gaussian:spread=1.6,sigmas=2.5 (also cone, sinc, bilinear).
+    #[arg(long, default_value = "gaussian:spread=1.6,sigmas=2.5")]
+    pub kernel: String,
+    /// Generic and view table size N (N×N).
+    #[arg(long, default_value_t = 65)]
+    pub table: usize,
+    /// Load the generic table from a file written by `footprint tables` (its N must equal --table).
+    #[arg(long)]
+    pub table_file: Option<std::path::PathBuf>,
+    /// Lookup, both when building the view table and when sampling it (or the generic table).
+    #[arg(long, value_enum, default_value_t = LookupArg::Bilinear)]
+    pub lookup: LookupArg,
+    /// Footprint method.
+    #[arg(long, value_enum, default_value_t = MethodArg::Robust)]
+    pub method: MethodArg,
+    /// Smallest footprint semi-axis, pixels (sub-pixel footprints are widened to it).
+    #[arg(long, default_value_t = footprint::geometry::DEFAULT_MIN_RADIUS_PX)]
+    pub min_radius: f32,
+}
+
+impl FootprintArgs {
+    /// The parsed `--kernel`.
+    pub fn kernel(&self) -> Result<footprint::Kernel, CliError> {
+        footprint::Kernel::parse(&self.kernel)
+            .map_err(|e| CliError::input(format!("--kernel '{}': {e}", self.kernel)))
+    }
+
+    /// The generic table: loaded from `--table-file` (which must be for `kernel` and of size N), or
+    /// built.
+    pub fn generic_table<const N: usize>(
+        &self,
+        kernel: &footprint::Kernel,
+    ) -> Result<Box<footprint::GenericTable<N>>, CliError> {
+        let Some(path) = &self.table_file else {
+            return Ok(Box::new(footprint::GenericTable::<N>::build(*kernel)));
+        };
+        let table = crate::commands::tables::load_table::<N>(path)?;
+        if table.kernel() != kernel {
+            return Err(CliError::input(format!(
+                "{}: table is for kernel {}, but --kernel is {kernel}",
+                path.display(),
+                table.kernel()
+            )));
+        }
+        Ok(table)
+    }
 }
 
 /// Parses `a,b,c,…` into exactly `n` finite numbers.

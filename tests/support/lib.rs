@@ -3,7 +3,7 @@
 //! what they found.
 
 use footprint::Kernel;
-use footprint_harness::cli::{LookupArg, MethodArg};
+use footprint_harness::cli::{FootprintArgs, LookupArg, MethodArg};
 use footprint_harness::commands::splat::{splat_image, SplatArgs};
 use footprint_harness::io::image::GreyImage;
 use glam::{DMat3, Mat3};
@@ -64,7 +64,14 @@ pub fn rows(m: &Mat3) -> [f32; 9] {
 /// bilinear, robust) for tests to modify.
 pub fn splat_args() -> SplatArgs {
     SplatArgs {
-        kernel: "gaussian:spread=1.6,sigmas=2.5".into(),
+        footprint: FootprintArgs {
+            kernel: "gaussian:spread=1.6,sigmas=2.5".into(),
+            table: 65,
+            table_file: None,
+            lookup: LookupArg::Bilinear,
+            method: MethodArg::Robust,
+            min_radius: footprint::geometry::DEFAULT_MIN_RADIUS_PX,
+        },
         spacing: [60.0, 30.0, 30.0],
         grid_matrix: None,
         view_matrix: None,
@@ -72,11 +79,6 @@ pub fn splat_args() -> SplatArgs {
         rotate_y: 0.0,
         rotate_z: 0.0,
         size: (256, 256),
-        table: 65,
-        table_file: None,
-        lookup: LookupArg::Bilinear,
-        method: MethodArg::Robust,
-        min_radius: footprint::geometry::DEFAULT_MIN_RADIUS_PX,
         center: None,
         out: PathBuf::from("unused.pfm"),
     }
@@ -86,7 +88,7 @@ pub fn splat_args() -> SplatArgs {
 pub fn with_reference(args: &SplatArgs) -> (GreyImage, GreyImage) {
     let core = splat_image(args).expect("core splat").0;
     let mut r = args.clone();
-    r.method = MethodArg::Reference;
+    r.footprint.method = MethodArg::Reference;
     (core, splat_image(&r).expect("reference splat").0)
 }
 

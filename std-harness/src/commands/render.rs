@@ -6,7 +6,7 @@
 //! +j down. The zoom that fits the volume's bounding box into 90 % of the image is multiplied by
 //! `--zoom`. `--view-matrix` gives V (world → screen, pixels per world unit) explicitly instead.
 
-use crate::cli::{parse_list, parse_size, LookupArg, MethodArg};
+use crate::cli::{parse_list, parse_size, FootprintArgs, MethodArg};
 use crate::io::image::encode_png_rgb;
 use crate::io::volume::{load_nrrd, load_raw, SampleType, Volume};
 use crate::io::{self, json::Json};
@@ -14,11 +14,11 @@ use crate::reference::render::{render_reference, ReferenceScene};
 use crate::{scene, tf, with_table_size, CliError};
 use clap::{Args, ValueEnum};
 use footprint::frame::{FrameSetup, Order};
-use footprint::geometry::{FootprintOptions, Mapping, DEFAULT_MIN_RADIUS_PX};
+use footprint::geometry::{FootprintOptions, Mapping};
 use footprint::render::{RenderBuffers, RenderStats, SheetRenderer, SheetRing};
 use footprint::shade::{Phong, Shader, Shading, TransferFunction};
 use footprint::splat::{Direct, Sampler};
-use footprint::{composite::RowSpan, GenericTable, Grid, Kernel, Lookup, View, ViewTable};
+use footprint::{composite::RowSpan, Grid, Kernel, Lookup, View, ViewTable};
 use glam::{Mat3, Vec3};
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -61,24 +61,10 @@ pub struct RenderArgs {
     /// --view and --zoom).
     #[arg(long, value_parser = parse_list::<9>, allow_hyphen_values = true)]
     pub view_matrix: Option<[f32; 9]>,
-    /// Kernel spec.
-    #[arg(long, default_value = "gaussian:spread=1.6,sigmas=2.5")]
-    pub kernel: String,
-    /// Generic and view table size N.
-    #[arg(long, default_value_t = 65)]
-    pub table: usize,
-    /// Load the generic table from a file written by `footprint tables`.
-    #[arg(long)]
-    pub table_file: Option<PathBuf>,
-    /// Table lookup, for building the view table and for sampling it.
-    #[arg(long, value_enum, default_value_t = LookupArg::Bilinear)]
-    pub lookup: LookupArg,
-    /// Footprint method (`reference` renders with the f64 reference, no tables).
-    #[arg(long, value_enum, default_value_t = MethodArg::Robust)]
-    pub method: MethodArg,
-    /// Smallest footprint semi-axis, pixels.
-    #[arg(long, default_value_t = DEFAULT_MIN_RADIUS_PX)]
-    pub min_radius: f32,
+    /// Kernel, tables, lookup, method (`reference` renders with the f64 reference) and minimum
+    /// footprint radius.
+    #[command(flatten)]
+    pub footprint: FootprintArgs,
     /// Transfer function: a preset (grey, ct-bone-skin, density) or a file of `t r g b a` lines.
     /// Default: density for the built-in scene, grey otherwise.
     #[arg(long)]
@@ -276,21 +262,20 @@ fn load_background(
 
 /// Loads and sets up everything `args` describes.
 pub fn prepare(args: &RenderArgs) -> Result<Prepared, CliError> {
-    let kernel = Kernel::parse(&args.kernel)
-        .map_err(|e| CliError::input(format!("--kernel '{}': {e}", args.kernel)))?;
+    let kernel = args.footprint.kernel()?;
     let (volume, name) = load_volume(args)?;
     let grid =
         Grid::from_spacing(volume.spacing).map_err(|e| CliError::input(format!("{name}: {e}")))?;
     let view =
         View::new(view_matrix(args, &volume)).map_err(|e| CliError::input(format!("view: {e}")))?;
-    let mapping = if args.method == MethodArg::Paper {
+    let mapping = if args.footprint.method == MethodArg::Paper {
         Mapping::PAPER
     } else {
         Mapping::Robust
     };
     let options = FootprintOptions {
         mapping,
-        min_radius_px: args.min_radius,
+        min_radius_px: args.footprint.min_radius,
     };
     let frame = FrameSetup::new(
         volume.dims,
@@ -371,23 +356,12 @@ pub fn render_core(
     p: &Prepared,
     args: &RenderArgs,
 ) -> Result<(Vec<[f32; 4]>, RenderStats, f64), CliError> {
-    let lookup = Lookup::from(args.lookup);
-    with_table_size!(args.table, N => {
-        let generic = match &args.table_file {
-            Some(path) => {
-                let t = super::tables::load_table::<N>(path)?;
-                if *t.kernel() != p.kernel {
-                    return Err(CliError::input(format!(
-                        "{}: table is for kernel {}, but --kernel is {}",
-                        path.display(), t.kernel(), p.kernel
-                    )));
-                }
-                t
-            }
-            None => Box::new(GenericTable::<N>::build(p.kernel)),
-        };
+    let fa = &args.footprint;
+    let lookup = Lookup::from(fa.lookup);
+    with_table_size!(fa.table, N => {
+        let generic = fa.generic_table::<N>(&p.kernel)?;
         let start = Instant::now();
-        let sampler: Box<dyn Sampler + '_> = match args.method {
+        let sampler: Box<dyn Sampler + '_> = match fa.method {
             MethodArg::Direct => Box::new(Direct { footprint: p.frame.footprint, table: &*generic, lookup }),
             _ => Box::new(ViewTable::<N>::build(&p.frame.footprint, &generic, lookup, lookup)),
         };
@@ -467,9 +441,15 @@ pub fn describe(p: &Prepared, args: &RenderArgs) -> Json {
         .arr_f64("spacing", &p.volume.spacing.map(f64::from))
         .arr_usize("size", &[args.size.0, args.size.1])
         .str("kernel", &p.kernel.to_string())
-        .num("table", args.table as f64)
-        .str("lookup", &format!("{:?}", args.lookup).to_lowercase())
-        .str("method", &format!("{:?}", args.method).to_lowercase())
+        .num("table", args.footprint.table as f64)
+        .str(
+            "lookup",
+            &format!("{:?}", args.footprint.lookup).to_lowercase(),
+        )
+        .str(
+            "method",
+            &format!("{:?}", args.footprint.method).to_lowercase(),
+        )
         .str("order", &format!("{:?}", args.order).to_lowercase())
         .str("shading", &args.shading)
         .str("tf", &p.tf_name)
@@ -483,7 +463,7 @@ pub fn describe(p: &Prepared, args: &RenderArgs) -> Json {
 
 pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     let p = prepare(args)?;
-    let (rgb, summary) = if args.method == MethodArg::Reference {
+    let (rgb, summary) = if args.footprint.method == MethodArg::Reference {
         let (img, secs) = render_ref(&p)?;
         let rgb: Vec<[f32; 4]> = img.iter().map(|c| c.map(|x| x as f32)).collect();
         crate::say!("{}: f64 reference render in {:.3} s", p.name, secs);

@@ -5,23 +5,22 @@
 //! voxel sits at the screen origin (W/2, H/2) unless --center moves it. Weights are px⁻² and
 //! integrate to one over the screen plane. PFM rows are stored bottom to top, as PFM requires.
 
-use crate::cli::{parse_list, parse_size, LookupArg, MethodArg};
+use crate::cli::{parse_list, parse_size, FootprintArgs, MethodArg};
 use crate::io::image::{save_grey, GreyImage};
 use crate::reference::ReferenceFootprint;
 use crate::{with_table_size, CliError};
 use clap::Args;
-use footprint::geometry::{Footprint, FootprintOptions, Mapping, DEFAULT_MIN_RADIUS_PX};
+use footprint::geometry::{Footprint, FootprintOptions, Mapping};
 use footprint::splat::{splat, Direct, ImageMut, Sampler};
-use footprint::{GenericTable, Grid, Kernel, Lookup, View, ViewTable};
+use footprint::{Grid, Lookup, View, ViewTable};
 use glam::Mat3;
 use std::path::PathBuf;
 use std::time::Instant;
 
 #[derive(Args, Debug, Clone)]
 pub struct SplatArgs {
-    /// Kernel spec, e.g. gaussian:spread=1.6,sigmas=2.5 (also cone, sinc, bilinear).
-    #[arg(long, default_value = "gaussian:spread=1.6,sigmas=2.5")]
-    pub kernel: String,
+    #[command(flatten)]
+    pub footprint: FootprintArgs,
     /// Voxel spacing along i,j,k in world units.
     #[arg(long, default_value = "1,1,1", value_parser = parse_list::<3>)]
     pub spacing: [f32; 3],
@@ -44,21 +43,6 @@ pub struct SplatArgs {
     /// Image size, WxH pixels.
     #[arg(long, default_value = "256x256", value_parser = parse_size)]
     pub size: (usize, usize),
-    /// Generic and view table size N (N×N).
-    #[arg(long, default_value_t = 65)]
-    pub table: usize,
-    /// Load the generic table from a file written by `footprint tables` (its N must equal --table).
-    #[arg(long)]
-    pub table_file: Option<PathBuf>,
-    /// Lookup, both when building the view table and when sampling it (or the generic table).
-    #[arg(long, value_enum, default_value_t = LookupArg::Bilinear)]
-    pub lookup: LookupArg,
-    /// Footprint method.
-    #[arg(long, value_enum, default_value_t = MethodArg::Robust)]
-    pub method: MethodArg,
-    /// Smallest footprint semi-axis, pixels (sub-pixel footprints are widened to it).
-    #[arg(long, default_value_t = DEFAULT_MIN_RADIUS_PX)]
-    pub min_radius: f32,
     /// Voxel position on screen, pixels (default: the image centre W/2,H/2).
     #[arg(long, value_parser = parse_list::<2>, allow_hyphen_values = true)]
     pub center: Option<[f32; 2]>,
@@ -97,8 +81,8 @@ pub fn compose_view(view_rows: Option<[f32; 9]>, rx: f32, ry: f32, rz: f32) -> M
 
 /// Renders the single sample described by `args` (no file is written).
 pub fn splat_image(args: &SplatArgs) -> Result<(GreyImage, SplatReport), CliError> {
-    let kernel = Kernel::parse(&args.kernel)
-        .map_err(|e| CliError::input(format!("--kernel '{}': {e}", args.kernel)))?;
+    let fa = &args.footprint;
+    let kernel = fa.kernel()?;
     let grid = match args.grid_matrix {
         Some(m) => Grid::from_matrix(Mat3::from_cols_array(&m).transpose()),
         None => Grid::from_spacing(args.spacing),
@@ -114,11 +98,11 @@ pub fn splat_image(args: &SplatArgs) -> Result<(GreyImage, SplatReport), CliErro
     let g2s = view.grid_to_screen(&grid);
     let (w, h) = args.size;
     let center = args.center.unwrap_or([w as f32 / 2.0, h as f32 / 2.0]);
-    let lookup = Lookup::from(args.lookup);
+    let lookup = Lookup::from(fa.lookup);
     let start = Instant::now();
-    if args.method == MethodArg::Reference {
+    if fa.method == MethodArg::Reference {
         let reference =
-            ReferenceFootprint::new(&kernel, &g2s.as_dmat3(), f64::from(args.min_radius))?;
+            ReferenceFootprint::new(&kernel, &g2s.as_dmat3(), f64::from(fa.min_radius))?;
         let mut out = vec![0.0f64; w * h];
         reference.splat([f64::from(center[0]), f64::from(center[1])], w, h, &mut out);
         let seconds = start.elapsed().as_secs_f64();
@@ -132,7 +116,7 @@ pub fn splat_image(args: &SplatArgs) -> Result<(GreyImage, SplatReport), CliErro
             &g2s,
             FootprintOptions {
                 mapping: Mapping::Robust,
-                min_radius_px: args.min_radius,
+                min_radius_px: fa.min_radius,
             },
         )?;
         let report = SplatReport {
@@ -149,7 +133,7 @@ pub fn splat_image(args: &SplatArgs) -> Result<(GreyImage, SplatReport), CliErro
         };
         return Ok((img, report));
     }
-    let mapping = if args.method == MethodArg::Paper {
+    let mapping = if fa.method == MethodArg::Paper {
         Mapping::PAPER
     } else {
         Mapping::Robust
@@ -159,27 +143,14 @@ pub fn splat_image(args: &SplatArgs) -> Result<(GreyImage, SplatReport), CliErro
         &g2s,
         FootprintOptions {
             mapping,
-            min_radius_px: args.min_radius,
+            min_radius_px: fa.min_radius,
         },
     )?;
     let mut pixels = vec![0.0f32; w * h];
-    with_table_size!(args.table, N => {
-        let generic = match &args.table_file {
-            Some(path) => {
-                let t = super::tables::load_table::<N>(path)?;
-                if *t.kernel() != kernel {
-                    return Err(CliError::input(format!(
-                        "{}: table is for kernel {}, but --kernel is {kernel}",
-                        path.display(),
-                        t.kernel()
-                    )));
-                }
-                t
-            }
-            None => Box::new(GenericTable::<N>::build(kernel)),
-        };
+    with_table_size!(fa.table, N => {
+        let generic = fa.generic_table::<N>(&kernel)?;
         let mut image = ImageMut::new(&mut pixels, w, h, w)?;
-        let sampler: Box<dyn Sampler + '_> = match args.method {
+        let sampler: Box<dyn Sampler + '_> = match fa.method {
             MethodArg::Direct => Box::new(Direct { footprint: fp, table: &*generic, lookup }),
             _ => Box::new(ViewTable::<N>::build(&fp, &generic, lookup, lookup)),
         };
@@ -206,13 +177,14 @@ pub fn splat_image(args: &SplatArgs) -> Result<(GreyImage, SplatReport), CliErro
 pub fn run(args: &SplatArgs) -> Result<(), CliError> {
     let (img, r) = splat_image(args)?;
     save_grey(&img, &args.out)?;
+    let fa = &args.footprint;
     crate::say!(
         "{}: {:?} {}x{} table, footprint half-extent {:.3} x {:.3} px, sheet axis {}, \
          sum of weights {:.6}, peak {:.6e} px^-2{}{}, {:.3} ms",
         args.out.display(),
-        args.method,
-        args.table,
-        args.table,
+        fa.method,
+        fa.table,
+        fa.table,
         r.half_extent[0],
         r.half_extent[1],
         ["i", "j", "k"][r.sheet_axis],

@@ -80,7 +80,7 @@ pub fn compare(core: &[[f32; 4]], reference: &[[f64; 4]]) -> ([ErrorStats; 4], E
 
 pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
     let r = &args.render;
-    if r.method == MethodArg::Reference {
+    if r.footprint.method == MethodArg::Reference {
         return Err(CliError::input(
             "verify compares a table method with the reference: choose robust, paper or direct",
         ));
