@@ -1,7 +1,9 @@
 //! The `footprint` command's render, verify and loaders, end to end (in-process through
 //! `footprint_harness::run`, the same entry point as the binary).
 
-use footprint_harness::io::volume::{load_nrrd, load_raw, SampleType, Samples};
+use footprint_harness::io::formats::nrrd::load as load_nrrd;
+use footprint_harness::io::formats::raw::{load as raw_load, RawOptions};
+use footprint_harness::io::volume::{SampleType, Samples};
 use std::path::{Path, PathBuf};
 
 fn tmpdir(name: &str) -> PathBuf {
@@ -174,7 +176,8 @@ fn nrrd_and_raw_load_every_type_and_byte_order() {
             }
             let raw = d.join(format!("{ty}-{big}.raw"));
             std::fs::write(&raw, &body).unwrap();
-            let v = load_raw(&raw, [3, 4, 5], st, big, [1.0, 1.0, 1.0]).unwrap();
+            let o = RawOptions { dims: [3, 4, 5], ty: st, big_endian: big, spacing: [1.0, 1.0, 1.0] };
+            let v = raw_load(&raw, &o).unwrap();
             assert_eq!(f64::from(v.value(59)), values[59]);
         }
     }

@@ -19,6 +19,7 @@
 //! - [`shade`]: transfer functions, Phong, Levoy iso-surfaces, grid-coordinate texture.
 //! - [`composite`]: Porter–Duff over/under of premultiplied RGBA.
 //! - [`render`]: the sheet renderer and the three-sheet ring for sources that cannot seek.
+//! - [`source`]: the `SheetSource` interface for voxels streamed from outside, and its driver.
 //!
 //! ## Conventions (kept everywhere)
 //! - world = G·(i, j, k), G the grid-to-world matrix (diagonal = spacing, world units such as mm);
@@ -54,6 +55,7 @@ pub mod kernel;
 pub mod math;
 pub mod render;
 pub mod shade;
+pub mod source;
 pub mod splat;
 pub mod table;
 

@@ -178,6 +178,21 @@ impl<'a, S: Sampler + ?Sized> SheetRenderer<'a, S> {
         Ok(r)
     }
 
+    /// The frame being rendered.
+    pub fn frame(&self) -> &'a FrameSetup {
+        self.frame
+    }
+
+    /// The compositing order.
+    pub fn order(&self) -> Order {
+        self.order
+    }
+
+    /// Counts so far.
+    pub fn stats(&self) -> RenderStats {
+        self.stats
+    }
+
     /// Classifies, shades, splats and composites sheet `index`.
     pub fn render_sheet<T: Sample>(
         &mut self,

@@ -12,8 +12,12 @@ use crate::frame::FrameSetup;
 use crate::math;
 use glam::Vec3;
 
-/// Value → straight RGBA lookup table over the window [lo, hi]; values outside clamp to the ends.
-/// Entries are linearly interpolated. `lut` may have any length ≥ 2.
+/// Value → straight RGBA lookup table over the window [lo, hi]; finite values outside clamp to the
+/// ends. Entries are linearly interpolated. `lut` may have any length ≥ 2.
+///
+/// Non-finite samples (NaN, ±∞) are *missing data*: they classify as transparent, so they cost
+/// nothing and never paint a pixel. (Clamping +∞ to the top of the window would show missing data
+/// as the densest material.)
 #[derive(Clone, Copy, Debug)]
 pub struct TransferFunction<'a> {
     /// Straight RGBA entries, evenly spaced from `lo` to `hi`; each channel in [0, 1].
@@ -25,12 +29,15 @@ pub struct TransferFunction<'a> {
 }
 
 impl TransferFunction<'_> {
-    /// Straight RGBA for `value`. NaN values are transparent.
+    /// Straight RGBA for `value`; transparent for a non-finite value.
     #[inline]
     pub fn lookup(&self, value: f32) -> [f32; 4] {
+        if !value.is_finite() {
+            return [0.0; 4];
+        }
         let n = self.lut.len();
         let t = (value - self.lo) / (self.hi - self.lo) * (n - 1) as f32;
-        if t.is_nan() {
+        if !t.is_finite() {
             return [0.0; 4];
         }
         let t = t.clamp(0.0, (n - 1) as f32);

@@ -86,6 +86,5 @@ from_core_error!(
     footprint::GeometryError,
     footprint::TableError,
     footprint::BufferError,
-    footprint::frame::FrameError,
-    footprint::render::RenderError
+    footprint::frame::FrameError
 );

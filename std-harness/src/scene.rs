@@ -37,9 +37,5 @@ pub fn default_volume() -> Volume {
     for v in &mut data {
         *v /= max;
     }
-    Volume {
-        dims: [n; 3],
-        spacing: [1.0; 3],
-        samples: Samples::F32(data),
-    }
+    Volume::new([n; 3], [1.0; 3], Samples::F32(data))
 }

@@ -8,7 +8,9 @@
 
 use crate::cli::{parse_list, parse_size, FootprintArgs, MethodArg};
 use crate::io::image::encode_png_rgb;
-use crate::io::volume::{load_nrrd, load_raw, SampleType, Volume};
+use crate::io::formats::{self, raw::RawOptions};
+use crate::io::stream::{file_range, is_stdin, FileSource, Layout, MemorySource, PipeSource};
+use crate::io::volume::{SampleType, Volume};
 use crate::io::{self, json::Json};
 use crate::reference::render::{render_reference, ReferenceScene};
 use crate::{scene, tf, with_table_size, CliError};
@@ -16,6 +18,7 @@ use clap::{Args, ValueEnum};
 use footprint::frame::{FrameSetup, Order};
 use footprint::geometry::{FootprintOptions, Mapping};
 use footprint::render::{RenderBuffers, RenderStats, SheetRenderer, SheetRing};
+use footprint::source::{render_from, SheetSource};
 use footprint::shade::{Phong, Shader, Shading, TransferFunction};
 use footprint::splat::{Direct, Sampler};
 use footprint::{composite::RowSpan, Grid, Kernel, Lookup, View, ViewTable};
@@ -45,8 +48,8 @@ impl From<OrderArg> for Order {
 /// Every flag of `render` (and of `verify`, which takes them all).
 #[derive(Args, Debug, Clone)]
 pub struct RenderArgs {
-    /// Volume: .nrrd / .nhdr, or headerless raw with --dims and --type. Omitted: the built-in
-    /// electron-density scene.
+    /// Volume: .nrrd/.nhdr, .vti, .vtk, .mhd/.mha, .nii/.nii.gz, or headerless raw with --dims and
+    /// --type. Omitted: the built-in electron-density scene.
     pub volume: Option<PathBuf>,
     /// Image size, WxH pixels.
     #[arg(long, default_value = "512x512", value_parser = parse_size)]
@@ -78,9 +81,14 @@ pub struct RenderArgs {
     /// Starting working image (PNG of the output size), composited behind the volume.
     #[arg(long)]
     pub background: Option<PathBuf>,
-    /// Compositing direction.
-    #[arg(long, value_enum, default_value_t = OrderArg::BackToFront)]
-    pub order: OrderArg,
+    /// Compositing direction (default back-to-front; a pipe's views impose theirs).
+    #[arg(long, value_enum)]
+    pub order: Option<OrderArg>,
+    /// Stream the volume a few sheets at a time instead of loading it: a raw file (with --dims and
+    /// --type), an NRRD with raw encoding or an uncompressed MetaImage; `-` reads raw z-slices from
+    /// standard input in file order (needs --dims and --type).
+    #[arg(long)]
+    pub stream: Option<PathBuf>,
     /// Write a JSON summary here.
     #[arg(long)]
     pub json: Option<PathBuf>,
@@ -141,7 +149,7 @@ pub fn parse_shading(s: &str, min_spacing: f32) -> Result<Shading, CliError> {
 
 /// A render, set up and ready to run: the volume, the frame, the shading.
 pub struct Prepared {
-    pub volume: Volume,
+    pub voxels: Voxels,
     pub name: String,
     pub kernel: Kernel,
     pub frame: FrameSetup,
@@ -167,25 +175,35 @@ impl Prepared {
         }
     }
 
-    /// Copies sheet `s` (along the frame's sheet axis) into `out`.
-    pub fn sheet(&self, s: usize, out: &mut [f32]) {
-        self.volume.sheet_into(self.frame.sheet_axis, s, out);
+    /// The volume, when it is in memory (not streamed).
+    pub fn volume(&self) -> Option<&Volume> {
+        match &self.voxels {
+            Voxels::Memory(v) => Some(v),
+            _ => None,
+        }
     }
 }
 
-/// V for `--view`/`--zoom` (fitted to the volume) or `--view-matrix`.
-pub fn view_matrix(args: &RenderArgs, volume: &Volume) -> Mat3 {
+/// Where the voxels come from.
+pub enum Voxels {
+    /// Loaded whole.
+    Memory(Volume),
+    /// Streamed from a seekable file.
+    File(Layout),
+    /// Streamed from standard input, z-slices in file order.
+    Stdin { dims: [usize; 3], ty: SampleType, big_endian: bool },
+}
+
+/// V for `--view`/`--zoom` (fitted to a volume of `dims` on grid `g`) or `--view-matrix`.
+pub fn view_matrix(args: &RenderArgs, dims: [usize; 3], g: Mat3) -> Mat3 {
     if let Some(m) = args.view_matrix {
         return Mat3::from_cols_array(&m).transpose();
     }
     let [az, el, roll] = args.view.map(f32::to_radians);
     let r = Mat3::from_rotation_z(roll) * Mat3::from_rotation_x(el) * Mat3::from_rotation_y(az);
-    // Half-extents on screen of the volume's bounding box (voxel centres ± half a voxel).
-    let half = Vec3::new(
-        volume.dims[0] as f32 * volume.spacing[0],
-        volume.dims[1] as f32 * volume.spacing[1],
-        volume.dims[2] as f32 * volume.spacing[2],
-    ) * 0.5;
+    // Half-extents on screen of the volume's box (voxel centres ± half a voxel), in world space
+    // through its grid-to-world matrix.
+    let half = Vec3::new(dims[0] as f32, dims[1] as f32, dims[2] as f32) * 0.5;
     let mut ext = Vec3::ZERO;
     for corner in 0..8 {
         let c = Vec3::new(
@@ -193,52 +211,81 @@ pub fn view_matrix(args: &RenderArgs, volume: &Volume) -> Mat3 {
             if corner & 2 == 0 { -half.y } else { half.y },
             if corner & 4 == 0 { -half.z } else { half.z },
         );
-        ext = ext.max((r * c).abs());
+        ext = ext.max((r * (g * c)).abs());
     }
     let (w, h) = (args.size.0 as f32, args.size.1 as f32);
     let fit = 0.9 * (w / (2.0 * ext.x)).min(h / (2.0 * ext.y));
     r * (fit * args.zoom)
 }
 
-fn load_volume(args: &RenderArgs) -> Result<(Volume, String), CliError> {
-    let Some(path) = &args.volume else {
-        return Ok((
-            scene::default_volume(),
-            "built-in electron-density scene".into(),
-        ));
+/// The raw-file options from `--dims`, `--type`, `--endian`, `--spacing`, if `--dims` was given.
+pub fn raw_options(args: &RenderArgs) -> Result<Option<RawOptions>, CliError> {
+    let Some(dims) = args.dims else { return Ok(None) };
+    let ty = args.sample_type.as_deref().ok_or_else(|| CliError::input("raw volumes need --type"))?;
+    let ty = SampleType::parse(ty).ok_or_else(|| CliError::input(format!("--type '{ty}' is not a sample type (u8, i8, u16, i16, u32, i32, f32, f64)")))?;
+    let big_endian = match args.endian.as_str() {
+        "little" => false,
+        "big" => true,
+        e => return Err(CliError::input(format!("--endian '{e}': expected little or big"))),
     };
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    let volume = match (ext.as_deref(), args.dims) {
-        (Some("nrrd" | "nhdr"), _) => load_nrrd(path)?,
-        (_, Some(dims)) => {
-            let ty = args
-                .sample_type
-                .as_deref()
-                .ok_or_else(|| CliError::input("raw volumes need --type"))?;
-            let ty = SampleType::parse(ty)
-                .ok_or_else(|| CliError::input(format!("--type '{ty}' is not a sample type")))?;
-            let big = match args.endian.as_str() {
-                "little" => false,
-                "big" => true,
-                e => {
-                    return Err(CliError::input(format!(
-                        "--endian '{e}': expected little or big"
-                    )))
-                }
-            };
-            load_raw(path, dims, ty, big, args.spacing)?
-        }
-        _ => {
-            return Err(CliError::input(format!(
-                "{}: unknown volume format (use .nrrd/.nhdr, or --dims and --type for raw)",
-                path.display()
-            )))
-        }
+    Ok(Some(RawOptions { dims, ty, big_endian, spacing: args.spacing }))
+}
+
+/// What `prepare` learns about the voxels before rendering.
+struct Loaded {
+    voxels: Voxels,
+    name: String,
+    dims: [usize; 3],
+    grid: Mat3,
+    /// The data's finite range, if it could be read without a second pass over a pipe.
+    range: Option<(f32, f32)>,
+}
+
+fn load_voxels(args: &RenderArgs) -> Result<Loaded, CliError> {
+    let raw = raw_options(args)?;
+    let Some(stream) = &args.stream else {
+        let (volume, name) = match &args.volume {
+            Some(path) => (formats::load(path, raw.as_ref())?, path.display().to_string()),
+            None => (scene::default_volume(), "built-in electron-density scene".to_string()),
+        };
+        let (dims, grid, range) = (volume.dims, volume.grid_to_world(), Some(volume.range()));
+        return Ok(Loaded { voxels: Voxels::Memory(volume), name, dims, grid, range });
     };
-    Ok((volume, path.display().to_string()))
+    if args.volume.is_some() {
+        return Err(CliError::input("give the volume either as VOLUME or with --stream, not both"));
+    }
+    let name = stream.display().to_string();
+    if is_stdin(stream) {
+        let o = raw.ok_or_else(|| CliError::input("--stream - (standard input) needs --dims and --type"))?;
+        crate::io::volume::byte_len(o.dims, o.ty).map_err(|e| CliError::input(format!("standard input: {e}")))?;
+        crate::io::volume::check_spacing(o.spacing).map_err(|e| CliError::input(format!("standard input: {e}")))?;
+        let grid = Mat3::from_diagonal(Vec3::from_array(o.spacing));
+        let voxels = Voxels::Stdin { dims: o.dims, ty: o.ty, big_endian: o.big_endian };
+        return Ok(Loaded { voxels, name: "standard input".into(), dims: o.dims, grid, range: None });
+    }
+    let lower = name.to_ascii_lowercase();
+    let (layout, spacing, directions) = if let Some(o) = &raw {
+        let layout = Layout { path: stream.clone(), offset: 0, dims: o.dims, ty: o.ty, big_endian: o.big_endian };
+        crate::io::volume::check_spacing(o.spacing).map_err(|e| crate::io::volume::at(stream, e))?;
+        (layout, o.spacing, crate::io::volume::AXIS_ALIGNED)
+    } else if lower.ends_with(".nrrd") || lower.ends_with(".nhdr") {
+        let (path, offset, h) = formats::nrrd::raw_layout(stream)?;
+        (Layout { path, offset, dims: h.dims, ty: h.ty, big_endian: h.big_endian }, h.spacing, h.directions)
+    } else if lower.ends_with(".mha") || lower.ends_with(".mhd") {
+        let (path, offset, h) = formats::metaimage::raw_layout(stream)?;
+        (Layout { path, offset, dims: h.dims, ty: h.ty, big_endian: h.big_endian }, h.spacing, h.directions)
+    } else {
+        return Err(crate::io::volume::at(stream, "streaming reads raw files (with --dims and --type), NRRD with raw encoding, or uncompressed MetaImage"));
+    };
+    let file_len = std::fs::metadata(&layout.path).map_err(|e| crate::io::volume::at(&layout.path, format!("cannot read: {e}")))?.len();
+    let need = crate::io::volume::byte_len(layout.dims, layout.ty).map_err(|e| crate::io::volume::at(&layout.path, e))? as u64;
+    if raw.is_some() && file_len != need {
+        return Err(crate::io::volume::at(&layout.path, format!("expected {need} bytes for --dims/--type, found {file_len}")));
+    }
+    let col = |c: usize| Vec3::from_array(directions[c]) * spacing[c];
+    let grid = Mat3::from_cols(col(0), col(1), col(2));
+    let range = if args.window.is_none() { Some(file_range(&layout)?) } else { None };
+    Ok(Loaded { dims: layout.dims, voxels: Voxels::File(layout), name, grid, range })
 }
 
 fn load_background(
@@ -263,28 +310,35 @@ fn load_background(
 /// Loads and sets up everything `args` describes.
 pub fn prepare(args: &RenderArgs) -> Result<Prepared, CliError> {
     let kernel = args.footprint.kernel()?;
-    let (volume, name) = load_volume(args)?;
-    let grid =
-        Grid::from_spacing(volume.spacing).map_err(|e| CliError::input(format!("{name}: {e}")))?;
-    let view =
-        View::new(view_matrix(args, &volume)).map_err(|e| CliError::input(format!("view: {e}")))?;
-    let mapping = if args.footprint.method == MethodArg::Paper {
-        Mapping::PAPER
-    } else {
-        Mapping::Robust
+    let Loaded { voxels, name, dims, grid, range } = load_voxels(args)?;
+    let grid = Grid::from_matrix(grid).map_err(|e| CliError::input(format!("{name}: {e}")))?;
+    let view = View::new(view_matrix(args, dims, grid.to_world())).map_err(|e| CliError::input(format!("view: {e}")))?;
+    let mapping = if args.footprint.method == MethodArg::Paper { Mapping::PAPER } else { Mapping::Robust };
+    let options = FootprintOptions { mapping, min_radius_px: args.footprint.min_radius };
+    let frame = FrameSetup::new(dims, &grid, &view, &kernel, options, [args.size.0, args.size.1])?;
+    let order = match &voxels {
+        Voxels::Stdin { .. } => {
+            if frame.sheet_axis != 2 {
+                return Err(CliError::input(format!(
+                    "standard input delivers z-slices in file order, but this view's sheets run along {}: \
+                     only views looking within 45° of the z axis work from a pipe (for example --view 0,0,0, \
+                     --view 180,0,0 or --view 30,20,0); stream a file to render any view",
+                    ["x", "y", "z"][frame.sheet_axis]
+                )));
+            }
+            let needed = frame.order_for_ascending();
+            if let Some(asked) = args.order.map(Order::from) {
+                if asked != needed {
+                    return Err(CliError::input(format!(
+                        "from a pipe this view composites {needed:?} (file order runs {} the viewer); drop --order",
+                        if frame.ascending_recedes { "away from" } else { "toward" }
+                    )));
+                }
+            }
+            needed
+        }
+        _ => args.order.map_or(Order::BackToFront, Order::from),
     };
-    let options = FootprintOptions {
-        mapping,
-        min_radius_px: args.footprint.min_radius,
-    };
-    let frame = FrameSetup::new(
-        volume.dims,
-        &grid,
-        &view,
-        &kernel,
-        options,
-        [args.size.0, args.size.1],
-    )?;
     let tf_name = args.tf.clone().unwrap_or_else(|| {
         if args.volume.is_none() {
             "density"
@@ -297,7 +351,12 @@ pub fn prepare(args: &RenderArgs) -> Result<Prepared, CliError> {
     let window = match args.window {
         Some(w) => w,
         None => {
-            let (lo, hi) = volume.range();
+            let (lo, hi) = match (range, &voxels) {
+                (Some(r), _) => r,
+                (None, Voxels::Stdin { ty: SampleType::U8, .. }) => (0.0, 255.0),
+                (None, Voxels::Stdin { ty: SampleType::I8, .. }) => (-128.0, 127.0),
+                (None, _) => return Err(CliError::input("standard input cannot be read twice: give --window LO,HI")),
+            };
             if !(hi > lo) {
                 return Err(CliError::input(format!(
                     "{name}: the data are constant ({lo}); give --window"
@@ -322,7 +381,7 @@ pub fn prepare(args: &RenderArgs) -> Result<Prepared, CliError> {
         .map(|p| load_background(p, args.size))
         .transpose()?;
     Ok(Prepared {
-        volume,
+        voxels,
         name,
         kernel,
         frame,
@@ -331,7 +390,7 @@ pub fn prepare(args: &RenderArgs) -> Result<Prepared, CliError> {
         shading,
         tf_name,
         background,
-        order: args.order.into(),
+        order,
         options,
     })
 }
@@ -397,28 +456,57 @@ fn run_sheets(
     )?;
     let mut storage = vec![0.0f32; 3 * f.sheet_shape().0];
     let mut ring = SheetRing::new(&mut storage, f, p.order)?;
-    let mut show = progress("render");
-    let count = f.sheet_count();
-    for step in 0..count {
-        let s = ring.sheet_index(step);
-        if let Some(done) = ring.push_with(|slot| {
-            p.sheet(s, slot);
-            Ok::<(), footprint::render::RenderError>(())
-        })? {
-            renderer.render_sheet(ring.sheet_index(done), ring.window(done))?;
-            show(done + 1, count);
+    let mut show = Progress { inner: progress("render"), count: f.sheet_count(), done: 0 };
+    match &p.voxels {
+        Voxels::Memory(v) => render_from(&mut renderer, &mut ring, &mut show.wrap(MemorySource(v)))?,
+        Voxels::File(layout) => render_from(&mut renderer, &mut ring, &mut show.wrap(FileSource::open(layout.clone())?))?,
+        Voxels::Stdin { dims, ty, big_endian } => {
+            let stdin = std::io::stdin().lock();
+            let src = PipeSource::new(std::io::BufReader::with_capacity(1 << 20, stdin), *dims, *ty, *big_endian, "standard input");
+            render_from(&mut renderer, &mut ring, &mut show.wrap(src))?
         }
-    }
-    if let Some(last) = ring.last() {
-        renderer.render_sheet(ring.sheet_index(last), ring.window(last))?;
-        show(count, count);
     }
     let stats = renderer.finish();
     Ok((image, stats))
 }
 
-/// The f64 reference render of `p` and its seconds.
+/// Shows progress as a source delivers sheets.
+struct Progress<F> {
+    inner: F,
+    count: usize,
+    done: usize,
+}
+
+/// A source that reports each sheet read.
+struct Reporting<'p, S, F> {
+    source: S,
+    progress: &'p mut Progress<F>,
+}
+
+impl<F: FnMut(usize, usize)> Progress<F> {
+    fn wrap<S>(&mut self, source: S) -> Reporting<'_, S, F> {
+        Reporting { source, progress: self }
+    }
+}
+
+impl<S: SheetSource<Sample = f32, Error = CliError>, F: FnMut(usize, usize)> SheetSource for Reporting<'_, S, F> {
+    type Sample = f32;
+    type Error = CliError;
+    fn read_sheet(&mut self, axis: usize, index: usize, out: &mut [f32]) -> Result<(), CliError> {
+        self.source.read_sheet(axis, index, out)?;
+        let p = &mut *self.progress;
+        p.done += 1;
+        (p.inner)(p.done, p.count);
+        Ok(())
+    }
+    fn sequential_axis(&self) -> Option<usize> {
+        self.source.sequential_axis()
+    }
+}
+
+/// The f64 reference render of `p` and its seconds (the volume must be in memory).
 pub fn render_ref(p: &Prepared) -> Result<(Vec<[f64; 4]>, f64), CliError> {
+    let volume = p.volume().ok_or_else(|| CliError::input("the f64 reference needs the volume in memory: drop --stream"))?;
     let start = Instant::now();
     let scene = ReferenceScene {
         frame: &p.frame,
@@ -428,7 +516,8 @@ pub fn render_ref(p: &Prepared) -> Result<(Vec<[f64; 4]>, f64), CliError> {
         order: p.order,
         background: p.background.as_deref(),
     };
-    let img = render_reference(&scene, |s, out| p.sheet(s, out), progress("reference"))?;
+    let axis = p.frame.sheet_axis;
+    let img = render_reference(&scene, |s, out| volume.sheet_into(axis, s, out), progress("reference"))?;
     Ok((img, start.elapsed().as_secs_f64()))
 }
 
@@ -437,8 +526,8 @@ pub fn describe(p: &Prepared, args: &RenderArgs) -> Json {
     let f = &p.frame;
     Json::object()
         .str("volume", &p.name)
-        .arr_usize("dims", &p.volume.dims)
-        .arr_f64("spacing", &p.volume.spacing.map(f64::from))
+        .arr_usize("dims", &p.frame.dims)
+        .arr_f64("spacing", &p.frame.spacing.map(f64::from))
         .arr_usize("size", &[args.size.0, args.size.1])
         .str("kernel", &p.kernel.to_string())
         .num("table", args.footprint.table as f64)
@@ -450,7 +539,8 @@ pub fn describe(p: &Prepared, args: &RenderArgs) -> Json {
             "method",
             &format!("{:?}", args.footprint.method).to_lowercase(),
         )
-        .str("order", &format!("{:?}", args.order).to_lowercase())
+        .str("order", &format!("{:?}", p.order).to_lowercase())
+        .bool("streamed", p.volume().is_none())
         .str("shading", &args.shading)
         .str("tf", &p.tf_name)
         .arr_f64("window", &p.window.map(f64::from))

@@ -1,8 +1,10 @@
 //! Files: images (PFM, PNG) and generic tables. Every write goes to a temporary file beside the
 //! target and is renamed into place, so a failure never leaves a half-written output.
 
+pub mod formats;
 pub mod image;
 pub mod json;
+pub mod stream;
 pub mod volume;
 
 use crate::CliError;
@@ -45,4 +47,18 @@ pub fn read_file(path: &Path) -> Result<Vec<u8>, CliError> {
     }
     std::fs::read(path)
         .map_err(|e| CliError::input(format!("{}: cannot read: {e}", path.display())))
+}
+
+/// Reads at most `limit` bytes from the start of a file (for headers of files that may be huge).
+pub fn read_prefix(path: &Path, limit: usize) -> Result<Vec<u8>, CliError> {
+    use std::io::Read;
+    if path.is_dir() {
+        return Err(CliError::input(format!("{}: is a directory, expected a file", path.display())));
+    }
+    let f = std::fs::File::open(path).map_err(|e| CliError::input(format!("{}: cannot read: {e}", path.display())))?;
+    let mut out = Vec::new();
+    f.take(limit as u64)
+        .read_to_end(&mut out)
+        .map_err(|e| CliError::input(format!("{}: cannot read: {e}", path.display())))?;
+    Ok(out)
 }

@@ -1,10 +1,10 @@
-//! Volumes in memory and the loaders of this stage: NRRD (attached `.nrrd` or detached `.nhdr`,
-//! raw encoding, either endianness, 8–64-bit integer and float samples) and headerless raw.
+//! Volumes in memory: dimensions, spacing, orientation and samples, and the sample decoding every
+//! loader shares (the loaders themselves are in [`super::formats`]).
 //!
 //! Data are x-fastest: sample (i, j, k) is at `i + dims[0]·(j + dims[1]·k)`.
 
 use crate::CliError;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// Sample storage, by type.
 #[derive(Clone, Debug, PartialEq)]
@@ -62,18 +62,35 @@ impl SampleType {
     }
 }
 
-/// A volume: dimensions, spacing (world units per voxel along i, j, k) and samples.
+/// A volume: dimensions, spacing, orientation and samples.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Volume {
     /// Voxels along i, j, k.
     pub dims: [usize; 3],
     /// World units per voxel along i, j, k.
     pub spacing: [f32; 3],
+    /// World direction (unit vector) of each grid axis: `directions[c]` for axis c. The identity for
+    /// formats that state only spacings.
+    pub directions: [[f32; 3]; 3],
     /// The samples.
     pub samples: Samples,
 }
 
+/// The identity orientation.
+pub const AXIS_ALIGNED: [[f32; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+
 impl Volume {
+    /// An axis-aligned volume.
+    pub fn new(dims: [usize; 3], spacing: [f32; 3], samples: Samples) -> Self {
+        Volume { dims, spacing, directions: AXIS_ALIGNED, samples }
+    }
+
+    /// The grid-to-world matrix G: column c = `directions[c] × spacing[c]`.
+    pub fn grid_to_world(&self) -> glam::Mat3 {
+        let col = |c: usize| glam::Vec3::from_array(self.directions[c]) * self.spacing[c];
+        glam::Mat3::from_cols(col(0), col(1), col(2))
+    }
+
     /// Sample at linear index `n` as f32.
     #[inline]
     pub fn value(&self, n: usize) -> f32 {
@@ -127,7 +144,8 @@ impl Volume {
     }
 }
 
-fn decode(bytes: &[u8], ty: SampleType, big_endian: bool) -> Samples {
+/// Decodes `bytes` (exactly `count × size` long) as samples of `ty`.
+pub fn decode(bytes: &[u8], ty: SampleType, big_endian: bool) -> Samples {
     macro_rules! conv {
         ($t:ty, $variant:ident) => {{
             const N: usize = std::mem::size_of::<$t>();
@@ -136,11 +154,7 @@ fn decode(bytes: &[u8], ty: SampleType, big_endian: bool) -> Samples {
                     .chunks_exact(N)
                     .map(|c| {
                         let a: [u8; N] = c.try_into().expect("chunk of N bytes");
-                        if big_endian {
-                            <$t>::from_be_bytes(a)
-                        } else {
-                            <$t>::from_le_bytes(a)
-                        }
+                        if big_endian { <$t>::from_be_bytes(a) } else { <$t>::from_le_bytes(a) }
                     })
                     .collect(),
             )
@@ -158,189 +172,58 @@ fn decode(bytes: &[u8], ty: SampleType, big_endian: bool) -> Samples {
     }
 }
 
-/// Largest volume accepted, voxels (4 Gi): beyond it the byte size overflows typical limits.
+/// Parses whitespace-separated numbers (ASCII data) as samples of `ty`; exactly `count` of them.
+pub fn decode_ascii(text: &[u8], ty: SampleType, count: usize) -> Result<Samples, String> {
+    let text = std::str::from_utf8(text).map_err(|_| "ASCII data is not text".to_string())?;
+    let mut values = Vec::with_capacity(count);
+    for word in text.split(|c: char| c.is_ascii_whitespace() || c == ',').filter(|w| !w.is_empty()) {
+        let v: f64 = word.parse().map_err(|_| format!("'{word}' is not a number"))?;
+        values.push(v);
+        if values.len() > count {
+            return Err(format!("more than the {count} values the header states"));
+        }
+    }
+    if values.len() != count {
+        return Err(format!("expected {count} values, found {}", values.len()));
+    }
+    Ok(match ty {
+        SampleType::U8 => Samples::U8(values.iter().map(|&v| v as u8).collect()),
+        SampleType::I8 => Samples::I8(values.iter().map(|&v| v as i8).collect()),
+        SampleType::U16 => Samples::U16(values.iter().map(|&v| v as u16).collect()),
+        SampleType::I16 => Samples::I16(values.iter().map(|&v| v as i16).collect()),
+        SampleType::U32 => Samples::U32(values.iter().map(|&v| v as u32).collect()),
+        SampleType::I32 => Samples::I32(values.iter().map(|&v| v as i32).collect()),
+        SampleType::F32 => Samples::F32(values.iter().map(|&v| v as f32).collect()),
+        SampleType::F64 => Samples::F64(values),
+    })
+}
+
+/// Largest volume accepted, voxels (2³²).
 pub const MAX_VOXELS: usize = 1 << 32;
 
-fn checked_len(path: &Path, dims: [usize; 3], ty: SampleType) -> Result<usize, CliError> {
-    let bad = |why: &str| CliError::input(format!("{}: dims {dims:?}: {why}", path.display()));
+/// Bytes for `dims` samples of `ty`, or why not: a zero dimension, or more than [`MAX_VOXELS`].
+pub fn byte_len(dims: [usize; 3], ty: SampleType) -> Result<usize, String> {
     if dims.contains(&0) {
-        return Err(bad("a dimension is zero"));
+        return Err(format!("dims {dims:?}: a dimension is zero"));
     }
     let n = dims
         .iter()
         .try_fold(1usize, |a, &d| a.checked_mul(d))
-        .ok_or_else(|| bad("too many voxels"))?;
-    if n > MAX_VOXELS {
-        return Err(bad("too many voxels"));
-    }
-    n.checked_mul(ty.size())
-        .ok_or_else(|| bad("too many bytes"))
+        .filter(|&n| n <= MAX_VOXELS)
+        .ok_or_else(|| format!("dims {dims:?}: more than {MAX_VOXELS} voxels"))?;
+    Ok(n * ty.size())
 }
 
-/// Reads a headerless raw volume.
-pub fn load_raw(
-    path: &Path,
-    dims: [usize; 3],
-    ty: SampleType,
-    big_endian: bool,
-    spacing: [f32; 3],
-) -> Result<Volume, CliError> {
-    let need = checked_len(path, dims, ty)?;
-    let bytes = super::read_file(path)?;
-    if bytes.len() != need {
-        return Err(CliError::input(format!(
-            "{}: expected {need} bytes for {}x{}x{} {:?}, found {}",
-            path.display(),
-            dims[0],
-            dims[1],
-            dims[2],
-            ty,
-            bytes.len()
-        )));
-    }
-    check_spacing(path, spacing)?;
-    Ok(Volume {
-        dims,
-        spacing,
-        samples: decode(&bytes, ty, big_endian),
-    })
-}
-
-fn check_spacing(path: &Path, spacing: [f32; 3]) -> Result<(), CliError> {
+/// Checks a spacing: finite and positive.
+pub fn check_spacing(spacing: [f32; 3]) -> Result<(), String> {
     if spacing.iter().all(|s| s.is_finite() && *s > 0.0) {
         Ok(())
     } else {
-        Err(CliError::input(format!(
-            "{}: spacing {spacing:?} must be finite and positive",
-            path.display()
-        )))
+        Err(format!("spacing {spacing:?} must be finite and positive"))
     }
 }
 
-/// Reads an NRRD volume (`.nrrd` with attached data or `.nhdr` with a `data file`).
-pub fn load_nrrd(path: &Path) -> Result<Volume, CliError> {
-    let bytes = super::read_file(path)?;
-    let err = |what: String| CliError::input(format!("{}: {what}", path.display()));
-    if !bytes.starts_with(b"NRRD000") {
-        return Err(err("not an NRRD file (missing NRRD000x magic)".into()));
-    }
-    // The header ends at the first empty line (or at end of file for a detached header).
-    let mut at = 0;
-    let mut fields: Vec<(String, String)> = Vec::new();
-    let mut first = true;
-    loop {
-        let end = bytes[at..].iter().position(|&b| b == b'\n').map(|p| at + p);
-        let line_bytes = &bytes[at..end.unwrap_or(bytes.len())];
-        at = end.map_or(bytes.len(), |e| e + 1);
-        let line = std::str::from_utf8(line_bytes).map_err(|_| err("header is not text".into()))?;
-        let line = line.trim_end_matches('\r');
-        if first {
-            first = false;
-        } else if line.is_empty() {
-            break;
-        } else if !line.starts_with('#') {
-            // "key: value" fields; "key:=value" key/value pairs are metadata and ignored.
-            if let Some((k, v)) = line.split_once(": ") {
-                fields.push((k.trim().to_ascii_lowercase(), v.trim().to_string()));
-            } else if !line.contains(":=") {
-                return Err(err(format!("malformed header line '{line}'")));
-            }
-        }
-        if end.is_none() {
-            break;
-        }
-    }
-    let get = |k: &str| {
-        fields
-            .iter()
-            .find(|(key, _)| key == k)
-            .map(|(_, v)| v.as_str())
-    };
-    let need = |k: &str| get(k).ok_or_else(|| err(format!("missing header field '{k}'")));
-    let ty = SampleType::parse(need("type")?)
-        .ok_or_else(|| err(format!("unsupported type '{}'", get("type").unwrap_or(""))))?;
-    let dimension: usize = need("dimension")?
-        .parse()
-        .map_err(|_| err("dimension is not a number".into()))?;
-    if dimension != 3 {
-        return Err(err(format!(
-            "dimension {dimension}: only 3D volumes are supported"
-        )));
-    }
-    let sizes: Vec<usize> = need("sizes")?
-        .split_whitespace()
-        .map(|s| s.parse())
-        .collect::<Result<_, _>>()
-        .map_err(|_| {
-            err(format!(
-                "sizes '{}' are not whole numbers",
-                get("sizes").unwrap_or("")
-            ))
-        })?;
-    if sizes.len() != 3 {
-        return Err(err(format!(
-            "sizes has {} entries, expected 3",
-            sizes.len()
-        )));
-    }
-    let dims = [sizes[0], sizes[1], sizes[2]];
-    let spacing = match get("spacings") {
-        Some(s) => {
-            let v: Vec<f32> = s
-                .split_whitespace()
-                .map(|x| x.parse())
-                .collect::<Result<_, _>>()
-                .map_err(|_| err(format!("spacings '{s}' are not numbers")))?;
-            if v.len() != 3 {
-                return Err(err(format!("spacings has {} entries, expected 3", v.len())));
-            }
-            [v[0], v[1], v[2]]
-        }
-        None => [1.0; 3],
-    };
-    check_spacing(path, spacing)?;
-    let encoding = need("encoding")?;
-    if encoding != "raw" {
-        return Err(err(format!(
-            "encoding '{encoding}' is not supported yet (raw only)"
-        )));
-    }
-    let big_endian = match get("endian") {
-        Some("big") => true,
-        Some("little") | None => false,
-        Some(other) => return Err(err(format!("endian '{other}' is not little or big"))),
-    };
-    if ty.size() > 1 && get("endian").is_none() {
-        return Err(err(
-            "missing header field 'endian' (required for multi-byte types)".into(),
-        ));
-    }
-    let len = checked_len(path, dims, ty)?;
-    let skip: usize = get("byte skip")
-        .map_or(Ok(0), |s| s.parse())
-        .map_err(|_| err("byte skip is not a whole number".into()))?;
-    let (data, source): (Vec<u8>, PathBuf) = match get("data file").or(get("datafile")) {
-        Some(name) => {
-            let p = path.parent().unwrap_or(Path::new(".")).join(name);
-            (super::read_file(&p)?, p)
-        }
-        None => (bytes[at..].to_vec(), path.to_path_buf()),
-    };
-    let body = data.get(skip..).unwrap_or(&[]);
-    if body.len() != len {
-        return Err(CliError::input(format!(
-            "{}: header says {}x{}x{} {:?} = {len} bytes, data has {}",
-            source.display(),
-            dims[0],
-            dims[1],
-            dims[2],
-            ty,
-            body.len()
-        )));
-    }
-    Ok(Volume {
-        dims,
-        spacing,
-        samples: decode(body, ty, big_endian),
-    })
+/// Error with the file's name in front.
+pub fn at(path: &Path, what: impl std::fmt::Display) -> CliError {
+    CliError::input(format!("{}: {what}", path.display()))
 }

@@ -1,0 +1,77 @@
+//! Sheet sources: where the voxels come from when the whole volume is never in memory — a file
+//! read a sheet at a time, a pipe, a sensor, a network, flash.
+//!
+//! A source fills one sheet (row-major over the sheet's in-sheet axes, see [`crate::frame`]) on
+//! request. [`render_from`] asks for the sheets of a frame in compositing order and keeps only
+//! three of them (in a caller-owned [`SheetRing`]), so memory stays bounded by the image and three
+//! sheets whatever the volume's size. A source that can only deliver sheets in one order (a pipe:
+//! ascending index along its slice axis) says so with [`SheetSource::sequential_axis`], and the
+//! driver refuses a frame it cannot serve before reading anything.
+
+use crate::frame::Order;
+use crate::render::{RenderError, SheetRenderer, SheetRing};
+use crate::shade::Sample;
+use crate::splat::Sampler;
+
+/// A source of sheets.
+pub trait SheetSource {
+    /// The sample type delivered.
+    type Sample: Sample;
+    /// The source's error; must be able to carry the renderer's.
+    type Error: From<RenderError>;
+
+    /// Fills `out` (exactly one sheet) with sheet `index` along grid axis `axis`.
+    fn read_sheet(&mut self, axis: usize, index: usize, out: &mut [Self::Sample]) -> Result<(), Self::Error>;
+
+    /// `Some(axis)` if this source can only deliver sheets along `axis`, in ascending index order,
+    /// each once (a pipe or a sensor); `None` if it can read any sheet of any axis (a seekable file).
+    fn sequential_axis(&self) -> Option<usize> {
+        None
+    }
+}
+
+/// Why a source cannot serve a frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct OrderMismatch {
+    /// The axis the source delivers sheets along.
+    pub source_axis: usize,
+    /// The frame's sheet axis.
+    pub frame_axis: usize,
+}
+
+/// The compositing order to use with `source` for `renderer`'s frame: `preferred` for a seekable
+/// source; for a sequential one, the order its ascending delivery implies, or an
+/// [`OrderMismatch`] if its axis is not the frame's sheet axis.
+pub fn order_for<S: SheetSource>(source: &S, frame: &crate::frame::FrameSetup, preferred: Order) -> Result<Order, OrderMismatch> {
+    match source.sequential_axis() {
+        None => Ok(preferred),
+        Some(axis) if axis == frame.sheet_axis => Ok(frame.order_for_ascending()),
+        Some(axis) => Err(OrderMismatch { source_axis: axis, frame_axis: frame.sheet_axis }),
+    }
+}
+
+/// Renders every sheet of `renderer`'s frame from `source`, in the renderer's compositing order,
+/// through `ring` (three sheets of caller storage). Call [`SheetRenderer::finish`] afterwards.
+/// For a sequential source, pick the renderer's order with [`order_for`] first.
+pub fn render_from<Smp, Src>(
+    renderer: &mut SheetRenderer<'_, Smp>,
+    ring: &mut SheetRing<'_, Src::Sample>,
+    source: &mut Src,
+) -> Result<(), Src::Error>
+where
+    Smp: Sampler + ?Sized,
+    Src: SheetSource,
+{
+    let axis = renderer.frame().sheet_axis;
+    let count = renderer.frame().sheet_count();
+    for step in 0..count {
+        let s = ring.sheet_index(step);
+        if let Some(done) = ring.push_with(|slot| source.read_sheet(axis, s, slot))? {
+            renderer.render_sheet(ring.sheet_index(done), ring.window(done))?;
+        }
+    }
+    if let Some(last) = ring.last() {
+        renderer.render_sheet(ring.sheet_index(last), ring.window(last))?;
+    }
+    Ok(())
+}

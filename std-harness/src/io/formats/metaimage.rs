@@ -1,0 +1,190 @@
+//! MetaImage (`.mhd` with a detached data file, `.mha` with `ElementDataFile = LOCAL`): `NDims = 3`,
+//! `DimSize`, `ElementType` (`MET_UCHAR` … `MET_DOUBLE`), `ElementSpacing` (or `ElementSize`),
+//! `ElementByteOrderMSB` / `BinaryDataByteOrderMSB`, `CompressedData` (zlib), `HeaderSize`,
+//! `TransformMatrix` (row i is grid axis i's direction).
+
+use super::compress;
+use crate::io::volume::{at, byte_len, check_spacing, decode, SampleType, Volume, AXIS_ALIGNED};
+use crate::CliError;
+use std::path::{Path, PathBuf};
+
+/// A parsed MetaImage header.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Header {
+    pub dims: [usize; 3],
+    pub spacing: [f32; 3],
+    pub directions: [[f32; 3]; 3],
+    pub ty: SampleType,
+    pub big_endian: bool,
+    pub compressed: bool,
+    /// `None` for LOCAL (data follow the header).
+    pub data_file: Option<String>,
+    /// HeaderSize: bytes to skip in the data file (−1: the data are its last bytes).
+    pub header_size: i64,
+    /// Bytes of header text (where LOCAL data start).
+    pub header_len: usize,
+}
+
+fn is_true(v: &str) -> bool {
+    v.eq_ignore_ascii_case("true") || v == "1"
+}
+
+/// Parses a MetaImage header from the start of `bytes` (up to and including `ElementDataFile`).
+pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
+    let mut at = 0;
+    let mut fields: Vec<(String, String)> = Vec::new();
+    while at < bytes.len() {
+        let end = bytes[at..].iter().position(|&b| b == b'\n').map_or(bytes.len(), |p| at + p);
+        let line = std::str::from_utf8(&bytes[at..end]).map_err(|_| "header is not text".to_string())?.trim();
+        at = (end + 1).min(bytes.len());
+        if line.is_empty() {
+            continue;
+        }
+        let (k, v) = line.split_once('=').ok_or_else(|| format!("malformed header line '{}'", line.chars().take(60).collect::<String>()))?;
+        let key = k.trim().to_string();
+        fields.push((key.clone(), v.trim().to_string()));
+        if key == "ElementDataFile" {
+            break;
+        }
+        if fields.len() > 200 {
+            return Err("header has no ElementDataFile".into());
+        }
+    }
+    let get = |keys: &[&str]| fields.iter().find(|(k, _)| keys.contains(&k.as_str())).map(|(_, v)| v.as_str());
+    let need = |k: &str| get(&[k]).ok_or_else(|| format!("missing header field '{k}'"));
+    if let Some(t) = get(&["ObjectType"]) {
+        if t != "Image" {
+            return Err(format!("ObjectType: expected Image, found '{t}'"));
+        }
+    }
+    if need("NDims")? != "3" {
+        return Err(format!("NDims: expected 3, found '{}'", need("NDims")?));
+    }
+    let ds = need("DimSize")?;
+    let d: Vec<usize> = ds.split_whitespace().map(|x| x.parse()).collect::<Result<_, _>>().map_err(|_| format!("DimSize: '{ds}' are not whole numbers"))?;
+    if d.len() != 3 {
+        return Err(format!("DimSize: expected 3 values, found {}", d.len()));
+    }
+    let dims = [d[0], d[1], d[2]];
+    let tyname = need("ElementType")?;
+    let ty = match tyname {
+        "MET_UCHAR" => SampleType::U8,
+        "MET_CHAR" => SampleType::I8,
+        "MET_USHORT" => SampleType::U16,
+        "MET_SHORT" => SampleType::I16,
+        "MET_UINT" => SampleType::U32,
+        "MET_INT" => SampleType::I32,
+        "MET_FLOAT" => SampleType::F32,
+        "MET_DOUBLE" => SampleType::F64,
+        o => return Err(format!("ElementType: '{o}' is not supported")),
+    };
+    byte_len(dims, ty)?;
+    let spacing = match get(&["ElementSpacing", "ElementSize"]) {
+        Some(s) => {
+            let v: Vec<f32> = s.split_whitespace().map(|x| x.parse()).collect::<Result<_, _>>().map_err(|_| format!("ElementSpacing: '{s}' are not numbers"))?;
+            if v.len() != 3 {
+                return Err(format!("ElementSpacing: expected 3 values, found {}", v.len()));
+            }
+            [v[0], v[1], v[2]]
+        }
+        None => [1.0; 3],
+    };
+    check_spacing(spacing)?;
+    let directions = match get(&["TransformMatrix", "Rotation", "Orientation"]) {
+        Some(s) => {
+            let v: Vec<f32> = s.split_whitespace().map(|x| x.parse()).collect::<Result<_, _>>().map_err(|_| format!("TransformMatrix: '{s}' are not numbers"))?;
+            if v.len() != 9 {
+                return Err(format!("TransformMatrix: expected 9 values, found {}", v.len()));
+            }
+            let mut d = AXIS_ALIGNED;
+            for (i, row) in d.iter_mut().enumerate() {
+                let r = [v[3 * i], v[3 * i + 1], v[3 * i + 2]];
+                let len = (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt();
+                if !(len > 0.0) {
+                    return Err(format!("TransformMatrix: row {i} is zero"));
+                }
+                *row = r.map(|x| x / len);
+            }
+            d
+        }
+        None => AXIS_ALIGNED,
+    };
+    let big_endian = get(&["ElementByteOrderMSB", "BinaryDataByteOrderMSB"]).is_some_and(is_true);
+    if get(&["BinaryData"]).is_some_and(|v| !is_true(v)) {
+        return Err("BinaryData = False (ASCII MetaImage) is not supported".into());
+    }
+    let compressed = get(&["CompressedData"]).is_some_and(is_true);
+    let header_size: i64 = get(&["HeaderSize"]).map_or(Ok(0), |v| v.parse().map_err(|_| format!("HeaderSize: '{v}' is not a whole number")))?;
+    if header_size < -1 || (header_size == -1 && compressed) {
+        return Err(format!("HeaderSize: {header_size} is not allowed here"));
+    }
+    let file = need("ElementDataFile")?;
+    let data_file = match file {
+        "LOCAL" => None,
+        f if f.starts_with("LIST") || f.contains('%') => return Err("ElementDataFile: lists and patterns are not supported".into()),
+        f => Some(f.to_string()),
+    };
+    Ok(Header { dims, spacing, directions, ty, big_endian, compressed, data_file, header_size, header_len: at })
+}
+
+fn data_bytes(path: &Path, h: &Header, file: &[u8]) -> Result<(PathBuf, Vec<u8>), CliError> {
+    let (source, owned);
+    let all: &[u8] = match &h.data_file {
+        Some(name) => {
+            source = path.parent().unwrap_or(Path::new(".")).join(name);
+            owned = crate::io::read_file(&source)?;
+            &owned
+        }
+        None => {
+            source = path.to_path_buf();
+            &file[h.header_len..]
+        }
+    };
+    Ok((source, all.to_vec()))
+}
+
+/// Loads a MetaImage volume.
+pub fn load(path: &Path) -> Result<Volume, CliError> {
+    let bytes = crate::io::read_file(path)?;
+    let h = parse_header(&bytes).map_err(|e| at(path, e))?;
+    let (source, all) = data_bytes(path, &h, &bytes)?;
+    let err = |e: String| at(&source, e);
+    let need = byte_len(h.dims, h.ty).map_err(err)?;
+    let body: Vec<u8> = if h.compressed {
+        let skip = usize::try_from(h.header_size).unwrap_or(0);
+        compress::unzlib(all.get(skip..).unwrap_or(&[]), need).map_err(err)?
+    } else {
+        let body = if h.header_size == -1 {
+            all.len().checked_sub(need).map(|s| &all[s..])
+        } else {
+            all.get(h.header_size as usize..)
+        }
+        .unwrap_or(&[]);
+        if body.len() != need {
+            return Err(err(format!("expected {need} bytes of {}x{}x{} {:?}, found {}", h.dims[0], h.dims[1], h.dims[2], h.ty, body.len())));
+        }
+        body.to_vec()
+    };
+    Ok(Volume { dims: h.dims, spacing: h.spacing, directions: h.directions, samples: decode(&body, h.ty, h.big_endian) })
+}
+
+/// Where the samples of an uncompressed MetaImage are, for streaming: (file, byte offset, header).
+pub fn raw_layout(path: &Path) -> Result<(PathBuf, u64, Header), CliError> {
+    let head = crate::io::read_prefix(path, 1 << 16)?;
+    let h = parse_header(&head).map_err(|e| at(path, e))?;
+    if h.compressed {
+        return Err(at(path, "streaming needs uncompressed data (CompressedData = False)"));
+    }
+    let source = match &h.data_file {
+        Some(name) => path.parent().unwrap_or(Path::new(".")).join(name),
+        None => path.to_path_buf(),
+    };
+    let need = byte_len(h.dims, h.ty).map_err(|e| at(path, e))? as u64;
+    let len = std::fs::metadata(&source).map_err(|e| at(&source, format!("cannot read: {e}")))?.len();
+    let start = if h.data_file.is_some() { 0 } else { h.header_len as u64 };
+    let offset = if h.header_size == -1 { len.saturating_sub(need) } else { start + h.header_size as u64 };
+    if len != offset + need {
+        return Err(at(&source, format!("expected {need} bytes of data after offset {offset}, the file has {len} bytes")));
+    }
+    Ok((source, offset, h))
+}

@@ -1,0 +1,247 @@
+//! NRRD (`.nrrd` with attached data, `.nhdr` with a detached data file).
+//!
+//! Read: magic `NRRD0001`–`NRRD0005`; `type` (every spelling of the spec), `dimension: 3`, `sizes`,
+//! `spacings` or `space directions` (a general grid-to-world matrix; `space origin` is accepted and
+//! not needed for rendering), `endian`, `encoding` (`raw`, `gzip`/`gz`, `ascii`/`text`/`txt`),
+//! `data file` / `datafile` (relative to the header), `line skip` / `lineskip`, `byte skip` /
+//! `byteskip` (−1 for raw: the data are the file's last bytes). `#` comments and `key:=value`
+//! pairs are ignored; other fields (`kinds`, `centers`, `space`, …) are accepted and ignored.
+
+use super::compress;
+use crate::io::volume::{at, byte_len, check_spacing, decode, decode_ascii, SampleType, Volume, AXIS_ALIGNED};
+use crate::CliError;
+use std::path::{Path, PathBuf};
+
+/// How the data are encoded.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Encoding {
+    Raw,
+    Gzip,
+    Ascii,
+}
+
+/// A parsed NRRD header.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Header {
+    pub ty: SampleType,
+    pub dims: [usize; 3],
+    pub spacing: [f32; 3],
+    pub directions: [[f32; 3]; 3],
+    pub big_endian: bool,
+    pub encoding: Encoding,
+    /// The detached data file as written (relative to the header), if any.
+    pub data_file: Option<String>,
+    pub line_skip: usize,
+    /// −1: the data are the last bytes of the (raw) file.
+    pub byte_skip: i64,
+    /// Bytes of header, including the blank line that ends it (where attached data start).
+    pub header_len: usize,
+}
+
+/// Parses `(x,y,z)`.
+fn vector(s: &str) -> Option<[f32; 3]> {
+    let inner = s.trim().strip_prefix('(')?.strip_suffix(')')?;
+    let v: Vec<f32> = inner.split(',').map(|x| x.trim().parse().ok()).collect::<Option<_>>()?;
+    (v.len() == 3 && v.iter().all(|x| x.is_finite())).then(|| [v[0], v[1], v[2]])
+}
+
+/// Parses a header from the start of `bytes`.
+pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
+    if !(bytes.len() >= 8 && bytes.starts_with(b"NRRD000") && (b'1'..=b'5').contains(&bytes[7])) {
+        return Err("not an NRRD file (expected magic NRRD0001 to NRRD0005)".into());
+    }
+    let mut at = 0;
+    let mut fields: Vec<(String, String)> = Vec::new();
+    let mut first = true;
+    loop {
+        let end = bytes[at..].iter().position(|&b| b == b'\n').map(|p| at + p);
+        let line_bytes = &bytes[at..end.unwrap_or(bytes.len())];
+        at = end.map_or(bytes.len(), |e| e + 1);
+        let line = std::str::from_utf8(line_bytes).map_err(|_| "header is not text".to_string())?;
+        let line = line.trim_end_matches('\r');
+        if first {
+            first = false;
+        } else if line.is_empty() {
+            break;
+        } else if !line.starts_with('#') {
+            if let Some((k, v)) = line.split_once(": ") {
+                fields.push((k.trim().to_ascii_lowercase(), v.trim().to_string()));
+            } else if !line.contains(":=") {
+                return Err(format!("malformed header line '{}'", line.chars().take(60).collect::<String>()));
+            }
+        }
+        if end.is_none() {
+            break;
+        }
+    }
+    let get = |keys: &[&str]| fields.iter().find(|(k, _)| keys.contains(&k.as_str())).map(|(_, v)| v.as_str());
+    let need = |k: &str| get(&[k]).ok_or_else(|| format!("missing header field '{k}'"));
+    let tyname = need("type")?;
+    let ty = SampleType::parse(tyname).ok_or_else(|| format!("type: '{tyname}' is not a supported sample type"))?;
+    let dimension = need("dimension")?;
+    if dimension.trim() != "3" {
+        return Err(format!("dimension: expected 3, found '{dimension}'"));
+    }
+    let sizes = need("sizes")?;
+    let dims: Vec<usize> = sizes
+        .split_whitespace()
+        .map(|s| s.parse())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("sizes: '{sizes}' are not whole numbers"))?;
+    if dims.len() != 3 {
+        return Err(format!("sizes: expected 3 values, found {}", dims.len()));
+    }
+    let dims = [dims[0], dims[1], dims[2]];
+    byte_len(dims, ty)?;
+    let (spacing, directions) = if let Some(sd) = get(&["space directions"]) {
+        // Three vectors "(x,y,z)", separated by spaces.
+        let parts: Vec<&str> = sd.split(')').map(str::trim).filter(|p| !p.is_empty()).collect();
+        if parts.len() != 3 {
+            return Err(format!("space directions: expected 3 vectors, found '{sd}'"));
+        }
+        let mut spacing = [0.0f32; 3];
+        let mut dirs = AXIS_ALIGNED;
+        for (c, p) in parts.iter().enumerate() {
+            let v = vector(&format!("{p})")).ok_or_else(|| format!("space directions: '{p})' is not a 3-vector"))?;
+            let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+            if !(len > 0.0) {
+                return Err(format!("space directions: vector {} has zero length", c + 1));
+            }
+            spacing[c] = len;
+            dirs[c] = v.map(|x| x / len);
+        }
+        (spacing, dirs)
+    } else if let Some(s) = get(&["spacings"]) {
+        let v: Vec<f32> = s
+            .split_whitespace()
+            .map(|x| x.parse())
+            .collect::<Result<_, _>>()
+            .map_err(|_| format!("spacings: '{s}' are not numbers"))?;
+        if v.len() != 3 {
+            return Err(format!("spacings: expected 3 values, found {}", v.len()));
+        }
+        ([v[0], v[1], v[2]], AXIS_ALIGNED)
+    } else {
+        ([1.0; 3], AXIS_ALIGNED)
+    };
+    check_spacing(spacing)?;
+    if let Some(o) = get(&["space origin"]) {
+        vector(o).ok_or_else(|| format!("space origin: '{o}' is not a 3-vector"))?;
+    }
+    let enc = need("encoding")?;
+    let encoding = match enc {
+        "raw" => Encoding::Raw,
+        "gzip" | "gz" => Encoding::Gzip,
+        "ascii" | "text" | "txt" => Encoding::Ascii,
+        other => return Err(format!("encoding: '{other}' is not supported (raw, gzip, ascii)")),
+    };
+    let big_endian = match get(&["endian"]) {
+        Some("big") => true,
+        Some("little") => false,
+        None if ty.size() == 1 || encoding == Encoding::Ascii => false,
+        None => return Err("missing header field 'endian' (required for multi-byte binary types)".into()),
+        Some(other) => return Err(format!("endian: expected little or big, found '{other}'")),
+    };
+    let number = |keys: &[&str], name: &str| -> Result<i64, String> {
+        get(keys).map_or(Ok(0), |v| v.trim().parse().map_err(|_| format!("{name}: '{v}' is not a whole number")))
+    };
+    let byte_skip = number(&["byte skip", "byteskip"], "byte skip")?;
+    if byte_skip < -1 || (byte_skip == -1 && encoding != Encoding::Raw) {
+        return Err(format!("byte skip: {byte_skip} is not allowed with {enc} encoding"));
+    }
+    let line_skip = number(&["line skip", "lineskip"], "line skip")?;
+    let line_skip = usize::try_from(line_skip).map_err(|_| format!("line skip: {line_skip} is negative"))?;
+    let data_file = get(&["data file", "datafile"]).map(str::to_string);
+    if data_file.as_deref().is_some_and(|d| d.starts_with("LIST") || d.contains('%')) {
+        return Err("data file: lists and formatted file names are not supported".into());
+    }
+    Ok(Header { ty, dims, spacing, directions, big_endian, encoding, data_file, line_skip, byte_skip, header_len: at })
+}
+
+/// Skips `n` lines of `data`.
+fn skip_lines(data: &[u8], n: usize) -> Result<&[u8], String> {
+    let mut rest = data;
+    for i in 0..n {
+        let p = rest.iter().position(|&b| b == b'\n').ok_or_else(|| format!("line skip: the data have only {i} lines"))?;
+        rest = &rest[p + 1..];
+    }
+    Ok(rest)
+}
+
+/// The file holding the data and the header's view of it.
+fn data_source(path: &Path, h: &Header) -> PathBuf {
+    match &h.data_file {
+        Some(name) => path.parent().unwrap_or(Path::new(".")).join(name),
+        None => path.to_path_buf(),
+    }
+}
+
+/// Loads an NRRD volume.
+pub fn load(path: &Path) -> Result<Volume, CliError> {
+    let bytes = crate::io::read_file(path)?;
+    let h = parse_header(&bytes).map_err(|e| at(path, e))?;
+    let source = data_source(path, &h);
+    let file_bytes;
+    let all: &[u8] = if h.data_file.is_some() {
+        file_bytes = crate::io::read_file(&source)?;
+        &file_bytes
+    } else {
+        &bytes[h.header_len..]
+    };
+    let err = |e: String| at(&source, e);
+    let need = byte_len(h.dims, h.ty).map_err(err)?;
+    let count = need / h.ty.size();
+    let samples = match h.encoding {
+        Encoding::Raw => {
+            let data = skip_lines(all, h.line_skip).map_err(err)?;
+            let body = if h.byte_skip == -1 {
+                data.len().checked_sub(need).map(|s| &data[s..])
+            } else {
+                usize::try_from(h.byte_skip).ok().and_then(|s| data.get(s..))
+            }
+            .unwrap_or(&[]);
+            if body.len() != need {
+                return Err(err(format!(
+                    "header says {}x{}x{} {:?} = {need} bytes, the data have {}",
+                    h.dims[0],
+                    h.dims[1],
+                    h.dims[2],
+                    h.ty,
+                    body.len()
+                )));
+            }
+            decode(body, h.ty, h.big_endian)
+        }
+        Encoding::Gzip => {
+            let data = skip_lines(all, h.line_skip).map_err(err)?;
+            // Byte skip applies to the decompressed stream.
+            let skip = usize::try_from(h.byte_skip).unwrap_or(0);
+            let inflated = compress::gunzip(data, need + skip).map_err(err)?;
+            decode(&inflated[skip..], h.ty, h.big_endian)
+        }
+        Encoding::Ascii => {
+            let data = skip_lines(all, h.line_skip).map_err(err)?;
+            decode_ascii(data, h.ty, count).map_err(err)?
+        }
+    };
+    Ok(Volume { dims: h.dims, spacing: h.spacing, directions: h.directions, samples })
+}
+
+/// Where the samples of a raw-encoded NRRD are, for streaming: (file, byte offset, header).
+pub fn raw_layout(path: &Path) -> Result<(PathBuf, u64, Header), CliError> {
+    // A header is small: read at most 64 KiB of it.
+    let head = crate::io::read_prefix(path, 1 << 16)?;
+    let h = parse_header(&head).map_err(|e| at(path, e))?;
+    if h.encoding != Encoding::Raw || h.line_skip != 0 {
+        return Err(at(path, "streaming needs raw encoding without line skip"));
+    }
+    let source = data_source(path, &h);
+    let need = byte_len(h.dims, h.ty).map_err(|e| at(path, e))? as u64;
+    let len = std::fs::metadata(&source).map_err(|e| at(&source, format!("cannot read: {e}")))?.len();
+    let start = if h.data_file.is_some() { 0 } else { h.header_len as u64 };
+    let offset = if h.byte_skip == -1 { len.saturating_sub(need) } else { start + h.byte_skip as u64 };
+    if len < offset + need || (h.byte_skip != -1 && len != offset + need) {
+        return Err(at(&source, format!("expected {} bytes of data after offset {offset}, the file has {len} bytes", need)));
+    }
+    Ok((source, offset, h))
+}

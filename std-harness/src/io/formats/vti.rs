@@ -1,0 +1,255 @@
+//! VTK XML ImageData (`.vti`): one piece, point data, one component; `format` ascii, binary
+//! (base64 inline) or appended (raw or base64); uncompressed or `vtkZLibDataCompressor`; header
+//! type UInt32 or UInt64; either byte order; `Spacing` and `Direction` (row-major) give the grid.
+
+use super::compress;
+use crate::io::volume::{at, byte_len, check_spacing, decode, decode_ascii, SampleType, Volume, AXIS_ALIGNED};
+use crate::CliError;
+use base64::Engine as _;
+use std::path::Path;
+
+/// Decodes base64 text that may be several separately padded streams back to back (VTK encodes
+/// a compressed array's header and its blocks separately), ignoring whitespace.
+fn base64_segments(text: &[u8]) -> Result<Vec<u8>, String> {
+    let clean: Vec<u8> = text.iter().copied().filter(|b| !b.is_ascii_whitespace()).collect();
+    let mut out = Vec::with_capacity(clean.len() / 4 * 3);
+    let mut start = 0;
+    let mut i = 0;
+    while i < clean.len() {
+        if clean[i] == b'=' {
+            while i < clean.len() && clean[i] == b'=' {
+                i += 1;
+            }
+            base64::engine::general_purpose::STANDARD
+                .decode_vec(&clean[start..i], &mut out)
+                .map_err(|e| format!("bad base64 data: {e}"))?;
+            start = i;
+        } else {
+            i += 1;
+        }
+    }
+    if start < clean.len() {
+        base64::engine::general_purpose::STANDARD
+            .decode_vec(&clean[start..], &mut out)
+            .map_err(|e| format!("bad base64 data: {e}"))?;
+    }
+    Ok(out)
+}
+
+/// What the XML says about the image and its data array.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Header {
+    pub dims: [usize; 3],
+    pub spacing: [f32; 3],
+    pub directions: [[f32; 3]; 3],
+    pub ty: SampleType,
+    pub big_endian: bool,
+    pub header64: bool,
+    pub zlib: bool,
+    pub format: Format,
+}
+
+/// Where the array's data are.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Format {
+    /// Whitespace-separated numbers inside the DataArray.
+    Ascii(Vec<u8>),
+    /// Base64 inside the DataArray.
+    Binary(Vec<u8>),
+    /// In the AppendedData section at this offset.
+    Appended { offset: usize },
+}
+
+fn numbers<T: std::str::FromStr>(s: &str, n: usize, what: &str) -> Result<Vec<T>, String> {
+    let v: Vec<T> = s.split_whitespace().map(|x| x.parse().ok()).collect::<Option<_>>().ok_or_else(|| format!("{what}: '{s}' is not {n} numbers"))?;
+    if v.len() != n {
+        return Err(format!("{what}: expected {n} numbers, found {}", v.len()));
+    }
+    Ok(v)
+}
+
+/// Splits a file at `<AppendedData`: (XML text, appended section after its `_`, its encoding).
+fn split_appended(bytes: &[u8]) -> Result<(String, Option<(&[u8], bool)>), String> {
+    let tag = b"<AppendedData";
+    match bytes.windows(tag.len()).position(|w| w == tag) {
+        None => Ok((String::from_utf8(bytes.to_vec()).map_err(|_| "XML is not UTF-8 text".to_string())?, None)),
+        Some(p) => {
+            let head = std::str::from_utf8(&bytes[..p]).map_err(|_| "XML is not UTF-8 text".to_string())?;
+            let rest = &bytes[p..];
+            let gt = rest.iter().position(|&b| b == b'>').ok_or("AppendedData tag is not closed")?;
+            let open = std::str::from_utf8(&rest[..gt]).map_err(|_| "AppendedData tag is not text")?;
+            let raw = !open.contains("base64");
+            let body = &rest[gt + 1..];
+            let us = body.iter().position(|&b| b == b'_').ok_or("AppendedData has no '_' marker")?;
+            Ok((format!("{head}</VTKFile>"), Some((&body[us + 1..], raw))))
+        }
+    }
+}
+
+/// Parses the XML of a `.vti` (the appended section, if any, is returned separately).
+pub fn parse_header(bytes: &[u8]) -> Result<(Header, Option<(&[u8], bool)>), String> {
+    let (xml, appended) = split_appended(bytes)?;
+    let doc = roxmltree::Document::parse(&xml).map_err(|e| format!("not valid XML: {e}"))?;
+    let root = doc.root_element();
+    if root.tag_name().name() != "VTKFile" || root.attribute("type") != Some("ImageData") {
+        return Err("not a VTK XML ImageData file (VTKFile type=\"ImageData\")".into());
+    }
+    let big_endian = match root.attribute("byte_order") {
+        Some("BigEndian") => true,
+        Some("LittleEndian") | None => false,
+        Some(o) => return Err(format!("byte_order: '{o}' is not LittleEndian or BigEndian")),
+    };
+    let header64 = match root.attribute("header_type") {
+        Some("UInt64") => true,
+        Some("UInt32") | None => false,
+        Some(o) => return Err(format!("header_type: '{o}' is not UInt32 or UInt64")),
+    };
+    let zlib = match root.attribute("compressor") {
+        None | Some("") => false,
+        Some("vtkZLibDataCompressor") => true,
+        Some(o) => return Err(format!("compressor: '{o}' is not supported (vtkZLibDataCompressor only)")),
+    };
+    let image = root.children().find(|n| n.has_tag_name("ImageData")).ok_or("no ImageData element")?;
+    let extent: Vec<i64> = numbers(image.attribute("WholeExtent").ok_or("ImageData has no WholeExtent")?, 6, "WholeExtent")?;
+    let mut dims = [0usize; 3];
+    for a in 0..3 {
+        let d = extent[2 * a + 1] - extent[2 * a] + 1;
+        dims[a] = usize::try_from(d).ok().filter(|&d| d > 0).ok_or_else(|| format!("WholeExtent: axis {a} is empty"))?;
+    }
+    let spacing: Vec<f32> = match image.attribute("Spacing") {
+        Some(s) => numbers(s, 3, "Spacing")?,
+        None => vec![1.0; 3],
+    };
+    let spacing = [spacing[0], spacing[1], spacing[2]];
+    check_spacing(spacing)?;
+    let directions = match image.attribute("Direction") {
+        // Row-major 3×3 whose columns are the axis directions.
+        Some(s) => {
+            let m: Vec<f32> = numbers(s, 9, "Direction")?;
+            let mut d = AXIS_ALIGNED;
+            for (c, col) in d.iter_mut().enumerate() {
+                let v = [m[c], m[3 + c], m[6 + c]];
+                let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+                if !(len > 0.0) {
+                    return Err(format!("Direction: column {c} is zero"));
+                }
+                *col = v.map(|x| x / len);
+            }
+            d
+        }
+        None => AXIS_ALIGNED,
+    };
+    let pieces: Vec<_> = image.children().filter(|n| n.has_tag_name("Piece")).collect();
+    if pieces.len() != 1 {
+        return Err(format!("expected one Piece, found {}", pieces.len()));
+    }
+    let point_data = pieces[0].children().find(|n| n.has_tag_name("PointData")).ok_or("Piece has no PointData")?;
+    let arrays: Vec<_> = point_data.children().filter(|n| n.has_tag_name("DataArray")).collect();
+    let array = match point_data.attribute("Scalars") {
+        Some(name) => arrays.iter().find(|a| a.attribute("Name") == Some(name)),
+        None => arrays.first(),
+    }
+    .ok_or("PointData has no scalar DataArray")?;
+    let comps = array.attribute("NumberOfComponents").unwrap_or("1");
+    if comps != "1" {
+        return Err(format!("NumberOfComponents: {comps} (only scalar data are supported)"));
+    }
+    let tyname = array.attribute("type").ok_or("DataArray has no type")?;
+    let ty = match tyname {
+        "Int8" => SampleType::I8,
+        "UInt8" => SampleType::U8,
+        "Int16" => SampleType::I16,
+        "UInt16" => SampleType::U16,
+        "Int32" => SampleType::I32,
+        "UInt32" => SampleType::U32,
+        "Float32" => SampleType::F32,
+        "Float64" => SampleType::F64,
+        o => return Err(format!("DataArray type '{o}' is not supported")),
+    };
+    byte_len(dims, ty)?;
+    let text = array.text().unwrap_or("").as_bytes().to_vec();
+    let format = match array.attribute("format").unwrap_or("ascii") {
+        "ascii" => Format::Ascii(text),
+        "binary" => Format::Binary(text),
+        "appended" => {
+            let off = array.attribute("offset").ok_or("appended DataArray has no offset")?;
+            Format::Appended { offset: off.trim().parse().map_err(|_| format!("offset: '{off}' is not a whole number"))? }
+        }
+        o => return Err(format!("DataArray format '{o}' is not ascii, binary or appended")),
+    };
+    if matches!(format, Format::Appended { .. }) && appended.is_none() {
+        return Err("appended DataArray but no AppendedData section".into());
+    }
+    Ok((Header { dims, spacing, directions, ty, big_endian, header64, zlib, format }, appended))
+}
+
+/// Reads header words (UInt32 or UInt64) from `b` at word index `i`.
+fn word(b: &[u8], i: usize, h: &Header) -> Result<usize, String> {
+    let size = if h.header64 { 8 } else { 4 };
+    let s = b.get(i * size..(i + 1) * size).ok_or("data block header is truncated")?;
+    let v = match (h.header64, h.big_endian) {
+        (false, false) => u64::from(u32::from_le_bytes(s.try_into().expect("4"))),
+        (false, true) => u64::from(u32::from_be_bytes(s.try_into().expect("4"))),
+        (true, false) => u64::from_le_bytes(s.try_into().expect("8")),
+        (true, true) => u64::from_be_bytes(s.try_into().expect("8")),
+    };
+    usize::try_from(v).map_err(|_| "data block header value is too large".to_string())
+}
+
+/// Decodes a binary block stream (header words, then data), compressed or not, into exactly `need`
+/// bytes.
+fn block_stream(b: &[u8], h: &Header, need: usize) -> Result<Vec<u8>, String> {
+    let size = if h.header64 { 8 } else { 4 };
+    if !h.zlib {
+        let n = word(b, 0, h)?;
+        if n != need {
+            return Err(format!("data block holds {n} bytes, the extent needs {need}"));
+        }
+        return b.get(size..size + n).map(<[u8]>::to_vec).ok_or_else(|| format!("data are truncated: expected {n} bytes"));
+    }
+    let blocks = word(b, 0, h)?;
+    let block_size = word(b, 1, h)?;
+    let last = word(b, 2, h)?;
+    if blocks == 0 || blocks > need.max(1) || block_size == 0 {
+        return Err(format!("compressed header: {blocks} blocks of {block_size} bytes is not plausible"));
+    }
+    let last = if last == 0 { block_size } else { last };
+    let total = (blocks - 1).checked_mul(block_size).and_then(|t| t.checked_add(last)).ok_or("compressed header overflows")?;
+    if total != need {
+        return Err(format!("compressed data hold {total} bytes, the extent needs {need}"));
+    }
+    let mut at = (3 + blocks) * size;
+    let mut out = Vec::with_capacity(need);
+    for k in 0..blocks {
+        let c = word(b, 3 + k, h)?;
+        let chunk = b.get(at..at.checked_add(c).ok_or("block size overflows")?).ok_or("compressed data are truncated")?;
+        let expect = if k + 1 == blocks { last } else { block_size };
+        out.extend(compress::unzlib(chunk, expect)?);
+        at += c;
+    }
+    Ok(out)
+}
+
+/// Loads a `.vti` volume.
+pub fn load(path: &Path) -> Result<Volume, CliError> {
+    let bytes = crate::io::read_file(path)?;
+    let (h, appended) = parse_header(&bytes).map_err(|e| at(path, e))?;
+    let need = byte_len(h.dims, h.ty).map_err(|e| at(path, e))?;
+    let err = |e: String| at(path, e);
+    let samples = match &h.format {
+        Format::Ascii(text) => decode_ascii(text, h.ty, need / h.ty.size()).map_err(err)?,
+        Format::Binary(text) => decode(&block_stream(&base64_segments(text).map_err(err)?, &h, need).map_err(err)?, h.ty, h.big_endian),
+        Format::Appended { offset } => {
+            let (section, raw) = appended.expect("checked by parse_header");
+            let start = section.get(*offset..).ok_or_else(|| err(format!("appended offset {offset} is past the end")))?;
+            let bytes = if raw {
+                block_stream(start, &h, need).map_err(err)?
+            } else {
+                let end = start.iter().position(|&b| b == b'<').unwrap_or(start.len());
+                block_stream(&base64_segments(&start[..end]).map_err(err)?, &h, need).map_err(err)?
+            };
+            decode(&bytes, h.ty, h.big_endian)
+        }
+    };
+    Ok(Volume { dims: h.dims, spacing: h.spacing, directions: h.directions, samples })
+}

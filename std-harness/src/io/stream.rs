@@ -1,0 +1,236 @@
+//! Sheet sources for the core's [`SheetSource`] interface: a volume in memory, a seekable file read
+//! a few sheets at a time, and a pipe read in file order. File and pipe keep memory bounded by a
+//! few sheets whatever the volume's size.
+
+use crate::io::volume::{SampleType, Volume};
+use crate::CliError;
+use footprint::render::RenderError;
+use footprint::source::SheetSource;
+use std::io::Read;
+use std::os::unix::fs::FileExt;
+use std::path::{Path, PathBuf};
+
+impl From<RenderError> for CliError {
+    fn from(e: RenderError) -> Self {
+        CliError::input(e.to_string())
+    }
+}
+
+/// Decodes `bytes` (a whole number of samples of `ty`) into f32s.
+pub fn decode_into(bytes: &[u8], ty: SampleType, big_endian: bool, out: &mut [f32]) {
+    macro_rules! conv {
+        ($t:ty) => {{
+            const N: usize = std::mem::size_of::<$t>();
+            for (o, c) in out.iter_mut().zip(bytes.chunks_exact(N)) {
+                let a: [u8; N] = c.try_into().expect("chunk of N bytes");
+                *o = (if big_endian { <$t>::from_be_bytes(a) } else { <$t>::from_le_bytes(a) }) as f32;
+            }
+        }};
+    }
+    match ty {
+        SampleType::U8 => conv!(u8),
+        SampleType::I8 => conv!(i8),
+        SampleType::U16 => conv!(u16),
+        SampleType::I16 => conv!(i16),
+        SampleType::U32 => conv!(u32),
+        SampleType::I32 => conv!(i32),
+        SampleType::F32 => conv!(f32),
+        SampleType::F64 => conv!(f64),
+    }
+}
+
+/// A volume already in memory.
+pub struct MemorySource<'a>(pub &'a Volume);
+
+impl SheetSource for MemorySource<'_> {
+    type Sample = f32;
+    type Error = CliError;
+    fn read_sheet(&mut self, axis: usize, index: usize, out: &mut [f32]) -> Result<(), CliError> {
+        self.0.sheet_into(axis, index, out);
+        Ok(())
+    }
+}
+
+/// Where a streamed file's samples are.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Layout {
+    /// The file holding the samples.
+    pub path: PathBuf,
+    /// Byte offset of sample (0, 0, 0).
+    pub offset: u64,
+    pub dims: [usize; 3],
+    pub ty: SampleType,
+    pub big_endian: bool,
+}
+
+/// Budget for the file source's sheet cache, bytes.
+pub const CACHE_BYTES: usize = 8 << 20;
+
+/// A seekable file read a few sheets at a time (positioned reads; no seeking state). Sheets along
+/// z are contiguous; along y each sheet is one row per z-slice; along x one sample per row, so
+/// sheets are read in chunks of consecutive indices (each z-slice read once per chunk) and cached.
+pub struct FileSource {
+    file: std::fs::File,
+    layout: Layout,
+    /// Cached sheets: axis, first index, count; data row-major per sheet.
+    cache: Vec<f32>,
+    cached: Option<(usize, usize, usize)>,
+    bytes: Vec<u8>,
+    last: Option<(usize, usize)>,
+}
+
+impl FileSource {
+    /// Opens `layout.path`, checking that it holds the samples the layout describes.
+    pub fn open(layout: Layout) -> Result<Self, CliError> {
+        let err = |e: std::io::Error| CliError::input(format!("{}: cannot read: {e}", layout.path.display()));
+        let file = std::fs::File::open(&layout.path).map_err(err)?;
+        let len = file.metadata().map_err(err)?.len();
+        let need = crate::io::volume::byte_len(layout.dims, layout.ty).map_err(|e| crate::io::volume::at(&layout.path, e))? as u64;
+        if len < layout.offset + need {
+            return Err(crate::io::volume::at(&layout.path, format!("holds {len} bytes, needs {} after offset {}", need, layout.offset)));
+        }
+        Ok(FileSource { file, layout, cache: Vec::new(), cached: None, bytes: Vec::new(), last: None })
+    }
+
+    fn read_at(&mut self, pos: u64, len: usize) -> Result<(), CliError> {
+        self.bytes.resize(len, 0);
+        self.file
+            .read_exact_at(&mut self.bytes, self.layout.offset + pos)
+            .map_err(|e| CliError::input(format!("{}: read failed: {e}", self.layout.path.display())))
+    }
+
+    /// Loads sheets [first, first + count) of `axis` into the cache.
+    fn fill(&mut self, axis: usize, first: usize, count: usize) -> Result<(), CliError> {
+        let [nx, ny, nz] = self.layout.dims;
+        let (ty, be, size) = (self.layout.ty, self.layout.big_endian, self.layout.ty.size());
+        let (a, b) = footprint::geometry::in_sheet_axes(axis);
+        let (na, nb) = (self.layout.dims[a], self.layout.dims[b]);
+        let len = na * nb;
+        self.cache.resize(count * len, 0.0);
+        match axis {
+            2 => {
+                // z-slices are contiguous: one read for the chunk.
+                self.read_at((first * nx * ny * size) as u64, count * nx * ny * size)?;
+                let bytes = std::mem::take(&mut self.bytes);
+                decode_into(&bytes, ty, be, &mut self.cache);
+                self.bytes = bytes;
+            }
+            1 => {
+                // Sheet y = j holds row j of every z-slice: per slice, rows first..first+count are
+                // contiguous.
+                let mut row = vec![0.0f32; count * nx];
+                for k in 0..nz {
+                    self.read_at(((k * ny + first) * nx * size) as u64, count * nx * size)?;
+                    decode_into(&self.bytes, ty, be, &mut row);
+                    for s in 0..count {
+                        self.cache[s * len + k * nx..s * len + (k + 1) * nx].copy_from_slice(&row[s * nx..(s + 1) * nx]);
+                    }
+                }
+            }
+            _ => {
+                // Sheet x = i holds column i of every row: read each z-slice once per chunk and
+                // keep the chunk's columns.
+                let mut slice = vec![0.0f32; nx * ny];
+                for k in 0..nz {
+                    self.read_at((k * nx * ny * size) as u64, nx * ny * size)?;
+                    decode_into(&self.bytes, ty, be, &mut slice);
+                    for j in 0..ny {
+                        for s in 0..count {
+                            self.cache[s * len + k * ny + j] = slice[j * nx + first + s];
+                        }
+                    }
+                }
+            }
+        }
+        self.cached = Some((axis, first, count));
+        Ok(())
+    }
+}
+
+impl SheetSource for FileSource {
+    type Sample = f32;
+    type Error = CliError;
+
+    fn read_sheet(&mut self, axis: usize, index: usize, out: &mut [f32]) -> Result<(), CliError> {
+        let hit = self.cached.is_some_and(|(ax, first, count)| ax == axis && index >= first && index < first + count);
+        if !hit {
+            let (a, b) = footprint::geometry::in_sheet_axes(axis);
+            let len = self.layout.dims[a] * self.layout.dims[b];
+            let n = self.layout.dims[axis];
+            let count = (CACHE_BYTES / (4 * len)).clamp(1, n);
+            // Read ahead in the direction the sheets are being requested.
+            let descending = self.last.is_some_and(|(ax, prev)| ax == axis && prev == index + 1);
+            let first = if descending { (index + 1).saturating_sub(count) } else { index.min(n - count) };
+            self.fill(axis, first, count)?;
+        }
+        let (_, first, _) = self.cached.expect("filled above");
+        let len = out.len();
+        out.copy_from_slice(&self.cache[(index - first) * len..(index - first + 1) * len]);
+        self.last = Some((axis, index));
+        Ok(())
+    }
+}
+
+/// A pipe (or any reader) delivering z-slices in file order.
+pub struct PipeSource<R: Read> {
+    reader: R,
+    dims: [usize; 3],
+    ty: SampleType,
+    big_endian: bool,
+    next: usize,
+    bytes: Vec<u8>,
+    name: String,
+}
+
+impl<R: Read> PipeSource<R> {
+    /// A source of `dims` samples of `ty` read from `reader`, z-slice after z-slice.
+    pub fn new(reader: R, dims: [usize; 3], ty: SampleType, big_endian: bool, name: &str) -> Self {
+        PipeSource { reader, dims, ty, big_endian, next: 0, bytes: Vec::new(), name: name.into() }
+    }
+}
+
+impl<R: Read> SheetSource for PipeSource<R> {
+    type Sample = f32;
+    type Error = CliError;
+
+    fn read_sheet(&mut self, axis: usize, index: usize, out: &mut [f32]) -> Result<(), CliError> {
+        if axis != 2 || index != self.next {
+            return Err(CliError::input(format!("{}: a pipe delivers z-slices in order; sheet {index} of axis {axis} was asked for", self.name)));
+        }
+        let len = self.dims[0] * self.dims[1] * self.ty.size();
+        self.bytes.resize(len, 0);
+        self.reader.read_exact(&mut self.bytes).map_err(|e| {
+            CliError::input(format!("{}: z-slice {index} of {}: {e} (the stream is shorter than --dims say)", self.name, self.dims[2]))
+        })?;
+        decode_into(&self.bytes, self.ty, self.big_endian, out);
+        self.next += 1;
+        Ok(())
+    }
+
+    fn sequential_axis(&self) -> Option<usize> {
+        Some(2)
+    }
+}
+
+/// Smallest and largest finite sample of a streamed file, read sequentially in bounded memory.
+pub fn file_range(layout: &Layout) -> Result<(f32, f32), CliError> {
+    let mut src = FileSource::open(layout.clone())?;
+    let [nx, ny, nz] = layout.dims;
+    let mut sheet = vec![0.0f32; nx * ny];
+    let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+    for k in 0..nz {
+        src.read_sheet(2, k, &mut sheet)?;
+        for &v in &sheet {
+            if v.is_finite() {
+                lo = lo.min(v);
+                hi = hi.max(v);
+            }
+        }
+    }
+    Ok((lo, hi))
+}
+
+/// Whether `path` means standard input.
+pub fn is_stdin(path: &Path) -> bool {
+    path.as_os_str() == "-"
+}
