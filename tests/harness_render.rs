@@ -176,7 +176,12 @@ fn nrrd_and_raw_load_every_type_and_byte_order() {
             }
             let raw = d.join(format!("{ty}-{big}.raw"));
             std::fs::write(&raw, &body).unwrap();
-            let o = RawOptions { dims: [3, 4, 5], ty: st, big_endian: big, spacing: [1.0, 1.0, 1.0] };
+            let o = RawOptions {
+                dims: [3, 4, 5],
+                ty: st,
+                big_endian: big,
+                spacing: [1.0, 1.0, 1.0],
+            };
             let v = raw_load(&raw, &o).unwrap();
             assert_eq!(f64::from(v.value(59)), values[59]);
         }

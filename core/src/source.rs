@@ -21,7 +21,12 @@ pub trait SheetSource {
     type Error: From<RenderError>;
 
     /// Fills `out` (exactly one sheet) with sheet `index` along grid axis `axis`.
-    fn read_sheet(&mut self, axis: usize, index: usize, out: &mut [Self::Sample]) -> Result<(), Self::Error>;
+    fn read_sheet(
+        &mut self,
+        axis: usize,
+        index: usize,
+        out: &mut [Self::Sample],
+    ) -> Result<(), Self::Error>;
 
     /// `Some(axis)` if this source can only deliver sheets along `axis`, in ascending index order,
     /// each once (a pipe or a sensor); `None` if it can read any sheet of any axis (a seekable file).
@@ -42,11 +47,18 @@ pub struct OrderMismatch {
 /// The compositing order to use with `source` for `renderer`'s frame: `preferred` for a seekable
 /// source; for a sequential one, the order its ascending delivery implies, or an
 /// [`OrderMismatch`] if its axis is not the frame's sheet axis.
-pub fn order_for<S: SheetSource>(source: &S, frame: &crate::frame::FrameSetup, preferred: Order) -> Result<Order, OrderMismatch> {
+pub fn order_for<S: SheetSource>(
+    source: &S,
+    frame: &crate::frame::FrameSetup,
+    preferred: Order,
+) -> Result<Order, OrderMismatch> {
     match source.sequential_axis() {
         None => Ok(preferred),
         Some(axis) if axis == frame.sheet_axis => Ok(frame.order_for_ascending()),
-        Some(axis) => Err(OrderMismatch { source_axis: axis, frame_axis: frame.sheet_axis }),
+        Some(axis) => Err(OrderMismatch {
+            source_axis: axis,
+            frame_axis: frame.sheet_axis,
+        }),
     }
 }
 

@@ -7,8 +7,8 @@
 //! `--zoom`. `--view-matrix` gives V (world → screen, pixels per world unit) explicitly instead.
 
 use crate::cli::{parse_list, parse_size, FootprintArgs, MethodArg};
-use crate::io::image::encode_png_rgb;
 use crate::io::formats::{self, raw::RawOptions};
+use crate::io::image::encode_png_rgb;
 use crate::io::stream::{file_range, is_stdin, FileSource, Layout, MemorySource, PipeSource};
 use crate::io::volume::{SampleType, Volume};
 use crate::io::{self, json::Json};
@@ -18,8 +18,8 @@ use clap::{Args, ValueEnum};
 use footprint::frame::{FrameSetup, Order};
 use footprint::geometry::{FootprintOptions, Mapping};
 use footprint::render::{RenderBuffers, RenderStats, SheetRenderer, SheetRing};
-use footprint::source::{render_from, SheetSource};
 use footprint::shade::{Phong, Shader, Shading, TransferFunction};
+use footprint::source::{render_from, SheetSource};
 use footprint::splat::{Direct, Sampler};
 use footprint::{composite::RowSpan, Grid, Kernel, Lookup, View, ViewTable};
 use glam::{Mat3, Vec3};
@@ -191,7 +191,11 @@ pub enum Voxels {
     /// Streamed from a seekable file.
     File(Layout),
     /// Streamed from standard input, z-slices in file order.
-    Stdin { dims: [usize; 3], ty: SampleType, big_endian: bool },
+    Stdin {
+        dims: [usize; 3],
+        ty: SampleType,
+        big_endian: bool,
+    },
 }
 
 /// V for `--view`/`--zoom` (fitted to a volume of `dims` on grid `g`) or `--view-matrix`.
@@ -220,15 +224,33 @@ pub fn view_matrix(args: &RenderArgs, dims: [usize; 3], g: Mat3) -> Mat3 {
 
 /// The raw-file options from `--dims`, `--type`, `--endian`, `--spacing`, if `--dims` was given.
 pub fn raw_options(args: &RenderArgs) -> Result<Option<RawOptions>, CliError> {
-    let Some(dims) = args.dims else { return Ok(None) };
-    let ty = args.sample_type.as_deref().ok_or_else(|| CliError::input("raw volumes need --type"))?;
-    let ty = SampleType::parse(ty).ok_or_else(|| CliError::input(format!("--type '{ty}' is not a sample type (u8, i8, u16, i16, u32, i32, f32, f64)")))?;
+    let Some(dims) = args.dims else {
+        return Ok(None);
+    };
+    let ty = args
+        .sample_type
+        .as_deref()
+        .ok_or_else(|| CliError::input("raw volumes need --type"))?;
+    let ty = SampleType::parse(ty).ok_or_else(|| {
+        CliError::input(format!(
+            "--type '{ty}' is not a sample type (u8, i8, u16, i16, u32, i32, f32, f64)"
+        ))
+    })?;
     let big_endian = match args.endian.as_str() {
         "little" => false,
         "big" => true,
-        e => return Err(CliError::input(format!("--endian '{e}': expected little or big"))),
+        e => {
+            return Err(CliError::input(format!(
+                "--endian '{e}': expected little or big"
+            )))
+        }
     };
-    Ok(Some(RawOptions { dims, ty, big_endian, spacing: args.spacing }))
+    Ok(Some(RawOptions {
+        dims,
+        ty,
+        big_endian,
+        spacing: args.spacing,
+    }))
 }
 
 /// What `prepare` learns about the voxels before rendering.
@@ -245,47 +267,118 @@ fn load_voxels(args: &RenderArgs) -> Result<Loaded, CliError> {
     let raw = raw_options(args)?;
     let Some(stream) = &args.stream else {
         let (volume, name) = match &args.volume {
-            Some(path) => (formats::load(path, raw.as_ref())?, path.display().to_string()),
-            None => (scene::default_volume(), "built-in electron-density scene".to_string()),
+            Some(path) => (
+                formats::load(path, raw.as_ref())?,
+                path.display().to_string(),
+            ),
+            None => (
+                scene::default_volume(),
+                "built-in electron-density scene".to_string(),
+            ),
         };
         let (dims, grid, range) = (volume.dims, volume.grid_to_world(), Some(volume.range()));
-        return Ok(Loaded { voxels: Voxels::Memory(volume), name, dims, grid, range });
+        return Ok(Loaded {
+            voxels: Voxels::Memory(volume),
+            name,
+            dims,
+            grid,
+            range,
+        });
     };
     if args.volume.is_some() {
-        return Err(CliError::input("give the volume either as VOLUME or with --stream, not both"));
+        return Err(CliError::input(
+            "give the volume either as VOLUME or with --stream, not both",
+        ));
     }
     let name = stream.display().to_string();
     if is_stdin(stream) {
-        let o = raw.ok_or_else(|| CliError::input("--stream - (standard input) needs --dims and --type"))?;
-        crate::io::volume::byte_len(o.dims, o.ty).map_err(|e| CliError::input(format!("standard input: {e}")))?;
-        crate::io::volume::check_spacing(o.spacing).map_err(|e| CliError::input(format!("standard input: {e}")))?;
+        let o = raw.ok_or_else(|| {
+            CliError::input("--stream - (standard input) needs --dims and --type")
+        })?;
+        crate::io::volume::byte_len(o.dims, o.ty)
+            .map_err(|e| CliError::input(format!("standard input: {e}")))?;
+        crate::io::volume::check_spacing(o.spacing)
+            .map_err(|e| CliError::input(format!("standard input: {e}")))?;
         let grid = Mat3::from_diagonal(Vec3::from_array(o.spacing));
-        let voxels = Voxels::Stdin { dims: o.dims, ty: o.ty, big_endian: o.big_endian };
-        return Ok(Loaded { voxels, name: "standard input".into(), dims: o.dims, grid, range: None });
+        let voxels = Voxels::Stdin {
+            dims: o.dims,
+            ty: o.ty,
+            big_endian: o.big_endian,
+        };
+        return Ok(Loaded {
+            voxels,
+            name: "standard input".into(),
+            dims: o.dims,
+            grid,
+            range: None,
+        });
     }
     let lower = name.to_ascii_lowercase();
     let (layout, spacing, directions) = if let Some(o) = &raw {
-        let layout = Layout { path: stream.clone(), offset: 0, dims: o.dims, ty: o.ty, big_endian: o.big_endian };
-        crate::io::volume::check_spacing(o.spacing).map_err(|e| crate::io::volume::at(stream, e))?;
+        let layout = Layout {
+            path: stream.clone(),
+            offset: 0,
+            dims: o.dims,
+            ty: o.ty,
+            big_endian: o.big_endian,
+        };
+        crate::io::volume::check_spacing(o.spacing)
+            .map_err(|e| crate::io::volume::at(stream, e))?;
         (layout, o.spacing, crate::io::volume::AXIS_ALIGNED)
     } else if lower.ends_with(".nrrd") || lower.ends_with(".nhdr") {
         let (path, offset, h) = formats::nrrd::raw_layout(stream)?;
-        (Layout { path, offset, dims: h.dims, ty: h.ty, big_endian: h.big_endian }, h.spacing, h.directions)
+        (
+            Layout {
+                path,
+                offset,
+                dims: h.dims,
+                ty: h.ty,
+                big_endian: h.big_endian,
+            },
+            h.spacing,
+            h.directions,
+        )
     } else if lower.ends_with(".mha") || lower.ends_with(".mhd") {
         let (path, offset, h) = formats::metaimage::raw_layout(stream)?;
-        (Layout { path, offset, dims: h.dims, ty: h.ty, big_endian: h.big_endian }, h.spacing, h.directions)
+        (
+            Layout {
+                path,
+                offset,
+                dims: h.dims,
+                ty: h.ty,
+                big_endian: h.big_endian,
+            },
+            h.spacing,
+            h.directions,
+        )
     } else {
         return Err(crate::io::volume::at(stream, "streaming reads raw files (with --dims and --type), NRRD with raw encoding, or uncompressed MetaImage"));
     };
-    let file_len = std::fs::metadata(&layout.path).map_err(|e| crate::io::volume::at(&layout.path, format!("cannot read: {e}")))?.len();
-    let need = crate::io::volume::byte_len(layout.dims, layout.ty).map_err(|e| crate::io::volume::at(&layout.path, e))? as u64;
+    let file_len = std::fs::metadata(&layout.path)
+        .map_err(|e| crate::io::volume::at(&layout.path, format!("cannot read: {e}")))?
+        .len();
+    let need = crate::io::volume::byte_len(layout.dims, layout.ty)
+        .map_err(|e| crate::io::volume::at(&layout.path, e))? as u64;
     if raw.is_some() && file_len != need {
-        return Err(crate::io::volume::at(&layout.path, format!("expected {need} bytes for --dims/--type, found {file_len}")));
+        return Err(crate::io::volume::at(
+            &layout.path,
+            format!("expected {need} bytes for --dims/--type, found {file_len}"),
+        ));
     }
     let col = |c: usize| Vec3::from_array(directions[c]) * spacing[c];
     let grid = Mat3::from_cols(col(0), col(1), col(2));
-    let range = if args.window.is_none() { Some(file_range(&layout)?) } else { None };
-    Ok(Loaded { dims: layout.dims, voxels: Voxels::File(layout), name, grid, range })
+    let range = if args.window.is_none() {
+        Some(file_range(&layout)?)
+    } else {
+        None
+    };
+    Ok(Loaded {
+        dims: layout.dims,
+        voxels: Voxels::File(layout),
+        name,
+        grid,
+        range,
+    })
 }
 
 fn load_background(
@@ -310,12 +403,33 @@ fn load_background(
 /// Loads and sets up everything `args` describes.
 pub fn prepare(args: &RenderArgs) -> Result<Prepared, CliError> {
     let kernel = args.footprint.kernel()?;
-    let Loaded { voxels, name, dims, grid, range } = load_voxels(args)?;
+    let Loaded {
+        voxels,
+        name,
+        dims,
+        grid,
+        range,
+    } = load_voxels(args)?;
     let grid = Grid::from_matrix(grid).map_err(|e| CliError::input(format!("{name}: {e}")))?;
-    let view = View::new(view_matrix(args, dims, grid.to_world())).map_err(|e| CliError::input(format!("view: {e}")))?;
-    let mapping = if args.footprint.method == MethodArg::Paper { Mapping::PAPER } else { Mapping::Robust };
-    let options = FootprintOptions { mapping, min_radius_px: args.footprint.min_radius };
-    let frame = FrameSetup::new(dims, &grid, &view, &kernel, options, [args.size.0, args.size.1])?;
+    let view = View::new(view_matrix(args, dims, grid.to_world()))
+        .map_err(|e| CliError::input(format!("view: {e}")))?;
+    let mapping = if args.footprint.method == MethodArg::Paper {
+        Mapping::PAPER
+    } else {
+        Mapping::Robust
+    };
+    let options = FootprintOptions {
+        mapping,
+        min_radius_px: args.footprint.min_radius,
+    };
+    let frame = FrameSetup::new(
+        dims,
+        &grid,
+        &view,
+        &kernel,
+        options,
+        [args.size.0, args.size.1],
+    )?;
     let order = match &voxels {
         Voxels::Stdin { .. } => {
             if frame.sheet_axis != 2 {
@@ -340,7 +454,7 @@ pub fn prepare(args: &RenderArgs) -> Result<Prepared, CliError> {
         _ => args.order.map_or(Order::BackToFront, Order::from),
     };
     let tf_name = args.tf.clone().unwrap_or_else(|| {
-        if args.volume.is_none() {
+        if args.volume.is_none() && args.stream.is_none() {
             "density"
         } else {
             "grey"
@@ -353,9 +467,23 @@ pub fn prepare(args: &RenderArgs) -> Result<Prepared, CliError> {
         None => {
             let (lo, hi) = match (range, &voxels) {
                 (Some(r), _) => r,
-                (None, Voxels::Stdin { ty: SampleType::U8, .. }) => (0.0, 255.0),
-                (None, Voxels::Stdin { ty: SampleType::I8, .. }) => (-128.0, 127.0),
-                (None, _) => return Err(CliError::input("standard input cannot be read twice: give --window LO,HI")),
+                (
+                    None,
+                    Voxels::Stdin {
+                        ty: SampleType::U8, ..
+                    },
+                ) => (0.0, 255.0),
+                (
+                    None,
+                    Voxels::Stdin {
+                        ty: SampleType::I8, ..
+                    },
+                ) => (-128.0, 127.0),
+                (None, _) => {
+                    return Err(CliError::input(
+                        "standard input cannot be read twice: give --window LO,HI",
+                    ))
+                }
             };
             if !(hi > lo) {
                 return Err(CliError::input(format!(
@@ -456,13 +584,33 @@ fn run_sheets(
     )?;
     let mut storage = vec![0.0f32; 3 * f.sheet_shape().0];
     let mut ring = SheetRing::new(&mut storage, f, p.order)?;
-    let mut show = Progress { inner: progress("render"), count: f.sheet_count(), done: 0 };
+    let mut show = Progress {
+        inner: progress("render"),
+        count: f.sheet_count(),
+        done: 0,
+    };
     match &p.voxels {
-        Voxels::Memory(v) => render_from(&mut renderer, &mut ring, &mut show.wrap(MemorySource(v)))?,
-        Voxels::File(layout) => render_from(&mut renderer, &mut ring, &mut show.wrap(FileSource::open(layout.clone())?))?,
-        Voxels::Stdin { dims, ty, big_endian } => {
+        Voxels::Memory(v) => {
+            render_from(&mut renderer, &mut ring, &mut show.wrap(MemorySource(v)))?
+        }
+        Voxels::File(layout) => render_from(
+            &mut renderer,
+            &mut ring,
+            &mut show.wrap(FileSource::open(layout.clone())?),
+        )?,
+        Voxels::Stdin {
+            dims,
+            ty,
+            big_endian,
+        } => {
             let stdin = std::io::stdin().lock();
-            let src = PipeSource::new(std::io::BufReader::with_capacity(1 << 20, stdin), *dims, *ty, *big_endian, "standard input");
+            let src = PipeSource::new(
+                std::io::BufReader::with_capacity(1 << 20, stdin),
+                *dims,
+                *ty,
+                *big_endian,
+                "standard input",
+            );
             render_from(&mut renderer, &mut ring, &mut show.wrap(src))?
         }
     }
@@ -485,11 +633,16 @@ struct Reporting<'p, S, F> {
 
 impl<F: FnMut(usize, usize)> Progress<F> {
     fn wrap<S>(&mut self, source: S) -> Reporting<'_, S, F> {
-        Reporting { source, progress: self }
+        Reporting {
+            source,
+            progress: self,
+        }
     }
 }
 
-impl<S: SheetSource<Sample = f32, Error = CliError>, F: FnMut(usize, usize)> SheetSource for Reporting<'_, S, F> {
+impl<S: SheetSource<Sample = f32, Error = CliError>, F: FnMut(usize, usize)> SheetSource
+    for Reporting<'_, S, F>
+{
     type Sample = f32;
     type Error = CliError;
     fn read_sheet(&mut self, axis: usize, index: usize, out: &mut [f32]) -> Result<(), CliError> {
@@ -506,7 +659,9 @@ impl<S: SheetSource<Sample = f32, Error = CliError>, F: FnMut(usize, usize)> She
 
 /// The f64 reference render of `p` and its seconds (the volume must be in memory).
 pub fn render_ref(p: &Prepared) -> Result<(Vec<[f64; 4]>, f64), CliError> {
-    let volume = p.volume().ok_or_else(|| CliError::input("the f64 reference needs the volume in memory: drop --stream"))?;
+    let volume = p.volume().ok_or_else(|| {
+        CliError::input("the f64 reference needs the volume in memory: drop --stream")
+    })?;
     let start = Instant::now();
     let scene = ReferenceScene {
         frame: &p.frame,
@@ -517,7 +672,11 @@ pub fn render_ref(p: &Prepared) -> Result<(Vec<[f64; 4]>, f64), CliError> {
         background: p.background.as_deref(),
     };
     let axis = p.frame.sheet_axis;
-    let img = render_reference(&scene, |s, out| volume.sheet_into(axis, s, out), progress("reference"))?;
+    let img = render_reference(
+        &scene,
+        |s, out| volume.sheet_into(axis, s, out),
+        progress("reference"),
+    )?;
     Ok((img, start.elapsed().as_secs_f64()))
 }
 

@@ -53,9 +53,13 @@ pub fn read_file(path: &Path) -> Result<Vec<u8>, CliError> {
 pub fn read_prefix(path: &Path, limit: usize) -> Result<Vec<u8>, CliError> {
     use std::io::Read;
     if path.is_dir() {
-        return Err(CliError::input(format!("{}: is a directory, expected a file", path.display())));
+        return Err(CliError::input(format!(
+            "{}: is a directory, expected a file",
+            path.display()
+        )));
     }
-    let f = std::fs::File::open(path).map_err(|e| CliError::input(format!("{}: cannot read: {e}", path.display())))?;
+    let f = std::fs::File::open(path)
+        .map_err(|e| CliError::input(format!("{}: cannot read: {e}", path.display())))?;
     let mut out = Vec::new();
     f.take(limit as u64)
         .read_to_end(&mut out)

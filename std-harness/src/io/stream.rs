@@ -23,7 +23,11 @@ pub fn decode_into(bytes: &[u8], ty: SampleType, big_endian: bool, out: &mut [f3
             const N: usize = std::mem::size_of::<$t>();
             for (o, c) in out.iter_mut().zip(bytes.chunks_exact(N)) {
                 let a: [u8; N] = c.try_into().expect("chunk of N bytes");
-                *o = (if big_endian { <$t>::from_be_bytes(a) } else { <$t>::from_le_bytes(a) }) as f32;
+                *o = (if big_endian {
+                    <$t>::from_be_bytes(a)
+                } else {
+                    <$t>::from_le_bytes(a)
+                }) as f32;
             }
         }};
     }
@@ -82,27 +86,49 @@ pub struct FileSource {
 impl FileSource {
     /// Opens `layout.path`, checking that it holds the samples the layout describes.
     pub fn open(layout: Layout) -> Result<Self, CliError> {
-        let err = |e: std::io::Error| CliError::input(format!("{}: cannot read: {e}", layout.path.display()));
+        let err = |e: std::io::Error| {
+            CliError::input(format!("{}: cannot read: {e}", layout.path.display()))
+        };
         let file = std::fs::File::open(&layout.path).map_err(err)?;
         let len = file.metadata().map_err(err)?.len();
-        let need = crate::io::volume::byte_len(layout.dims, layout.ty).map_err(|e| crate::io::volume::at(&layout.path, e))? as u64;
+        let need = crate::io::volume::byte_len(layout.dims, layout.ty)
+            .map_err(|e| crate::io::volume::at(&layout.path, e))? as u64;
         if len < layout.offset + need {
-            return Err(crate::io::volume::at(&layout.path, format!("holds {len} bytes, needs {} after offset {}", need, layout.offset)));
+            return Err(crate::io::volume::at(
+                &layout.path,
+                format!(
+                    "holds {len} bytes, needs {} after offset {}",
+                    need, layout.offset
+                ),
+            ));
         }
-        Ok(FileSource { file, layout, cache: Vec::new(), cached: None, bytes: Vec::new(), last: None })
+        Ok(FileSource {
+            file,
+            layout,
+            cache: Vec::new(),
+            cached: None,
+            bytes: Vec::new(),
+            last: None,
+        })
     }
 
     fn read_at(&mut self, pos: u64, len: usize) -> Result<(), CliError> {
         self.bytes.resize(len, 0);
         self.file
             .read_exact_at(&mut self.bytes, self.layout.offset + pos)
-            .map_err(|e| CliError::input(format!("{}: read failed: {e}", self.layout.path.display())))
+            .map_err(|e| {
+                CliError::input(format!("{}: read failed: {e}", self.layout.path.display()))
+            })
     }
 
     /// Loads sheets [first, first + count) of `axis` into the cache.
     fn fill(&mut self, axis: usize, first: usize, count: usize) -> Result<(), CliError> {
         let [nx, ny, nz] = self.layout.dims;
-        let (ty, be, size) = (self.layout.ty, self.layout.big_endian, self.layout.ty.size());
+        let (ty, be, size) = (
+            self.layout.ty,
+            self.layout.big_endian,
+            self.layout.ty.size(),
+        );
         let (a, b) = footprint::geometry::in_sheet_axes(axis);
         let (na, nb) = (self.layout.dims[a], self.layout.dims[b]);
         let len = na * nb;
@@ -123,7 +149,8 @@ impl FileSource {
                     self.read_at(((k * ny + first) * nx * size) as u64, count * nx * size)?;
                     decode_into(&self.bytes, ty, be, &mut row);
                     for s in 0..count {
-                        self.cache[s * len + k * nx..s * len + (k + 1) * nx].copy_from_slice(&row[s * nx..(s + 1) * nx]);
+                        self.cache[s * len + k * nx..s * len + (k + 1) * nx]
+                            .copy_from_slice(&row[s * nx..(s + 1) * nx]);
                     }
                 }
             }
@@ -152,15 +179,23 @@ impl SheetSource for FileSource {
     type Error = CliError;
 
     fn read_sheet(&mut self, axis: usize, index: usize, out: &mut [f32]) -> Result<(), CliError> {
-        let hit = self.cached.is_some_and(|(ax, first, count)| ax == axis && index >= first && index < first + count);
+        let hit = self.cached.is_some_and(|(ax, first, count)| {
+            ax == axis && index >= first && index < first + count
+        });
         if !hit {
             let (a, b) = footprint::geometry::in_sheet_axes(axis);
             let len = self.layout.dims[a] * self.layout.dims[b];
             let n = self.layout.dims[axis];
             let count = (CACHE_BYTES / (4 * len)).clamp(1, n);
             // Read ahead in the direction the sheets are being requested.
-            let descending = self.last.is_some_and(|(ax, prev)| ax == axis && prev == index + 1);
-            let first = if descending { (index + 1).saturating_sub(count) } else { index.min(n - count) };
+            let descending = self
+                .last
+                .is_some_and(|(ax, prev)| ax == axis && prev == index + 1);
+            let first = if descending {
+                (index + 1).saturating_sub(count)
+            } else {
+                index.min(n - count)
+            };
             self.fill(axis, first, count)?;
         }
         let (_, first, _) = self.cached.expect("filled above");
@@ -185,7 +220,15 @@ pub struct PipeSource<R: Read> {
 impl<R: Read> PipeSource<R> {
     /// A source of `dims` samples of `ty` read from `reader`, z-slice after z-slice.
     pub fn new(reader: R, dims: [usize; 3], ty: SampleType, big_endian: bool, name: &str) -> Self {
-        PipeSource { reader, dims, ty, big_endian, next: 0, bytes: Vec::new(), name: name.into() }
+        PipeSource {
+            reader,
+            dims,
+            ty,
+            big_endian,
+            next: 0,
+            bytes: Vec::new(),
+            name: name.into(),
+        }
     }
 }
 
@@ -195,12 +238,18 @@ impl<R: Read> SheetSource for PipeSource<R> {
 
     fn read_sheet(&mut self, axis: usize, index: usize, out: &mut [f32]) -> Result<(), CliError> {
         if axis != 2 || index != self.next {
-            return Err(CliError::input(format!("{}: a pipe delivers z-slices in order; sheet {index} of axis {axis} was asked for", self.name)));
+            return Err(CliError::input(format!(
+                "{}: a pipe delivers z-slices in order; sheet {index} of axis {axis} was asked for",
+                self.name
+            )));
         }
         let len = self.dims[0] * self.dims[1] * self.ty.size();
         self.bytes.resize(len, 0);
         self.reader.read_exact(&mut self.bytes).map_err(|e| {
-            CliError::input(format!("{}: z-slice {index} of {}: {e} (the stream is shorter than --dims say)", self.name, self.dims[2]))
+            CliError::input(format!(
+                "{}: z-slice {index} of {}: {e} (the stream is shorter than --dims say)",
+                self.name, self.dims[2]
+            ))
         })?;
         decode_into(&self.bytes, self.ty, self.big_endian, out);
         self.next += 1;

@@ -82,7 +82,12 @@ pub const AXIS_ALIGNED: [[f32; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0,
 impl Volume {
     /// An axis-aligned volume.
     pub fn new(dims: [usize; 3], spacing: [f32; 3], samples: Samples) -> Self {
-        Volume { dims, spacing, directions: AXIS_ALIGNED, samples }
+        Volume {
+            dims,
+            spacing,
+            directions: AXIS_ALIGNED,
+            samples,
+        }
     }
 
     /// The grid-to-world matrix G: column c = `directions[c] × spacing[c]`.
@@ -154,7 +159,11 @@ pub fn decode(bytes: &[u8], ty: SampleType, big_endian: bool) -> Samples {
                     .chunks_exact(N)
                     .map(|c| {
                         let a: [u8; N] = c.try_into().expect("chunk of N bytes");
-                        if big_endian { <$t>::from_be_bytes(a) } else { <$t>::from_le_bytes(a) }
+                        if big_endian {
+                            <$t>::from_be_bytes(a)
+                        } else {
+                            <$t>::from_le_bytes(a)
+                        }
                     })
                     .collect(),
             )
@@ -176,8 +185,13 @@ pub fn decode(bytes: &[u8], ty: SampleType, big_endian: bool) -> Samples {
 pub fn decode_ascii(text: &[u8], ty: SampleType, count: usize) -> Result<Samples, String> {
     let text = std::str::from_utf8(text).map_err(|_| "ASCII data is not text".to_string())?;
     let mut values = Vec::with_capacity(count);
-    for word in text.split(|c: char| c.is_ascii_whitespace() || c == ',').filter(|w| !w.is_empty()) {
-        let v: f64 = word.parse().map_err(|_| format!("'{word}' is not a number"))?;
+    for word in text
+        .split(|c: char| c.is_ascii_whitespace() || c == ',')
+        .filter(|w| !w.is_empty())
+    {
+        let v: f64 = word
+            .parse()
+            .map_err(|_| format!("'{word}' is not a number"))?;
         values.push(v);
         if values.len() > count {
             return Err(format!("more than the {count} values the header states"));

@@ -13,7 +13,11 @@ fn inflate(r: impl Read, expected: usize, what: &str) -> Result<Vec<u8>, String>
     if out.len() != expected {
         return Err(format!(
             "{what} data decompresses to {}{} bytes, expected {expected}",
-            if out.len() > expected { "more than " } else { "" },
+            if out.len() > expected {
+                "more than "
+            } else {
+                ""
+            },
             out.len().min(expected)
         ));
     }

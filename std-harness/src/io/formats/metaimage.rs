@@ -34,13 +34,23 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
     let mut at = 0;
     let mut fields: Vec<(String, String)> = Vec::new();
     while at < bytes.len() {
-        let end = bytes[at..].iter().position(|&b| b == b'\n').map_or(bytes.len(), |p| at + p);
-        let line = std::str::from_utf8(&bytes[at..end]).map_err(|_| "header is not text".to_string())?.trim();
+        let end = bytes[at..]
+            .iter()
+            .position(|&b| b == b'\n')
+            .map_or(bytes.len(), |p| at + p);
+        let line = std::str::from_utf8(&bytes[at..end])
+            .map_err(|_| "header is not text".to_string())?
+            .trim();
         at = (end + 1).min(bytes.len());
         if line.is_empty() {
             continue;
         }
-        let (k, v) = line.split_once('=').ok_or_else(|| format!("malformed header line '{}'", line.chars().take(60).collect::<String>()))?;
+        let (k, v) = line.split_once('=').ok_or_else(|| {
+            format!(
+                "malformed header line '{}'",
+                line.chars().take(60).collect::<String>()
+            )
+        })?;
         let key = k.trim().to_string();
         fields.push((key.clone(), v.trim().to_string()));
         if key == "ElementDataFile" {
@@ -50,7 +60,12 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
             return Err("header has no ElementDataFile".into());
         }
     }
-    let get = |keys: &[&str]| fields.iter().find(|(k, _)| keys.contains(&k.as_str())).map(|(_, v)| v.as_str());
+    let get = |keys: &[&str]| {
+        fields
+            .iter()
+            .find(|(k, _)| keys.contains(&k.as_str()))
+            .map(|(_, v)| v.as_str())
+    };
     let need = |k: &str| get(&[k]).ok_or_else(|| format!("missing header field '{k}'"));
     if let Some(t) = get(&["ObjectType"]) {
         if t != "Image" {
@@ -61,7 +76,11 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
         return Err(format!("NDims: expected 3, found '{}'", need("NDims")?));
     }
     let ds = need("DimSize")?;
-    let d: Vec<usize> = ds.split_whitespace().map(|x| x.parse()).collect::<Result<_, _>>().map_err(|_| format!("DimSize: '{ds}' are not whole numbers"))?;
+    let d: Vec<usize> = ds
+        .split_whitespace()
+        .map(|x| x.parse())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("DimSize: '{ds}' are not whole numbers"))?;
     if d.len() != 3 {
         return Err(format!("DimSize: expected 3 values, found {}", d.len()));
     }
@@ -81,9 +100,16 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
     byte_len(dims, ty)?;
     let spacing = match get(&["ElementSpacing", "ElementSize"]) {
         Some(s) => {
-            let v: Vec<f32> = s.split_whitespace().map(|x| x.parse()).collect::<Result<_, _>>().map_err(|_| format!("ElementSpacing: '{s}' are not numbers"))?;
+            let v: Vec<f32> = s
+                .split_whitespace()
+                .map(|x| x.parse())
+                .collect::<Result<_, _>>()
+                .map_err(|_| format!("ElementSpacing: '{s}' are not numbers"))?;
             if v.len() != 3 {
-                return Err(format!("ElementSpacing: expected 3 values, found {}", v.len()));
+                return Err(format!(
+                    "ElementSpacing: expected 3 values, found {}",
+                    v.len()
+                ));
             }
             [v[0], v[1], v[2]]
         }
@@ -92,9 +118,16 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
     check_spacing(spacing)?;
     let directions = match get(&["TransformMatrix", "Rotation", "Orientation"]) {
         Some(s) => {
-            let v: Vec<f32> = s.split_whitespace().map(|x| x.parse()).collect::<Result<_, _>>().map_err(|_| format!("TransformMatrix: '{s}' are not numbers"))?;
+            let v: Vec<f32> = s
+                .split_whitespace()
+                .map(|x| x.parse())
+                .collect::<Result<_, _>>()
+                .map_err(|_| format!("TransformMatrix: '{s}' are not numbers"))?;
             if v.len() != 9 {
-                return Err(format!("TransformMatrix: expected 9 values, found {}", v.len()));
+                return Err(format!(
+                    "TransformMatrix: expected 9 values, found {}",
+                    v.len()
+                ));
             }
             let mut d = AXIS_ALIGNED;
             for (i, row) in d.iter_mut().enumerate() {
@@ -114,17 +147,32 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
         return Err("BinaryData = False (ASCII MetaImage) is not supported".into());
     }
     let compressed = get(&["CompressedData"]).is_some_and(is_true);
-    let header_size: i64 = get(&["HeaderSize"]).map_or(Ok(0), |v| v.parse().map_err(|_| format!("HeaderSize: '{v}' is not a whole number")))?;
+    let header_size: i64 = get(&["HeaderSize"]).map_or(Ok(0), |v| {
+        v.parse()
+            .map_err(|_| format!("HeaderSize: '{v}' is not a whole number"))
+    })?;
     if header_size < -1 || (header_size == -1 && compressed) {
         return Err(format!("HeaderSize: {header_size} is not allowed here"));
     }
     let file = need("ElementDataFile")?;
     let data_file = match file {
         "LOCAL" => None,
-        f if f.starts_with("LIST") || f.contains('%') => return Err("ElementDataFile: lists and patterns are not supported".into()),
+        f if f.starts_with("LIST") || f.contains('%') => {
+            return Err("ElementDataFile: lists and patterns are not supported".into())
+        }
         f => Some(f.to_string()),
     };
-    Ok(Header { dims, spacing, directions, ty, big_endian, compressed, data_file, header_size, header_len: at })
+    Ok(Header {
+        dims,
+        spacing,
+        directions,
+        ty,
+        big_endian,
+        compressed,
+        data_file,
+        header_size,
+        header_len: at,
+    })
 }
 
 fn data_bytes(path: &Path, h: &Header, file: &[u8]) -> Result<(PathBuf, Vec<u8>), CliError> {
@@ -161,11 +209,23 @@ pub fn load(path: &Path) -> Result<Volume, CliError> {
         }
         .unwrap_or(&[]);
         if body.len() != need {
-            return Err(err(format!("expected {need} bytes of {}x{}x{} {:?}, found {}", h.dims[0], h.dims[1], h.dims[2], h.ty, body.len())));
+            return Err(err(format!(
+                "expected {need} bytes of {}x{}x{} {:?}, found {}",
+                h.dims[0],
+                h.dims[1],
+                h.dims[2],
+                h.ty,
+                body.len()
+            )));
         }
         body.to_vec()
     };
-    Ok(Volume { dims: h.dims, spacing: h.spacing, directions: h.directions, samples: decode(&body, h.ty, h.big_endian) })
+    Ok(Volume {
+        dims: h.dims,
+        spacing: h.spacing,
+        directions: h.directions,
+        samples: decode(&body, h.ty, h.big_endian),
+    })
 }
 
 /// Where the samples of an uncompressed MetaImage are, for streaming: (file, byte offset, header).
@@ -173,18 +233,36 @@ pub fn raw_layout(path: &Path) -> Result<(PathBuf, u64, Header), CliError> {
     let head = crate::io::read_prefix(path, 1 << 16)?;
     let h = parse_header(&head).map_err(|e| at(path, e))?;
     if h.compressed {
-        return Err(at(path, "streaming needs uncompressed data (CompressedData = False)"));
+        return Err(at(
+            path,
+            "streaming needs uncompressed data (CompressedData = False)",
+        ));
     }
     let source = match &h.data_file {
         Some(name) => path.parent().unwrap_or(Path::new(".")).join(name),
         None => path.to_path_buf(),
     };
     let need = byte_len(h.dims, h.ty).map_err(|e| at(path, e))? as u64;
-    let len = std::fs::metadata(&source).map_err(|e| at(&source, format!("cannot read: {e}")))?.len();
-    let start = if h.data_file.is_some() { 0 } else { h.header_len as u64 };
-    let offset = if h.header_size == -1 { len.saturating_sub(need) } else { start + h.header_size as u64 };
+    let len = std::fs::metadata(&source)
+        .map_err(|e| at(&source, format!("cannot read: {e}")))?
+        .len();
+    let start = if h.data_file.is_some() {
+        0
+    } else {
+        h.header_len as u64
+    };
+    let offset = if h.header_size == -1 {
+        len.saturating_sub(need)
+    } else {
+        start + h.header_size as u64
+    };
     if len != offset + need {
-        return Err(at(&source, format!("expected {need} bytes of data after offset {offset}, the file has {len} bytes")));
+        return Err(at(
+            &source,
+            format!(
+                "expected {need} bytes of data after offset {offset}, the file has {len} bytes"
+            ),
+        ));
     }
     Ok((source, offset, h))
 }

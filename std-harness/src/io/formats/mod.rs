@@ -24,14 +24,19 @@ use crate::CliError;
 use std::path::Path;
 
 /// The formats by extension, for messages.
-pub const EXTENSIONS: &str = ".nrrd, .nhdr, .vti, .vtk, .mhd, .mha, .nii, .nii.gz, or raw with --dims and --type";
+pub const EXTENSIONS: &str =
+    ".nrrd, .nhdr, .vti, .vtk, .mhd, .mha, .nii, .nii.gz, or raw with --dims and --type";
 
 /// Loads `path` by its extension; `raw` options (from `--dims`/`--type`) make it headerless raw.
 pub fn load(path: &Path, raw: Option<&raw::RawOptions>) -> Result<Volume, CliError> {
     if let Some(o) = raw {
         return raw::load(path, o);
     }
-    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("").to_ascii_lowercase();
+    let name = path
+        .file_name()
+        .and_then(|n| n.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
     let ext = name.rsplit('.').next().unwrap_or("");
     match ext {
         "nrrd" | "nhdr" => nrrd::load(path),
@@ -40,6 +45,9 @@ pub fn load(path: &Path, raw: Option<&raw::RawOptions>) -> Result<Volume, CliErr
         "mhd" | "mha" => metaimage::load(path),
         "nii" => nifti::load(path),
         "gz" if name.ends_with(".nii.gz") => nifti::load(path),
-        _ => Err(at(path, format!("unknown volume format (use {EXTENSIONS})"))),
+        _ => Err(at(
+            path,
+            format!("unknown volume format (use {EXTENSIONS})"),
+        )),
     }
 }

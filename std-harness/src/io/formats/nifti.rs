@@ -4,7 +4,9 @@
 //! (if `qform_code` > 0). Either byte order (detected from `sizeof_hdr`).
 
 use super::compress;
-use crate::io::volume::{at, byte_len, check_spacing, decode, SampleType, Samples, Volume, AXIS_ALIGNED};
+use crate::io::volume::{
+    at, byte_len, check_spacing, decode, SampleType, Samples, Volume, AXIS_ALIGNED,
+};
 use crate::CliError;
 use std::path::Path;
 
@@ -27,24 +29,41 @@ pub struct Header {
 /// Parses the 348-byte header at the start of `b`.
 pub fn parse_header(b: &[u8]) -> Result<Header, String> {
     if b.len() < HEADER_LEN {
-        return Err(format!("file is {} bytes, shorter than a NIfTI-1 header ({HEADER_LEN})", b.len()));
+        return Err(format!(
+            "file is {} bytes, shorter than a NIfTI-1 header ({HEADER_LEN})",
+            b.len()
+        ));
     }
-    let big_endian = match (i32::from_le_bytes(b[0..4].try_into().expect("4")), i32::from_be_bytes(b[0..4].try_into().expect("4"))) {
+    let big_endian = match (
+        i32::from_le_bytes(b[0..4].try_into().expect("4")),
+        i32::from_be_bytes(b[0..4].try_into().expect("4")),
+    ) {
         (348, _) => false,
         (_, 348) => true,
         _ => return Err("sizeof_hdr is not 348: not a NIfTI-1 file".into()),
     };
     let i16_at = |o: usize| {
         let a = [b[o], b[o + 1]];
-        if big_endian { i16::from_be_bytes(a) } else { i16::from_le_bytes(a) }
+        if big_endian {
+            i16::from_be_bytes(a)
+        } else {
+            i16::from_le_bytes(a)
+        }
     };
     let f32_at = |o: usize| {
         let a = [b[o], b[o + 1], b[o + 2], b[o + 3]];
-        if big_endian { f32::from_be_bytes(a) } else { f32::from_le_bytes(a) }
+        if big_endian {
+            f32::from_be_bytes(a)
+        } else {
+            f32::from_le_bytes(a)
+        }
     };
     let magic = &b[344..348];
     if magic != b"n+1\0" {
-        return Err(format!("magic {:?}: only single-file NIfTI-1 (n+1) is supported", String::from_utf8_lossy(magic)));
+        return Err(format!(
+            "magic {:?}: only single-file NIfTI-1 (n+1) is supported",
+            String::from_utf8_lossy(magic)
+        ));
     }
     let ndim = i16_at(40);
     if !(3..=7).contains(&ndim) {
@@ -53,11 +72,18 @@ pub fn parse_header(b: &[u8]) -> Result<Header, String> {
     let mut dims = [0usize; 3];
     for (a, d) in dims.iter_mut().enumerate() {
         let v = i16_at(42 + 2 * a);
-        *d = usize::try_from(v).ok().filter(|&v| v > 0).ok_or_else(|| format!("dim[{}] = {v} is not positive", a + 1))?;
+        *d = usize::try_from(v)
+            .ok()
+            .filter(|&v| v > 0)
+            .ok_or_else(|| format!("dim[{}] = {v} is not positive", a + 1))?;
     }
     for a in 3..ndim as usize {
         if i16_at(42 + 2 * a) > 1 {
-            return Err(format!("dim[{}] = {}: only 3D volumes are supported", a + 1, i16_at(42 + 2 * a)));
+            return Err(format!(
+                "dim[{}] = {}: only 3D volumes are supported",
+                a + 1,
+                i16_at(42 + 2 * a)
+            ));
         }
     }
     let datatype = i16_at(70);
@@ -73,16 +99,23 @@ pub fn parse_header(b: &[u8]) -> Result<Header, String> {
         o => return Err(format!("datatype {o} is not supported")),
     };
     if i16_at(72) as usize != 8 * ty.size() {
-        return Err(format!("bitpix {} does not match datatype {datatype}", i16_at(72)));
+        return Err(format!(
+            "bitpix {} does not match datatype {datatype}",
+            i16_at(72)
+        ));
     }
     byte_len(dims, ty)?;
     let pixdim = [f32_at(80).abs(), f32_at(84).abs(), f32_at(88).abs()];
     let vox = f32_at(108);
     if !(vox >= HEADER_LEN as f32 && vox.fract() == 0.0 && vox < 1e9) {
-        return Err(format!("vox_offset {vox} is not a whole number ≥ {HEADER_LEN}"));
+        return Err(format!(
+            "vox_offset {vox} is not a whole number ≥ {HEADER_LEN}"
+        ));
     }
     let (slope, inter) = (f32_at(112), f32_at(116));
-    let scale = (slope.is_finite() && inter.is_finite() && slope != 0.0 && (slope, inter) != (1.0, 0.0)).then_some((slope, inter));
+    let scale =
+        (slope.is_finite() && inter.is_finite() && slope != 0.0 && (slope, inter) != (1.0, 0.0))
+            .then_some((slope, inter));
     let (qform, sform) = (i16_at(252), i16_at(254));
     let (spacing, directions) = if sform > 0 {
         // srow_x, srow_y, srow_z at 280, 296, 312: column j of the 3×3 part is axis j's step.
@@ -104,9 +137,21 @@ pub fn parse_header(b: &[u8]) -> Result<Header, String> {
         let qa = (1.0 - (qb * qb + qc * qc + qd * qd)).max(0.0).sqrt();
         let qfac = if f32_at(76) < 0.0 { -1.0 } else { 1.0 };
         let r = [
-            [qa * qa + qb * qb - qc * qc - qd * qd, 2.0 * (qb * qc - qa * qd), 2.0 * (qb * qd + qa * qc)],
-            [2.0 * (qb * qc + qa * qd), qa * qa + qc * qc - qb * qb - qd * qd, 2.0 * (qc * qd - qa * qb)],
-            [2.0 * (qb * qd - qa * qc), 2.0 * (qc * qd + qa * qb), qa * qa + qd * qd - qc * qc - qb * qb],
+            [
+                qa * qa + qb * qb - qc * qc - qd * qd,
+                2.0 * (qb * qc - qa * qd),
+                2.0 * (qb * qd + qa * qc),
+            ],
+            [
+                2.0 * (qb * qc + qa * qd),
+                qa * qa + qc * qc - qb * qb - qd * qd,
+                2.0 * (qc * qd - qa * qb),
+            ],
+            [
+                2.0 * (qb * qd - qa * qc),
+                2.0 * (qc * qd + qa * qb),
+                qa * qa + qd * qd - qc * qc - qb * qb,
+            ],
         ];
         let col = |c: usize, s: f32| [r[0][c] * s, r[1][c] * s, r[2][c] * s];
         (pixdim, [col(0, 1.0), col(1, 1.0), col(2, qfac)])
@@ -114,7 +159,15 @@ pub fn parse_header(b: &[u8]) -> Result<Header, String> {
         (pixdim, AXIS_ALIGNED)
     };
     check_spacing(spacing)?;
-    Ok(Header { dims, spacing, directions, ty, big_endian, vox_offset: vox as usize, scale })
+    Ok(Header {
+        dims,
+        spacing,
+        directions,
+        ty,
+        big_endian,
+        vox_offset: vox as usize,
+        scale,
+    })
 }
 
 /// Loads a `.nii` or `.nii.gz` volume.
@@ -123,7 +176,8 @@ pub fn load(path: &Path) -> Result<Volume, CliError> {
     let gz = file.starts_with(&[0x1f, 0x8b]);
     let bytes = if gz {
         // The header is inside the stream: inflate up to the largest volume accepted.
-        compress::gunzip_limited(&file, crate::io::volume::MAX_VOXELS.saturating_mul(8)).map_err(|e| at(path, e))?
+        compress::gunzip_limited(&file, crate::io::volume::MAX_VOXELS.saturating_mul(8))
+            .map_err(|e| at(path, e))?
     } else {
         file
     };
@@ -131,12 +185,24 @@ pub fn load(path: &Path) -> Result<Volume, CliError> {
     let need = byte_len(h.dims, h.ty).map_err(|e| at(path, e))?;
     let body = bytes.get(h.vox_offset..).unwrap_or(&[]);
     if body.len() < need {
-        return Err(at(path, format!("data truncated: need {need} bytes after vox_offset {}, found {}", h.vox_offset, body.len())));
+        return Err(at(
+            path,
+            format!(
+                "data truncated: need {need} bytes after vox_offset {}, found {}",
+                h.vox_offset,
+                body.len()
+            ),
+        ));
     }
     let mut samples = decode(&body[..need], h.ty, h.big_endian);
     if let Some((slope, inter)) = h.scale {
         let v = Volume::new(h.dims, h.spacing, samples);
         samples = Samples::F32((0..v.len()).map(|n| v.value(n) * slope + inter).collect());
     }
-    Ok(Volume { dims: h.dims, spacing: h.spacing, directions: h.directions, samples })
+    Ok(Volume {
+        dims: h.dims,
+        spacing: h.spacing,
+        directions: h.directions,
+        samples,
+    })
 }

@@ -8,7 +8,9 @@
 //! pairs are ignored; other fields (`kinds`, `centers`, `space`, …) are accepted and ignored.
 
 use super::compress;
-use crate::io::volume::{at, byte_len, check_spacing, decode, decode_ascii, SampleType, Volume, AXIS_ALIGNED};
+use crate::io::volume::{
+    at, byte_len, check_spacing, decode, decode_ascii, SampleType, Volume, AXIS_ALIGNED,
+};
 use crate::CliError;
 use std::path::{Path, PathBuf};
 
@@ -41,7 +43,10 @@ pub struct Header {
 /// Parses `(x,y,z)`.
 fn vector(s: &str) -> Option<[f32; 3]> {
     let inner = s.trim().strip_prefix('(')?.strip_suffix(')')?;
-    let v: Vec<f32> = inner.split(',').map(|x| x.trim().parse().ok()).collect::<Option<_>>()?;
+    let v: Vec<f32> = inner
+        .split(',')
+        .map(|x| x.trim().parse().ok())
+        .collect::<Option<_>>()?;
     (v.len() == 3 && v.iter().all(|x| x.is_finite())).then(|| [v[0], v[1], v[2]])
 }
 
@@ -67,17 +72,26 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
             if let Some((k, v)) = line.split_once(": ") {
                 fields.push((k.trim().to_ascii_lowercase(), v.trim().to_string()));
             } else if !line.contains(":=") {
-                return Err(format!("malformed header line '{}'", line.chars().take(60).collect::<String>()));
+                return Err(format!(
+                    "malformed header line '{}'",
+                    line.chars().take(60).collect::<String>()
+                ));
             }
         }
         if end.is_none() {
             break;
         }
     }
-    let get = |keys: &[&str]| fields.iter().find(|(k, _)| keys.contains(&k.as_str())).map(|(_, v)| v.as_str());
+    let get = |keys: &[&str]| {
+        fields
+            .iter()
+            .find(|(k, _)| keys.contains(&k.as_str()))
+            .map(|(_, v)| v.as_str())
+    };
     let need = |k: &str| get(&[k]).ok_or_else(|| format!("missing header field '{k}'"));
     let tyname = need("type")?;
-    let ty = SampleType::parse(tyname).ok_or_else(|| format!("type: '{tyname}' is not a supported sample type"))?;
+    let ty = SampleType::parse(tyname)
+        .ok_or_else(|| format!("type: '{tyname}' is not a supported sample type"))?;
     let dimension = need("dimension")?;
     if dimension.trim() != "3" {
         return Err(format!("dimension: expected 3, found '{dimension}'"));
@@ -95,17 +109,27 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
     byte_len(dims, ty)?;
     let (spacing, directions) = if let Some(sd) = get(&["space directions"]) {
         // Three vectors "(x,y,z)", separated by spaces.
-        let parts: Vec<&str> = sd.split(')').map(str::trim).filter(|p| !p.is_empty()).collect();
+        let parts: Vec<&str> = sd
+            .split(')')
+            .map(str::trim)
+            .filter(|p| !p.is_empty())
+            .collect();
         if parts.len() != 3 {
-            return Err(format!("space directions: expected 3 vectors, found '{sd}'"));
+            return Err(format!(
+                "space directions: expected 3 vectors, found '{sd}'"
+            ));
         }
         let mut spacing = [0.0f32; 3];
         let mut dirs = AXIS_ALIGNED;
         for (c, p) in parts.iter().enumerate() {
-            let v = vector(&format!("{p})")).ok_or_else(|| format!("space directions: '{p})' is not a 3-vector"))?;
+            let v = vector(&format!("{p})"))
+                .ok_or_else(|| format!("space directions: '{p})' is not a 3-vector"))?;
             let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
             if !(len > 0.0) {
-                return Err(format!("space directions: vector {} has zero length", c + 1));
+                return Err(format!(
+                    "space directions: vector {} has zero length",
+                    c + 1
+                ));
             }
             spacing[c] = len;
             dirs[c] = v.map(|x| x / len);
@@ -133,36 +157,68 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
         "raw" => Encoding::Raw,
         "gzip" | "gz" => Encoding::Gzip,
         "ascii" | "text" | "txt" => Encoding::Ascii,
-        other => return Err(format!("encoding: '{other}' is not supported (raw, gzip, ascii)")),
+        other => {
+            return Err(format!(
+                "encoding: '{other}' is not supported (raw, gzip, ascii)"
+            ))
+        }
     };
     let big_endian = match get(&["endian"]) {
         Some("big") => true,
         Some("little") => false,
         None if ty.size() == 1 || encoding == Encoding::Ascii => false,
-        None => return Err("missing header field 'endian' (required for multi-byte binary types)".into()),
+        None => {
+            return Err(
+                "missing header field 'endian' (required for multi-byte binary types)".into(),
+            )
+        }
         Some(other) => return Err(format!("endian: expected little or big, found '{other}'")),
     };
     let number = |keys: &[&str], name: &str| -> Result<i64, String> {
-        get(keys).map_or(Ok(0), |v| v.trim().parse().map_err(|_| format!("{name}: '{v}' is not a whole number")))
+        get(keys).map_or(Ok(0), |v| {
+            v.trim()
+                .parse()
+                .map_err(|_| format!("{name}: '{v}' is not a whole number"))
+        })
     };
     let byte_skip = number(&["byte skip", "byteskip"], "byte skip")?;
     if byte_skip < -1 || (byte_skip == -1 && encoding != Encoding::Raw) {
-        return Err(format!("byte skip: {byte_skip} is not allowed with {enc} encoding"));
+        return Err(format!(
+            "byte skip: {byte_skip} is not allowed with {enc} encoding"
+        ));
     }
     let line_skip = number(&["line skip", "lineskip"], "line skip")?;
-    let line_skip = usize::try_from(line_skip).map_err(|_| format!("line skip: {line_skip} is negative"))?;
+    let line_skip =
+        usize::try_from(line_skip).map_err(|_| format!("line skip: {line_skip} is negative"))?;
     let data_file = get(&["data file", "datafile"]).map(str::to_string);
-    if data_file.as_deref().is_some_and(|d| d.starts_with("LIST") || d.contains('%')) {
+    if data_file
+        .as_deref()
+        .is_some_and(|d| d.starts_with("LIST") || d.contains('%'))
+    {
         return Err("data file: lists and formatted file names are not supported".into());
     }
-    Ok(Header { ty, dims, spacing, directions, big_endian, encoding, data_file, line_skip, byte_skip, header_len: at })
+    Ok(Header {
+        ty,
+        dims,
+        spacing,
+        directions,
+        big_endian,
+        encoding,
+        data_file,
+        line_skip,
+        byte_skip,
+        header_len: at,
+    })
 }
 
 /// Skips `n` lines of `data`.
 fn skip_lines(data: &[u8], n: usize) -> Result<&[u8], String> {
     let mut rest = data;
     for i in 0..n {
-        let p = rest.iter().position(|&b| b == b'\n').ok_or_else(|| format!("line skip: the data have only {i} lines"))?;
+        let p = rest
+            .iter()
+            .position(|&b| b == b'\n')
+            .ok_or_else(|| format!("line skip: the data have only {i} lines"))?;
         rest = &rest[p + 1..];
     }
     Ok(rest)
@@ -197,7 +253,9 @@ pub fn load(path: &Path) -> Result<Volume, CliError> {
             let body = if h.byte_skip == -1 {
                 data.len().checked_sub(need).map(|s| &data[s..])
             } else {
-                usize::try_from(h.byte_skip).ok().and_then(|s| data.get(s..))
+                usize::try_from(h.byte_skip)
+                    .ok()
+                    .and_then(|s| data.get(s..))
             }
             .unwrap_or(&[]);
             if body.len() != need {
@@ -224,7 +282,12 @@ pub fn load(path: &Path) -> Result<Volume, CliError> {
             decode_ascii(data, h.ty, count).map_err(err)?
         }
     };
-    Ok(Volume { dims: h.dims, spacing: h.spacing, directions: h.directions, samples })
+    Ok(Volume {
+        dims: h.dims,
+        spacing: h.spacing,
+        directions: h.directions,
+        samples,
+    })
 }
 
 /// Where the samples of a raw-encoded NRRD are, for streaming: (file, byte offset, header).
@@ -237,11 +300,27 @@ pub fn raw_layout(path: &Path) -> Result<(PathBuf, u64, Header), CliError> {
     }
     let source = data_source(path, &h);
     let need = byte_len(h.dims, h.ty).map_err(|e| at(path, e))? as u64;
-    let len = std::fs::metadata(&source).map_err(|e| at(&source, format!("cannot read: {e}")))?.len();
-    let start = if h.data_file.is_some() { 0 } else { h.header_len as u64 };
-    let offset = if h.byte_skip == -1 { len.saturating_sub(need) } else { start + h.byte_skip as u64 };
+    let len = std::fs::metadata(&source)
+        .map_err(|e| at(&source, format!("cannot read: {e}")))?
+        .len();
+    let start = if h.data_file.is_some() {
+        0
+    } else {
+        h.header_len as u64
+    };
+    let offset = if h.byte_skip == -1 {
+        len.saturating_sub(need)
+    } else {
+        start + h.byte_skip as u64
+    };
     if len < offset + need || (h.byte_skip != -1 && len != offset + need) {
-        return Err(at(&source, format!("expected {} bytes of data after offset {offset}, the file has {len} bytes", need)));
+        return Err(at(
+            &source,
+            format!(
+                "expected {} bytes of data after offset {offset}, the file has {len} bytes",
+                need
+            ),
+        ));
     }
     Ok((source, offset, h))
 }

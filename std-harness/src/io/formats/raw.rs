@@ -36,5 +36,9 @@ pub fn load(path: &Path, o: &RawOptions) -> Result<Volume, CliError> {
             ),
         ));
     }
-    Ok(Volume::new(o.dims, o.spacing, decode(&bytes, o.ty, o.big_endian)))
+    Ok(Volume::new(
+        o.dims,
+        o.spacing,
+        decode(&bytes, o.ty, o.big_endian),
+    ))
 }

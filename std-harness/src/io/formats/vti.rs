@@ -3,7 +3,9 @@
 //! type UInt32 or UInt64; either byte order; `Spacing` and `Direction` (row-major) give the grid.
 
 use super::compress;
-use crate::io::volume::{at, byte_len, check_spacing, decode, decode_ascii, SampleType, Volume, AXIS_ALIGNED};
+use crate::io::volume::{
+    at, byte_len, check_spacing, decode, decode_ascii, SampleType, Volume, AXIS_ALIGNED,
+};
 use crate::CliError;
 use base64::Engine as _;
 use std::path::Path;
@@ -11,7 +13,11 @@ use std::path::Path;
 /// Decodes base64 text that may be several separately padded streams back to back (VTK encodes
 /// a compressed array's header and its blocks separately), ignoring whitespace.
 fn base64_segments(text: &[u8]) -> Result<Vec<u8>, String> {
-    let clean: Vec<u8> = text.iter().copied().filter(|b| !b.is_ascii_whitespace()).collect();
+    let clean: Vec<u8> = text
+        .iter()
+        .copied()
+        .filter(|b| !b.is_ascii_whitespace())
+        .collect();
     let mut out = Vec::with_capacity(clean.len() / 4 * 3);
     let mut start = 0;
     let mut i = 0;
@@ -61,7 +67,11 @@ pub enum Format {
 }
 
 fn numbers<T: std::str::FromStr>(s: &str, n: usize, what: &str) -> Result<Vec<T>, String> {
-    let v: Vec<T> = s.split_whitespace().map(|x| x.parse().ok()).collect::<Option<_>>().ok_or_else(|| format!("{what}: '{s}' is not {n} numbers"))?;
+    let v: Vec<T> = s
+        .split_whitespace()
+        .map(|x| x.parse().ok())
+        .collect::<Option<_>>()
+        .ok_or_else(|| format!("{what}: '{s}' is not {n} numbers"))?;
     if v.len() != n {
         return Err(format!("{what}: expected {n} numbers, found {}", v.len()));
     }
@@ -72,15 +82,26 @@ fn numbers<T: std::str::FromStr>(s: &str, n: usize, what: &str) -> Result<Vec<T>
 fn split_appended(bytes: &[u8]) -> Result<(String, Option<(&[u8], bool)>), String> {
     let tag = b"<AppendedData";
     match bytes.windows(tag.len()).position(|w| w == tag) {
-        None => Ok((String::from_utf8(bytes.to_vec()).map_err(|_| "XML is not UTF-8 text".to_string())?, None)),
+        None => Ok((
+            String::from_utf8(bytes.to_vec()).map_err(|_| "XML is not UTF-8 text".to_string())?,
+            None,
+        )),
         Some(p) => {
-            let head = std::str::from_utf8(&bytes[..p]).map_err(|_| "XML is not UTF-8 text".to_string())?;
+            let head = std::str::from_utf8(&bytes[..p])
+                .map_err(|_| "XML is not UTF-8 text".to_string())?;
             let rest = &bytes[p..];
-            let gt = rest.iter().position(|&b| b == b'>').ok_or("AppendedData tag is not closed")?;
-            let open = std::str::from_utf8(&rest[..gt]).map_err(|_| "AppendedData tag is not text")?;
+            let gt = rest
+                .iter()
+                .position(|&b| b == b'>')
+                .ok_or("AppendedData tag is not closed")?;
+            let open =
+                std::str::from_utf8(&rest[..gt]).map_err(|_| "AppendedData tag is not text")?;
             let raw = !open.contains("base64");
             let body = &rest[gt + 1..];
-            let us = body.iter().position(|&b| b == b'_').ok_or("AppendedData has no '_' marker")?;
+            let us = body
+                .iter()
+                .position(|&b| b == b'_')
+                .ok_or("AppendedData has no '_' marker")?;
             Ok((format!("{head}</VTKFile>"), Some((&body[us + 1..], raw))))
         }
     }
@@ -97,7 +118,11 @@ pub fn parse_header(bytes: &[u8]) -> Result<(Header, Option<(&[u8], bool)>), Str
     let big_endian = match root.attribute("byte_order") {
         Some("BigEndian") => true,
         Some("LittleEndian") | None => false,
-        Some(o) => return Err(format!("byte_order: '{o}' is not LittleEndian or BigEndian")),
+        Some(o) => {
+            return Err(format!(
+                "byte_order: '{o}' is not LittleEndian or BigEndian"
+            ))
+        }
     };
     let header64 = match root.attribute("header_type") {
         Some("UInt64") => true,
@@ -107,14 +132,30 @@ pub fn parse_header(bytes: &[u8]) -> Result<(Header, Option<(&[u8], bool)>), Str
     let zlib = match root.attribute("compressor") {
         None | Some("") => false,
         Some("vtkZLibDataCompressor") => true,
-        Some(o) => return Err(format!("compressor: '{o}' is not supported (vtkZLibDataCompressor only)")),
+        Some(o) => {
+            return Err(format!(
+                "compressor: '{o}' is not supported (vtkZLibDataCompressor only)"
+            ))
+        }
     };
-    let image = root.children().find(|n| n.has_tag_name("ImageData")).ok_or("no ImageData element")?;
-    let extent: Vec<i64> = numbers(image.attribute("WholeExtent").ok_or("ImageData has no WholeExtent")?, 6, "WholeExtent")?;
+    let image = root
+        .children()
+        .find(|n| n.has_tag_name("ImageData"))
+        .ok_or("no ImageData element")?;
+    let extent: Vec<i64> = numbers(
+        image
+            .attribute("WholeExtent")
+            .ok_or("ImageData has no WholeExtent")?,
+        6,
+        "WholeExtent",
+    )?;
     let mut dims = [0usize; 3];
     for a in 0..3 {
         let d = extent[2 * a + 1] - extent[2 * a] + 1;
-        dims[a] = usize::try_from(d).ok().filter(|&d| d > 0).ok_or_else(|| format!("WholeExtent: axis {a} is empty"))?;
+        dims[a] = usize::try_from(d)
+            .ok()
+            .filter(|&d| d > 0)
+            .ok_or_else(|| format!("WholeExtent: axis {a} is empty"))?;
     }
     let spacing: Vec<f32> = match image.attribute("Spacing") {
         Some(s) => numbers(s, 3, "Spacing")?,
@@ -139,12 +180,21 @@ pub fn parse_header(bytes: &[u8]) -> Result<(Header, Option<(&[u8], bool)>), Str
         }
         None => AXIS_ALIGNED,
     };
-    let pieces: Vec<_> = image.children().filter(|n| n.has_tag_name("Piece")).collect();
+    let pieces: Vec<_> = image
+        .children()
+        .filter(|n| n.has_tag_name("Piece"))
+        .collect();
     if pieces.len() != 1 {
         return Err(format!("expected one Piece, found {}", pieces.len()));
     }
-    let point_data = pieces[0].children().find(|n| n.has_tag_name("PointData")).ok_or("Piece has no PointData")?;
-    let arrays: Vec<_> = point_data.children().filter(|n| n.has_tag_name("DataArray")).collect();
+    let point_data = pieces[0]
+        .children()
+        .find(|n| n.has_tag_name("PointData"))
+        .ok_or("Piece has no PointData")?;
+    let arrays: Vec<_> = point_data
+        .children()
+        .filter(|n| n.has_tag_name("DataArray"))
+        .collect();
     let array = match point_data.attribute("Scalars") {
         Some(name) => arrays.iter().find(|a| a.attribute("Name") == Some(name)),
         None => arrays.first(),
@@ -152,7 +202,9 @@ pub fn parse_header(bytes: &[u8]) -> Result<(Header, Option<(&[u8], bool)>), Str
     .ok_or("PointData has no scalar DataArray")?;
     let comps = array.attribute("NumberOfComponents").unwrap_or("1");
     if comps != "1" {
-        return Err(format!("NumberOfComponents: {comps} (only scalar data are supported)"));
+        return Err(format!(
+            "NumberOfComponents: {comps} (only scalar data are supported)"
+        ));
     }
     let tyname = array.attribute("type").ok_or("DataArray has no type")?;
     let ty = match tyname {
@@ -172,21 +224,46 @@ pub fn parse_header(bytes: &[u8]) -> Result<(Header, Option<(&[u8], bool)>), Str
         "ascii" => Format::Ascii(text),
         "binary" => Format::Binary(text),
         "appended" => {
-            let off = array.attribute("offset").ok_or("appended DataArray has no offset")?;
-            Format::Appended { offset: off.trim().parse().map_err(|_| format!("offset: '{off}' is not a whole number"))? }
+            let off = array
+                .attribute("offset")
+                .ok_or("appended DataArray has no offset")?;
+            Format::Appended {
+                offset: off
+                    .trim()
+                    .parse()
+                    .map_err(|_| format!("offset: '{off}' is not a whole number"))?,
+            }
         }
-        o => return Err(format!("DataArray format '{o}' is not ascii, binary or appended")),
+        o => {
+            return Err(format!(
+                "DataArray format '{o}' is not ascii, binary or appended"
+            ))
+        }
     };
     if matches!(format, Format::Appended { .. }) && appended.is_none() {
         return Err("appended DataArray but no AppendedData section".into());
     }
-    Ok((Header { dims, spacing, directions, ty, big_endian, header64, zlib, format }, appended))
+    Ok((
+        Header {
+            dims,
+            spacing,
+            directions,
+            ty,
+            big_endian,
+            header64,
+            zlib,
+            format,
+        },
+        appended,
+    ))
 }
 
 /// Reads header words (UInt32 or UInt64) from `b` at word index `i`.
 fn word(b: &[u8], i: usize, h: &Header) -> Result<usize, String> {
     let size = if h.header64 { 8 } else { 4 };
-    let s = b.get(i * size..(i + 1) * size).ok_or("data block header is truncated")?;
+    let s = b
+        .get(i * size..(i + 1) * size)
+        .ok_or("data block header is truncated")?;
     let v = match (h.header64, h.big_endian) {
         (false, false) => u64::from(u32::from_le_bytes(s.try_into().expect("4"))),
         (false, true) => u64::from(u32::from_be_bytes(s.try_into().expect("4"))),
@@ -203,26 +280,40 @@ fn block_stream(b: &[u8], h: &Header, need: usize) -> Result<Vec<u8>, String> {
     if !h.zlib {
         let n = word(b, 0, h)?;
         if n != need {
-            return Err(format!("data block holds {n} bytes, the extent needs {need}"));
+            return Err(format!(
+                "data block holds {n} bytes, the extent needs {need}"
+            ));
         }
-        return b.get(size..size + n).map(<[u8]>::to_vec).ok_or_else(|| format!("data are truncated: expected {n} bytes"));
+        return b
+            .get(size..size + n)
+            .map(<[u8]>::to_vec)
+            .ok_or_else(|| format!("data are truncated: expected {n} bytes"));
     }
     let blocks = word(b, 0, h)?;
     let block_size = word(b, 1, h)?;
     let last = word(b, 2, h)?;
     if blocks == 0 || blocks > need.max(1) || block_size == 0 {
-        return Err(format!("compressed header: {blocks} blocks of {block_size} bytes is not plausible"));
+        return Err(format!(
+            "compressed header: {blocks} blocks of {block_size} bytes is not plausible"
+        ));
     }
     let last = if last == 0 { block_size } else { last };
-    let total = (blocks - 1).checked_mul(block_size).and_then(|t| t.checked_add(last)).ok_or("compressed header overflows")?;
+    let total = (blocks - 1)
+        .checked_mul(block_size)
+        .and_then(|t| t.checked_add(last))
+        .ok_or("compressed header overflows")?;
     if total != need {
-        return Err(format!("compressed data hold {total} bytes, the extent needs {need}"));
+        return Err(format!(
+            "compressed data hold {total} bytes, the extent needs {need}"
+        ));
     }
     let mut at = (3 + blocks) * size;
     let mut out = Vec::with_capacity(need);
     for k in 0..blocks {
         let c = word(b, 3 + k, h)?;
-        let chunk = b.get(at..at.checked_add(c).ok_or("block size overflows")?).ok_or("compressed data are truncated")?;
+        let chunk = b
+            .get(at..at.checked_add(c).ok_or("block size overflows")?)
+            .ok_or("compressed data are truncated")?;
         let expect = if k + 1 == blocks { last } else { block_size };
         out.extend(compress::unzlib(chunk, expect)?);
         at += c;
@@ -238,18 +329,30 @@ pub fn load(path: &Path) -> Result<Volume, CliError> {
     let err = |e: String| at(path, e);
     let samples = match &h.format {
         Format::Ascii(text) => decode_ascii(text, h.ty, need / h.ty.size()).map_err(err)?,
-        Format::Binary(text) => decode(&block_stream(&base64_segments(text).map_err(err)?, &h, need).map_err(err)?, h.ty, h.big_endian),
+        Format::Binary(text) => decode(
+            &block_stream(&base64_segments(text).map_err(err)?, &h, need).map_err(err)?,
+            h.ty,
+            h.big_endian,
+        ),
         Format::Appended { offset } => {
             let (section, raw) = appended.expect("checked by parse_header");
-            let start = section.get(*offset..).ok_or_else(|| err(format!("appended offset {offset} is past the end")))?;
+            let start = section
+                .get(*offset..)
+                .ok_or_else(|| err(format!("appended offset {offset} is past the end")))?;
             let bytes = if raw {
                 block_stream(start, &h, need).map_err(err)?
             } else {
                 let end = start.iter().position(|&b| b == b'<').unwrap_or(start.len());
-                block_stream(&base64_segments(&start[..end]).map_err(err)?, &h, need).map_err(err)?
+                block_stream(&base64_segments(&start[..end]).map_err(err)?, &h, need)
+                    .map_err(err)?
             };
             decode(&bytes, h.ty, h.big_endian)
         }
     };
-    Ok(Volume { dims: h.dims, spacing: h.spacing, directions: h.directions, samples })
+    Ok(Volume {
+        dims: h.dims,
+        spacing: h.spacing,
+        directions: h.directions,
+        samples,
+    })
 }

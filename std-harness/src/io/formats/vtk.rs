@@ -23,8 +23,14 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
     let mut at = 0;
     // The header is line-oriented: read lines until LOOKUP_TABLE (which ends it).
     while at < bytes.len() && lines.len() < 64 {
-        let end = bytes[at..].iter().position(|&b| b == b'\n').map_or(bytes.len(), |p| at + p);
-        let line = std::str::from_utf8(&bytes[at..end]).map_err(|_| "header is not text".to_string())?.trim().to_string();
+        let end = bytes[at..]
+            .iter()
+            .position(|&b| b == b'\n')
+            .map_or(bytes.len(), |p| at + p);
+        let line = std::str::from_utf8(&bytes[at..end])
+            .map_err(|_| "header is not text".to_string())?
+            .trim()
+            .to_string();
         at = (end + 1).min(bytes.len());
         let done = line.to_ascii_uppercase().starts_with("LOOKUP_TABLE");
         lines.push(line);
@@ -32,7 +38,10 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
             break;
         }
     }
-    if !lines.first().is_some_and(|l| l.starts_with("# vtk DataFile")) {
+    if !lines
+        .first()
+        .is_some_and(|l| l.starts_with("# vtk DataFile"))
+    {
         return Err("not a legacy VTK file (expected '# vtk DataFile Version')".into());
     }
     if lines.len() < 3 {
@@ -43,12 +52,17 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
         "BINARY" => true,
         o => return Err(format!("line 3: expected ASCII or BINARY, found '{o}'")),
     };
-    let (mut dims, mut spacing, mut ty, mut points, mut dataset, mut lut) = (None, None, None, None, None, false);
+    let (mut dims, mut spacing, mut ty, mut points, mut dataset, mut lut) =
+        (None, None, None, None, None, false);
     for line in &lines[3..] {
         let words: Vec<&str> = line.split_whitespace().collect();
         let Some(key) = words.first() else { continue };
         let nums = |n: usize| -> Result<Vec<f64>, String> {
-            let v: Vec<f64> = words[1..].iter().map(|w| w.parse().ok()).collect::<Option<_>>().ok_or_else(|| format!("{key}: '{line}' has a non-number"))?;
+            let v: Vec<f64> = words[1..]
+                .iter()
+                .map(|w| w.parse().ok())
+                .collect::<Option<_>>()
+                .ok_or_else(|| format!("{key}: '{line}' has a non-number"))?;
             if v.len() != n {
                 return Err(format!("{key}: expected {n} numbers, found {}", v.len()));
             }
@@ -58,8 +72,12 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
             "DATASET" => dataset = words.get(1).map(|s| s.to_ascii_uppercase()),
             "DIMENSIONS" => {
                 let v = nums(3)?;
-                if v.iter().any(|&x| !(x >= 1.0 && x.fract() == 0.0 && x < 1e12)) {
-                    return Err(format!("DIMENSIONS: '{line}' are not positive whole numbers"));
+                if v.iter()
+                    .any(|&x| !(x >= 1.0 && x.fract() == 0.0 && x < 1e12))
+                {
+                    return Err(format!(
+                        "DIMENSIONS: '{line}' are not positive whole numbers"
+                    ));
                 }
                 dims = Some([v[0] as usize, v[1] as usize, v[2] as usize]);
             }
@@ -94,12 +112,17 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
                 });
             }
             "LOOKUP_TABLE" => lut = true,
-            "CELL_DATA" | "FIELD" | "VECTORS" | "NORMALS" => return Err(format!("{key} before the scalars is not supported")),
+            "CELL_DATA" | "FIELD" | "VECTORS" | "NORMALS" => {
+                return Err(format!("{key} before the scalars is not supported"))
+            }
             _ => {}
         }
     }
     if dataset.as_deref() != Some("STRUCTURED_POINTS") {
-        return Err(format!("DATASET: expected STRUCTURED_POINTS, found {}", dataset.as_deref().unwrap_or("none")));
+        return Err(format!(
+            "DATASET: expected STRUCTURED_POINTS, found {}",
+            dataset.as_deref().unwrap_or("none")
+        ));
     }
     let dims = dims.ok_or("missing DIMENSIONS")?;
     let ty = ty.ok_or("missing SCALARS")?;
@@ -108,11 +131,19 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
     }
     let n = byte_len(dims, ty)? / ty.size();
     if points != Some(n as f64) {
-        return Err(format!("POINT_DATA: expected {n} (the DIMENSIONS' product), found {points:?}"));
+        return Err(format!(
+            "POINT_DATA: expected {n} (the DIMENSIONS' product), found {points:?}"
+        ));
     }
     let spacing = spacing.unwrap_or([1.0; 3]);
     check_spacing(spacing)?;
-    Ok(Header { dims, spacing, ty, binary, data_start: at })
+    Ok(Header {
+        dims,
+        spacing,
+        ty,
+        binary,
+        data_start: at,
+    })
 }
 
 /// Loads a legacy `.vtk` volume.
@@ -123,7 +154,15 @@ pub fn load(path: &Path) -> Result<Volume, CliError> {
     let data = &bytes[h.data_start..];
     let samples = if h.binary {
         // Anything after the samples (a trailing newline, further sections) is ignored.
-        let body = data.get(..need).ok_or_else(|| at(path, format!("binary data truncated: need {need} bytes, found {}", data.len())))?;
+        let body = data.get(..need).ok_or_else(|| {
+            at(
+                path,
+                format!(
+                    "binary data truncated: need {need} bytes, found {}",
+                    data.len()
+                ),
+            )
+        })?;
         decode(body, h.ty, true)
     } else {
         // ASCII: exactly the point count, then anything that is not a number ends the data.

@@ -1,0 +1,421 @@
+//! One volume saved in every supported format and encoding renders to the same image; streamed
+//! renders (seekable file, pipe) equal in-memory ones.
+//!
+//! The writers here are minimal and independent of the readers: each follows its format's
+//! documentation, so a reader that misreads a field shows up as a different image.
+
+use base64::Engine as _;
+use flate2::write::{GzEncoder, ZlibEncoder};
+use flate2::Compression;
+use footprint::source::SheetSource;
+use footprint_harness::io::stream::{FileSource, Layout, PipeSource};
+use footprint_harness::io::volume::SampleType;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+const DIMS: [usize; 3] = [20, 16, 12];
+const SPACING: [f32; 3] = [1.0, 1.5, 2.5];
+
+/// A test volume of u16 samples: a blob with some structure.
+fn samples() -> Vec<u16> {
+    let mut v = Vec::new();
+    for k in 0..DIMS[2] {
+        for j in 0..DIMS[1] {
+            for i in 0..DIMS[0] {
+                let (x, y, z) = (
+                    i as f32 - 9.5,
+                    (j as f32 - 7.5) * 1.5,
+                    (k as f32 - 5.5) * 2.5,
+                );
+                let r2 = x * x + y * y + z * z;
+                v.push(
+                    (4000.0 * (-r2 / 60.0).exp() + 300.0 * ((i + 2 * j + 3 * k) % 7) as f32) as u16,
+                );
+            }
+        }
+    }
+    v
+}
+
+fn le(v: &[u16]) -> Vec<u8> {
+    v.iter().flat_map(|x| x.to_le_bytes()).collect()
+}
+fn be(v: &[u16]) -> Vec<u8> {
+    v.iter().flat_map(|x| x.to_be_bytes()).collect()
+}
+fn gz(b: &[u8]) -> Vec<u8> {
+    let mut e = GzEncoder::new(Vec::new(), Compression::default());
+    e.write_all(b).unwrap();
+    e.finish().unwrap()
+}
+fn zlib(b: &[u8]) -> Vec<u8> {
+    let mut e = ZlibEncoder::new(Vec::new(), Compression::default());
+    e.write_all(b).unwrap();
+    e.finish().unwrap()
+}
+fn b64(b: &[u8]) -> String {
+    base64::engine::general_purpose::STANDARD.encode(b)
+}
+fn ascii(v: &[u16]) -> String {
+    v.iter()
+        .map(|x| x.to_string())
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+fn write(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, bytes).unwrap();
+    p
+}
+
+fn nrrd(dir: &Path, v: &[u16]) -> Vec<PathBuf> {
+    let head = |enc: &str, extra: &str| {
+        format!("NRRD0004\n# written by tests/formats.rs\ntype: unsigned short\ndimension: 3\nsizes: 20 16 12\n{extra}encoding: {enc}\n")
+    };
+    let sp = "spacings: 1 1.5 2.5\nendian: little\n";
+    let sd = "space: right-anterior-superior\nspace directions: (1,0,0) (0,1.5,0) (0,0,2.5)\nspace origin: (0,0,0)\nendian: big\n";
+    write(dir, "v.raw", &le(v));
+    vec![
+        write(dir, "detached.nhdr", (head("raw", sp) + "data file: v.raw\n").as_bytes()),
+        write(dir, "attached.nrrd", &[(head("raw", sp) + "\n").into_bytes(), le(v)].concat()),
+        write(dir, "gzip.nrrd", &[(head("gzip", sp) + "\n").into_bytes(), gz(&le(v))].concat()),
+        write(dir, "ascii.nrrd", (head("ascii", "spacings: 1 1.5 2.5\n") + "\n" + &ascii(v)).as_bytes()),
+        write(dir, "directions-big.nrrd", &[(head("raw", sd) + "\n").into_bytes(), be(v)].concat()),
+        write(dir, "old-spellings.nrrd", &[(format!("NRRD0001\ntype: ushort\ndimension: 3\nsizes: 20 16 12\nspacings: 1 1.5 2.5\nendian: little\nencoding: raw\nbyteskip: 4\n\n")).into_bytes(), vec![9; 4], le(v)].concat()),
+    ]
+}
+
+fn vti(dir: &Path, v: &[u16]) -> Vec<PathBuf> {
+    let head = |extra: &str| {
+        format!("<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"0.1\" byte_order=\"LittleEndian\" header_type=\"UInt32\"{extra}>\n<ImageData WholeExtent=\"0 19 0 15 0 11\" Origin=\"0 0 0\" Spacing=\"1 1.5 2.5\" Direction=\"1 0 0 0 1 0 0 0 1\">\n<Piece Extent=\"0 19 0 15 0 11\">\n<PointData Scalars=\"density\">\n")
+    };
+    let tail = "</PointData>\n<CellData>\n</CellData>\n</Piece>\n</ImageData>\n";
+    let data = le(v);
+    let n = data.len() as u32;
+    // Uncompressed inline binary: UInt32 byte count, then the data, one base64 stream.
+    let plain = b64(&[n.to_le_bytes().to_vec(), data.clone()].concat());
+    // zlib: blocks of 2048 bytes, header [nblocks, blocksize, lastsize, sizes...] encoded apart.
+    let blocks: Vec<Vec<u8>> = data.chunks(2048).map(zlib).collect();
+    let last = (data.len() % 2048) as u32;
+    let mut header = vec![blocks.len() as u32, 2048, last];
+    header.extend(blocks.iter().map(|b| b.len() as u32));
+    let hbytes: Vec<u8> = header.iter().flat_map(|x| x.to_le_bytes()).collect();
+    let compressed = b64(&hbytes) + &b64(&blocks.concat());
+    let array = |fmt: &str, body: &str, extra: &str| {
+        format!("<DataArray type=\"UInt16\" Name=\"density\" format=\"{fmt}\"{extra}>\n{body}\n</DataArray>\n")
+    };
+    let appended = [
+        (head("")
+            + &array("appended", "", " offset=\"0\"")
+            + tail
+            + "<AppendedData encoding=\"raw\">\n_")
+            .into_bytes(),
+        n.to_le_bytes().to_vec(),
+        data.clone(),
+        b"\n</AppendedData>\n</VTKFile>\n".to_vec(),
+    ]
+    .concat();
+    vec![
+        write(
+            dir,
+            "ascii.vti",
+            (head("") + &array("ascii", &ascii(v), "") + tail + "</VTKFile>\n").as_bytes(),
+        ),
+        write(
+            dir,
+            "binary.vti",
+            (head("") + &array("binary", &plain, "") + tail + "</VTKFile>\n").as_bytes(),
+        ),
+        write(
+            dir,
+            "zlib.vti",
+            (head(" compressor=\"vtkZLibDataCompressor\"")
+                + &array("binary", &compressed, "")
+                + tail
+                + "</VTKFile>\n")
+                .as_bytes(),
+        ),
+        write(dir, "appended.vti", &appended),
+    ]
+}
+
+fn vtk(dir: &Path, v: &[u16]) -> Vec<PathBuf> {
+    let head = |mode: &str| {
+        format!("# vtk DataFile Version 3.0\ntest volume\n{mode}\nDATASET STRUCTURED_POINTS\nDIMENSIONS 20 16 12\nORIGIN 0 0 0\nSPACING 1 1.5 2.5\nPOINT_DATA 3840\nSCALARS density unsigned_short 1\nLOOKUP_TABLE default\n")
+    };
+    vec![
+        write(
+            dir,
+            "ascii.vtk",
+            (head("ASCII") + &ascii(v) + "\n").as_bytes(),
+        ),
+        write(
+            dir,
+            "binary.vtk",
+            &[head("BINARY").into_bytes(), be(v), b"\n".to_vec()].concat(),
+        ),
+    ]
+}
+
+fn metaimage(dir: &Path, v: &[u16]) -> Vec<PathBuf> {
+    let head = |extra: &str, file: &str| {
+        format!("ObjectType = Image\nNDims = 3\nDimSize = 20 16 12\nElementType = MET_USHORT\nElementSpacing = 1 1.5 2.5\nTransformMatrix = 1 0 0 0 1 0 0 0 1\n{extra}ElementDataFile = {file}\n")
+    };
+    let z = zlib(&le(v));
+    write(dir, "meta.zraw", &z);
+    vec![
+        write(
+            dir,
+            "local.mha",
+            &[
+                head("ElementByteOrderMSB = False\n", "LOCAL").into_bytes(),
+                le(v),
+            ]
+            .concat(),
+        ),
+        write(
+            dir,
+            "big.mha",
+            &[
+                head("BinaryDataByteOrderMSB = True\n", "LOCAL").into_bytes(),
+                be(v),
+            ]
+            .concat(),
+        ),
+        write(dir, "detached.mhd", head("", "v.raw").as_bytes()),
+        write(
+            dir,
+            "zlib.mhd",
+            head(
+                &format!("CompressedData = True\nCompressedDataSize = {}\n", z.len()),
+                "meta.zraw",
+            )
+            .as_bytes(),
+        ),
+    ]
+}
+
+/// A NIfTI-1 header (little-endian), datatype 512 (u16), optional scaling.
+fn nifti_header(slope: f32, inter: f32) -> Vec<u8> {
+    let mut h = vec![0u8; 352];
+    h[0..4].copy_from_slice(&348i32.to_le_bytes());
+    let dims: [i16; 8] = [3, 20, 16, 12, 1, 1, 1, 1];
+    for (i, d) in dims.iter().enumerate() {
+        h[40 + 2 * i..42 + 2 * i].copy_from_slice(&d.to_le_bytes());
+    }
+    h[70..72].copy_from_slice(&512i16.to_le_bytes());
+    h[72..74].copy_from_slice(&16i16.to_le_bytes());
+    for (i, p) in [1.0f32, 1.0, 1.5, 2.5].iter().enumerate() {
+        h[76 + 4 * i..80 + 4 * i].copy_from_slice(&p.to_le_bytes());
+    }
+    h[108..112].copy_from_slice(&352f32.to_le_bytes());
+    h[112..116].copy_from_slice(&slope.to_le_bytes());
+    h[116..120].copy_from_slice(&inter.to_le_bytes());
+    h[344..348].copy_from_slice(b"n+1\0");
+    h
+}
+
+fn nifti(dir: &Path, v: &[u16]) -> Vec<PathBuf> {
+    let plain = [nifti_header(0.0, 0.0), le(v)].concat();
+    // Stored values s with scl_slope 2, scl_inter −100 mean 2s − 100: store (v + 100)/2 for even v.
+    let halves: Vec<u16> = v.iter().map(|&x| (x & !1).wrapping_add(100) / 2).collect();
+    let scaled = [nifti_header(2.0, -100.0), le(&halves)].concat();
+    vec![
+        write(dir, "plain.nii", &plain),
+        write(dir, "plain.nii.gz", &gz(&plain)),
+        write(dir, "scaled.nii", &scaled),
+    ]
+}
+
+fn tmpdir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("fp-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn render(args: &[&str], out: &Path) -> Vec<u8> {
+    let mut v = vec![
+        "footprint",
+        "render",
+        "--size",
+        "64x64",
+        "--window",
+        "0,4500",
+        "--shading",
+        "phong",
+    ];
+    v.extend_from_slice(args);
+    v.extend_from_slice(&["--out", out.to_str().unwrap()]);
+    assert_eq!(footprint_harness::run(v.clone()), 0, "{v:?}");
+    std::fs::read(out).unwrap()
+}
+
+#[test]
+fn every_format_renders_the_same_image() {
+    let d = tmpdir("formats");
+    let v = samples();
+    let out = d.join("out.png");
+    let raw = write(&d, "volume.raw", &le(&v));
+    let reference = render(
+        &[
+            raw.to_str().unwrap(),
+            "--dims",
+            "20,16,12",
+            "--type",
+            "u16",
+            "--spacing",
+            "1,1.5,2.5",
+            "--view",
+            "30,20,0",
+        ],
+        &out,
+    );
+    let mut files = nrrd(&d, &v);
+    files.extend(vti(&d, &v));
+    files.extend(vtk(&d, &v));
+    files.extend(metaimage(&d, &v));
+    files.extend(nifti(&d, &v));
+    assert_eq!(files.len(), 19);
+    for f in &files {
+        let name = f.file_name().unwrap().to_str().unwrap();
+        let img = render(&[f.to_str().unwrap(), "--view", "30,20,0"], &out);
+        if name == "scaled.nii" {
+            // Values rounded to even numbers by the writer: a close, not identical, image.
+            let (w, h, a) = footprint_harness::io::image::decode_png_rgba(&img, "a").unwrap();
+            let (_, _, b) = footprint_harness::io::image::decode_png_rgba(&reference, "b").unwrap();
+            let worst = a
+                .iter()
+                .zip(&b)
+                .flat_map(|(p, q)| (0..3).map(move |c| (p[c] - q[c]).abs()))
+                .fold(0.0f32, f32::max);
+            assert!(worst <= 3.0 / 255.0, "{name}: differs by {worst} ({w}x{h})");
+        } else {
+            assert!(
+                img == reference,
+                "{name} renders differently from the raw volume"
+            );
+        }
+    }
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn streamed_renders_equal_loaded_renders() {
+    let d = tmpdir("stream");
+    let v = samples();
+    let out = d.join("out.png");
+    let files = nrrd(&d, &v);
+    let mhd = metaimage(&d, &v);
+    let raw = d.join("v.raw");
+    // Straight (sheets along z, the file's slice axis), and views whose sheets run along y and x.
+    for view in ["30,20,0", "0,80,0", "80,0,0", "180,0,0"] {
+        let loaded = render(&[files[0].to_str().unwrap(), "--view", view], &out);
+        for (args, what) in [
+            (
+                vec!["--stream", files[0].to_str().unwrap()],
+                "detached NRRD",
+            ),
+            (
+                vec!["--stream", files[1].to_str().unwrap()],
+                "attached NRRD",
+            ),
+            (vec!["--stream", mhd[0].to_str().unwrap()], "MetaImage"),
+            (
+                vec![
+                    "--stream",
+                    raw.to_str().unwrap(),
+                    "--dims",
+                    "20,16,12",
+                    "--type",
+                    "u16",
+                    "--spacing",
+                    "1,1.5,2.5",
+                ],
+                "raw",
+            ),
+        ] {
+            let mut a = args.clone();
+            a.extend_from_slice(&["--view", view]);
+            assert!(
+                render(&a, &out) == loaded,
+                "{what} streamed at view {view} differs from loaded"
+            );
+        }
+    }
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+/// The pipe source delivers what the file source does, z-slice by z-slice, and refuses anything else.
+#[test]
+fn pipe_source_reads_file_order_only() {
+    let d = tmpdir("pipe");
+    let v = samples();
+    let raw = write(&d, "v.raw", &le(&v));
+    let layout = Layout {
+        path: raw,
+        offset: 0,
+        dims: DIMS,
+        ty: SampleType::U16,
+        big_endian: false,
+    };
+    let mut file = FileSource::open(layout).unwrap();
+    let bytes = le(&v);
+    let mut pipe = PipeSource::new(
+        std::io::Cursor::new(bytes.clone()),
+        DIMS,
+        SampleType::U16,
+        false,
+        "test pipe",
+    );
+    assert_eq!(pipe.sequential_axis(), Some(2));
+    let (mut a, mut b) = (vec![0.0f32; 320], vec![0.0f32; 320]);
+    for k in 0..DIMS[2] {
+        file.read_sheet(2, k, &mut a).unwrap();
+        pipe.read_sheet(2, k, &mut b).unwrap();
+        assert_eq!(a, b, "slice {k}");
+    }
+    let mut pipe = PipeSource::new(
+        std::io::Cursor::new(bytes.clone()),
+        DIMS,
+        SampleType::U16,
+        false,
+        "test pipe",
+    );
+    assert!(pipe.read_sheet(2, 1, &mut b).is_err(), "out of order");
+    assert!(pipe.read_sheet(1, 0, &mut b).is_err(), "another axis");
+    let mut short = PipeSource::new(
+        std::io::Cursor::new(bytes[..1000].to_vec()),
+        DIMS,
+        SampleType::U16,
+        false,
+        "test pipe",
+    );
+    let err = short
+        .read_sheet(2, 0, &mut b)
+        .and_then(|_| short.read_sheet(2, 1, &mut b))
+        .unwrap_err();
+    assert!(err.message.contains("shorter than --dims"), "{err}");
+    // Strided sheets from the file source match the volume read whole, along every axis.
+    let vol = footprint_harness::io::formats::nrrd::load(&nrrd(&d, &v)[0]).unwrap();
+    let layout = Layout {
+        path: d.join("v.raw"),
+        offset: 0,
+        dims: DIMS,
+        ty: SampleType::U16,
+        big_endian: false,
+    };
+    let mut file = FileSource::open(layout).unwrap();
+    for axis in 0..3 {
+        let (x, y) = footprint::geometry::in_sheet_axes(axis);
+        let len = DIMS[x] * DIMS[y];
+        let (mut a, mut b) = (vec![0.0f32; len], vec![0.0f32; len]);
+        for s in (0..DIMS[axis]).rev().chain(0..DIMS[axis]) {
+            file.read_sheet(axis, s, &mut a).unwrap();
+            vol.sheet_into(axis, s, &mut b);
+            assert_eq!(a, b, "axis {axis} sheet {s}");
+        }
+    }
+    std::fs::remove_dir_all(&d).unwrap();
+}
