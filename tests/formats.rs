@@ -14,7 +14,6 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 const DIMS: [usize; 3] = [20, 16, 12];
-const SPACING: [f32; 3] = [1.0, 1.5, 2.5];
 
 /// A test volume of u16 samples: a blob with some structure.
 fn samples() -> Vec<u16> {
@@ -82,7 +81,7 @@ fn nrrd(dir: &Path, v: &[u16]) -> Vec<PathBuf> {
         write(dir, "gzip.nrrd", &[(head("gzip", sp) + "\n").into_bytes(), gz(&le(v))].concat()),
         write(dir, "ascii.nrrd", (head("ascii", "spacings: 1 1.5 2.5\n") + "\n" + &ascii(v)).as_bytes()),
         write(dir, "directions-big.nrrd", &[(head("raw", sd) + "\n").into_bytes(), be(v)].concat()),
-        write(dir, "old-spellings.nrrd", &[(format!("NRRD0001\ntype: ushort\ndimension: 3\nsizes: 20 16 12\nspacings: 1 1.5 2.5\nendian: little\nencoding: raw\nbyteskip: 4\n\n")).into_bytes(), vec![9; 4], le(v)].concat()),
+        write(dir, "old-spellings.nrrd", &[b"NRRD0001\ntype: ushort\ndimension: 3\nsizes: 20 16 12\nspacings: 1 1.5 2.5\nendian: little\nencoding: raw\nbyteskip: 4\n\n".to_vec(), vec![9; 4], le(v)].concat()),
     ]
 }
 
@@ -407,11 +406,11 @@ fn pipe_source_reads_file_order_only() {
         big_endian: false,
     };
     let mut file = FileSource::open(layout).unwrap();
-    for axis in 0..3 {
+    for (axis, &count) in DIMS.iter().enumerate() {
         let (x, y) = footprint::geometry::in_sheet_axes(axis);
         let len = DIMS[x] * DIMS[y];
         let (mut a, mut b) = (vec![0.0f32; len], vec![0.0f32; len]);
-        for s in (0..DIMS[axis]).rev().chain(0..DIMS[axis]) {
+        for s in (0..count).rev().chain(0..count) {
             file.read_sheet(axis, s, &mut a).unwrap();
             vol.sheet_into(axis, s, &mut b);
             assert_eq!(a, b, "axis {axis} sheet {s}");

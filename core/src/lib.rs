@@ -123,5 +123,7 @@ from_error!(
     Kernel(KernelSpecError),
     Geometry(GeometryError),
     Table(TableError),
-    Buffer(BufferError)
+    Buffer(BufferError),
+    Frame(frame::FrameError),
+    Render(render::RenderError)
 );

@@ -78,8 +78,15 @@ fn numbers<T: std::str::FromStr>(s: &str, n: usize, what: &str) -> Result<Vec<T>
     Ok(v)
 }
 
-/// Splits a file at `<AppendedData`: (XML text, appended section after its `_`, its encoding).
-fn split_appended(bytes: &[u8]) -> Result<(String, Option<(&[u8], bool)>), String> {
+/// The AppendedData section: its bytes after the `_` marker, and whether they are raw (not base64).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Appended<'a> {
+    pub bytes: &'a [u8],
+    pub raw: bool,
+}
+
+/// Splits a file at `<AppendedData`: the XML text, and the appended section if there is one.
+fn split_appended(bytes: &[u8]) -> Result<(String, Option<Appended<'_>>), String> {
     let tag = b"<AppendedData";
     match bytes.windows(tag.len()).position(|w| w == tag) {
         None => Ok((
@@ -102,13 +109,19 @@ fn split_appended(bytes: &[u8]) -> Result<(String, Option<(&[u8], bool)>), Strin
                 .iter()
                 .position(|&b| b == b'_')
                 .ok_or("AppendedData has no '_' marker")?;
-            Ok((format!("{head}</VTKFile>"), Some((&body[us + 1..], raw))))
+            Ok((
+                format!("{head}</VTKFile>"),
+                Some(Appended {
+                    bytes: &body[us + 1..],
+                    raw,
+                }),
+            ))
         }
     }
 }
 
 /// Parses the XML of a `.vti` (the appended section, if any, is returned separately).
-pub fn parse_header(bytes: &[u8]) -> Result<(Header, Option<(&[u8], bool)>), String> {
+pub fn parse_header(bytes: &[u8]) -> Result<(Header, Option<Appended<'_>>), String> {
     let (xml, appended) = split_appended(bytes)?;
     let doc = roxmltree::Document::parse(&xml).map_err(|e| format!("not valid XML: {e}"))?;
     let root = doc.root_element();
@@ -335,7 +348,10 @@ pub fn load(path: &Path) -> Result<Volume, CliError> {
             h.big_endian,
         ),
         Format::Appended { offset } => {
-            let (section, raw) = appended.expect("checked by parse_header");
+            let Appended {
+                bytes: section,
+                raw,
+            } = appended.expect("checked by parse_header");
             let start = section
                 .get(*offset..)
                 .ok_or_else(|| err(format!("appended offset {offset} is past the end")))?;
