@@ -325,7 +325,7 @@ impl<'a, S: Sampler + ?Sized> SheetRenderer<'a, S> {
 /// World-space gradient (value units per world unit) at voxel (u, v) of `window`'s current
 /// sheet: central differences along each grid axis (one-sided at the volume's faces, zero along
 /// an axis one voxel thick), turned into world space by G⁻ᵀ so anisotropic and sheared grids
-/// are honoured.
+/// are honoured. Non-finite neighbours count as the centre's value.
 pub fn gradient<T: Sample>(
     frame: &FrameSetup,
     window: &SheetWindow<'_, T>,
@@ -335,15 +335,21 @@ pub fn gradient<T: Sample>(
     let (_, na, nb) = frame.sheet_shape();
     let (k, (a, b)) = (frame.sheet_axis, frame.in_sheet);
     let cur = window.current;
-    let at = |uu: usize, vv: usize| cur[vv * na + uu].to_f32();
     let here = v * na + u;
+    let centre = cur[here].to_f32();
+    // A non-finite neighbour is missing data: it stands in as the centre's value (no slope toward
+    // it), so no NaN reaches a normal.
+    let finite = |x: f32| if x.is_finite() { x } else { centre };
+    let at = |uu: usize, vv: usize| finite(cur[vv * na + uu].to_f32());
     let mut g = [0.0f32; 3];
     g[a] = central(u, na, |x| at(x, v));
     g[b] = central(v, nb, |y| at(u, y));
-    g[k] = match (window.lower, window.upper) {
-        (Some(lo), Some(hi)) => 0.5 * (hi[here].to_f32() - lo[here].to_f32()),
-        (Some(lo), None) => cur[here].to_f32() - lo[here].to_f32(),
-        (None, Some(hi)) => hi[here].to_f32() - cur[here].to_f32(),
+    let lower = window.lower.map(|s| finite(s[here].to_f32()));
+    let upper = window.upper.map(|s| finite(s[here].to_f32()));
+    g[k] = match (lower, upper) {
+        (Some(lo), Some(hi)) => 0.5 * (hi - lo),
+        (Some(lo), None) => centre - lo,
+        (None, Some(hi)) => hi - centre,
         (None, None) => 0.0,
     };
     frame.grid_inverse_transpose * Vec3::from_array(g)

@@ -1,0 +1,325 @@
+//! Bad input never hurts: every malformed volume is a one-line error naming the file and what was
+//! expected, exit code 2, no panic, and no output file left behind.
+
+use footprint_harness::io::formats;
+use std::path::{Path, PathBuf};
+
+fn tmpdir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("fp-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// (file name, contents, a word the message must contain).
+type Case = (&'static str, Vec<u8>, &'static str);
+
+fn nrrd(fields: &str, data: &[u8]) -> Vec<u8> {
+    [format!("NRRD0004\n{fields}\n").into_bytes(), data.to_vec()].concat()
+}
+
+const OK_NRRD: &str = "type: uint8\ndimension: 3\nsizes: 4 3 2\nencoding: raw\n";
+
+fn gz(b: &[u8]) -> Vec<u8> {
+    use std::io::Write;
+    let mut e = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
+    e.write_all(b).unwrap();
+    e.finish().unwrap()
+}
+
+fn vti(attrs: &str, array: &str) -> Vec<u8> {
+    format!(
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"0.1\" byte_order=\"LittleEndian\"{attrs}>\n<ImageData WholeExtent=\"0 3 0 2 0 1\" Spacing=\"1 1 1\">\n<Piece Extent=\"0 3 0 2 0 1\"><PointData Scalars=\"s\">{array}</PointData></Piece></ImageData></VTKFile>\n"
+    )
+    .into_bytes()
+}
+
+fn vtk(mode: &str, dims: &str, points: &str, ty: &str, data: &[u8]) -> Vec<u8> {
+    [
+        format!("# vtk DataFile Version 3.0\nbad\n{mode}\nDATASET STRUCTURED_POINTS\nDIMENSIONS {dims}\nSPACING 1 1 1\nPOINT_DATA {points}\nSCALARS s {ty} 1\nLOOKUP_TABLE default\n").into_bytes(),
+        data.to_vec(),
+    ]
+    .concat()
+}
+
+fn mha(fields: &str, data: &[u8]) -> Vec<u8> {
+    [
+        format!("ObjectType = Image\nNDims = 3\n{fields}ElementDataFile = LOCAL\n").into_bytes(),
+        data.to_vec(),
+    ]
+    .concat()
+}
+
+fn nifti(datatype: i16, dims: [i16; 3], vox: f32, data_len: usize) -> Vec<u8> {
+    let mut h = vec![0u8; 352];
+    h[0..4].copy_from_slice(&348i32.to_le_bytes());
+    for (i, d) in [3i16, dims[0], dims[1], dims[2], 1, 1, 1, 1]
+        .iter()
+        .enumerate()
+    {
+        h[40 + 2 * i..42 + 2 * i].copy_from_slice(&d.to_le_bytes());
+    }
+    h[70..72].copy_from_slice(&datatype.to_le_bytes());
+    h[72..74].copy_from_slice(&8i16.to_le_bytes());
+    for i in 0..4 {
+        h[76 + 4 * i..80 + 4 * i].copy_from_slice(&1f32.to_le_bytes());
+    }
+    h[108..112].copy_from_slice(&vox.to_le_bytes());
+    h[344..348].copy_from_slice(b"n+1\0");
+    h.extend(vec![7u8; data_len]);
+    h
+}
+
+fn cases() -> Vec<Case> {
+    let data = vec![5u8; 24];
+    vec![
+        // NRRD
+        ("truncated.nrrd", nrrd(OK_NRRD, &data[..23]), "24 bytes"),
+        ("too-long.nrrd", nrrd(OK_NRRD, &[0u8; 25]), "24 bytes"),
+        ("unknown-type.nrrd", nrrd(&OK_NRRD.replace("uint8", "complex"), &data), "type"),
+        ("unknown-encoding.nrrd", nrrd(&OK_NRRD.replace("raw", "bzip2"), &data), "encoding"),
+        ("corrupt-gzip.nrrd", nrrd(&OK_NRRD.replace("raw", "gzip"), &[0x1f, 0x8b, 8, 0, 1, 2, 3, 4, 5, 6, 7]), "gzip"),
+        ("short-gzip.nrrd", nrrd(&OK_NRRD.replace("raw", "gzip"), &gz(&data[..10])), "expected 24"),
+        ("non-numeric-sizes.nrrd", nrrd(&OK_NRRD.replace("4 3 2", "4 three 2"), &data), "sizes"),
+        ("missing-type.nrrd", nrrd(&OK_NRRD.replace("type: uint8\n", ""), &data), "type"),
+        ("zero-dims.nrrd", nrrd(&OK_NRRD.replace("4 3 2", "4 0 2"), &[]), "zero"),
+        ("overflow-dims.nrrd", nrrd(&OK_NRRD.replace("4 3 2", "99999999999 99999999999 99999999999"), &[]), "voxels"),
+        ("nan-spacing.nrrd", nrrd(&(OK_NRRD.to_string() + "spacings: 1 nan 1\n"), &data), "spacing"),
+        ("bad-ascii.nrrd", nrrd(&OK_NRRD.replace("raw", "ascii"), b"1 2 3 x"), "not a number"),
+        ("bad-magic.nrrd", b"NRRD0009\ntype: uint8\n\n".to_vec(), "magic"),
+        // VTK XML
+        ("bad-base64.vti", vti("", "<DataArray type=\"UInt8\" Name=\"s\" format=\"binary\">@@@@!!!</DataArray>"), "base64"),
+        ("corrupt-zlib.vti", vti(" header_type=\"UInt32\" compressor=\"vtkZLibDataCompressor\"", "<DataArray type=\"UInt8\" Name=\"s\" format=\"binary\">AQAAABgAAAAYAAAACgAAAA==AAECAwQFBgcICQ==</DataArray>"), "zlib"),
+        ("wrong-count.vti", vti("", "<DataArray type=\"UInt8\" Name=\"s\" format=\"ascii\">1 2 3</DataArray>"), "expected 24"),
+        ("unknown-type.vti", vti("", "<DataArray type=\"Int64\" Name=\"s\" format=\"ascii\">1</DataArray>"), "Int64"),
+        ("not-xml.vti", b"<VTKFile type=\"ImageData\"><unclosed".to_vec(), "XML"),
+        ("lz4.vti", vti(" compressor=\"vtkLZ4DataCompressor\"", ""), "compressor"),
+        // Legacy VTK
+        ("truncated-binary.vtk", vtk("BINARY", "4 3 2", "24", "unsigned_char", &data[..20]), "truncated"),
+        ("point-mismatch.vtk", vtk("ASCII", "4 3 2", "25", "unsigned_char", b"1"), "POINT_DATA"),
+        ("unknown-type.vtk", vtk("ASCII", "4 3 2", "24", "quaternion", b"1"), "type"),
+        ("negative-dims.vtk", vtk("ASCII", "4 -3 2", "24", "float", b"1"), "DIMENSIONS"),
+        ("bad-mode.vtk", vtk("UTF8", "4 3 2", "24", "float", b"1"), "ASCII or BINARY"),
+        // MetaImage
+        ("truncated.mha", mha("DimSize = 4 3 2\nElementType = MET_UCHAR\n", &data[..3]), "24 bytes"),
+        ("unknown-type.mha", mha("DimSize = 4 3 2\nElementType = MET_LONG_LONG\n", &data), "ElementType"),
+        ("corrupt-zlib.mha", mha("DimSize = 4 3 2\nElementType = MET_UCHAR\nCompressedData = True\n", b"not zlib at all"), "zlib"),
+        ("missing-dimsize.mha", mha("ElementType = MET_UCHAR\n", &data), "DimSize"),
+        // NIfTI
+        ("truncated.nii", nifti(2, [4, 3, 2], 352.0, 10), "truncated"),
+        ("bad-datatype.nii", nifti(1792, [4, 3, 2], 352.0, 24), "datatype"),
+        ("zero-dim.nii", nifti(2, [4, 0, 2], 352.0, 24), "dim[2]"),
+        ("bad-vox-offset.nii", nifti(2, [4, 3, 2], 10.0, 24), "vox_offset"),
+        ("short-header.nii", vec![0u8; 100], "shorter"),
+        ("corrupt.nii.gz", vec![0x1f, 0x8b, 8, 0, 9, 9, 9], "gzip"),
+        // Any format
+        ("empty.nrrd", vec![], "magic"),
+        ("empty.vti", vec![], "XML"),
+        ("empty.vtk", vec![], "legacy VTK"),
+        ("empty.mha", vec![], "NDims"),
+        ("empty.nii", vec![], "shorter"),
+        ("unknown.xyz", data.clone(), "unknown volume format"),
+    ]
+}
+
+fn run(args: &[&str]) -> i32 {
+    let mut v = vec!["footprint", "render"];
+    v.extend_from_slice(args);
+    footprint_harness::run(v)
+}
+
+#[test]
+fn malformed_volumes_fail_cleanly() {
+    let d = tmpdir("bad-input");
+    let out = d.join("out.png");
+    for (name, bytes, word) in cases() {
+        let p = d.join(name);
+        std::fs::write(&p, &bytes).unwrap();
+        let err = formats::load(&p, None).expect_err(name).message;
+        assert!(
+            err.contains(name),
+            "{name}: message does not name the file: {err}"
+        );
+        assert!(
+            err.contains(word),
+            "{name}: message should say '{word}': {err}"
+        );
+        assert!(
+            !err.contains('\n'),
+            "{name}: message is not one line: {err}"
+        );
+        assert_eq!(
+            run(&[
+                p.to_str().unwrap(),
+                "--size",
+                "16x16",
+                "--out",
+                out.to_str().unwrap()
+            ]),
+            2,
+            "{name}"
+        );
+        assert!(!out.exists(), "{name} left an output");
+    }
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn bad_paths_and_sizes_fail_cleanly() {
+    let d = tmpdir("bad-paths");
+    let out = d.join("out.png");
+    let o = out.to_str().unwrap();
+    let dir = d.join("a-directory.nrrd");
+    std::fs::create_dir_all(&dir).unwrap();
+    let msg = formats::load(&dir, None).unwrap_err().message;
+    assert!(msg.contains("is a directory"), "{msg}");
+    let raw = d.join("v.raw");
+    std::fs::write(&raw, [1u8; 24]).unwrap();
+    let r = raw.to_str().unwrap();
+    for args in [
+        vec![dir.to_str().unwrap(), "--out", o],
+        vec!["/no/such/volume.nhdr", "--out", o],
+        vec![r, "--dims", "4,3,3", "--type", "u8", "--out", o],
+        vec![r, "--dims", "4,3,0", "--type", "u8", "--out", o],
+        vec![
+            r,
+            "--dims",
+            "99999999999,99999999999,99999999999",
+            "--type",
+            "u8",
+            "--out",
+            o,
+        ],
+        vec![
+            r,
+            "--dims",
+            "4,3,2",
+            "--type",
+            "u8",
+            "--size",
+            "100000x100000",
+            "--out",
+            o,
+        ],
+        vec![
+            r, "--dims", "4,3,2", "--type", "u8", "--size", "0x5", "--out", o,
+        ],
+        vec![
+            r,
+            "--dims",
+            "4,3,2",
+            "--type",
+            "u8",
+            "--spacing",
+            "1,-1,1",
+            "--out",
+            o,
+        ],
+        vec!["--stream", r, "--out", o],
+        vec!["--stream", "-", "--out", o],
+        vec!["--stream", r, "--dims", "4,3,3", "--type", "u8", "--out", o],
+        vec![
+            r, "--stream", r, "--dims", "4,3,2", "--type", "u8", "--out", o,
+        ],
+    ] {
+        assert_eq!(run(&args), 2, "{args:?}");
+        assert!(!out.exists(), "{args:?} left an output");
+    }
+    // Writing into a folder that does not exist fails without leaving a temporary file.
+    let nowhere = d.join("missing-dir").join("x.png");
+    assert_eq!(
+        run(&[
+            r,
+            "--dims",
+            "4,3,2",
+            "--type",
+            "u8",
+            "--size",
+            "8x8",
+            "--out",
+            nowhere.to_str().unwrap()
+        ]),
+        2
+    );
+    assert!(std::fs::read_dir(&d).unwrap().all(|e| !e
+        .unwrap()
+        .file_name()
+        .to_string_lossy()
+        .contains(".tmp-")));
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+/// Non-finite samples are missing data: transparent, and in gradients they count as the centre's
+/// value. A volume of NaN and ±∞ around a finite core renders exactly like the core alone under
+/// emission, and under Phong no NaN reaches a normal.
+#[test]
+fn non_finite_samples_are_transparent() {
+    let d = tmpdir("nonfinite");
+    let mut with = Vec::new();
+    let mut without = Vec::new();
+    for n in 0..(8 * 8 * 8) {
+        let (i, j, k) = (n % 8, (n / 8) % 8, n / 64);
+        let core = (2..6).contains(&i) && (2..6).contains(&j) && (2..6).contains(&k);
+        let bad = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY][n % 3];
+        with.extend_from_slice(&(if core { 0.7f32 } else { bad }).to_le_bytes());
+        without.extend_from_slice(&(if core { 0.7f32 } else { 0.0 }).to_le_bytes());
+    }
+    let (a, b) = (d.join("with.raw"), d.join("without.raw"));
+    std::fs::write(&a, &with).unwrap();
+    std::fs::write(&b, &without).unwrap();
+    let render = |p: &Path, shading: &str, out: &Path| {
+        let args = [
+            p.to_str().unwrap(),
+            "--dims",
+            "8,8,8",
+            "--type",
+            "f32",
+            "--window",
+            "0,1",
+            "--shading",
+            shading,
+            "--size",
+            "48x48",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        assert_eq!(run(&args), 0);
+        footprint_harness::io::image::decode_png_rgba(&std::fs::read(out).unwrap(), "png")
+            .unwrap()
+            .2
+    };
+    let (ea, eb) = (
+        render(&a, "emission", &d.join("a.png")),
+        render(&b, "emission", &d.join("b.png")),
+    );
+    assert!(ea == eb, "non-finite samples changed the emission image");
+    // Phong: the core is constant and its missing neighbours count as the centre's value, so every
+    // core gradient is zero and every voxel is lit by ambient + diffuse = 0.9 (the default Phong):
+    // the Phong image is 0.9 × the emission image, to 8-bit rounding.
+    let pa = render(&a, "phong", &d.join("pa.png"));
+    let worst = pa
+        .iter()
+        .zip(&ea)
+        .flat_map(|(p, e)| (0..3).map(move |ch| (p[ch] - 0.9 * e[ch]).abs()))
+        .fold(0.0f32, f32::max);
+    assert!(
+        worst <= 1.0 / 255.0,
+        "Phong next to missing data differs from 0.9 × emission by {worst}"
+    );
+    assert!(pa.iter().any(|p| p[0] > 0.1), "the core is visible");
+    // Without --window the range ignores non-finite samples (all-finite part is constant 0.7 and
+    // 0 in the second file, so its window is [0, 0.7]).
+    let range = footprint_harness::io::formats::load(
+        &b,
+        Some(&footprint_harness::io::formats::raw::RawOptions {
+            dims: [8, 8, 8],
+            ty: footprint_harness::io::volume::SampleType::F32,
+            big_endian: false,
+            spacing: [1.0; 3],
+        }),
+    )
+    .unwrap()
+    .range();
+    assert_eq!(range, (0.0, 0.7));
+    std::fs::remove_dir_all(&d).unwrap();
+}
