@@ -1,0 +1,7 @@
+#![no_main]
+//! Fuzz target: `metaimage_header` must return a value or an error for any input, never panic.
+use libfuzzer_sys::fuzz_target;
+
+fuzz_target!(|data: &[u8]| {
+    let _ = footprint_harness::io::formats::metaimage::parse_header(data);
+});
