@@ -136,6 +136,17 @@ fn vti(dir: &Path, v: &[u16]) -> Vec<PathBuf> {
                 .as_bytes(),
         ),
         write(dir, "appended.vti", &appended),
+        write(
+            dir,
+            "appended-base64.vti",
+            (head("")
+                + &array("appended", "", " offset=\"0\"")
+                + tail
+                + "<AppendedData encoding=\"base64\">\n_"
+                + &plain
+                + "\n</AppendedData>\n</VTKFile>\n")
+                .as_bytes(),
+        ),
     ]
 }
 
@@ -276,7 +287,7 @@ fn every_format_renders_the_same_image() {
     files.extend(vtk(&d, &v));
     files.extend(metaimage(&d, &v));
     files.extend(nifti(&d, &v));
-    assert_eq!(files.len(), 19);
+    assert_eq!(files.len(), 20);
     for f in &files {
         let name = f.file_name().unwrap().to_str().unwrap();
         let img = render(&[f.to_str().unwrap(), "--view", "30,20,0"], &out);
@@ -417,4 +428,59 @@ fn pipe_source_reads_file_order_only() {
         }
     }
     std::fs::remove_dir_all(&d).unwrap();
+}
+
+/// Orientation reaches the renderer the same way from every format that states it: the grid axes
+/// permuted (i → world y, j → world z, k → world x) in NRRD `space directions`, VTI `Direction`
+/// (row-major, columns are the axes), MetaImage `TransformMatrix` (row i is axis i) and a NIfTI
+/// sform all give one image, and it differs from the axis-aligned one.
+#[test]
+fn orientation_is_honoured_by_every_format() {
+    let d = tmpdir("orientation");
+    let v = samples();
+    let out = d.join("out.png");
+    write(&d, "v.raw", &le(&v));
+    let nrrd = write(&d, "o.nhdr", b"NRRD0005\ntype: uint16\ndimension: 3\nsizes: 20 16 12\nspace dimension: 3\nspace directions: (0,1,0) (0,0,1.5) (2.5,0,0)\nendian: little\nencoding: raw\ndata file: v.raw\n");
+    let data = le(&v);
+    let plain = b64(&[(data.len() as u32).to_le_bytes().to_vec(), data.clone()].concat());
+    let vti = write(&d, "o.vti", format!("<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"0.1\" byte_order=\"LittleEndian\" header_type=\"UInt32\">\n<ImageData WholeExtent=\"0 19 0 15 0 11\" Spacing=\"1 1.5 2.5\" Direction=\"0 0 1 1 0 0 0 1 0\">\n<Piece Extent=\"0 19 0 15 0 11\"><PointData Scalars=\"s\"><DataArray type=\"UInt16\" Name=\"s\" format=\"binary\">{plain}</DataArray></PointData></Piece></ImageData></VTKFile>\n").as_bytes());
+    let mha = write(&d, "o.mha", &[b"ObjectType = Image\nNDims = 3\nDimSize = 20 16 12\nElementType = MET_USHORT\nElementSpacing = 1 1.5 2.5\nTransformMatrix = 0 1 0 0 0 1 1 0 0\nElementDataFile = LOCAL\n".to_vec(), data.clone()].concat());
+    let mut h = nifti_header(0.0, 0.0);
+    h[254..256].copy_from_slice(&1i16.to_le_bytes());
+    // srow_x/y/z: world = S · (i, j, k); column j is axis j's step.
+    let rows = [
+        [0.0f32, 0.0, 2.5, 0.0],
+        [1.0, 0.0, 0.0, 0.0],
+        [0.0, 1.5, 0.0, 0.0],
+    ];
+    for (r, row) in rows.iter().enumerate() {
+        for (c, x) in row.iter().enumerate() {
+            h[280 + 16 * r + 4 * c..284 + 16 * r + 4 * c].copy_from_slice(&x.to_le_bytes());
+        }
+    }
+    let nii = write(&d, "o.nii", &[h, data].concat());
+    let view = ["--view", "30,20,0"];
+    let imgs: Vec<Vec<u8>> = [&nrrd, &vti, &mha, &nii]
+        .iter()
+        .map(|p| render(&[p.to_str().unwrap(), view[0], view[1]], &out))
+        .collect();
+    for (img, name) in imgs.iter().zip(["nhdr", "vti", "mha", "nii"]) {
+        assert!(
+            img == &imgs[0],
+            "the oriented {name} renders differently from the NRRD"
+        );
+    }
+    let aligned = render(
+        &[nrrd::aligned(&d).to_str().unwrap(), view[0], view[1]],
+        &out,
+    );
+    assert!(aligned != imgs[0], "orientation made no difference");
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+mod nrrd {
+    /// The same data with the same spacings but no orientation.
+    pub fn aligned(d: &std::path::Path) -> std::path::PathBuf {
+        super::write(d, "aligned.nhdr", b"NRRD0004\ntype: uint16\ndimension: 3\nsizes: 20 16 12\nspacings: 1 1.5 2.5\nendian: little\nencoding: raw\ndata file: v.raw\n")
+    }
 }
