@@ -132,11 +132,9 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
             let mut d = AXIS_ALIGNED;
             for (i, row) in d.iter_mut().enumerate() {
                 let r = [v[3 * i], v[3 * i + 1], v[3 * i + 2]];
-                let len = (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt();
-                if !(len > 0.0) {
-                    return Err(format!("TransformMatrix: row {i} is zero"));
-                }
-                *row = r.map(|x| x / len);
+                *row = super::axis_step(r)
+                    .ok_or_else(|| format!("TransformMatrix: row {i} is zero"))?
+                    .1;
             }
             d
         }
@@ -238,31 +236,13 @@ pub fn raw_layout(path: &Path) -> Result<(PathBuf, u64, Header), CliError> {
             "streaming needs uncompressed data (CompressedData = False)",
         ));
     }
-    let source = match &h.data_file {
-        Some(name) => path.parent().unwrap_or(Path::new(".")).join(name),
-        None => path.to_path_buf(),
-    };
-    let need = byte_len(h.dims, h.ty).map_err(|e| at(path, e))? as u64;
-    let len = std::fs::metadata(&source)
-        .map_err(|e| at(&source, format!("cannot read: {e}")))?
-        .len();
-    let start = if h.data_file.is_some() {
-        0
-    } else {
-        h.header_len as u64
-    };
-    let offset = if h.header_size == -1 {
-        len.saturating_sub(need)
-    } else {
-        start + h.header_size as u64
-    };
-    if len != offset + need {
-        return Err(at(
-            &source,
-            format!(
-                "expected {need} bytes of data after offset {offset}, the file has {len} bytes"
-            ),
-        ));
-    }
+    let (source, offset) = super::raw_data_at(
+        path,
+        h.data_file.as_deref(),
+        h.header_len,
+        h.header_size,
+        h.dims,
+        h.ty,
+    )?;
     Ok((source, offset, h))
 }

@@ -19,9 +19,56 @@ pub mod raw;
 pub mod vti;
 pub mod vtk;
 
-use crate::io::volume::{at, Volume};
+use crate::io::volume::{at, byte_len, SampleType, Volume};
 use crate::CliError;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+
+/// Splits a grid axis's world step into (spacing, unit direction); `None` if it is zero or not
+/// finite.
+pub fn axis_step(v: [f32; 3]) -> Option<(f32, [f32; 3])> {
+    let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    (len > 0.0 && len.is_finite()).then(|| (len, v.map(|x| x / len)))
+}
+
+/// Where the samples of an uncompressed file are, for streaming: the data file (`data_file`
+/// relative to the header at `path`, or `path` itself with the data after `header_len` bytes) and
+/// the byte offset `skip` bytes in (−1: the file's last bytes). Checks the file holds them exactly.
+pub fn raw_data_at(
+    path: &Path,
+    data_file: Option<&str>,
+    header_len: usize,
+    skip: i64,
+    dims: [usize; 3],
+    ty: SampleType,
+) -> Result<(PathBuf, u64), CliError> {
+    let source = match data_file {
+        Some(name) => path.parent().unwrap_or(Path::new(".")).join(name),
+        None => path.to_path_buf(),
+    };
+    let need = byte_len(dims, ty).map_err(|e| at(path, e))? as u64;
+    let len = std::fs::metadata(&source)
+        .map_err(|e| at(&source, format!("cannot read: {e}")))?
+        .len();
+    let start = if data_file.is_some() {
+        0
+    } else {
+        header_len as u64
+    };
+    let offset = if skip == -1 {
+        len.saturating_sub(need)
+    } else {
+        start + skip.max(0) as u64
+    };
+    if len != offset + need {
+        return Err(at(
+            &source,
+            format!(
+                "expected {need} bytes of data after offset {offset}, the file has {len} bytes"
+            ),
+        ));
+    }
+    Ok((source, offset))
+}
 
 /// The formats by extension, for messages.
 pub const EXTENSIONS: &str =

@@ -124,12 +124,8 @@ pub fn parse_header(b: &[u8]) -> Result<Header, String> {
         let mut d = AXIS_ALIGNED;
         for c in 0..3 {
             let v = [m(0, c), m(1, c), m(2, c)];
-            let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-            if !(len > 0.0 && len.is_finite()) {
-                return Err(format!("sform column {c} is zero or not finite"));
-            }
-            spacing[c] = len;
-            d[c] = v.map(|x| x / len);
+            (spacing[c], d[c]) = super::axis_step(v)
+                .ok_or_else(|| format!("sform column {c} is zero or not finite"))?;
         }
         (spacing, d)
     } else if qform > 0 {

@@ -124,15 +124,8 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
         for (c, p) in parts.iter().enumerate() {
             let v = vector(&format!("{p})"))
                 .ok_or_else(|| format!("space directions: '{p})' is not a 3-vector"))?;
-            let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-            if !(len > 0.0) {
-                return Err(format!(
-                    "space directions: vector {} has zero length",
-                    c + 1
-                ));
-            }
-            spacing[c] = len;
-            dirs[c] = v.map(|x| x / len);
+            (spacing[c], dirs[c]) = super::axis_step(v)
+                .ok_or_else(|| format!("space directions: vector {} has zero length", c + 1))?;
         }
         (spacing, dirs)
     } else if let Some(s) = get(&["spacings"]) {
@@ -298,29 +291,13 @@ pub fn raw_layout(path: &Path) -> Result<(PathBuf, u64, Header), CliError> {
     if h.encoding != Encoding::Raw || h.line_skip != 0 {
         return Err(at(path, "streaming needs raw encoding without line skip"));
     }
-    let source = data_source(path, &h);
-    let need = byte_len(h.dims, h.ty).map_err(|e| at(path, e))? as u64;
-    let len = std::fs::metadata(&source)
-        .map_err(|e| at(&source, format!("cannot read: {e}")))?
-        .len();
-    let start = if h.data_file.is_some() {
-        0
-    } else {
-        h.header_len as u64
-    };
-    let offset = if h.byte_skip == -1 {
-        len.saturating_sub(need)
-    } else {
-        start + h.byte_skip as u64
-    };
-    if len < offset + need || (h.byte_skip != -1 && len != offset + need) {
-        return Err(at(
-            &source,
-            format!(
-                "expected {} bytes of data after offset {offset}, the file has {len} bytes",
-                need
-            ),
-        ));
-    }
+    let (source, offset) = super::raw_data_at(
+        path,
+        h.data_file.as_deref(),
+        h.header_len,
+        h.byte_skip,
+        h.dims,
+        h.ty,
+    )?;
     Ok((source, offset, h))
 }

@@ -183,11 +183,9 @@ pub fn parse_header(bytes: &[u8]) -> Result<(Header, Option<Appended<'_>>), Stri
             let mut d = AXIS_ALIGNED;
             for (c, col) in d.iter_mut().enumerate() {
                 let v = [m[c], m[3 + c], m[6 + c]];
-                let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-                if !(len > 0.0) {
-                    return Err(format!("Direction: column {c} is zero"));
-                }
-                *col = v.map(|x| x / len);
+                *col = super::axis_step(v)
+                    .ok_or_else(|| format!("Direction: column {c} is zero"))?
+                    .1;
             }
             d
         }
