@@ -22,6 +22,25 @@ fn g2s(across: f32) -> Mat3 {
         * zoom
 }
 
+/// One splat per iteration at a varying sub-pixel position (as the voxels of a sheet), through a
+/// sampler of a concrete type (monomorphised, as the renderer uses it).
+fn bench_one<S: Sampler>(
+    group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    name: &str,
+    sampler: &S,
+) {
+    let mut px = vec![0.0f32; 128 * 128];
+    group.bench_function(BenchmarkId::from_parameter(name), |b| {
+        let mut img = ImageMut::new(&mut px, 128, 128, 128).unwrap();
+        let mut i = 0u32;
+        b.iter(|| {
+            i = i.wrapping_add(1);
+            let centre = [64.0 + (i % 7) as f32 * 0.137, 64.0 + (i % 5) as f32 * 0.211];
+            splat(black_box(sampler), centre, &1.0f32, &mut img).unwrap()
+        });
+    });
+}
+
 fn bench_splat_n<const N: usize>(c: &mut Criterion) {
     let kernel = Kernel::PAPER_GAUSSIAN;
     let generic = Box::new(GenericTable::<N>::build(kernel));
@@ -35,24 +54,16 @@ fn bench_splat_n<const N: usize>(c: &mut Criterion) {
                 table: &*generic,
                 lookup,
             };
-            let samplers: [(&dyn Sampler, &str); 2] = [(&*table, "robust"), (&direct, "direct")];
-            for (sampler, method) in samplers {
-                let name = format!(
-                    "n={N}/{lname}/{method}/float/{}/fp={across}px",
-                    math::BACKEND
-                );
-                let mut px = vec![0.0f32; 128 * 128];
-                group.bench_function(BenchmarkId::from_parameter(name), |b| {
-                    let mut img = ImageMut::new(&mut px, 128, 128, 128).unwrap();
-                    let mut i = 0u32;
-                    b.iter(|| {
-                        // Vary the sub-pixel position, as voxels of a sheet do.
-                        i = i.wrapping_add(1);
-                        let centre = [64.0 + (i % 7) as f32 * 0.137, 64.0 + (i % 5) as f32 * 0.211];
-                        splat(black_box(sampler), centre, &1.0f32, &mut img).unwrap()
-                    });
-                });
-            }
+            bench_one(
+                &mut group,
+                &format!("n={N}/{lname}/robust/float/{}/fp={across}px", math::BACKEND),
+                &*table,
+            );
+            bench_one(
+                &mut group,
+                &format!("n={N}/{lname}/direct/float/{}/fp={across}px", math::BACKEND),
+                &direct,
+            );
         }
     }
     group.finish();
