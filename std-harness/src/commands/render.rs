@@ -326,31 +326,11 @@ fn load_voxels(args: &RenderArgs) -> Result<Loaded, CliError> {
             .map_err(|e| crate::io::volume::at(stream, e))?;
         (layout, o.spacing, crate::io::volume::AXIS_ALIGNED)
     } else if lower.ends_with(".nrrd") || lower.ends_with(".nhdr") {
-        let (path, offset, h) = formats::nrrd::raw_layout(stream)?;
-        (
-            Layout {
-                path,
-                offset,
-                dims: h.dims,
-                ty: h.ty,
-                big_endian: h.big_endian,
-            },
-            h.spacing,
-            h.directions,
-        )
+        let s = formats::nrrd::raw_layout(stream)?;
+        (s.layout, s.spacing, s.directions)
     } else if lower.ends_with(".mha") || lower.ends_with(".mhd") {
-        let (path, offset, h) = formats::metaimage::raw_layout(stream)?;
-        (
-            Layout {
-                path,
-                offset,
-                dims: h.dims,
-                ty: h.ty,
-                big_endian: h.big_endian,
-            },
-            h.spacing,
-            h.directions,
-        )
+        let s = formats::metaimage::raw_layout(stream)?;
+        (s.layout, s.spacing, s.directions)
     } else {
         return Err(crate::io::volume::at(stream, "streaming reads raw files (with --dims and --type), NRRD with raw encoding, or uncompressed MetaImage"));
     };

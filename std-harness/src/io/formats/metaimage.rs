@@ -3,7 +3,7 @@
 //! `ElementByteOrderMSB` / `BinaryDataByteOrderMSB`, `CompressedData` (zlib), `HeaderSize`,
 //! `TransformMatrix` (row i is grid axis i's direction).
 
-use super::compress;
+use super::{compress, numbers};
 use crate::io::volume::{at, byte_len, check_spacing, decode, SampleType, Volume, AXIS_ALIGNED};
 use crate::CliError;
 use std::path::{Path, PathBuf};
@@ -76,14 +76,7 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
         return Err(format!("NDims: expected 3, found '{}'", need("NDims")?));
     }
     let ds = need("DimSize")?;
-    let d: Vec<usize> = ds
-        .split_whitespace()
-        .map(|x| x.parse())
-        .collect::<Result<_, _>>()
-        .map_err(|_| format!("DimSize: '{ds}' are not whole numbers"))?;
-    if d.len() != 3 {
-        return Err(format!("DimSize: expected 3 values, found {}", d.len()));
-    }
+    let d: Vec<usize> = numbers(ds, 3, "DimSize")?;
     let dims = [d[0], d[1], d[2]];
     let tyname = need("ElementType")?;
     let ty = match tyname {
@@ -100,17 +93,7 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
     byte_len(dims, ty)?;
     let spacing = match get(&["ElementSpacing", "ElementSize"]) {
         Some(s) => {
-            let v: Vec<f32> = s
-                .split_whitespace()
-                .map(|x| x.parse())
-                .collect::<Result<_, _>>()
-                .map_err(|_| format!("ElementSpacing: '{s}' are not numbers"))?;
-            if v.len() != 3 {
-                return Err(format!(
-                    "ElementSpacing: expected 3 values, found {}",
-                    v.len()
-                ));
-            }
+            let v: Vec<f32> = numbers(s, 3, "ElementSpacing")?;
             [v[0], v[1], v[2]]
         }
         None => [1.0; 3],
@@ -118,17 +101,7 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
     check_spacing(spacing)?;
     let directions = match get(&["TransformMatrix", "Rotation", "Orientation"]) {
         Some(s) => {
-            let v: Vec<f32> = s
-                .split_whitespace()
-                .map(|x| x.parse())
-                .collect::<Result<_, _>>()
-                .map_err(|_| format!("TransformMatrix: '{s}' are not numbers"))?;
-            if v.len() != 9 {
-                return Err(format!(
-                    "TransformMatrix: expected 9 values, found {}",
-                    v.len()
-                ));
-            }
+            let v: Vec<f32> = numbers(s, 9, "TransformMatrix")?;
             let mut d = AXIS_ALIGNED;
             for (i, row) in d.iter_mut().enumerate() {
                 let r = [v[3 * i], v[3 * i + 1], v[3 * i + 2]];
@@ -226,8 +199,8 @@ pub fn load(path: &Path) -> Result<Volume, CliError> {
     })
 }
 
-/// Where the samples of an uncompressed MetaImage are, for streaming: (file, byte offset, header).
-pub fn raw_layout(path: &Path) -> Result<(PathBuf, u64, Header), CliError> {
+/// Where the samples of an uncompressed MetaImage are, and its grid, for streaming.
+pub fn raw_layout(path: &Path) -> Result<super::Streamable, CliError> {
     let head = crate::io::read_prefix(path, 1 << 16)?;
     let h = parse_header(&head).map_err(|e| at(path, e))?;
     if h.compressed {
@@ -236,13 +209,17 @@ pub fn raw_layout(path: &Path) -> Result<(PathBuf, u64, Header), CliError> {
             "streaming needs uncompressed data (CompressedData = False)",
         ));
     }
-    let (source, offset) = super::raw_data_at(
+    super::raw_data_at(
         path,
-        h.data_file.as_deref(),
-        h.header_len,
-        h.header_size,
-        h.dims,
-        h.ty,
-    )?;
-    Ok((source, offset, h))
+        super::RawHeader {
+            data_file: h.data_file.as_deref(),
+            header_len: h.header_len,
+            skip: h.header_size,
+            dims: h.dims,
+            ty: h.ty,
+            big_endian: h.big_endian,
+            spacing: h.spacing,
+            directions: h.directions,
+        },
+    )
 }

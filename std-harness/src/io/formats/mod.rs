@@ -19,9 +19,31 @@ pub mod raw;
 pub mod vti;
 pub mod vtk;
 
+use crate::io::stream::Layout;
 use crate::io::volume::{at, byte_len, SampleType, Volume};
 use crate::CliError;
-use std::path::{Path, PathBuf};
+use std::path::Path;
+
+/// Parses exactly `n` whitespace-separated numbers of field `what` (for messages).
+pub fn numbers<T: std::str::FromStr>(s: &str, n: usize, what: &str) -> Result<Vec<T>, String> {
+    let v: Vec<T> = s
+        .split_whitespace()
+        .map(|x| x.parse().ok())
+        .collect::<Option<_>>()
+        .ok_or_else(|| format!("{what}: '{s}' is not {n} numbers"))?;
+    if v.len() != n {
+        return Err(format!("{what}: expected {n} numbers, found {}", v.len()));
+    }
+    Ok(v)
+}
+
+/// What streaming needs from an uncompressed file's header: where its samples are, and the grid.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Streamable {
+    pub layout: Layout,
+    pub spacing: [f32; 3],
+    pub directions: [[f32; 3]; 3],
+}
 
 /// Splits a grid axis's world step into (spacing, unit direction); `None` if it is zero or not
 /// finite.
@@ -30,17 +52,32 @@ pub fn axis_step(v: [f32; 3]) -> Option<(f32, [f32; 3])> {
     (len > 0.0 && len.is_finite()).then(|| (len, v.map(|x| x / len)))
 }
 
+/// What the header of an uncompressed file says, for [`raw_data_at`].
+pub struct RawHeader<'a> {
+    pub data_file: Option<&'a str>,
+    pub header_len: usize,
+    pub skip: i64,
+    pub dims: [usize; 3],
+    pub ty: SampleType,
+    pub big_endian: bool,
+    pub spacing: [f32; 3],
+    pub directions: [[f32; 3]; 3],
+}
+
 /// Where the samples of an uncompressed file are, for streaming: the data file (`data_file`
 /// relative to the header at `path`, or `path` itself with the data after `header_len` bytes) and
 /// the byte offset `skip` bytes in (−1: the file's last bytes). Checks the file holds them exactly.
-pub fn raw_data_at(
-    path: &Path,
-    data_file: Option<&str>,
-    header_len: usize,
-    skip: i64,
-    dims: [usize; 3],
-    ty: SampleType,
-) -> Result<(PathBuf, u64), CliError> {
+pub fn raw_data_at(path: &Path, h: RawHeader<'_>) -> Result<Streamable, CliError> {
+    let RawHeader {
+        data_file,
+        header_len,
+        skip,
+        dims,
+        ty,
+        big_endian,
+        spacing,
+        directions,
+    } = h;
     let source = match data_file {
         Some(name) => path.parent().unwrap_or(Path::new(".")).join(name),
         None => path.to_path_buf(),
@@ -67,7 +104,18 @@ pub fn raw_data_at(
             ),
         ));
     }
-    Ok((source, offset))
+    let layout = Layout {
+        path: source,
+        offset,
+        dims,
+        ty,
+        big_endian,
+    };
+    Ok(Streamable {
+        layout,
+        spacing,
+        directions,
+    })
 }
 
 /// The formats by extension, for messages.

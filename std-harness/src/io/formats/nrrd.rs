@@ -7,7 +7,7 @@
 //! `byteskip` (−1 for raw: the data are the file's last bytes). `#` comments and `key:=value`
 //! pairs are ignored; other fields (`kinds`, `centers`, `space`, …) are accepted and ignored.
 
-use super::compress;
+use super::{compress, numbers};
 use crate::io::volume::{
     at, byte_len, check_spacing, decode, decode_ascii, SampleType, Volume, AXIS_ALIGNED,
 };
@@ -97,14 +97,7 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
         return Err(format!("dimension: expected 3, found '{dimension}'"));
     }
     let sizes = need("sizes")?;
-    let dims: Vec<usize> = sizes
-        .split_whitespace()
-        .map(|s| s.parse())
-        .collect::<Result<_, _>>()
-        .map_err(|_| format!("sizes: '{sizes}' are not whole numbers"))?;
-    if dims.len() != 3 {
-        return Err(format!("sizes: expected 3 values, found {}", dims.len()));
-    }
+    let dims: Vec<usize> = numbers(sizes, 3, "sizes")?;
     let dims = [dims[0], dims[1], dims[2]];
     byte_len(dims, ty)?;
     let (spacing, directions) = if let Some(sd) = get(&["space directions"]) {
@@ -129,14 +122,7 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
         }
         (spacing, dirs)
     } else if let Some(s) = get(&["spacings"]) {
-        let v: Vec<f32> = s
-            .split_whitespace()
-            .map(|x| x.parse())
-            .collect::<Result<_, _>>()
-            .map_err(|_| format!("spacings: '{s}' are not numbers"))?;
-        if v.len() != 3 {
-            return Err(format!("spacings: expected 3 values, found {}", v.len()));
-        }
+        let v: Vec<f32> = numbers(s, 3, "spacings")?;
         ([v[0], v[1], v[2]], AXIS_ALIGNED)
     } else {
         ([1.0; 3], AXIS_ALIGNED)
@@ -283,21 +269,25 @@ pub fn load(path: &Path) -> Result<Volume, CliError> {
     })
 }
 
-/// Where the samples of a raw-encoded NRRD are, for streaming: (file, byte offset, header).
-pub fn raw_layout(path: &Path) -> Result<(PathBuf, u64, Header), CliError> {
+/// Where the samples of a raw-encoded NRRD are, and its grid, for streaming.
+pub fn raw_layout(path: &Path) -> Result<super::Streamable, CliError> {
     // A header is small: read at most 64 KiB of it.
     let head = crate::io::read_prefix(path, 1 << 16)?;
     let h = parse_header(&head).map_err(|e| at(path, e))?;
     if h.encoding != Encoding::Raw || h.line_skip != 0 {
         return Err(at(path, "streaming needs raw encoding without line skip"));
     }
-    let (source, offset) = super::raw_data_at(
+    super::raw_data_at(
         path,
-        h.data_file.as_deref(),
-        h.header_len,
-        h.byte_skip,
-        h.dims,
-        h.ty,
-    )?;
-    Ok((source, offset, h))
+        super::RawHeader {
+            data_file: h.data_file.as_deref(),
+            header_len: h.header_len,
+            skip: h.byte_skip,
+            dims: h.dims,
+            ty: h.ty,
+            big_endian: h.big_endian,
+            spacing: h.spacing,
+            directions: h.directions,
+        },
+    )
 }

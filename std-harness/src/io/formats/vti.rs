@@ -2,7 +2,7 @@
 //! (base64 inline) or appended (raw or base64); uncompressed or `vtkZLibDataCompressor`; header
 //! type UInt32 or UInt64; either byte order; `Spacing` and `Direction` (row-major) give the grid.
 
-use super::compress;
+use super::{compress, numbers};
 use crate::io::volume::{
     at, byte_len, check_spacing, decode, decode_ascii, SampleType, Volume, AXIS_ALIGNED,
 };
@@ -64,18 +64,6 @@ pub enum Format {
     Binary(Vec<u8>),
     /// In the AppendedData section at this offset.
     Appended { offset: usize },
-}
-
-fn numbers<T: std::str::FromStr>(s: &str, n: usize, what: &str) -> Result<Vec<T>, String> {
-    let v: Vec<T> = s
-        .split_whitespace()
-        .map(|x| x.parse().ok())
-        .collect::<Option<_>>()
-        .ok_or_else(|| format!("{what}: '{s}' is not {n} numbers"))?;
-    if v.len() != n {
-        return Err(format!("{what}: expected {n} numbers, found {}", v.len()));
-    }
-    Ok(v)
 }
 
 /// The AppendedData section: its bytes after the `_` marker, and whether they are raw (not base64).
