@@ -5,6 +5,9 @@
 //! `cargo run -p footprint --example sensor_stream` prints an ASCII picture of the result and its
 //! counts. On a small target the same code runs with `static` buffers instead of `Vec`s.
 
+// `core/clippy.toml` bans floats for the fixed-point modules only.
+#![allow(clippy::disallowed_types)]
+
 use footprint::composite::RowSpan;
 use footprint::frame::{FrameSetup, Order};
 use footprint::geometry::FootprintOptions;

@@ -18,6 +18,7 @@
 //! - [`frame`]: one view of one volume: placement, sheet axis and order, buffer sizes.
 //! - [`shade`]: transfer functions, Phong, Levoy iso-surfaces, grid-coordinate texture.
 //! - [`composite`]: Porter–Duff over/under of premultiplied RGBA.
+//! - [`fixed`]: the integer-only splat, accumulator and compositing (formats, rounding, headroom).
 //! - [`render`]: the sheet renderer and the three-sheet ring for sources that cannot seek.
 //! - [`source`]: the `SheetSource` interface for voxels streamed from outside, and its driver.
 //!
@@ -47,8 +48,13 @@
 #![deny(missing_docs, rustdoc::broken_intra_doc_links)]
 // `!(x > 0.0)` is how this crate sends NaN down the rejecting branch; `x <= 0.0` would let it through.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
+// `f32`/`f64` are listed in `core/clippy.toml` as disallowed types, denied only inside the
+// fixed-point path's integer modules (`fixed::splat`, `fixed::composite`); everywhere else floats
+// are the point.
+#![allow(clippy::disallowed_types)]
 
 pub mod composite;
+pub mod fixed;
 pub mod frame;
 pub mod geometry;
 pub mod kernel;
@@ -82,6 +88,8 @@ pub enum Error {
     Frame(frame::FrameError),
     /// A sheet the renderer refused.
     Render(render::RenderError),
+    /// A view outside the fixed-point path's range.
+    Fixed(fixed::FixedError),
 }
 
 impl fmt::Display for Error {
@@ -93,6 +101,7 @@ impl fmt::Display for Error {
             Error::Buffer(e) => e.fmt(f),
             Error::Frame(e) => e.fmt(f),
             Error::Render(e) => e.fmt(f),
+            Error::Fixed(e) => e.fmt(f),
         }
     }
 }
@@ -106,6 +115,7 @@ impl core::error::Error for Error {
             Error::Buffer(e) => Some(e),
             Error::Frame(e) => Some(e),
             Error::Render(e) => Some(e),
+            Error::Fixed(e) => Some(e),
         }
     }
 }
@@ -125,5 +135,6 @@ from_error!(
     Table(TableError),
     Buffer(BufferError),
     Frame(frame::FrameError),
-    Render(render::RenderError)
+    Render(render::RenderError),
+    Fixed(fixed::FixedError)
 );

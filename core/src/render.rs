@@ -14,11 +14,17 @@
 //! (up to the kernel's ripple). The accumulated sheet is clamped to [0, 1] per channel and
 //! composited: *over* the working image back to front, *under* it front to back. Both give the same
 //! image up to rounding (associativity of Porter–Duff over).
+//!
+//! # Precision
+//! The renderer is generic over a [`Precision`]: [`FloatPath`] (f32 accumulator and image, any
+//! [`Sampler`]) or [`FixedPath`] (integer table, `i64` accumulator, Q24 image; see
+//! [`crate::fixed`]). One build holds both, so they can be compared on the same frame.
 
 use crate::composite::{clamp_unit, over, RowSpan};
+use crate::fixed::{self, FixedError, FixedTable, Placement};
 use crate::frame::{FrameSetup, Order};
 use crate::shade::{Lighting, Sample, Shader};
-use crate::splat::{splat_rows, BufferError, ImageMut, Sampler};
+use crate::splat::{splat_rows, BufferError, ImageMut, Sampler, SplatStats};
 use core::fmt;
 use glam::Vec3;
 
@@ -81,15 +87,170 @@ pub struct SheetWindow<'s, T> {
 }
 
 /// The caller-owned buffers of a render, each [`FrameSetup::image_len`] long except `rows`
-/// (one per image row).
+/// (one per image row). `A` and `P` are the [`Precision`]'s accumulator and image pixels:
+/// `[f32; 4]` and `[f32; 4]` for [`FloatPath`], `[i64; 4]` and `[u32; 4]` for [`FixedPath`].
 #[derive(Debug)]
-pub struct RenderBuffers<'a> {
+pub struct RenderBuffers<'a, A = [f32; 4], P = [f32; 4]> {
     /// Sheet accumulator, premultiplied RGBA; must be all zero at the start (left all zero).
-    pub accumulator: &'a mut [[f32; 4]],
+    pub accumulator: &'a mut [A],
     /// Working image, premultiplied RGBA, row-major, top row first: the result.
-    pub image: &'a mut [[f32; 4]],
+    pub image: &'a mut [P],
     /// Per-row extent of what the current sheet touched.
     pub rows: &'a mut [RowSpan],
+}
+
+/// What a [`SheetRenderer`] splats with and accumulates into.
+pub trait Precision {
+    /// A voxel's value as the splat takes it (premultiplied RGBA).
+    type Value: Copy;
+    /// A sheet-accumulator pixel.
+    type Acc: Copy;
+    /// A working-image pixel (premultiplied RGBA).
+    type Pixel: Copy;
+    /// The cleared accumulator pixel (what a caller fills a fresh accumulator with).
+    const ACC_ZERO: Self::Acc;
+    /// Transparent black.
+    const CLEAR: Self::Pixel;
+    /// The value of a voxel shaded to premultiplied RGBA (float, from the shader).
+    fn value(&self, rgba: [f32; 4]) -> Self::Value;
+    /// Whether a value is fully transparent (such voxels are skipped).
+    fn is_transparent(value: &Self::Value) -> bool;
+    /// Splats voxel (u, v) of sheet `sheet` of `frame` into `acc`, reporting touched rows.
+    fn splat(
+        &self,
+        frame: &FrameSetup,
+        sheet: usize,
+        uv: (usize, usize),
+        value: &Self::Value,
+        acc: &mut ImageMut<'_, Self::Acc>,
+        touched: impl FnMut(usize, usize, usize),
+    ) -> Result<SplatStats, BufferError>;
+    /// Composites one row of the accumulated sheet into the image (over back to front, under
+    /// front to back) and clears the accumulator row.
+    fn composite_row(&self, acc: &mut [Self::Acc], image: &mut [Self::Pixel], order: Order);
+    /// `front = front over back`, pixel by pixel.
+    fn over_row(&self, front: &mut [Self::Pixel], back: &[Self::Pixel]);
+}
+
+/// Float accumulation through any [`Sampler`] (view table or direct).
+#[derive(Debug)]
+pub struct FloatPath<'a, S: ?Sized> {
+    /// The footprint sampler.
+    pub sampler: &'a S,
+}
+
+impl<S: Sampler + ?Sized> Precision for FloatPath<'_, S> {
+    type Value = [f32; 4];
+    type Acc = [f32; 4];
+    type Pixel = [f32; 4];
+    const ACC_ZERO: [f32; 4] = [0.0; 4];
+    const CLEAR: [f32; 4] = [0.0; 4];
+
+    #[inline]
+    fn value(&self, rgba: [f32; 4]) -> [f32; 4] {
+        rgba
+    }
+
+    #[inline]
+    fn is_transparent(value: &[f32; 4]) -> bool {
+        !(value[3] > 0.0)
+    }
+
+    #[inline]
+    fn splat(
+        &self,
+        f: &FrameSetup,
+        sheet: usize,
+        (u, v): (usize, usize),
+        value: &[f32; 4],
+        acc: &mut ImageMut<'_, [f32; 4]>,
+        touched: impl FnMut(usize, usize, usize),
+    ) -> Result<SplatStats, BufferError> {
+        let cols = f.grid_to_screen;
+        let (a, b) = f.in_sheet;
+        let p = f.origin
+            + cols.col(f.sheet_axis) * sheet as f32
+            + cols.col(a) * u as f32
+            + cols.col(b) * v as f32;
+        let value = value.map(|c| c * f.cell_area);
+        splat_rows(self.sampler, [p.x, p.y], &value, acc, touched)
+    }
+
+    fn composite_row(&self, acc: &mut [[f32; 4]], image: &mut [[f32; 4]], order: Order) {
+        for (a, i) in acc.iter_mut().zip(image.iter_mut()) {
+            let s = clamp_unit(*a);
+            *a = [0.0; 4];
+            *i = match order {
+                Order::BackToFront => over(s, *i),
+                Order::FrontToBack => over(*i, s),
+            };
+        }
+    }
+
+    fn over_row(&self, front: &mut [[f32; 4]], back: &[[f32; 4]]) {
+        for (i, b) in front.iter_mut().zip(back) {
+            *i = over(*i, *b);
+        }
+    }
+}
+
+/// Fixed-point accumulation (see [`crate::fixed`]): an integer M×M table, Q24 voxel placement,
+/// `i64` accumulator and Q24 image. Splat and compositing use no floating point.
+#[derive(Clone, Copy, Debug)]
+pub struct FixedPath<'a, const M: usize> {
+    table: &'a FixedTable<M>,
+    place: Placement,
+}
+
+impl<'a, const M: usize> FixedPath<'a, M> {
+    /// The fixed path for `frame` through `table` (built for this frame). Refused when the
+    /// volume lands outside the fixed-point screen range.
+    pub fn new(frame: &FrameSetup, table: &'a FixedTable<M>) -> Result<Self, FixedError> {
+        Ok(FixedPath {
+            table,
+            place: Placement::new(frame)?,
+        })
+    }
+}
+
+impl<const M: usize> Precision for FixedPath<'_, M> {
+    type Value = [u32; 4];
+    type Acc = [i64; 4];
+    type Pixel = [u32; 4];
+    const ACC_ZERO: [i64; 4] = [0; 4];
+    const CLEAR: [u32; 4] = [0; 4];
+
+    #[inline]
+    fn value(&self, rgba: [f32; 4]) -> [u32; 4] {
+        fixed::quantise(rgba)
+    }
+
+    #[inline]
+    fn is_transparent(value: &[u32; 4]) -> bool {
+        value[3] == 0
+    }
+
+    #[inline]
+    fn splat(
+        &self,
+        _: &FrameSetup,
+        sheet: usize,
+        (u, v): (usize, usize),
+        value: &[u32; 4],
+        acc: &mut ImageMut<'_, [i64; 4]>,
+        touched: impl FnMut(usize, usize, usize),
+    ) -> Result<SplatStats, BufferError> {
+        let center = self.place.at(sheet, u, v);
+        Ok(fixed::splat::splat(self.table, center, value, acc, touched))
+    }
+
+    fn composite_row(&self, acc: &mut [[i64; 4]], image: &mut [[u32; 4]], order: Order) {
+        fixed::composite::composite_row(acc, image, self.table.frac_bits(), order);
+    }
+
+    fn over_row(&self, front: &mut [[u32; 4]], back: &[[u32; 4]]) {
+        fixed::composite::over_row(front, back);
+    }
 }
 
 /// Counts of one render.
@@ -107,23 +268,22 @@ pub struct RenderStats {
     pub pixels_composited: u64,
 }
 
-/// Renders sheets into caller-owned buffers. Generic over the footprint sampler (a view table or
-/// the direct method).
-pub struct SheetRenderer<'a, S: ?Sized> {
+/// Renders sheets into caller-owned buffers, with float or fixed-point accumulation
+/// ([`Precision`]).
+pub struct SheetRenderer<'a, P: Precision> {
     frame: &'a FrameSetup,
-    sampler: &'a S,
+    path: P,
     shader: Shader<'a>,
     lighting: Lighting,
     order: Order,
-    buffers: RenderBuffers<'a>,
-    background: Option<&'a [[f32; 4]]>,
+    buffers: RenderBuffers<'a, P::Acc, P::Pixel>,
+    background: Option<&'a [P::Pixel]>,
     stats: RenderStats,
 }
 
-impl<'a, S: Sampler + ?Sized> SheetRenderer<'a, S> {
-    /// Starts a frame. `background` is the starting working image (back to front) or what is
-    /// composited under the result at [`SheetRenderer::finish`] (front to back); `None` means
-    /// transparent black. Checks every buffer's size.
+impl<'a, S: Sampler + ?Sized> SheetRenderer<'a, FloatPath<'a, S>> {
+    /// Starts a float frame through `sampler` (a view table or the direct method); see
+    /// [`SheetRenderer::with_path`].
     pub fn new(
         frame: &'a FrameSetup,
         sampler: &'a S,
@@ -131,6 +291,29 @@ impl<'a, S: Sampler + ?Sized> SheetRenderer<'a, S> {
         order: Order,
         buffers: RenderBuffers<'a>,
         background: Option<&'a [[f32; 4]]>,
+    ) -> Result<Self, RenderError> {
+        Self::with_path(
+            frame,
+            FloatPath { sampler },
+            shader,
+            order,
+            buffers,
+            background,
+        )
+    }
+}
+
+impl<'a, P: Precision> SheetRenderer<'a, P> {
+    /// Starts a frame. `background` is the starting working image (back to front) or what is
+    /// composited under the result at [`SheetRenderer::finish`] (front to back); `None` means
+    /// transparent black. Checks every buffer's size.
+    pub fn with_path(
+        frame: &'a FrameSetup,
+        path: P,
+        shader: Shader<'a>,
+        order: Order,
+        buffers: RenderBuffers<'a, P::Acc, P::Pixel>,
+        background: Option<&'a [P::Pixel]>,
     ) -> Result<Self, RenderError> {
         let n = frame.image_len();
         for len in [
@@ -162,7 +345,7 @@ impl<'a, S: Sampler + ?Sized> SheetRenderer<'a, S> {
         }
         let r = SheetRenderer {
             frame,
-            sampler,
+            path,
             shader,
             lighting: Lighting::new(frame),
             order,
@@ -172,7 +355,7 @@ impl<'a, S: Sampler + ?Sized> SheetRenderer<'a, S> {
         };
         match (order, background) {
             (Order::BackToFront, Some(bg)) => r.buffers.image[..n].copy_from_slice(&bg[..n]),
-            _ => r.buffers.image[..n].fill([0.0; 4]),
+            _ => r.buffers.image[..n].fill(P::CLEAR),
         }
         r.buffers.rows[..frame.size[1]].fill(RowSpan::EMPTY);
         Ok(r)
@@ -206,16 +389,28 @@ impl<'a, S: Sampler + ?Sized> SheetRenderer<'a, S> {
             window.lower.map(<[T]>::len),
             window.upper.map(<[T]>::len),
         ];
-        self.splat_sheet(index, lengths, |u, v| {
+        let path = &self.path;
+        let shade = |u: usize, v: usize| {
             let value = window.current[v * na + u].to_f32();
-            shader.shade(
+            path.value(shader.shade(
                 &lighting,
                 value,
                 || gradient(f, &window, u, v),
                 f.grid_index(index, u, v),
                 f.dims,
-            )
-        })
+            ))
+        };
+        Self::splat_sheet(
+            f,
+            &self.path,
+            &mut self.buffers,
+            &mut self.stats,
+            index,
+            lengths,
+            shade,
+        )?;
+        self.composite_sheet();
+        Ok(())
     }
 
     /// Splats and composites sheet `index` of voxels the caller has already shaded: premultiplied
@@ -228,20 +423,52 @@ impl<'a, S: Sampler + ?Sized> SheetRenderer<'a, S> {
         rgba: &[[f32; 4]],
     ) -> Result<(), RenderError> {
         let na = self.frame.sheet_shape().1;
-        self.splat_sheet(index, [Some(rgba.len()), None, None], |u, v| {
-            rgba[v * na + u]
-        })
+        let path = &self.path;
+        Self::splat_sheet(
+            self.frame,
+            path,
+            &mut self.buffers,
+            &mut self.stats,
+            index,
+            [Some(rgba.len()), None, None],
+            |u, v| path.value(rgba[v * na + u]),
+        )?;
+        self.composite_sheet();
+        Ok(())
     }
 
-    /// Checks sheet `index` and the given sheet `lengths`, then splats the premultiplied RGBA that
-    /// `shade(u, v)` gives for every voxel (skipping α = 0) and composites the sheet.
-    fn splat_sheet(
+    /// [`SheetRenderer::render_shaded_sheet`] with values already in the precision's own format
+    /// (for [`FixedPath`], Q24 premultiplied RGBA): no float work per voxel at all.
+    pub fn render_value_sheet(
         &mut self,
         index: usize,
-        lengths: [Option<usize>; 3],
-        mut shade: impl FnMut(usize, usize) -> [f32; 4],
+        values: &[P::Value],
     ) -> Result<(), RenderError> {
-        let f = self.frame;
+        let na = self.frame.sheet_shape().1;
+        Self::splat_sheet(
+            self.frame,
+            &self.path,
+            &mut self.buffers,
+            &mut self.stats,
+            index,
+            [Some(values.len()), None, None],
+            |u, v| values[v * na + u],
+        )?;
+        self.composite_sheet();
+        Ok(())
+    }
+
+    /// Checks sheet `index` and the given sheet `lengths`, then splats the value that
+    /// `shade(u, v)` gives for every voxel (skipping transparent ones).
+    fn splat_sheet(
+        f: &FrameSetup,
+        path: &P,
+        buffers: &mut RenderBuffers<'a, P::Acc, P::Pixel>,
+        stats: &mut RenderStats,
+        index: usize,
+        lengths: [Option<usize>; 3],
+        mut shade: impl FnMut(usize, usize) -> P::Value,
+    ) -> Result<(), RenderError> {
         let count = f.sheet_count();
         if index >= count {
             return Err(RenderError::SheetIndex { index, count });
@@ -250,35 +477,23 @@ impl<'a, S: Sampler + ?Sized> SheetRenderer<'a, S> {
         if let Some(got) = lengths.into_iter().flatten().find(|&l| l != len) {
             return Err(RenderError::SheetLength { expected: len, got });
         }
-        let (k, (a, b)) = (f.sheet_axis, f.in_sheet);
-        let cols = f.grid_to_screen;
-        let (ca, cb) = (cols.col(a), cols.col(b));
-        let base = f.origin + cols.col(k) * index as f32;
-        let mut image = ImageMut::new(
-            &mut *self.buffers.accumulator,
-            f.size[0],
-            f.size[1],
-            f.size[0],
-        )?;
-        let rows = &mut *self.buffers.rows;
+        let mut image = ImageMut::new(&mut *buffers.accumulator, f.size[0], f.size[1], f.size[0])?;
+        let rows = &mut *buffers.rows;
         for v in 0..nb {
             for u in 0..na {
-                self.stats.voxels += 1;
-                let rgba = shade(u, v);
-                if !(rgba[3] > 0.0) {
+                stats.voxels += 1;
+                let value = shade(u, v);
+                if P::is_transparent(&value) {
                     continue;
                 }
-                let p = base + ca * u as f32 + cb * v as f32;
-                let value = rgba.map(|c| c * f.cell_area);
-                let s = splat_rows(self.sampler, [p.x, p.y], &value, &mut image, |y, x0, x1| {
+                let s = path.splat(f, index, (u, v), &value, &mut image, |y, x0, x1| {
                     rows[y].include(x0, x1)
                 })?;
-                self.stats.voxels_splatted += 1;
-                self.stats.pixel_updates += u64::from(s.pixels_updated);
+                stats.voxels_splatted += 1;
+                stats.pixel_updates += u64::from(s.pixels_updated);
             }
         }
-        self.composite_sheet();
-        self.stats.sheets += 1;
+        stats.sheets += 1;
         Ok(())
     }
 
@@ -294,16 +509,9 @@ impl<'a, S: Sampler + ?Sized> SheetRenderer<'a, S> {
             if span.is_empty() {
                 continue;
             }
-            let row = y * w;
-            for x in span.lo as usize..=span.hi as usize {
-                let s = clamp_unit(acc[row + x]);
-                acc[row + x] = [0.0; 4];
-                let i = &mut img[row + x];
-                *i = match self.order {
-                    Order::BackToFront => over(s, *i),
-                    Order::FrontToBack => over(*i, s),
-                };
-            }
+            let (lo, hi) = (y * w + span.lo as usize, y * w + span.hi as usize + 1);
+            self.path
+                .composite_row(&mut acc[lo..hi], &mut img[lo..hi], self.order);
             self.stats.pixels_composited += u64::from(span.hi - span.lo + 1);
             *span = RowSpan::EMPTY;
         }
@@ -314,9 +522,7 @@ impl<'a, S: Sampler + ?Sized> SheetRenderer<'a, S> {
     pub fn finish(self) -> RenderStats {
         if let (Order::FrontToBack, Some(bg)) = (self.order, self.background) {
             let n = self.frame.image_len();
-            for (i, b) in self.buffers.image[..n].iter_mut().zip(&bg[..n]) {
-                *i = over(*i, *b);
-            }
+            self.path.over_row(&mut self.buffers.image[..n], &bg[..n]);
         }
         self.stats
     }

@@ -9,9 +9,8 @@
 //! driver refuses a frame it cannot serve before reading anything.
 
 use crate::frame::Order;
-use crate::render::{RenderError, SheetRenderer, SheetRing};
+use crate::render::{Precision, RenderError, SheetRenderer, SheetRing};
 use crate::shade::Sample;
-use crate::splat::Sampler;
 
 /// A source of sheets.
 pub trait SheetSource {
@@ -65,13 +64,13 @@ pub fn order_for<S: SheetSource>(
 /// Renders every sheet of `renderer`'s frame from `source`, in the renderer's compositing order,
 /// through `ring` (three sheets of caller storage). Call [`SheetRenderer::finish`] afterwards.
 /// For a sequential source, pick the renderer's order with [`order_for`] first.
-pub fn render_from<Smp, Src>(
-    renderer: &mut SheetRenderer<'_, Smp>,
+pub fn render_from<P, Src>(
+    renderer: &mut SheetRenderer<'_, P>,
     ring: &mut SheetRing<'_, Src::Sample>,
     source: &mut Src,
 ) -> Result<(), Src::Error>
 where
-    Smp: Sampler + ?Sized,
+    P: Precision,
     Src: SheetSource,
 {
     let axis = renderer.frame().sheet_axis;

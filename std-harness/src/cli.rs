@@ -58,6 +58,16 @@ pub enum MethodArg {
     Reference,
 }
 
+/// How the sheet accumulator, the working image and compositing count.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum AccumArg {
+    /// f32 throughout.
+    Float,
+    /// Integers only in the splat and compositing (see the core's `fixed` module): an integer
+    /// table, an i64 accumulator, a Q24 image. Bit-exact on every target.
+    Fixed,
+}
+
 /// The footprint flags `splat`, `render` and `verify` share.
 #[derive(clap::Args, Debug, Clone)]
 pub struct FootprintArgs {

@@ -19,7 +19,7 @@ mod format;
 mod generic;
 mod view;
 
-pub use format::{crc32, TableError, FORMAT_VERSION, MAGIC};
+pub use format::{crc32, Crc32, TableError, FORMAT_VERSION, MAGIC};
 pub use generic::GenericTable;
 pub use view::ViewTable;
 

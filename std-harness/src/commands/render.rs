@@ -6,7 +6,7 @@
 //! +j down. The zoom that fits the volume's bounding box into 90 % of the image is multiplied by
 //! `--zoom`. `--view-matrix` gives V (world → screen, pixels per world unit) explicitly instead.
 
-use crate::cli::{parse_list, parse_size, FootprintArgs, MethodArg};
+use crate::cli::{parse_list, parse_size, AccumArg, FootprintArgs, MethodArg};
 use crate::io::formats::{self, raw::RawOptions};
 use crate::io::image::encode_png_rgb;
 use crate::io::stream::{file_range, is_stdin, FileSource, Layout, MemorySource, PipeSource};
@@ -15,12 +15,15 @@ use crate::io::{self, json::Json};
 use crate::reference::render::{render_reference, ReferenceScene};
 use crate::{scene, tf, with_table_size, CliError};
 use clap::{Args, ValueEnum};
+use footprint::fixed::{self, FixedTable};
 use footprint::frame::{FrameSetup, Order};
 use footprint::geometry::{FootprintOptions, Mapping};
-use footprint::render::{RenderBuffers, RenderStats, SheetRenderer, SheetRing};
+use footprint::render::{
+    FixedPath, FloatPath, Precision, RenderBuffers, RenderStats, SheetRenderer, SheetRing,
+};
 use footprint::shade::{Phong, Shader, Shading, TransferFunction};
 use footprint::source::{render_from, SheetSource};
-use footprint::splat::{Direct, Sampler};
+use footprint::splat::Direct;
 use footprint::{composite::RowSpan, Grid, Kernel, Lookup, View, ViewTable};
 use glam::{Mat3, Vec3};
 use std::io::IsTerminal;
@@ -68,6 +71,9 @@ pub struct RenderArgs {
     /// footprint radius.
     #[command(flatten)]
     pub footprint: FootprintArgs,
+    /// Accumulation: float, or fixed (integer splat, accumulator and compositing; bit-exact).
+    #[arg(long, value_enum, default_value_t = AccumArg::Float)]
+    pub accum: AccumArg,
     /// Transfer function: a preset (grey, ct-bone-skin, density) or a file of `t r g b a` lines.
     /// Default: density for the built-in scene, grey otherwise.
     #[arg(long)]
@@ -518,35 +524,67 @@ pub fn progress(label: &'static str) -> impl FnMut(usize, usize) {
     }
 }
 
-/// The core's render of `p`: premultiplied RGBA, counts, seconds.
+/// The core's render of `p` with `args`' table, method and accumulation: premultiplied RGBA
+/// (fixed-point output converted exactly to f32), counts, seconds.
 pub fn render_core(
     p: &Prepared,
     args: &RenderArgs,
 ) -> Result<(Vec<[f32; 4]>, RenderStats, f64), CliError> {
+    render_core_with(p, args, args.accum)
+}
+
+/// [`render_core`] with the accumulation given explicitly.
+pub fn render_core_with(
+    p: &Prepared,
+    args: &RenderArgs,
+    accum: AccumArg,
+) -> Result<(Vec<[f32; 4]>, RenderStats, f64), CliError> {
     let fa = &args.footprint;
     let lookup = Lookup::from(fa.lookup);
+    let fixed_range =
+        |e: fixed::FixedError| CliError::input(format!("{}: --accum fixed: {e}", p.name));
     with_table_size!(fa.table, N => {
         let generic = fa.generic_table::<N>(&p.kernel)?;
         let start = Instant::now();
-        // Each sampler gets its own monomorphised sheet loop: no virtual call per pixel.
-        let (image, stats) = match fa.method {
-            MethodArg::Direct => run_sheets(p, &Direct { footprint: p.frame.footprint, table: &*generic, lookup })?,
-            _ => run_sheets(p, &*Box::new(ViewTable::<N>::build(&p.frame.footprint, &generic, lookup, lookup)))?,
+        // Each path gets its own monomorphised sheet loop: no virtual call per pixel.
+        let (image, stats) = match (accum, fa.method) {
+            (AccumArg::Float, MethodArg::Direct) => {
+                let sampler = Direct { footprint: p.frame.footprint, table: &*generic, lookup };
+                run_sheets(p, FloatPath { sampler: &sampler }, p.background.as_deref())?
+            }
+            (AccumArg::Float, _) => {
+                let table = Box::new(ViewTable::<N>::build(&p.frame.footprint, &generic, lookup, lookup));
+                run_sheets(p, FloatPath { sampler: &*table }, p.background.as_deref())?
+            }
+            (AccumArg::Fixed, method) => {
+                let mut table = Box::new(FixedTable::<N>::zeroed());
+                match method {
+                    MethodArg::Direct => table.build_direct(&p.frame, &generic, lookup),
+                    _ => table.build_view(&p.frame, &generic, lookup, lookup),
+                }
+                .map_err(fixed_range)?;
+                let path = FixedPath::new(&p.frame, &*table).map_err(fixed_range)?;
+                let bg: Option<Vec<[u32; 4]>> =
+                    p.background.as_ref().map(|b| b.iter().map(|&c| fixed::quantise(c)).collect());
+                let (img, stats) = run_sheets(p, path, bg.as_deref())?;
+                (img.into_iter().map(fixed::to_f32).collect(), stats)
+            }
         };
         (image, stats, start.elapsed().as_secs_f64())
     })
 }
 
 /// Drives the core renderer through a [`SheetRing`], as a streaming source would.
-fn run_sheets<S: Sampler>(
+fn run_sheets<P: Precision>(
     p: &Prepared,
-    sampler: &S,
-) -> Result<(Vec<[f32; 4]>, RenderStats), CliError> {
+    path: P,
+    background: Option<&[P::Pixel]>,
+) -> Result<(Vec<P::Pixel>, RenderStats), CliError> {
     let f = &p.frame;
     let n = f.image_len();
     let (mut accum, mut image, mut rows) = (
-        vec![[0.0f32; 4]; n],
-        vec![[0.0f32; 4]; n],
+        vec![P::ACC_ZERO; n],
+        vec![P::CLEAR; n],
         vec![RowSpan::EMPTY; f.size[1]],
     );
     let buffers = RenderBuffers {
@@ -554,14 +592,7 @@ fn run_sheets<S: Sampler>(
         image: &mut image,
         rows: &mut rows,
     };
-    let mut renderer = SheetRenderer::new(
-        f,
-        sampler,
-        p.shader(),
-        p.order,
-        buffers,
-        p.background.as_deref(),
-    )?;
+    let mut renderer = SheetRenderer::with_path(f, path, p.shader(), p.order, buffers, background)?;
     let mut storage = vec![0.0f32; 3 * f.sheet_shape().0];
     let mut ring = SheetRing::new(&mut storage, f, p.order)?;
     let mut show = Progress {
@@ -679,6 +710,7 @@ pub fn describe(p: &Prepared, args: &RenderArgs) -> Json {
             &format!("{:?}", args.footprint.method).to_lowercase(),
         )
         .str("order", &format!("{:?}", p.order).to_lowercase())
+        .str("accum", &format!("{:?}", args.accum).to_lowercase())
         .bool("streamed", p.volume().is_none())
         .str("shading", &args.shading)
         .str("tf", &p.tf_name)

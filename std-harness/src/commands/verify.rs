@@ -9,8 +9,8 @@
 //! over 3N values): the colour a person sees. PSNR is reported as infinite (JSON null) when the
 //! images are identical.
 
-use super::render::{describe, prepare, render_core, render_ref, RenderArgs};
-use crate::cli::MethodArg;
+use super::render::{describe, prepare, render_core, render_core_with, render_ref, RenderArgs};
+use crate::cli::{AccumArg, MethodArg};
 use crate::io::{self, image::encode_png_rgb, json::Json};
 use crate::CliError;
 use clap::Args;
@@ -112,6 +112,21 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         overall.rmse,
         overall.max_abs
     );
+    // The fixed path is also measured against the float path of the same table and method.
+    let fixed_vs_float = if r.accum == AccumArg::Fixed {
+        let (float, _, _) = render_core_with(&p, r, AccumArg::Float)?;
+        let float: Vec<[f64; 4]> = float.iter().map(|c| c.map(f64::from)).collect();
+        let (_, e) = compare(&core, &float);
+        crate::say!(
+            "fixed vs float {:>9.2} {:>9.2e} {:>9.2e}   (RGB, same table and method)",
+            e.psnr_db,
+            e.rmse,
+            e.max_abs
+        );
+        Some(e)
+    } else {
+        None
+    };
     if let Some(out) = &r.out {
         io::write_atomic(out, &encode_png_rgb(&core, r.size.0, r.size.1)?)?;
     }
@@ -126,8 +141,11 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
             .obj("g", per[1].json())
             .obj("b", per[2].json())
             .obj("a", per[3].json());
-        let summary = describe(&p, r)
-            .str("command", "verify")
+        let mut summary = describe(&p, r).str("command", "verify");
+        if let Some(e) = fixed_vs_float {
+            summary = summary.obj("fixed_vs_float", e.json());
+        }
+        let summary = summary
             .num("core_seconds", core_s)
             .num("reference_seconds", ref_s)
             .num("voxels_splatted", stats.voxels_splatted as f64)
