@@ -360,6 +360,24 @@ pub struct Footprint {
 }
 
 impl Footprint {
+    /// A footprint that covers nothing (zero box, zero weight): the placeholder in a `static`
+    /// [`crate::ViewTable::zeroed`] before the first build.
+    pub const EMPTY: Footprint = Footprint {
+        to_unit: [[0.0; 2]; 2],
+        half_extent: [0.0; 2],
+        scale: 0.0,
+        renormalise: false,
+        clamped: false,
+        cheated: false,
+        covariance: Sym2 {
+            xx: 0.0,
+            xy: 0.0,
+            yy: 0.0,
+        },
+        sheet_axis: 2,
+        shape: Shape::Radial,
+    };
+
     /// Sets up the footprint of `kernel` for `grid_to_screen` = V·G (see [`View::grid_to_screen`]).
     pub fn new(
         kernel: &Kernel,

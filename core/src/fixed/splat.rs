@@ -161,6 +161,12 @@ pub fn splat<const M: usize>(
         floor_pos(center[0] + ex - HALF_POS),
     );
     let mut v = value.map(i64::from);
+    // CI builds once with `--cfg footprint_audit_plant` to show that clippy and the object-code
+    // audit (embedded/elf_check.py) both catch this float multiply. Never set otherwise.
+    #[cfg(footprint_audit_plant)]
+    {
+        v[0] = (v[0] as f32 * 1.0001) as i64;
+    }
     if table.renorm != 0 {
         let mut sum = 0i64;
         table.for_each(center, ys, xs, |_, _, w| sum += w);
