@@ -88,6 +88,66 @@ fn verify_passes_and_fails_on_its_threshold() {
     std::fs::remove_dir_all(&d).unwrap();
 }
 
+#[test]
+fn verify_fixed_reports_against_reference_and_float() {
+    let d = tmpdir("verify-fixed");
+    let json = d.join("v.json");
+    let heart = data("heart_32x32x12_float32_le.nhdr");
+    let args = [
+        "verify",
+        s(&heart),
+        "--accum",
+        "fixed",
+        "--size",
+        "96x96",
+        "--table",
+        "33",
+        "--view",
+        "30,20,0",
+        "--min-psnr",
+        "40",
+        "--json",
+        s(&json),
+    ];
+    assert_eq!(run(&args), 0);
+    let j = std::fs::read_to_string(&json).unwrap();
+    for key in [
+        "\"accum\": \"fixed\"",
+        "\"fixed_vs_float\"",
+        "\"pass\": true",
+    ] {
+        assert!(j.contains(key), "{key} missing from {j}");
+    }
+    // A view that puts the volume's ends beyond the fixed-point range (2³⁰ px) while the
+    // geometry still accepts its footprints is a typed error (exit 2), and writes nothing.
+    let raw = d.join("line.raw");
+    std::fs::write(
+        &raw,
+        (0..2048u32).map(|i| (i % 251) as u8).collect::<Vec<_>>(),
+    )
+    .unwrap();
+    let out = d.join("far.png");
+    let far = [
+        "render",
+        s(&raw),
+        "--dims",
+        "2048,1,1",
+        "--type",
+        "u8",
+        "--accum",
+        "fixed",
+        "--size",
+        "32x32",
+        "--view-matrix",
+        "1.5e6,0,0,0,1.5e6,0,0,0,1.5e6",
+        "--out",
+        s(&out),
+    ];
+    assert_eq!(run(&far), 2);
+    assert!(!out.exists());
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
 fn write_nrrd(
     dir: &Path,
     name: &str,
