@@ -19,8 +19,13 @@ LINK=(-C link-arg=-Tlink.x)
 fail() { echo "embedded: FAIL: $*" >&2; exit 1; }
 
 echo "== host"
-host_debug=$(cargo run -q -p footprint-scene-host | tee /dev/stderr | grep '^fixed checksum')
-host_release=$(cargo run -q --release -p footprint-scene-host -- --threads 4 | tee /dev/stderr | grep '^fixed checksum')
+# (Not `tee /dev/stderr`: reopening stderr truncates it when it is a log file.)
+out=$(cargo run -q -p footprint-scene-host)
+echo "$out"
+host_debug=$(grep '^fixed checksum' <<<"$out")
+out=$(cargo run -q --release -p footprint-scene-host -- --threads 4)
+echo "$out"
+host_release=$(grep '^fixed checksum' <<<"$out")
 [ "$host_debug" = "$host_release" ] || fail "host debug ($host_debug) and release ($host_release) differ"
 
 # run MACHINE CPU ELF: prints the firmware's output, fails on a non-zero exit or a timeout.
@@ -47,7 +52,11 @@ for spec in "thumbv7m-none-eabi mps2-an385 cortex-m3 M3" "thumbv7em-none-eabihf 
   echo "== $name stack bound"
   RUSTC_BOOTSTRAP=1 RUSTFLAGS="-Z emit-stack-sizes ${LINK[*]}" \
     cargo build -q --release -p footprint-firmware --target "$target" --target-dir target/stack
-  bound_out=$(python3 elf_check.py stack-bound "target/stack/$target/release/footprint-firmware" __stext "$STACK_BUDGET")
+  # The render's worst case plus the frames of its callers from the reset handler (main's own
+  # printing goes through core::fmt's indirect calls and is not bounded; it runs after the
+  # high-water mark is taken).
+  bound_out=$(python3 elf_check.py stack-bound "target/stack/$target/release/footprint-firmware" \
+    "__stext>main>___cortex_m_rt_main>footprint_firmware6render" "$STACK_BUDGET")
   echo "$bound_out"
   bound=$(sed -n 's/^stack-bound: worst case from [^:]*: \([0-9]*\) bytes.*/\1/p' <<<"$bound_out")
   used=$(sed -n 's/^stack high-water \([0-9]*\) bytes/\1/p' <<<"$out")

@@ -6,8 +6,9 @@
       footprint::fixed::composite) calls a soft-float routine (__aeabi_f*/__aeabi_d*, __addsf3 …)
       or executes a VFP instruction (v*.f32/f64, vmov to or from s/d registers).
 
-  elf_check.py stack-bound ELF ROOT BUDGET
-      Worst-case stack of the function named ROOT (or whose symbol contains it), from the compiler's per-function
+  elf_check.py stack-bound ELF CHAIN BUDGET
+      Worst-case stack of the last function in CHAIN ("a>b>c", names or name fragments: the
+      callers from the reset handler down, then the function bounded), from the compiler's per-function
       stack sizes (-Z emit-stack-sizes; functions built without it, such as compiler-builtins, are
       sized from their prologue) over the direct call graph. Fails on recursion, on an indirect
       call outside panic paths, or if the bound exceeds BUDGET bytes. Panic paths (symbols with
@@ -112,56 +113,70 @@ def prologue_size(insns):
     return size
 
 
-def stack_bound(elf, root, budget):
+def stack_bound(elf, chain, budget):
+    """Worst-case stack of the last function of `chain` (">"-separated names or name fragments),
+    plus the frames of the functions before it (its callers down from the reset handler)."""
     funcs = functions(elf)
     sizes = {}
     text = tool("llvm-readobj", "--stack-sizes", elf)
     for m in re.finditer(r"Functions: \[([^\]]*)\]\s*Size: (0x[0-9a-fA-F]+|\d+)", text):
         for f in m.group(1).split(","):
             sizes[f.strip()] = int(m.group(2), 0)
-    roots = [n for n in funcs if n == root] or [n for n in funcs if root in n]
-    if len(roots) != 1:
-        sys.exit(f"stack-bound: {len(roots)} functions match '{root}': {roots[:5]}")
-    memo, estimated, indirect_panic, on_path = {}, set(), set(), []
 
-    def cost(name):
-        if name in memo:
-            return memo[name]
+    def find(fragment):
+        found = [n for n in funcs if n == fragment] or [n for n in funcs if fragment in n]
+        if len(found) != 1:
+            sys.exit(f"stack-bound: {len(found)} functions match '{fragment}': {found[:5]}")
+        return found[0]
+
+    names = [find(f) for f in chain.split(">")]
+    estimated, indirect_panic, on_path, memo = set(), set(), [], {}
+
+    def frame(name):
+        if name in sizes:
+            return sizes[name]
+        estimated.add(name)
+        return prologue_size(funcs.get(name, []))
+
+    def cost(name, panicking):
+        # Keyed by whether a panic function is on the path, so the result does not depend on
+        # the order the graph is walked in.
+        panicking = panicking or "panic" in name
+        key = (name, panicking)
+        if key in memo:
+            return memo[key]
         if name in on_path:
             sys.exit(f"stack-bound: recursion through {name}: unbounded")
         on_path.append(name)
-        insns = funcs.get(name, [])
-        if name in sizes:
-            frame = sizes[name]
-        else:
-            frame = prologue_size(insns)
-            estimated.add(name)
-        calls, indirect = callees(name, insns)
+        calls, indirect = callees(name, funcs.get(name, []))
         if indirect:
-            if "panic" in name or any("panic" in p for p in on_path):
+            if panicking:
                 indirect_panic.add(name)
             else:
                 sys.exit(f"stack-bound: indirect call in {name} (path {' > '.join(on_path)}): unbounded")
         best, via = 0, None
-        for c in calls:
+        for c in sorted(calls):
             if c in funcs:
-                v = cost(c)[0]
+                v = cost(c, panicking)[0]
                 if v > best:
                     best, via = v, c
         on_path.pop()
-        memo[name] = (frame + best, via, frame)
-        return memo[name]
+        memo[key] = (frame(name) + best, via, frame(name), panicking)
+        return memo[key]
 
-    total = cost(roots[0])[0]
-    path, n = [], roots[0]
+    callers = sum(frame(n) for n in names[:-1])
+    total = callers + cost(names[-1], False)[0]
+    print(f"stack-bound: worst case from {' > '.join(names)}: {total} bytes (budget {budget})")
+    print("  frame  function (callers, then the worst path)")
+    for n in names[:-1]:
+        print(f"  {frame(n):>6}  {n}{' (prologue)' if n in estimated else ''}")
+    n, panicking = names[-1], False
     while n:
-        path.append(f"{memo[n][2]:>6}  {n}{' (prologue)' if n in estimated else ''}")
-        n = memo[n][1]
-    print(f"stack-bound: worst case from {roots[0]}: {total} bytes (budget {budget})")
-    print("  frame  function (worst path)")
-    for p in path:
-        print(f"  {p}")
-    print(f"  {len(memo)} functions reached; {len(estimated)} sized from their prologue; "
+        panicking = panicking or "panic" in n
+        entry = memo[(n, panicking)]
+        print(f"  {entry[2]:>6}  {n}{' (prologue)' if n in estimated else ''}")
+        n = entry[1]
+    print(f"  {len(memo)} (function, panicking) pairs reached; {len(estimated)} sized from their prologue; "
           f"{len(indirect_panic)} with indirect calls on panic paths (not followed)")
     if total > budget:
         sys.exit(f"stack-bound: {total} bytes exceeds the budget of {budget}")
