@@ -1,85 +1,257 @@
-//! Per-splat and per-view costs against table size, lookup and method.
+//! Per-splat, per-view and per-frame costs against table size, lookup, method and precision.
 //!
-//! Names spell the configuration: `splat/n=33/bilinear/robust/float/libm/fp=8px` is one voxel
-//! whose footprint is about 8 px across, through a 33×33 view table read bilinearly, float
-//! accumulation, libm backend. `view_table/n=33/bilinear` builds one view table.
-//! `cargo bench --bench splat`; `cargo test --benches` runs each once as a smoke test.
+//! Names spell the configuration:
+//! - `splat/n=33/bilinear/direct/fixed/libm/fp=8px`: one voxel whose footprint is about 8 px
+//!   across, read from a 33×33 table bilinearly, by the direct method (`view` is the two-stage
+//!   view-table method), fixed-point accumulation, libm backend;
+//! - `setup/n=33/view/fixed`: building one view's table (`view` float, `view` fixed, `direct`
+//!   fixed);
+//! - `frame/headsq/n=65/bilinear/view/float`: a whole 512×512 frame of a shared volume.
+//!
+//! `cargo bench --bench splat` runs them all; `cargo bench --bench splat --features micromath`
+//! runs them with the micromath backend (the name's backend part follows). `cargo test --benches`
+//! runs each once as a smoke test. Tests never assert on time.
 
-use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use footprint::geometry::{Footprint, FootprintOptions};
+use criterion::measurement::WallTime;
+use criterion::{criterion_group, criterion_main, BenchmarkGroup, Criterion};
+use footprint::fixed::{self, FixedTable};
+use footprint::frame::FrameSetup;
+use footprint::geometry::FootprintOptions;
 use footprint::splat::{splat, Direct, ImageMut, Sampler};
-use footprint::{math, GenericTable, Kernel, Lookup, ViewTable};
+use footprint::{math, GenericTable, Grid, Kernel, Lookup, View, ViewTable};
 use glam::Mat3;
 use std::hint::black_box;
+use std::time::Duration;
 
-/// Grid-to-screen for a footprint about `across` pixels wide (paper Gaussian, spread 1.6), an
-/// oblique view with 2:1 anisotropy.
-fn g2s(across: f32) -> Mat3 {
-    let zoom = across / (2.0 * 1.6 * 2.0);
-    Mat3::from_rotation_z(0.5)
-        * Mat3::from_rotation_x(0.3)
-        * Mat3::from_diagonal(glam::Vec3::new(2.0, 1.0, 1.0))
-        * zoom
+/// Table sizes benchmarked (the paper used 5, 11, 21 and 101).
+macro_rules! for_sizes {
+    ($f:ident, $c:expr) => {
+        $f::<5>($c);
+        $f::<11>($c);
+        $f::<21>($c);
+        $f::<33>($c);
+        $f::<65>($c);
+        $f::<101>($c);
+        $f::<129>($c);
+    };
 }
 
-/// One splat per iteration at a varying sub-pixel position (as the voxels of a sheet), through a
-/// sampler of a concrete type (monomorphised, as the renderer uses it).
-fn bench_one<S: Sampler>(
-    group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
-    name: &str,
-    sampler: &S,
-) {
-    let mut px = vec![0.0f32; 128 * 128];
-    group.bench_function(BenchmarkId::from_parameter(name), |b| {
+/// A one-voxel frame whose footprint is about `across` pixels wide (paper Gaussian, spread 1.6):
+/// an oblique view of a 2:1:1 grid.
+fn frame(across: f32) -> FrameSetup {
+    let zoom = across / (2.0 * 1.6 * 2.0);
+    let view = Mat3::from_rotation_z(0.5) * Mat3::from_rotation_x(0.3) * zoom;
+    FrameSetup::new(
+        [1, 1, 1],
+        &Grid::from_spacing([2.0, 1.0, 1.0]).unwrap(),
+        &View::new(view).unwrap(),
+        &Kernel::PAPER_GAUSSIAN,
+        FootprintOptions::default(),
+        [128, 128],
+    )
+    .unwrap()
+}
+
+/// The sub-pixel centre of iteration `i` (varying, as the voxels of a sheet).
+fn centre(i: u32) -> [f32; 2] {
+    [64.0 + (i % 7) as f32 * 0.137, 64.0 + (i % 5) as f32 * 0.211]
+}
+
+fn float_splat<S: Sampler>(g: &mut BenchmarkGroup<'_, WallTime>, name: &str, sampler: &S) {
+    let mut px = vec![[0.0f32; 4]; 128 * 128];
+    g.bench_function(name, |b| {
         let mut img = ImageMut::new(&mut px, 128, 128, 128).unwrap();
         let mut i = 0u32;
+        let value = [0.3f32, 0.4, 0.5, 0.6];
         b.iter(|| {
             i = i.wrapping_add(1);
-            let centre = [64.0 + (i % 7) as f32 * 0.137, 64.0 + (i % 5) as f32 * 0.211];
-            splat(black_box(sampler), centre, &1.0f32, &mut img).unwrap()
+            splat(black_box(sampler), centre(i), &value, &mut img).unwrap()
         });
     });
 }
 
-fn bench_splat_n<const N: usize>(c: &mut Criterion) {
-    let kernel = Kernel::PAPER_GAUSSIAN;
-    let generic = Box::new(GenericTable::<N>::build(kernel));
-    let mut group = c.benchmark_group("splat");
-    for across in [2.0f32, 8.0, 32.0] {
-        let fp = Footprint::new(&kernel, &g2s(across), FootprintOptions::default()).unwrap();
-        for (lookup, lname) in [(Lookup::Nearest, "nearest"), (Lookup::Bilinear, "bilinear")] {
-            let table = Box::new(ViewTable::<N>::build(&fp, &generic, lookup, lookup));
-            let direct = Direct {
-                footprint: fp,
-                table: &*generic,
-                lookup,
-            };
-            bench_one(
-                &mut group,
-                &format!("n={N}/{lname}/robust/float/{}/fp={across}px", math::BACKEND),
-                &*table,
-            );
-            bench_one(
-                &mut group,
-                &format!("n={N}/{lname}/direct/float/{}/fp={across}px", math::BACKEND),
-                &direct,
-            );
-        }
-    }
-    group.finish();
-    let fp = Footprint::new(&kernel, &g2s(32.0), FootprintOptions::default()).unwrap();
-    let mut table = Box::new(ViewTable::<N>::zeroed(fp));
-    c.bench_function(&format!("view_table/n={N}/bilinear"), |b| {
-        b.iter(|| table.build_into(black_box(&fp), &generic, Lookup::Bilinear, Lookup::Bilinear))
+fn fixed_splat<const N: usize>(
+    g: &mut BenchmarkGroup<'_, WallTime>,
+    name: &str,
+    t: &FixedTable<N>,
+) {
+    let mut px = vec![[0i64; 4]; 128 * 128];
+    g.bench_function(name, |b| {
+        let mut img = ImageMut::new(&mut px, 128, 128, 128).unwrap();
+        let mut i = 0u32;
+        let value = fixed::quantise([0.3, 0.4, 0.5, 0.6]);
+        b.iter(|| {
+            i = i.wrapping_add(1);
+            let c = centre(i).map(|x| (f64::from(x) * f64::from(1u32 << 24)) as i64);
+            fixed::splat::splat(black_box(t), c, &value, &mut img, |_, _, _| {})
+        });
     });
 }
 
-fn benches(c: &mut Criterion) {
-    bench_splat_n::<11>(c);
-    bench_splat_n::<33>(c);
-    bench_splat_n::<65>(c);
-    bench_splat_n::<129>(c);
+fn splats<const N: usize>(c: &mut Criterion) {
+    let generic = Box::new(GenericTable::<N>::build(Kernel::PAPER_GAUSSIAN));
+    let mut g = c.benchmark_group("splat");
+    let be = math::BACKEND;
+    for across in [2.0f32, 8.0, 32.0] {
+        let f = frame(across);
+        for (lookup, l) in [(Lookup::Nearest, "nearest"), (Lookup::Bilinear, "bilinear")] {
+            let view = Box::new(ViewTable::<N>::build(
+                &f.footprint,
+                &generic,
+                lookup,
+                lookup,
+            ));
+            let direct = Direct {
+                footprint: f.footprint,
+                table: &*generic,
+                lookup,
+            };
+            float_splat(
+                &mut g,
+                &format!("n={N}/{l}/view/float/{be}/fp={across}px"),
+                &*view,
+            );
+            float_splat(
+                &mut g,
+                &format!("n={N}/{l}/direct/float/{be}/fp={across}px"),
+                &direct,
+            );
+            let mut t = Box::new(FixedTable::<N>::zeroed());
+            t.build_view(&f, &generic, lookup, lookup).unwrap();
+            fixed_splat(
+                &mut g,
+                &format!("n={N}/{l}/view/fixed/{be}/fp={across}px"),
+                &*t,
+            );
+            t.build_direct(&f, &generic, lookup).unwrap();
+            fixed_splat(
+                &mut g,
+                &format!("n={N}/{l}/direct/fixed/{be}/fp={across}px"),
+                &*t,
+            );
+        }
+    }
+    g.finish();
 }
 
-criterion_group!(splat_benches, benches);
+fn setups<const N: usize>(c: &mut Criterion) {
+    let generic = Box::new(GenericTable::<N>::build(Kernel::PAPER_GAUSSIAN));
+    let f = frame(32.0);
+    let be = math::BACKEND;
+    let mut g = c.benchmark_group("setup");
+    let mut view = Box::new(ViewTable::<N>::zeroed(f.footprint));
+    g.bench_function(format!("n={N}/view/float/{be}"), |b| {
+        b.iter(|| {
+            view.build_into(
+                black_box(&f.footprint),
+                &generic,
+                Lookup::Bilinear,
+                Lookup::Bilinear,
+            )
+        })
+    });
+    let mut t = Box::new(FixedTable::<N>::zeroed());
+    g.bench_function(format!("n={N}/view/fixed/{be}"), |b| {
+        b.iter(|| {
+            t.build_view(black_box(&f), &generic, Lookup::Bilinear, Lookup::Bilinear)
+                .unwrap()
+        })
+    });
+    g.bench_function(format!("n={N}/direct/fixed/{be}"), |b| {
+        b.iter(|| {
+            t.build_direct(black_box(&f), &generic, Lookup::Bilinear)
+                .unwrap()
+        })
+    });
+    g.finish();
+}
+
+fn per_splat(c: &mut Criterion) {
+    for_sizes!(splats, c);
+}
+
+fn per_view(c: &mut Criterion) {
+    for_sizes!(setups, c);
+}
+
+/// Whole 512×512 frames of `walnut` (from ../shared/data, when present) and `headsq`.
+fn frames(c: &mut Criterion) {
+    let shared = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data");
+    let volumes = [
+        (
+            "headsq",
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("tests/data/headsq_64x64x93_int16_le.nhdr"),
+        ),
+        (
+            "walnut",
+            shared.join("walnut/walnut_128x96x114_uint16_le.nhdr"),
+        ),
+    ];
+    let configs: [&[&str]; 5] = [
+        &[
+            "--table", "65", "--lookup", "bilinear", "--method", "robust", "--accum", "float",
+        ],
+        &[
+            "--table", "65", "--lookup", "bilinear", "--method", "robust", "--accum", "fixed",
+        ],
+        &[
+            "--table", "65", "--lookup", "bilinear", "--method", "direct", "--accum", "float",
+        ],
+        &[
+            "--table", "33", "--lookup", "nearest", "--method", "robust", "--accum", "float",
+        ],
+        &[
+            "--table", "129", "--lookup", "nearest", "--method", "robust", "--accum", "float",
+        ],
+    ];
+    let mut g = c.benchmark_group("frame");
+    g.sample_size(10);
+    for (name, path) in &volumes {
+        if !path.exists() {
+            eprintln!(
+                "frame benches: {} not found, {name} skipped",
+                path.display()
+            );
+            continue;
+        }
+        for cfg in configs {
+            let mut args = vec![
+                path.to_str().unwrap(),
+                "--size",
+                "512x512",
+                "--view",
+                "30,20,0",
+            ];
+            args.extend_from_slice(cfg);
+            let r = footprint_harness::commands::render::parse_args(&args).unwrap();
+            let p = footprint_harness::commands::render::prepare(&r).unwrap();
+            let label = format!(
+                "{name}/n={}/{}/{}/{}/{}",
+                cfg[1],
+                cfg[3],
+                if cfg[5] == "robust" { "view" } else { "direct" },
+                cfg[7],
+                math::BACKEND
+            );
+            g.bench_function(label, |b| {
+                b.iter(|| footprint_harness::commands::render::render_core(&p, &r).unwrap())
+            });
+        }
+    }
+    g.finish();
+}
+
+fn quick() -> Criterion {
+    Criterion::default()
+        .warm_up_time(Duration::from_millis(300))
+        .measurement_time(Duration::from_secs(1))
+        .sample_size(20)
+}
+
+criterion_group! {
+    name = splat_benches;
+    config = quick();
+    targets = per_splat, per_view, frames
+}
 criterion_main!(splat_benches);
