@@ -148,6 +148,67 @@ fn verify_fixed_reports_against_reference_and_float() {
     std::fs::remove_dir_all(&d).unwrap();
 }
 
+#[test]
+fn quality_chooses_records_and_meets_its_target() {
+    let d = tmpdir("quality");
+    let json = d.join("q.json");
+    let heart = data("heart_32x32x12_float32_le.nhdr");
+    let out = d.join("q.png");
+    let args = [
+        "render",
+        s(&heart),
+        "--quality",
+        "40",
+        "--size",
+        "96x96",
+        "--view",
+        "30,20,0",
+        "--json",
+        s(&json),
+        "--out",
+        s(&out),
+    ];
+    assert_eq!(run(&args), 0);
+    let j = std::fs::read_to_string(&json).unwrap();
+    for key in [
+        "\"quality\"",
+        "\"target_db\": 40",
+        "\"predicted_db\"",
+        "\"chosen\": \"n=",
+    ] {
+        assert!(j.contains(key), "{key} missing from {j}");
+    }
+    // verify takes --quality too, and the achieved PSNR meets the request.
+    for q in ["30", "40", "50"] {
+        let verify = [
+            "verify",
+            s(&heart),
+            "--quality",
+            q,
+            "--min-psnr",
+            q,
+            "--size",
+            "96x96",
+            "--view",
+            "30,20,0",
+        ];
+        assert_eq!(run(&verify), 0, "--quality {q}");
+    }
+    // --quality replaces the table flags, so giving both is refused.
+    let both = [
+        "render",
+        s(&heart),
+        "--quality",
+        "40",
+        "--table",
+        "65",
+        "--out",
+        s(&out),
+    ];
+    assert_eq!(run(&both), 2);
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
 fn write_nrrd(
     dir: &Path,
     name: &str,

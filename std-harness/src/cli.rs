@@ -27,10 +27,13 @@ pub enum Command {
     Tables(commands::tables::TablesArgs),
     /// Compare two single-channel PFM images: max |A − B| relative to B's peak.
     Compare(commands::compare::CompareArgs),
+    /// Sweep table size, lookup, method and accumulation on one scene: frame time against error
+    /// (tradeoff.csv/.svg/.png with the Pareto frontier) and stability (stability.svg/.png).
+    Chart(commands::chart::ChartArgs),
 }
 
 /// Table lookup, as on the command line.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, ValueEnum)]
 pub enum LookupArg {
     Nearest,
     Bilinear,
@@ -46,7 +49,7 @@ impl From<LookupArg> for footprint::Lookup {
 }
 
 /// How the footprint is evaluated.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, ValueEnum)]
 pub enum MethodArg {
     /// View table built through the Cholesky (or sheet-parallelogram) map: no singular angle.
     Robust,
@@ -74,8 +77,9 @@ pub struct FootprintArgs {
     /// Kernel spec, e.g. gaussian:spread=1.6,sigmas=2.5 (also cone, sinc, bilinear).
     #[arg(long, default_value = "gaussian:spread=1.6,sigmas=2.5")]
     pub kernel: String,
-    /// Generic and view table size N (N×N).
-    #[arg(long, default_value_t = 65)]
+    /// Generic and view table size N (N×N). The default, 129, is on the Pareto frontier of
+    /// `footprint chart` for both charted scenes (README, "Speed against accuracy").
+    #[arg(long, default_value_t = 129)]
     pub table: usize,
     /// Load the generic table from a file written by `footprint tables` (its N must equal --table).
     #[arg(long)]
@@ -89,6 +93,28 @@ pub struct FootprintArgs {
     /// Smallest footprint semi-axis, pixels (sub-pixel footprints are widened to it).
     #[arg(long, default_value_t = footprint::geometry::DEFAULT_MIN_RADIUS_PX)]
     pub min_radius: f32,
+    /// `--method paper` only: how close to 45° (degrees) the paper's rotation cheat nudges θ;
+    /// 0 disables it, and the singular angle becomes a typed error.
+    #[arg(long, default_value_t = 0.01)]
+    pub paper_cheat: f32,
+}
+
+impl FootprintArgs {
+    /// The ellipse-to-circle map `--method` and `--paper-cheat` ask for.
+    pub fn mapping(&self) -> Result<footprint::geometry::Mapping, CliError> {
+        if self.method != MethodArg::Paper {
+            return Ok(footprint::geometry::Mapping::Robust);
+        }
+        if !(self.paper_cheat >= 0.0 && self.paper_cheat < 45.0) {
+            return Err(CliError::input(format!(
+                "--paper-cheat {}: expected degrees in [0, 45)",
+                self.paper_cheat
+            )));
+        }
+        Ok(footprint::geometry::Mapping::Paper {
+            cheat_deg: self.paper_cheat,
+        })
+    }
 }
 
 impl FootprintArgs {
@@ -179,6 +205,7 @@ where
         Command::Verify(a) => commands::verify::run(&a),
         Command::Tables(a) => commands::tables::run(&a),
         Command::Compare(a) => commands::compare::run(&a),
+        Command::Chart(a) => commands::chart::run(&a),
     };
     match result {
         Ok(()) => 0,

@@ -24,6 +24,7 @@ pub mod cli;
 pub mod commands;
 pub mod dispatch;
 pub mod io;
+pub mod quality;
 pub mod reference;
 pub mod scene;
 pub mod tf;

@@ -71,6 +71,7 @@ pub fn splat_args() -> SplatArgs {
             lookup: LookupArg::Bilinear,
             method: MethodArg::Robust,
             min_radius: footprint::geometry::DEFAULT_MIN_RADIUS_PX,
+            paper_cheat: 0.01,
         },
         spacing: [60.0, 30.0, 30.0],
         grid_matrix: None,

@@ -1,5 +1,6 @@
 //! One module per subcommand.
 
+pub mod chart;
 pub mod compare;
 pub mod render;
 pub mod splat;

@@ -17,7 +17,7 @@ use crate::{scene, tf, with_table_size, CliError};
 use clap::{Args, ValueEnum};
 use footprint::fixed::{self, FixedTable};
 use footprint::frame::{FrameSetup, Order};
-use footprint::geometry::{FootprintOptions, Mapping};
+use footprint::geometry::FootprintOptions;
 use footprint::render::{
     FixedPath, FloatPath, Precision, RenderBuffers, RenderStats, SheetRenderer, SheetRing,
 };
@@ -74,6 +74,10 @@ pub struct RenderArgs {
     /// Accumulation: float, or fixed (integer splat, accumulator and compositing; bit-exact).
     #[arg(long, value_enum, default_value_t = AccumArg::Float)]
     pub accum: AccumArg,
+    /// Target PSNR against the f64 reference, dB: choose the cheapest table size, lookup, method
+    /// and accumulation predicted to reach it for this scene and view (overrides those flags).
+    #[arg(long, conflicts_with_all = ["table", "lookup", "method", "accum", "table_file"])]
+    pub quality: Option<f64>,
     /// Transfer function: a preset (grey, ct-bone-skin, density) or a file of `t r g b a` lines.
     /// Default: density for the built-in scene, grey otherwise.
     #[arg(long)]
@@ -128,6 +132,20 @@ fn parse_dims(s: &str) -> Result<[usize; 3], String> {
             .map_err(|_| format!("'{p}' is not a whole number"))?;
     }
     Ok(out)
+}
+
+/// `render`'s flags from a list of arguments (as on the command line after `render`), for
+/// programs that drive the harness (benches, charts).
+pub fn parse_args(args: &[&str]) -> Result<RenderArgs, CliError> {
+    #[derive(clap::Parser)]
+    struct Wrapper {
+        #[command(flatten)]
+        render: RenderArgs,
+    }
+    use clap::Parser as _;
+    Wrapper::try_parse_from(std::iter::once("render").chain(args.iter().copied()))
+        .map(|w| w.render)
+        .map_err(|e| CliError::input(e.to_string()))
 }
 
 /// Parses `--shading`; iso-surfaces are `1.5 × min_spacing` thick (world units).
@@ -399,11 +417,7 @@ pub fn prepare(args: &RenderArgs) -> Result<Prepared, CliError> {
     let grid = Grid::from_matrix(grid).map_err(|e| CliError::input(format!("{name}: {e}")))?;
     let view = View::new(view_matrix(args, dims, grid.to_world()))
         .map_err(|e| CliError::input(format!("view: {e}")))?;
-    let mapping = if args.footprint.method == MethodArg::Paper {
-        Mapping::PAPER
-    } else {
-        Mapping::Robust
-    };
+    let mapping = args.footprint.mapping()?;
     let options = FootprintOptions {
         mapping,
         min_radius_px: args.footprint.min_radius,
@@ -507,6 +521,32 @@ pub fn prepare(args: &RenderArgs) -> Result<Prepared, CliError> {
         order,
         options,
     })
+}
+
+/// `args` with `--quality`'s choice applied (unchanged without `--quality`), and the choice.
+pub fn apply_quality(
+    p: &Prepared,
+    args: &RenderArgs,
+) -> Result<(RenderArgs, Option<crate::quality::Choice>), CliError> {
+    let Some(q) = args.quality else {
+        return Ok((args.clone(), None));
+    };
+    let choice = crate::quality::choose(p, q)?;
+    let e = p.frame.footprint.half_extent;
+    crate::say!("{}", choice.explain(2.0 * e[0].max(e[1])));
+    let mut chosen = choice.config.apply(args);
+    chosen.quality = None;
+    Ok((chosen, Some(choice)))
+}
+
+/// The JSON record of a `--quality` choice.
+pub fn quality_json(c: &crate::quality::Choice) -> Json {
+    Json::object()
+        .num("target_db", c.target_db)
+        .num("predicted_db", c.predicted_db)
+        .num("footprint_error", c.footprint_error)
+        .num("k_db", crate::quality::K_DB)
+        .str("chosen", &c.config.label())
 }
 
 /// Shows `sheet n/N` on stderr when it is a terminal.
@@ -724,6 +764,8 @@ pub fn describe(p: &Prepared, args: &RenderArgs) -> Json {
 
 pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     let p = prepare(args)?;
+    let (args, choice) = apply_quality(&p, args)?;
+    let args = &args;
     let (rgb, summary) = if args.footprint.method == MethodArg::Reference {
         let (img, secs) = render_ref(&p)?;
         let rgb: Vec<[f32; 4]> = img.iter().map(|c| c.map(|x| x as f32)).collect();
@@ -751,6 +793,10 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
             .num("pixel_updates", stats.pixel_updates as f64)
             .num("pixels_composited", stats.pixels_composited as f64);
         (img, j)
+    };
+    let summary = match &choice {
+        Some(c) => summary.obj("quality", quality_json(c)),
+        None => summary,
     };
     let out = args
         .out

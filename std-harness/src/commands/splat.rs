@@ -133,11 +133,7 @@ pub fn splat_image(args: &SplatArgs) -> Result<(GreyImage, SplatReport), CliErro
         };
         return Ok((img, report));
     }
-    let mapping = if fa.method == MethodArg::Paper {
-        Mapping::PAPER
-    } else {
-        Mapping::Robust
-    };
+    let mapping = fa.mapping()?;
     let fp = Footprint::new(
         &kernel,
         &g2s,

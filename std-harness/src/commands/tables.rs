@@ -11,7 +11,7 @@ pub struct TablesArgs {
     #[arg(long, default_value = "gaussian:spread=1.6,sigmas=2.5")]
     pub kernel: String,
     /// Table size N (N×N samples over [-1,1]²).
-    #[arg(long, default_value_t = 65)]
+    #[arg(long, default_value_t = 129)]
     pub size: usize,
     /// Output file.
     #[arg(long)]

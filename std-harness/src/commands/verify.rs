@@ -9,7 +9,10 @@
 //! over 3N values): the colour a person sees. PSNR is reported as infinite (JSON null) when the
 //! images are identical.
 
-use super::render::{describe, prepare, render_core, render_core_with, render_ref, RenderArgs};
+use super::render::{
+    apply_quality, describe, prepare, quality_json, render_core, render_core_with, render_ref,
+    RenderArgs,
+};
 use crate::cli::{AccumArg, MethodArg};
 use crate::io::{self, image::encode_png_rgb, json::Json};
 use crate::CliError;
@@ -86,6 +89,8 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         ));
     }
     let p = prepare(r)?;
+    let (chosen, choice) = apply_quality(&p, r)?;
+    let r = &chosen;
     let (core, stats, core_s) = render_core(&p, r)?;
     let (reference, ref_s) = render_ref(&p)?;
     let (per, overall) = compare(&core, &reference);
@@ -144,6 +149,9 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         let mut summary = describe(&p, r).str("command", "verify");
         if let Some(e) = fixed_vs_float {
             summary = summary.obj("fixed_vs_float", e.json());
+        }
+        if let Some(c) = &choice {
+            summary = summary.obj("quality", quality_json(c));
         }
         let summary = summary
             .num("core_seconds", core_s)

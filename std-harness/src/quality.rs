@@ -1,0 +1,239 @@
+//! `--quality DB`: the cheapest configuration (table size, lookup, method, accumulation) expected
+//! to reach DB of PSNR against the f64 reference for this scene and view.
+//!
+//! # The model
+//! An image's error comes from its footprints' error: every pixel sums footprint weights, so a
+//! relative footprint error e shows up as an image error of about e times the local signal. The
+//! model therefore measures, for each candidate, the **footprint error at this view**: one voxel
+//! with this frame's footprint (its size in pixels, its anisotropy and orientation), splatted
+//! through the candidate's table and lookup at a sub-pixel position and compared with the exact
+//! f64 footprint (max |core − reference| / reference peak). That takes a few milliseconds per
+//! candidate and captures both what the table resolution can resolve and how the footprint's
+//! size in pixels samples it (`footprint chart`'s stability panel (c) shows that dependence).
+//! The image PSNR is then predicted as
+//!
+//! `PSNR ≈ K − 20·log₁₀(e)`,
+//!
+//! K calibrated from `footprint chart` sweeps of every shared volume (README, "Choosing the
+//! configuration"): K is the smallest PSNR + 20·log₁₀(e) measured over all of them, less a margin,
+//! so the prediction errs low. Fixed-point accumulation adds < 10⁻⁵ of error (114–144 dB against
+//! float), so it shares the float prediction.
+//!
+//! # Cost
+//! Candidates are tried cheapest first, in the order of `RELATIVE_COST`, measured frame times
+//! relative to the fastest configuration (same sweeps); a smaller table wins a tie.
+
+use crate::cli::{AccumArg, LookupArg, MethodArg};
+use crate::commands::chart::Config;
+use crate::commands::render::Prepared;
+use crate::reference::ReferenceFootprint;
+use crate::{with_table_size, CliError};
+use footprint::splat::{splat, Direct, ImageMut, Sampler};
+use footprint::{Lookup, ViewTable};
+use glam::Mat3;
+
+/// K, dB: the calibration constant of `PSNR ≈ K − 20·log₁₀(e)` (see the module docs).
+pub const K_DB: f64 = CALIBRATED_K_DB - MARGIN_DB;
+/// The smallest PSNR + 20·log₁₀(e) measured in the calibration sweeps: every shared volume at
+/// 512×512, views 0,0,0 and 30,20,0, all 56 configurations (560 renders); the minimum, 21.8 dB,
+/// is `heart` seen along z with a 21×21 nearest table. (Over those sweeps K ranged up to ~55 dB:
+/// the model is deliberately pessimistic.)
+pub const CALIBRATED_K_DB: f64 = 21.8;
+/// Safety margin below the calibrated value, dB.
+pub const MARGIN_DB: f64 = 1.0;
+
+/// Frame time relative to the fastest class, by (lookup, method, accumulation): medians over the
+/// calibration sweeps at view 0,0,0 of each class's frame time over the sweep's fastest. Table
+/// size hardly matters within a class (the per-pixel work does not depend on it).
+pub const RELATIVE_COST: [(LookupArg, MethodArg, AccumArg, f64); 8] = [
+    (LookupArg::Nearest, MethodArg::Robust, AccumArg::Float, 1.0),
+    (
+        LookupArg::Bilinear,
+        MethodArg::Robust,
+        AccumArg::Float,
+        1.33,
+    ),
+    (LookupArg::Nearest, MethodArg::Direct, AccumArg::Float, 1.46),
+    (LookupArg::Nearest, MethodArg::Direct, AccumArg::Fixed, 1.55),
+    (LookupArg::Nearest, MethodArg::Robust, AccumArg::Fixed, 1.62),
+    (
+        LookupArg::Bilinear,
+        MethodArg::Direct,
+        AccumArg::Float,
+        1.99,
+    ),
+    (
+        LookupArg::Bilinear,
+        MethodArg::Robust,
+        AccumArg::Fixed,
+        2.02,
+    ),
+    (
+        LookupArg::Bilinear,
+        MethodArg::Direct,
+        AccumArg::Fixed,
+        2.03,
+    ),
+];
+
+/// What `--quality` chose, and why.
+#[derive(Clone, Debug)]
+pub struct Choice {
+    pub target_db: f64,
+    pub config: Config,
+    /// Predicted PSNR of the choice, dB.
+    pub predicted_db: f64,
+    /// Its footprint error at this view.
+    pub footprint_error: f64,
+    /// Cheaper candidates and their predictions, cheapest first.
+    pub rejected: Vec<(Config, f64)>,
+}
+
+impl Choice {
+    /// One line for the terminal.
+    pub fn explain(&self, footprint_px: f32) -> String {
+        let rejected = match self.rejected.first() {
+            Some((c, db)) => format!(
+                "; {} cheaper configurations predicted below it (the cheapest, {}, {:.1} dB)",
+                self.rejected.len(),
+                c.label(),
+                db
+            ),
+            None => "; it is the cheapest configuration".into(),
+        };
+        format!(
+            "--quality {:.1} dB: chose {} (predicted {:.1} dB: footprint error {:.2e} at this view's {:.1}-px footprint, K = {:.1} dB){rejected}",
+            self.target_db,
+            self.config.label(),
+            self.predicted_db,
+            self.footprint_error,
+            footprint_px,
+            K_DB
+        )
+    }
+}
+
+/// PSNR predicted from a footprint error `e`.
+pub fn predict_db(e: f64) -> f64 {
+    if e > 0.0 {
+        K_DB - 20.0 * e.log10()
+    } else {
+        f64::INFINITY
+    }
+}
+
+fn cost(c: &Config) -> f64 {
+    let base = RELATIVE_COST
+        .iter()
+        .find(|(l, m, a, _)| *l == c.lookup && *m == c.method && *a == c.accum)
+        .map_or(f64::INFINITY, |e| e.3);
+    // Tie-break: a smaller table builds faster and fits cache better.
+    base * (1.0 + c.table as f64 * 1e-6)
+}
+
+/// The candidates, cheapest first.
+pub fn candidates() -> Vec<Config> {
+    let mut v = Config::all();
+    v.sort_by(|a, b| cost(a).total_cmp(&cost(b)));
+    v
+}
+
+/// Sub-pixel positions (fractions of a pixel) at which the footprint error is measured.
+const PHASES: [[f32; 2]; 4] = [[0.31, 0.17], [0.77, 0.59], [0.05, 0.88], [0.52, 0.41]];
+
+/// Max |core − reference| / reference peak for one voxel of `p`'s footprint through a table of
+/// `c`'s size, lookup and method, over four sub-pixel positions (nearest lookup's error depends
+/// strongly on where the centre falls).
+pub fn footprint_error(p: &Prepared, c: &Config) -> Result<f64, CliError> {
+    let fp = p.frame.footprint;
+    let e = fp.half_extent[0].max(fp.half_extent[1]);
+    let side = ((2.0 * e).ceil() as usize + 6).clamp(16, 256);
+    let reference = ReferenceFootprint::new(
+        &p.kernel,
+        &dmat(&p.frame.grid_to_screen),
+        f64::from(p.options.min_radius_px),
+    )
+    .map_err(|e| CliError::input(format!("{}: {e}", p.name)))?;
+    let lookup = Lookup::from(c.lookup);
+    let mut worst = 0.0f64;
+    with_table_size!(c.table, N => {
+        let generic = Box::new(footprint::GenericTable::<N>::build(p.kernel));
+        let sampler: Box<dyn Sampler> = if c.method == MethodArg::Direct {
+            Box::new(Direct { footprint: fp, table: &*generic, lookup })
+        } else {
+            Box::new(ViewTable::<N>::build(&fp, &generic, lookup, lookup))
+        };
+        for phase in PHASES {
+            let centre = [side as f32 / 2.0 + phase[0], side as f32 / 2.0 + phase[1]];
+            let mut want = vec![0.0f64; side * side];
+            reference.splat([f64::from(centre[0]), f64::from(centre[1])], side, side, &mut want);
+            let mut got = vec![0.0f32; side * side];
+            let mut image = ImageMut::new(&mut got, side, side, side)?;
+            splat(&*sampler, centre, &1.0f32, &mut image)?;
+            let peak = want.iter().fold(0.0f64, |m, &v| m.max(v));
+            if peak > 0.0 {
+                let e = got
+                    .iter()
+                    .zip(&want)
+                    .fold(0.0f64, |m, (&g, &w)| m.max((f64::from(g) - w).abs()));
+                worst = worst.max(e / peak);
+            }
+        }
+    })?;
+    Ok(worst)
+}
+
+fn dmat(m: &Mat3) -> glam::DMat3 {
+    glam::DMat3::from_cols_array(&m.to_cols_array().map(f64::from))
+}
+
+/// The cheapest configuration predicted to reach `target_db` for `p`; the most accurate one if
+/// none is.
+pub fn choose(p: &Prepared, target_db: f64) -> Result<Choice, CliError> {
+    if !(target_db.is_finite() && target_db > 0.0) {
+        return Err(CliError::input(format!(
+            "--quality {target_db}: expected a PSNR in dB above 0"
+        )));
+    }
+    let mut rejected = Vec::new();
+    let mut best: Option<(Config, f64, f64)> = None;
+    let mut errors = std::collections::HashMap::new();
+    for c in candidates() {
+        // Fixed and float share a table error: measure it once.
+        let key = (c.table, c.lookup, c.method);
+        let e = match errors.get(&key) {
+            Some(&e) => e,
+            None => {
+                let e = footprint_error(p, &c)?;
+                errors.insert(key, e);
+                e
+            }
+        };
+        let db = predict_db(e);
+        if db >= target_db {
+            return Ok(Choice {
+                target_db,
+                config: c,
+                predicted_db: db,
+                footprint_error: e,
+                rejected,
+            });
+        }
+        if best.is_none_or(|b| db > b.2) {
+            best = Some((c, e, db));
+        }
+        rejected.push((c, db));
+    }
+    let (config, e, db) = best.expect("at least one candidate");
+    crate::say!(
+        "--quality {target_db:.1} dB: no configuration is predicted to reach it; using the most accurate ({:.1} dB)",
+        db
+    );
+    Ok(Choice {
+        target_db,
+        config,
+        predicted_db: db,
+        footprint_error: e,
+        rejected: Vec::new(),
+    })
+}
