@@ -36,7 +36,7 @@ use glam::Mat3;
 pub const K_DB: f64 = CALIBRATED_K_DB - MARGIN_DB;
 /// The smallest PSNR + 20·log₁₀(e) measured in the calibration sweeps: every shared volume at
 /// 512×512, views 0,0,0 and 30,20,0, all 56 configurations (560 renders); the minimum, 21.8 dB,
-/// is `heart` seen along z with a 21×21 nearest table. (Over those sweeps K ranged up to ~55 dB:
+/// is `heart` seen along z with a 5×5 nearest table. (Over those sweeps K ranged up to 61.7 dB:
 /// the model is deliberately pessimistic.)
 pub const CALIBRATED_K_DB: f64 = 21.8;
 /// Safety margin below the calibrated value, dB.
