@@ -30,7 +30,6 @@ use crate::reference::ReferenceFootprint;
 use crate::{with_table_size, CliError};
 use footprint::splat::{splat, Direct, ImageMut, Sampler};
 use footprint::{Lookup, ViewTable};
-use glam::Mat3;
 
 /// K, dB: the calibration constant of `PSNR ≈ K − 20·log₁₀(e)` (see the module docs).
 pub const K_DB: f64 = CALIBRATED_K_DB - MARGIN_DB;
@@ -150,7 +149,7 @@ pub fn footprint_error(p: &Prepared, c: &Config) -> Result<f64, CliError> {
     let side = ((2.0 * e).ceil() as usize + 6).clamp(16, 256);
     let reference = ReferenceFootprint::new(
         &p.kernel,
-        &dmat(&p.frame.grid_to_screen),
+        &p.frame.grid_to_screen.as_dmat3(),
         f64::from(p.options.min_radius_px),
     )
     .map_err(|e| CliError::input(format!("{}: {e}", p.name)))?;
@@ -181,10 +180,6 @@ pub fn footprint_error(p: &Prepared, c: &Config) -> Result<f64, CliError> {
         }
     })?;
     Ok(worst)
-}
-
-fn dmat(m: &Mat3) -> glam::DMat3 {
-    glam::DMat3::from_cols_array(&m.to_cols_array().map(f64::from))
 }
 
 /// The cheapest configuration predicted to reach `target_db` for `p`; the most accurate one if

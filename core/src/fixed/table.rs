@@ -3,10 +3,9 @@
 
 use super::{MAX_ENTRY_FRAC, POS_FRAC};
 use crate::frame::FrameSetup;
-use crate::geometry::mul2;
 use crate::kernel::Shape;
 use crate::math;
-use crate::table::{GenericTable, Lookup};
+use crate::table::{for_each_view_node, GenericTable, Lookup};
 use core::fmt;
 
 /// Largest screen coordinate, footprint half-extent or table coordinate the fixed path accepts,
@@ -106,13 +105,9 @@ impl<const M: usize> FixedTable<M> {
         // A view-table value interpolates generic values, so this bounds every entry.
         let bound = fp.scale * frame.cell_area * max_abs(generic.as_slice());
         let scale = self.set_maps(frame, bound)?;
-        for (row, line) in self.data.iter_mut().enumerate() {
-            let y = -ey + 2.0 * ey * row as f32 / steps;
-            for (col, e) in line.iter_mut().enumerate() {
-                let x = -ex + 2.0 * ex * col as f32 / steps;
-                *e = quantise(generic.sample(mul2(&fp.to_unit, [x, y]), build) * scale);
-            }
-        }
+        for_each_view_node(fp, generic, build, &mut self.data, |e, t| {
+            *e = quantise(t * scale)
+        });
         let half = 0.5 * steps;
         let npp = [steps / (2.0 * ex), steps / (2.0 * ey)];
         self.t_map = [

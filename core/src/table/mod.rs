@@ -21,6 +21,7 @@ mod view;
 
 pub use format::{crc32, Crc32, TableError, FORMAT_VERSION, MAGIC};
 pub use generic::GenericTable;
+pub(crate) use view::for_each_view_node;
 pub use view::ViewTable;
 
 /// How a table is read between its nodes.

@@ -54,14 +54,9 @@ impl<const M: usize> ViewTable<M> {
     ) {
         let [ex, ey] = footprint.half_extent;
         let steps = (M - 1) as f32;
-        for (row, line) in self.data.iter_mut().enumerate() {
-            let y = -ey + 2.0 * ey * row as f32 / steps;
-            for (col, value) in line.iter_mut().enumerate() {
-                let x = -ex + 2.0 * ex * col as f32 / steps;
-                let u = mul2(&footprint.to_unit, [x, y]);
-                *value = footprint.scale * generic.sample(u, build);
-            }
-        }
+        for_each_view_node(footprint, generic, build, &mut self.data, |value, t| {
+            *value = footprint.scale * t
+        });
         self.footprint = *footprint;
         self.nodes_per_px = [steps / (2.0 * ex), steps / (2.0 * ey)];
         self.lookup = sample;
@@ -86,5 +81,30 @@ impl<const M: usize> ViewTable<M> {
             (q[1] + ey) * self.nodes_per_px[1],
         ];
         sample_nodes(self.as_slice(), M, t, self.lookup)
+    }
+}
+
+/// Calls `set(node, T)` for every node of an M×M table over `footprint`'s screen box (node
+/// (row, col) at screen offset (−eₓ + 2eₓ·col/(M−1), −e_y + 2e_y·row/(M−1)) px), with T the
+/// generic table read at that node's unit coordinates with `build` lookup. The float view table
+/// and the fixed-point one both sample through this, so they share their nodes bit for bit.
+pub(crate) fn for_each_view_node<T, const N: usize, const M: usize>(
+    footprint: &Footprint,
+    generic: &GenericTable<N>,
+    build: Lookup,
+    data: &mut [[T; M]; M],
+    mut set: impl FnMut(&mut T, f32),
+) {
+    let [ex, ey] = footprint.half_extent;
+    let steps = (M - 1) as f32;
+    for (row, line) in data.iter_mut().enumerate() {
+        let y = -ey + 2.0 * ey * row as f32 / steps;
+        for (col, value) in line.iter_mut().enumerate() {
+            let x = -ex + 2.0 * ex * col as f32 / steps;
+            set(
+                value,
+                generic.sample(mul2(&footprint.to_unit, [x, y]), build),
+            );
+        }
     }
 }
