@@ -224,8 +224,8 @@ fn frames(c: &mut Criterion) {
                 "30,20,0",
             ];
             args.extend_from_slice(cfg);
-            let r = footprint_harness::commands::render::parse_args(&args).unwrap();
-            let p = footprint_harness::commands::render::prepare(&r).unwrap();
+            let r = footprint_harness::args::parse_args(&args).unwrap();
+            let p = footprint_harness::pipeline::prepare(&r).unwrap();
             let label = format!(
                 "{name}/n={}/{}/{}/{}/{}",
                 cfg[1],
@@ -235,7 +235,7 @@ fn frames(c: &mut Criterion) {
                 math::BACKEND
             );
             g.bench_function(label, |b| {
-                b.iter(|| footprint_harness::commands::render::render_core(&p, &r).unwrap())
+                b.iter(|| footprint_harness::pipeline::render_core(&p, &r).unwrap())
             });
         }
     }

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Everything the embedded demo must show, in one run (CI calls it; it works locally too):
-#  1. the host renders the scene (debug, and release on 4 threads) to one fixed-point checksum;
+#  1. the host renders the scene (debug, and release on 4 threads) to one fixed-point checksum,
+#     the one pinned in expected-checksum.txt;
 #  2. the firmware renders it on QEMU mps2-an385 (Cortex-M3, no FPU) and mps2-an386 (Cortex-M4F)
 #     and prints the same checksum, its painted-stack high-water mark, static RAM and flash;
 #  3. the fixed path's splat and compositing contain no float (object-code audit on M3, M4F and
@@ -27,6 +28,11 @@ out=$(cargo run -q --release -p footprint-scene-host -- --threads 4)
 echo "$out"
 host_release=$(grep '^fixed checksum' <<<"$out")
 [ "$host_debug" = "$host_release" ] || fail "host debug ($host_debug) and release ($host_release) differ"
+# The checksum is pinned: a change to the fixed path's output is a reviewed decision (update
+# expected-checksum.txt in the same commit), never an accident.
+expected=$(cat expected-checksum.txt)
+[ "$host_debug" = "$expected" ] || fail "host '$host_debug', expected-checksum.txt '$expected'"
+echo "host fixed checksum equals expected-checksum.txt"
 
 # run MACHINE CPU ELF: prints the firmware's output, fails on a non-zero exit or a timeout.
 run() {

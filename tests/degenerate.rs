@@ -3,7 +3,7 @@
 use footprint::geometry::{Footprint, FootprintOptions, GeometryError, MAX_HALF_EXTENT_PX};
 use footprint::splat::{splat, BufferError, ImageMut};
 use footprint::{GenericTable, Grid, Kernel, KernelSpecError, Lookup, View, ViewTable};
-use footprint_harness::cli::MethodArg;
+use footprint_harness::args::MethodArg;
 use footprint_suite::{assert_le, max_rel_diff, rows, splat_args, with_reference};
 use glam::Mat3;
 use proptest::prelude::*;

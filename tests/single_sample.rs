@@ -3,7 +3,7 @@
 //! 1 % (max abs difference relative to the reference's peak). Also the other methods and kernels,
 //! with the measured errors printed (`-- --nocapture`).
 
-use footprint_harness::cli::{LookupArg, MethodArg};
+use footprint_harness::args::{LookupArg, MethodArg};
 use footprint_suite::{assert_le, max_rel_diff, splat_args, with_reference};
 use proptest::prelude::*;
 

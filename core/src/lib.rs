@@ -12,14 +12,16 @@
 //! ## Where things live
 //! - [`math`]: the one door to float functions (`libm` or `micromath` backend).
 //! - [`kernel`]: kernels, their footprints, specs like `gaussian:spread=1.6,sigmas=2.5`.
-//! - [`geometry`]: grid, view, the screen ellipse, its extent and its map to the unit circle.
+//! - [`geometry`]: grid, view, the screen ellipse, its extent and its map to the unit circle
+//!   (`ellipse.rs`), and the paper's θ decomposition (`paper.rs`).
 //! - [`table`]: generic and view tables, lookup, the table byte format.
-//! - [`splat`]: spreading one voxel into a caller-owned image.
+//! - [`splat`](mod@splat): spreading one voxel into a caller-owned image.
 //! - [`frame`]: one view of one volume: placement, sheet axis and order, buffer sizes.
 //! - [`shade`]: transfer functions, Phong, Levoy iso-surfaces, grid-coordinate texture.
 //! - [`composite`]: Porter–Duff over/under of premultiplied RGBA.
 //! - [`fixed`]: the integer-only splat, accumulator and compositing (formats, rounding, headroom).
-//! - [`render`]: the sheet renderer and the three-sheet ring for sources that cannot seek.
+//! - [`render`]: the sheet renderer (`mod.rs`), its float and fixed precisions (`precision.rs`),
+//!   and the sheet window, ring and gradient (`sheets.rs`).
 //! - [`source`]: the `SheetSource` interface for voxels streamed from outside, and its driver.
 //!
 //! ## Conventions (kept everywhere)

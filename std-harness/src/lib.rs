@@ -1,10 +1,28 @@
 //! The std harness for Footprint: the `footprint` command line, file I/O, the table preprocessor
 //! and an f64 reference renderer that uses no tables, against which the core is verified.
 //!
-//! - [`cli`]: argument parsing and the entry point [`run`].
+//! # Layers
+//! Data flows one way, top to bottom; no module imports one above it, and no command imports
+//! another (`tests/layering.rs` checks both):
+//!
+//! ```text
+//! cli        parse the command line, dispatch (nothing imports it)
+//!  └ commands   one thin adapter per subcommand: parse, call, report
+//!     └ charts     sweeps and plots for `chart`
+//!        └ pipeline   load → prepare → run (core, reference), configurations, --quality
+//!           └ args, metrics   shared argument structs; image comparisons
+//!              └ scene, tf   the built-in volume; transfer functions
+//!                 └ io, reference, dispatch   files and formats; the f64 reference; N → const N
+//! ```
+//!
+//! - [`cli`]: the entry point [`run`].
 //! - [`commands`]: one module per subcommand.
-//! - [`reference`]: the f64, table-free footprint (exact line integrals).
-//! - [`io`]: image and table files (always written atomically: temporary file, then rename).
+//! - [`charts`]: `footprint chart`'s sweeps and drawing.
+//! - [`pipeline`]: the render pipeline the commands share.
+//! - [`args`]: argument structs and value parsers shared by several commands.
+//! - [`metrics`]: PSNR, RMSE, max error; max relative footprint difference.
+//! - [`reference`]: the f64, table-free footprint (exact line integrals) and renderer.
+//! - [`io`]: volume formats, streaming sources, images, tables, JSON (written atomically).
 //! - [`dispatch`]: runtime table size → const generic.
 
 // `!(x > y)` sends NaN down the rejecting branch, on purpose (as in the core).
@@ -20,11 +38,14 @@ macro_rules! say {
     }};
 }
 
+pub mod args;
+pub mod charts;
 pub mod cli;
 pub mod commands;
 pub mod dispatch;
 pub mod io;
-pub mod quality;
+pub mod metrics;
+pub mod pipeline;
 pub mod reference;
 pub mod scene;
 pub mod tf;

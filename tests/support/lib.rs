@@ -3,9 +3,9 @@
 //! what they found.
 
 use footprint::Kernel;
-use footprint_harness::cli::{FootprintArgs, LookupArg, MethodArg};
-use footprint_harness::commands::splat::{splat_image, SplatArgs};
+use footprint_harness::args::{FootprintArgs, LookupArg, MethodArg};
 use footprint_harness::io::image::GreyImage;
+use footprint_harness::{args::SplatArgs, pipeline::single::splat_image};
 use glam::{DMat3, Mat3};
 use std::path::PathBuf;
 
@@ -95,7 +95,7 @@ pub fn with_reference(args: &SplatArgs) -> (GreyImage, GreyImage) {
 
 /// max |a − b| / max(b): the footprint difference relative to the reference's peak.
 pub fn max_rel_diff(a: &GreyImage, b: &GreyImage) -> f64 {
-    footprint_harness::commands::compare::max_rel_diff(a, b).expect("comparable images")
+    footprint_harness::metrics::max_rel_diff(a, b).expect("comparable images")
 }
 
 /// Asserts `value <= bound`, printing both and the context.

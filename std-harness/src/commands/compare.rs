@@ -1,6 +1,7 @@
 //! `footprint compare`: how far apart two single-channel PFM images are.
 
-use crate::io::{self, image::decode_pfm, image::GreyImage};
+use crate::io::{self, image::decode_pfm};
+use crate::metrics::max_rel_diff;
 use crate::CliError;
 use clap::Args;
 use std::path::PathBuf;
@@ -14,27 +15,6 @@ pub struct CompareArgs {
     /// Fail (exit 1) if max |A − B| / peak(B) exceeds this.
     #[arg(long)]
     pub max_diff: Option<f64>,
-}
-
-/// max |a − b| / max(b), the "normalised footprint" difference used throughout the tests.
-pub fn max_rel_diff(a: &GreyImage, b: &GreyImage) -> Result<f64, CliError> {
-    if (a.width, a.height) != (b.width, b.height) {
-        return Err(CliError::input(format!(
-            "images differ in size: {}x{} vs {}x{}",
-            a.width, a.height, b.width, b.height
-        )));
-    }
-    let peak = f64::from(b.peak());
-    if peak <= 0.0 {
-        return Err(CliError::input("reference image has no positive value"));
-    }
-    let worst = a
-        .data
-        .iter()
-        .zip(&b.data)
-        .map(|(x, y)| f64::from(x - y).abs())
-        .fold(0.0, f64::max);
-    Ok(worst / peak)
 }
 
 pub fn run(args: &CompareArgs) -> Result<(), CliError> {

@@ -2,19 +2,13 @@
 //! how far apart they are.
 //!
 //! Colour space: the renderers' output, linear premultiplied RGBA in [0, 1], composited over the
-//! background (transparent black if none), exactly what `render` writes to its PNG before 8-bit
-//! quantisation. Per channel c over the N pixels:
-//! MSE_c = Σ (core − ref)² / N, RMSE_c = √MSE_c, PSNR_c = 10·log₁₀(1 / MSE_c) dB (peak 1), max abs
-//! = max |core − ref|. *Overall* is the same over the R, G and B channels together (MSE averaged
-//! over 3N values): the colour a person sees. PSNR is reported as infinite (JSON null) when the
-//! images are identical.
+//! background (transparent black if none); the measures are [`crate::metrics`]'.
 
-use super::render::{
-    apply_quality, describe, prepare, quality_json, render_core, render_core_with, render_ref,
-    RenderArgs,
-};
-use crate::cli::{AccumArg, MethodArg};
+use crate::args::{AccumArg, MethodArg, RenderArgs};
 use crate::io::{self, image::encode_png_rgb, json::Json};
+use crate::metrics::compare;
+use crate::pipeline::quality::{apply_quality, quality_json};
+use crate::pipeline::{describe, prepare, render_core, render_core_with, render_ref};
 use crate::CliError;
 use clap::Args;
 use std::path::PathBuf;
@@ -29,56 +23,6 @@ pub struct VerifyArgs {
     /// Also write the reference render (PNG) here.
     #[arg(long)]
     pub reference_out: Option<PathBuf>,
-}
-
-/// Error statistics of one channel or of RGB together.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ErrorStats {
-    pub mse: f64,
-    pub rmse: f64,
-    pub psnr_db: f64,
-    pub max_abs: f64,
-}
-
-impl ErrorStats {
-    fn from_sums(sum_sq: f64, count: usize, max_abs: f64) -> Self {
-        let mse = sum_sq / count as f64;
-        let psnr_db = if mse > 0.0 {
-            10.0 * (1.0 / mse).log10()
-        } else {
-            f64::INFINITY
-        };
-        ErrorStats {
-            mse,
-            rmse: mse.sqrt(),
-            psnr_db,
-            max_abs,
-        }
-    }
-    fn json(&self) -> Json {
-        Json::object()
-            .num("psnr_db", self.psnr_db)
-            .num("rmse", self.rmse)
-            .num("max_abs", self.max_abs)
-            .num("mse", self.mse)
-    }
-}
-
-/// Per-channel (R, G, B, A) and overall (RGB) errors of `core` against `reference`.
-pub fn compare(core: &[[f32; 4]], reference: &[[f64; 4]]) -> ([ErrorStats; 4], ErrorStats) {
-    let mut sq = [0.0f64; 4];
-    let mut mx = [0.0f64; 4];
-    for (c, r) in core.iter().zip(reference) {
-        for ch in 0..4 {
-            let d = (f64::from(c[ch]) - r[ch]).abs();
-            sq[ch] += d * d;
-            mx[ch] = mx[ch].max(d);
-        }
-    }
-    let n = core.len().max(1);
-    let per = [0, 1, 2, 3].map(|ch| ErrorStats::from_sums(sq[ch], n, mx[ch]));
-    let overall = ErrorStats::from_sums(sq[0] + sq[1] + sq[2], 3 * n, mx[0].max(mx[1]).max(mx[2]));
-    (per, overall)
 }
 
 pub fn run(args: &VerifyArgs) -> Result<(), CliError> {

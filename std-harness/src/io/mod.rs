@@ -5,6 +5,7 @@ pub mod formats;
 pub mod image;
 pub mod json;
 pub mod stream;
+pub mod table;
 pub mod volume;
 
 use crate::CliError;

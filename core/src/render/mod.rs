@@ -20,13 +20,17 @@
 //! [`Sampler`]) or [`FixedPath`] (integer table, `i64` accumulator, Q24 image; see
 //! [`crate::fixed`]). One build holds both, so they can be compared on the same frame.
 
-use crate::composite::{clamp_unit, over, RowSpan};
-use crate::fixed::{self, FixedError, FixedTable, Placement};
+mod precision;
+mod sheets;
+
+pub use precision::{FixedPath, FloatPath, Precision};
+pub use sheets::{gradient, SheetRing, SheetWindow};
+
+use crate::composite::RowSpan;
 use crate::frame::{FrameSetup, Order};
 use crate::shade::{Lighting, Sample, Shader};
-use crate::splat::{splat_rows, BufferError, ImageMut, Sampler, SplatStats};
+use crate::splat::{BufferError, ImageMut, Sampler};
 use core::fmt;
-use glam::Vec3;
 
 /// Why a render step was refused.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -36,7 +40,7 @@ pub enum RenderError {
     Buffer(BufferError),
     /// A sheet holds the wrong number of samples.
     SheetLength {
-        /// Samples expected (dims[a] × dims[b]).
+        /// Samples expected (`dims[a] × dims[b]`).
         expected: usize,
         /// Samples given.
         got: usize,
@@ -73,19 +77,6 @@ impl From<BufferError> for RenderError {
     }
 }
 
-/// One sheet and its neighbours along the sheet axis (index − 1 and index + 1), each
-/// `dims[a] × dims[b]` samples, row-major over the in-sheet axes. Missing neighbours (at the volume's
-/// faces) are `None`; gradients there are one-sided.
-#[derive(Clone, Copy, Debug)]
-pub struct SheetWindow<'s, T> {
-    /// Sheet index − 1.
-    pub lower: Option<&'s [T]>,
-    /// The sheet to render.
-    pub current: &'s [T],
-    /// Sheet index + 1.
-    pub upper: Option<&'s [T]>,
-}
-
 /// The caller-owned buffers of a render, each [`FrameSetup::image_len`] long except `rows`
 /// (one per image row). `A` and `P` are the [`Precision`]'s accumulator and image pixels:
 /// `[f32; 4]` and `[f32; 4]` for [`FloatPath`], `[i64; 4]` and `[u32; 4]` for [`FixedPath`].
@@ -97,160 +88,6 @@ pub struct RenderBuffers<'a, A = [f32; 4], P = [f32; 4]> {
     pub image: &'a mut [P],
     /// Per-row extent of what the current sheet touched.
     pub rows: &'a mut [RowSpan],
-}
-
-/// What a [`SheetRenderer`] splats with and accumulates into.
-pub trait Precision {
-    /// A voxel's value as the splat takes it (premultiplied RGBA).
-    type Value: Copy;
-    /// A sheet-accumulator pixel.
-    type Acc: Copy;
-    /// A working-image pixel (premultiplied RGBA).
-    type Pixel: Copy;
-    /// The cleared accumulator pixel (what a caller fills a fresh accumulator with).
-    const ACC_ZERO: Self::Acc;
-    /// Transparent black.
-    const CLEAR: Self::Pixel;
-    /// The value of a voxel shaded to premultiplied RGBA (float, from the shader).
-    fn value(&self, rgba: [f32; 4]) -> Self::Value;
-    /// Whether a value is fully transparent (such voxels are skipped).
-    fn is_transparent(value: &Self::Value) -> bool;
-    /// Splats voxel (u, v) of sheet `sheet` of `frame` into `acc`, reporting touched rows.
-    fn splat(
-        &self,
-        frame: &FrameSetup,
-        sheet: usize,
-        uv: (usize, usize),
-        value: &Self::Value,
-        acc: &mut ImageMut<'_, Self::Acc>,
-        touched: impl FnMut(usize, usize, usize),
-    ) -> Result<SplatStats, BufferError>;
-    /// Composites one row of the accumulated sheet into the image (over back to front, under
-    /// front to back) and clears the accumulator row.
-    fn composite_row(&self, acc: &mut [Self::Acc], image: &mut [Self::Pixel], order: Order);
-    /// `front = front over back`, pixel by pixel.
-    fn over_row(&self, front: &mut [Self::Pixel], back: &[Self::Pixel]);
-}
-
-/// Float accumulation through any [`Sampler`] (view table or direct).
-#[derive(Debug)]
-pub struct FloatPath<'a, S: ?Sized> {
-    /// The footprint sampler.
-    pub sampler: &'a S,
-}
-
-impl<S: Sampler + ?Sized> Precision for FloatPath<'_, S> {
-    type Value = [f32; 4];
-    type Acc = [f32; 4];
-    type Pixel = [f32; 4];
-    const ACC_ZERO: [f32; 4] = [0.0; 4];
-    const CLEAR: [f32; 4] = [0.0; 4];
-
-    #[inline]
-    fn value(&self, rgba: [f32; 4]) -> [f32; 4] {
-        rgba
-    }
-
-    #[inline]
-    fn is_transparent(value: &[f32; 4]) -> bool {
-        !(value[3] > 0.0)
-    }
-
-    #[inline]
-    fn splat(
-        &self,
-        f: &FrameSetup,
-        sheet: usize,
-        (u, v): (usize, usize),
-        value: &[f32; 4],
-        acc: &mut ImageMut<'_, [f32; 4]>,
-        touched: impl FnMut(usize, usize, usize),
-    ) -> Result<SplatStats, BufferError> {
-        let cols = f.grid_to_screen;
-        let (a, b) = f.in_sheet;
-        let p = f.origin
-            + cols.col(f.sheet_axis) * sheet as f32
-            + cols.col(a) * u as f32
-            + cols.col(b) * v as f32;
-        let value = value.map(|c| c * f.cell_area);
-        splat_rows(self.sampler, [p.x, p.y], &value, acc, touched)
-    }
-
-    fn composite_row(&self, acc: &mut [[f32; 4]], image: &mut [[f32; 4]], order: Order) {
-        for (a, i) in acc.iter_mut().zip(image.iter_mut()) {
-            let s = clamp_unit(*a);
-            *a = [0.0; 4];
-            *i = match order {
-                Order::BackToFront => over(s, *i),
-                Order::FrontToBack => over(*i, s),
-            };
-        }
-    }
-
-    fn over_row(&self, front: &mut [[f32; 4]], back: &[[f32; 4]]) {
-        for (i, b) in front.iter_mut().zip(back) {
-            *i = over(*i, *b);
-        }
-    }
-}
-
-/// Fixed-point accumulation (see [`crate::fixed`]): an integer M×M table, Q24 voxel placement,
-/// `i64` accumulator and Q24 image. Splat and compositing use no floating point.
-#[derive(Clone, Copy, Debug)]
-pub struct FixedPath<'a, const M: usize> {
-    table: &'a FixedTable<M>,
-    place: Placement,
-}
-
-impl<'a, const M: usize> FixedPath<'a, M> {
-    /// The fixed path for `frame` through `table` (built for this frame). Refused when the
-    /// volume lands outside the fixed-point screen range.
-    pub fn new(frame: &FrameSetup, table: &'a FixedTable<M>) -> Result<Self, FixedError> {
-        Ok(FixedPath {
-            table,
-            place: Placement::new(frame)?,
-        })
-    }
-}
-
-impl<const M: usize> Precision for FixedPath<'_, M> {
-    type Value = [u32; 4];
-    type Acc = [i64; 4];
-    type Pixel = [u32; 4];
-    const ACC_ZERO: [i64; 4] = [0; 4];
-    const CLEAR: [u32; 4] = [0; 4];
-
-    #[inline]
-    fn value(&self, rgba: [f32; 4]) -> [u32; 4] {
-        fixed::quantise(rgba)
-    }
-
-    #[inline]
-    fn is_transparent(value: &[u32; 4]) -> bool {
-        value[3] == 0
-    }
-
-    #[inline]
-    fn splat(
-        &self,
-        _: &FrameSetup,
-        sheet: usize,
-        (u, v): (usize, usize),
-        value: &[u32; 4],
-        acc: &mut ImageMut<'_, [i64; 4]>,
-        touched: impl FnMut(usize, usize, usize),
-    ) -> Result<SplatStats, BufferError> {
-        let center = self.place.at(sheet, u, v);
-        Ok(fixed::splat::splat(self.table, center, value, acc, touched))
-    }
-
-    fn composite_row(&self, acc: &mut [[i64; 4]], image: &mut [[u32; 4]], order: Order) {
-        fixed::composite::composite_row(acc, image, self.table.frac_bits(), order);
-    }
-
-    fn over_row(&self, front: &mut [[u32; 4]], back: &[[u32; 4]]) {
-        fixed::composite::over_row(front, back);
-    }
 }
 
 /// Counts of one render.
@@ -525,155 +362,5 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
             self.path.over_row(&mut self.buffers.image[..n], &bg[..n]);
         }
         self.stats
-    }
-}
-
-/// World-space gradient (value units per world unit) at voxel (u, v) of `window`'s current
-/// sheet: central differences along each grid axis (one-sided at the volume's faces, zero along
-/// an axis one voxel thick), turned into world space by G⁻ᵀ so anisotropic and sheared grids
-/// are honoured. Non-finite neighbours count as the centre's value.
-pub fn gradient<T: Sample>(
-    frame: &FrameSetup,
-    window: &SheetWindow<'_, T>,
-    u: usize,
-    v: usize,
-) -> Vec3 {
-    let (_, na, nb) = frame.sheet_shape();
-    let (k, (a, b)) = (frame.sheet_axis, frame.in_sheet);
-    let cur = window.current;
-    let here = v * na + u;
-    let centre = cur[here].to_f32();
-    // A non-finite neighbour is missing data: it stands in as the centre's value (no slope toward
-    // it), so no NaN reaches a normal.
-    let finite = |x: f32| if x.is_finite() { x } else { centre };
-    let at = |uu: usize, vv: usize| finite(cur[vv * na + uu].to_f32());
-    let mut g = [0.0f32; 3];
-    g[a] = central(u, na, |x| at(x, v));
-    g[b] = central(v, nb, |y| at(u, y));
-    let lower = window.lower.map(|s| finite(s[here].to_f32()));
-    let upper = window.upper.map(|s| finite(s[here].to_f32()));
-    g[k] = match (lower, upper) {
-        (Some(lo), Some(hi)) => 0.5 * (hi - lo),
-        (Some(lo), None) => centre - lo,
-        (None, Some(hi)) => hi - centre,
-        (None, None) => 0.0,
-    };
-    frame.grid_inverse_transpose * Vec3::from_array(g)
-}
-
-/// Central difference of `f` at `i` on 0..n (one-sided at the ends, zero if n = 1), per grid step.
-#[inline]
-fn central(i: usize, n: usize, f: impl Fn(usize) -> f32) -> f32 {
-    if n < 2 {
-        return 0.0;
-    }
-    let (lo, hi) = (i.saturating_sub(1), (i + 1).min(n - 1));
-    (f(hi) - f(lo)) / (hi - lo) as f32
-}
-
-/// Three sheet buffers in caller-owned storage, filled in sequence order, so a source that cannot
-/// seek (a pipe, a sensor) never needs more than three sheets in memory.
-///
-/// Push sheets in the order [`FrameSetup::sheet_at`] gives; after each push, [`SheetRing::push`]
-/// reports the sequence position whose neighbours are now known, and [`SheetRing::window`] lends
-/// its [`SheetWindow`]. After the last push, [`SheetRing::last`] gives the final position.
-#[derive(Debug)]
-pub struct SheetRing<'a, T> {
-    storage: &'a mut [T],
-    len: usize,
-    pushed: usize,
-    total: usize,
-    ascending: bool,
-}
-
-impl<'a, T: Copy> SheetRing<'a, T> {
-    /// A ring over `storage` (at least 3 × sheet length) for `frame`'s sheets in `order`.
-    pub fn new(
-        storage: &'a mut [T],
-        frame: &FrameSetup,
-        order: Order,
-    ) -> Result<Self, RenderError> {
-        let len = frame.sheet_shape().0;
-        if storage.len() < 3 * len {
-            return Err(BufferError::TooSmall {
-                needed: 3 * len,
-                got: storage.len(),
-            }
-            .into());
-        }
-        Ok(SheetRing {
-            storage,
-            len,
-            pushed: 0,
-            total: frame.sheet_count(),
-            ascending: frame.ascending_for(order),
-        })
-    }
-
-    /// Fills the next sheet in sequence by calling `fill` with its slot (exactly one sheet long);
-    /// returns the sequence position that is now complete (the one before), if any.
-    pub fn push_with<E>(
-        &mut self,
-        fill: impl FnOnce(&mut [T]) -> Result<(), E>,
-    ) -> Result<Option<usize>, E>
-    where
-        E: From<RenderError>,
-    {
-        if self.pushed >= self.total {
-            return Err(RenderError::TooManySheets.into());
-        }
-        let slot = self.pushed % 3;
-        fill(&mut self.storage[slot * self.len..(slot + 1) * self.len])?;
-        self.pushed += 1;
-        Ok(if self.pushed >= 2 {
-            Some(self.pushed - 2)
-        } else {
-            None
-        })
-    }
-
-    /// Copies the next sheet in; see [`SheetRing::push_with`].
-    pub fn push(&mut self, sheet: &[T]) -> Result<Option<usize>, RenderError> {
-        if sheet.len() != self.len {
-            return Err(RenderError::SheetLength {
-                expected: self.len,
-                got: sheet.len(),
-            });
-        }
-        self.push_with(|slot| {
-            slot.copy_from_slice(sheet);
-            Ok(())
-        })
-    }
-
-    /// The last sequence position, once every sheet has been pushed.
-    pub fn last(&self) -> Option<usize> {
-        (self.pushed == self.total && self.total > 0).then(|| self.total - 1)
-    }
-
-    /// The sheet index at sequence position `n`.
-    pub fn sheet_index(&self, n: usize) -> usize {
-        if self.ascending {
-            n
-        } else {
-            self.total - 1 - n
-        }
-    }
-
-    /// The window of sequence position `n` (which must be one of the last two pushed).
-    pub fn window(&self, n: usize) -> SheetWindow<'_, T> {
-        let slot = |m: usize| &self.storage[(m % 3) * self.len..(m % 3 + 1) * self.len];
-        let before = (n >= 1).then(|| slot(n - 1));
-        let after = (n + 1 < self.pushed).then(|| slot(n + 1));
-        let (lower, upper) = if self.ascending {
-            (before, after)
-        } else {
-            (after, before)
-        };
-        SheetWindow {
-            lower,
-            current: slot(n),
-            upper,
-        }
     }
 }

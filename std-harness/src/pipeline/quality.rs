@@ -23,9 +23,10 @@
 //! Candidates are tried cheapest first, in the order of `RELATIVE_COST`, measured frame times
 //! relative to the fastest configuration (same sweeps); a smaller table wins a tie.
 
-use crate::cli::{AccumArg, LookupArg, MethodArg};
-use crate::commands::chart::Config;
-use crate::commands::render::Prepared;
+use super::config::Config;
+use super::prepare::Prepared;
+use crate::args::{AccumArg, LookupArg, MethodArg, RenderArgs};
+use crate::io::json::Json;
 use crate::reference::ReferenceFootprint;
 use crate::{with_table_size, CliError};
 use footprint::splat::{splat, Direct, ImageMut, Sampler};
@@ -231,4 +232,30 @@ pub fn choose(p: &Prepared, target_db: f64) -> Result<Choice, CliError> {
         footprint_error: e,
         rejected: Vec::new(),
     })
+}
+
+/// `args` with `--quality`'s choice applied (unchanged without `--quality`), and the choice.
+pub fn apply_quality(
+    p: &Prepared,
+    args: &RenderArgs,
+) -> Result<(RenderArgs, Option<Choice>), CliError> {
+    let Some(q) = args.quality else {
+        return Ok((args.clone(), None));
+    };
+    let choice = choose(p, q)?;
+    let e = p.frame.footprint.half_extent;
+    crate::say!("{}", choice.explain(2.0 * e[0].max(e[1])));
+    let mut chosen = choice.config.apply(args);
+    chosen.quality = None;
+    Ok((chosen, Some(choice)))
+}
+
+/// The JSON record of a `--quality` choice.
+pub fn quality_json(c: &Choice) -> Json {
+    Json::object()
+        .num("target_db", c.target_db)
+        .num("predicted_db", c.predicted_db)
+        .num("footprint_error", c.footprint_error)
+        .num("k_db", K_DB)
+        .str("chosen", &c.config.label())
 }

@@ -1,0 +1,162 @@
+//! The two precisions a [`SheetRenderer`](super::SheetRenderer) runs in: [`FloatPath`] (f32
+//! accumulator and image, any [`Sampler`]) and [`FixedPath`] (integer table, `i64` accumulator, Q24
+//! image; see [`crate::fixed`]).
+
+use crate::composite::{clamp_unit, over};
+use crate::fixed::{self, FixedError, FixedTable, Placement};
+use crate::frame::{FrameSetup, Order};
+use crate::splat::{splat_rows, BufferError, ImageMut, Sampler, SplatStats};
+
+/// What a [`SheetRenderer`](super::SheetRenderer) splats with and accumulates into.
+pub trait Precision {
+    /// A voxel's value as the splat takes it (premultiplied RGBA).
+    type Value: Copy;
+    /// A sheet-accumulator pixel.
+    type Acc: Copy;
+    /// A working-image pixel (premultiplied RGBA).
+    type Pixel: Copy;
+    /// The cleared accumulator pixel (what a caller fills a fresh accumulator with).
+    const ACC_ZERO: Self::Acc;
+    /// Transparent black.
+    const CLEAR: Self::Pixel;
+    /// The value of a voxel shaded to premultiplied RGBA (float, from the shader).
+    fn value(&self, rgba: [f32; 4]) -> Self::Value;
+    /// Whether a value is fully transparent (such voxels are skipped).
+    fn is_transparent(value: &Self::Value) -> bool;
+    /// Splats voxel (u, v) of sheet `sheet` of `frame` into `acc`, reporting touched rows.
+    fn splat(
+        &self,
+        frame: &FrameSetup,
+        sheet: usize,
+        uv: (usize, usize),
+        value: &Self::Value,
+        acc: &mut ImageMut<'_, Self::Acc>,
+        touched: impl FnMut(usize, usize, usize),
+    ) -> Result<SplatStats, BufferError>;
+    /// Composites one row of the accumulated sheet into the image (over back to front, under
+    /// front to back) and clears the accumulator row.
+    fn composite_row(&self, acc: &mut [Self::Acc], image: &mut [Self::Pixel], order: Order);
+    /// `front = front over back`, pixel by pixel.
+    fn over_row(&self, front: &mut [Self::Pixel], back: &[Self::Pixel]);
+}
+
+/// Float accumulation through any [`Sampler`] (view table or direct).
+#[derive(Debug)]
+pub struct FloatPath<'a, S: ?Sized> {
+    /// The footprint sampler.
+    pub sampler: &'a S,
+}
+
+impl<S: Sampler + ?Sized> Precision for FloatPath<'_, S> {
+    type Value = [f32; 4];
+    type Acc = [f32; 4];
+    type Pixel = [f32; 4];
+    const ACC_ZERO: [f32; 4] = [0.0; 4];
+    const CLEAR: [f32; 4] = [0.0; 4];
+
+    #[inline]
+    fn value(&self, rgba: [f32; 4]) -> [f32; 4] {
+        rgba
+    }
+
+    #[inline]
+    fn is_transparent(value: &[f32; 4]) -> bool {
+        !(value[3] > 0.0)
+    }
+
+    #[inline]
+    fn splat(
+        &self,
+        f: &FrameSetup,
+        sheet: usize,
+        (u, v): (usize, usize),
+        value: &[f32; 4],
+        acc: &mut ImageMut<'_, [f32; 4]>,
+        touched: impl FnMut(usize, usize, usize),
+    ) -> Result<SplatStats, BufferError> {
+        let cols = f.grid_to_screen;
+        let (a, b) = f.in_sheet;
+        let p = f.origin
+            + cols.col(f.sheet_axis) * sheet as f32
+            + cols.col(a) * u as f32
+            + cols.col(b) * v as f32;
+        let value = value.map(|c| c * f.cell_area);
+        splat_rows(self.sampler, [p.x, p.y], &value, acc, touched)
+    }
+
+    fn composite_row(&self, acc: &mut [[f32; 4]], image: &mut [[f32; 4]], order: Order) {
+        for (a, i) in acc.iter_mut().zip(image.iter_mut()) {
+            let s = clamp_unit(*a);
+            *a = [0.0; 4];
+            *i = match order {
+                Order::BackToFront => over(s, *i),
+                Order::FrontToBack => over(*i, s),
+            };
+        }
+    }
+
+    fn over_row(&self, front: &mut [[f32; 4]], back: &[[f32; 4]]) {
+        for (i, b) in front.iter_mut().zip(back) {
+            *i = over(*i, *b);
+        }
+    }
+}
+
+/// Fixed-point accumulation (see [`crate::fixed`]): an integer M×M table, Q24 voxel placement,
+/// `i64` accumulator and Q24 image. Splat and compositing use no floating point.
+#[derive(Clone, Copy, Debug)]
+pub struct FixedPath<'a, const M: usize> {
+    table: &'a FixedTable<M>,
+    place: Placement,
+}
+
+impl<'a, const M: usize> FixedPath<'a, M> {
+    /// The fixed path for `frame` through `table` (built for this frame). Refused when the
+    /// volume lands outside the fixed-point screen range.
+    pub fn new(frame: &FrameSetup, table: &'a FixedTable<M>) -> Result<Self, FixedError> {
+        Ok(FixedPath {
+            table,
+            place: Placement::new(frame)?,
+        })
+    }
+}
+
+impl<const M: usize> Precision for FixedPath<'_, M> {
+    type Value = [u32; 4];
+    type Acc = [i64; 4];
+    type Pixel = [u32; 4];
+    const ACC_ZERO: [i64; 4] = [0; 4];
+    const CLEAR: [u32; 4] = [0; 4];
+
+    #[inline]
+    fn value(&self, rgba: [f32; 4]) -> [u32; 4] {
+        fixed::quantise(rgba)
+    }
+
+    #[inline]
+    fn is_transparent(value: &[u32; 4]) -> bool {
+        value[3] == 0
+    }
+
+    #[inline]
+    fn splat(
+        &self,
+        _: &FrameSetup,
+        sheet: usize,
+        (u, v): (usize, usize),
+        value: &[u32; 4],
+        acc: &mut ImageMut<'_, [i64; 4]>,
+        touched: impl FnMut(usize, usize, usize),
+    ) -> Result<SplatStats, BufferError> {
+        let center = self.place.at(sheet, u, v);
+        Ok(fixed::splat::splat(self.table, center, value, acc, touched))
+    }
+
+    fn composite_row(&self, acc: &mut [[i64; 4]], image: &mut [[u32; 4]], order: Order) {
+        fixed::composite::composite_row(acc, image, self.table.frac_bits(), order);
+    }
+
+    fn over_row(&self, front: &mut [[u32; 4]], back: &[[u32; 4]]) {
+        fixed::composite::over_row(front, back);
+    }
+}

@@ -1,0 +1,315 @@
+//! Argument structs and value parsers that several commands share. This module imports no command
+//! and nothing above the pipeline: commands flatten these structs into their own, and the pipeline
+//! reads them.
+//!
+//! Value formats: lists are comma-separated (`60,30,30`), sizes `WxH`, angles in degrees, matrices
+//! nine numbers in row-major order.
+
+use crate::CliError;
+use clap::{Args, ValueEnum};
+use footprint::frame::Order;
+use std::path::PathBuf;
+
+/// Table lookup, as on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, ValueEnum)]
+pub enum LookupArg {
+    Nearest,
+    Bilinear,
+}
+
+impl From<LookupArg> for footprint::Lookup {
+    fn from(l: LookupArg) -> Self {
+        match l {
+            LookupArg::Nearest => footprint::Lookup::Nearest,
+            LookupArg::Bilinear => footprint::Lookup::Bilinear,
+        }
+    }
+}
+
+/// How the footprint is evaluated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, ValueEnum)]
+pub enum MethodArg {
+    /// View table built through the Cholesky (or sheet-parallelogram) map: no singular angle.
+    Robust,
+    /// View table built through the paper's θ/Sx/Sy decomposition with its 0.01° cheat.
+    Paper,
+    /// No view table: each pixel is mapped straight into the generic table.
+    Direct,
+    /// f64, no tables: the exact line integral (the float reference).
+    Reference,
+}
+
+/// How the sheet accumulator, the working image and compositing count.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum AccumArg {
+    /// f32 throughout.
+    Float,
+    /// Integers only in the splat and compositing (see the core's `fixed` module): an integer
+    /// table, an i64 accumulator, a Q24 image. Bit-exact on every target.
+    Fixed,
+}
+
+/// The footprint flags `splat`, `render` and `verify` share.
+#[derive(clap::Args, Debug, Clone)]
+pub struct FootprintArgs {
+    /// Kernel spec, e.g. gaussian:spread=1.6,sigmas=2.5 (also cone, sinc, bilinear).
+    #[arg(long, default_value = "gaussian:spread=1.6,sigmas=2.5")]
+    pub kernel: String,
+    /// Generic and view table size N (N×N). The default, 129, is on the Pareto frontier of
+    /// `footprint chart` for both charted scenes (README, "Speed against accuracy").
+    #[arg(long, default_value_t = 129)]
+    pub table: usize,
+    /// Load the generic table from a file written by `footprint tables` (its N must equal --table).
+    #[arg(long)]
+    pub table_file: Option<std::path::PathBuf>,
+    /// Lookup, both when building the view table and when sampling it (or the generic table).
+    #[arg(long, value_enum, default_value_t = LookupArg::Bilinear)]
+    pub lookup: LookupArg,
+    /// Footprint method.
+    #[arg(long, value_enum, default_value_t = MethodArg::Robust)]
+    pub method: MethodArg,
+    /// Smallest footprint semi-axis, pixels (sub-pixel footprints are widened to it).
+    #[arg(long, default_value_t = footprint::geometry::DEFAULT_MIN_RADIUS_PX)]
+    pub min_radius: f32,
+    /// `--method paper` only: how close to 45° (degrees) the paper's rotation cheat nudges θ;
+    /// 0 disables it, and the singular angle becomes a typed error.
+    #[arg(long, default_value_t = 0.01)]
+    pub paper_cheat: f32,
+}
+
+impl FootprintArgs {
+    /// The ellipse-to-circle map `--method` and `--paper-cheat` ask for.
+    pub fn mapping(&self) -> Result<footprint::geometry::Mapping, CliError> {
+        if self.method != MethodArg::Paper {
+            return Ok(footprint::geometry::Mapping::Robust);
+        }
+        if !(self.paper_cheat >= 0.0 && self.paper_cheat < 45.0) {
+            return Err(CliError::input(format!(
+                "--paper-cheat {}: expected degrees in [0, 45)",
+                self.paper_cheat
+            )));
+        }
+        Ok(footprint::geometry::Mapping::Paper {
+            cheat_deg: self.paper_cheat,
+        })
+    }
+}
+
+impl FootprintArgs {
+    /// The parsed `--kernel`.
+    pub fn kernel(&self) -> Result<footprint::Kernel, CliError> {
+        footprint::Kernel::parse(&self.kernel)
+            .map_err(|e| CliError::input(format!("--kernel '{}': {e}", self.kernel)))
+    }
+
+    /// The generic table: loaded from `--table-file` (which must be for `kernel` and of size N), or
+    /// built.
+    pub fn generic_table<const N: usize>(
+        &self,
+        kernel: &footprint::Kernel,
+    ) -> Result<Box<footprint::GenericTable<N>>, CliError> {
+        let Some(path) = &self.table_file else {
+            return Ok(Box::new(footprint::GenericTable::<N>::build(*kernel)));
+        };
+        let table = crate::io::table::load_table::<N>(path)?;
+        if table.kernel() != kernel {
+            return Err(CliError::input(format!(
+                "{}: table is for kernel {}, but --kernel is {kernel}",
+                path.display(),
+                table.kernel()
+            )));
+        }
+        Ok(table)
+    }
+}
+
+/// Parses `a,b,c,…` into exactly `n` finite numbers.
+pub fn parse_list<const N: usize>(s: &str) -> Result<[f32; N], String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    if parts.len() != N {
+        return Err(format!(
+            "expected {N} comma-separated numbers, got {}",
+            parts.len()
+        ));
+    }
+    let mut out = [0.0f32; N];
+    for (o, p) in out.iter_mut().zip(parts) {
+        *o = p
+            .trim()
+            .parse()
+            .map_err(|_| format!("'{p}' is not a number"))?;
+        if !o.is_finite() {
+            return Err(format!("'{p}' is not finite"));
+        }
+    }
+    Ok(out)
+}
+
+/// Parses `WxH` (each 1 … 16384).
+pub fn parse_size(s: &str) -> Result<(usize, usize), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("'{s}' is not WxH"))?;
+    let parse = |v: &str| -> Result<usize, String> {
+        let n: usize = v
+            .parse()
+            .map_err(|_| format!("'{v}' is not a whole number"))?;
+        if !(1..=16384).contains(&n) {
+            return Err(format!("image side {n} is outside 1..=16384"));
+        }
+        Ok(n)
+    };
+    Ok((parse(w)?, parse(h)?))
+}
+
+/// Compositing direction on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum OrderArg {
+    /// Farthest sheet first, composited over (the paper's order).
+    BackToFront,
+    /// Nearest sheet first, composited under.
+    FrontToBack,
+}
+
+impl From<OrderArg> for Order {
+    fn from(o: OrderArg) -> Self {
+        match o {
+            OrderArg::BackToFront => Order::BackToFront,
+            OrderArg::FrontToBack => Order::FrontToBack,
+        }
+    }
+}
+
+/// Every flag of `render` (and of `verify`, which takes them all).
+#[derive(Args, Debug, Clone)]
+pub struct RenderArgs {
+    /// Volume: .nrrd/.nhdr, .vti, .vtk, .mhd/.mha, .nii/.nii.gz, or headerless raw with --dims and
+    /// --type. Omitted: the built-in electron-density scene.
+    pub volume: Option<PathBuf>,
+    /// Image size, WxH pixels.
+    #[arg(long, default_value = "512x512", value_parser = parse_size)]
+    pub size: (usize, usize),
+    /// View angles AZ,EL,ROLL in degrees (see the module docs).
+    #[arg(long, default_value = "0,0,0", value_parser = parse_list::<3>, allow_hyphen_values = true)]
+    pub view: [f32; 3],
+    /// Multiplies the zoom that fits the volume into the image.
+    #[arg(long, default_value_t = 1.0)]
+    pub zoom: f32,
+    /// Explicit world-to-screen matrix, nine numbers row-major, pixels per world unit (overrides
+    /// --view and --zoom).
+    #[arg(long, value_parser = parse_list::<9>, allow_hyphen_values = true)]
+    pub view_matrix: Option<[f32; 9]>,
+    /// Kernel, tables, lookup, method (`reference` renders with the f64 reference) and minimum
+    /// footprint radius.
+    #[command(flatten)]
+    pub footprint: FootprintArgs,
+    /// Accumulation: float, or fixed (integer splat, accumulator and compositing; bit-exact).
+    #[arg(long, value_enum, default_value_t = AccumArg::Float)]
+    pub accum: AccumArg,
+    /// Target PSNR against the f64 reference, dB: choose the cheapest table size, lookup, method
+    /// and accumulation predicted to reach it for this scene and view (overrides those flags).
+    #[arg(long, conflicts_with_all = ["table", "lookup", "method", "accum", "table_file"])]
+    pub quality: Option<f64>,
+    /// Transfer function: a preset (grey, ct-bone-skin, density) or a file of `t r g b a` lines.
+    /// Default: density for the built-in scene, grey otherwise.
+    #[arg(long)]
+    pub tf: Option<String>,
+    /// Value window LO,HI mapped onto the transfer function (default: the data's range).
+    #[arg(long, value_parser = parse_list::<2>, allow_hyphen_values = true)]
+    pub window: Option<[f32; 2]>,
+    /// Shading: emission, phong, iso:VALUE (Levoy iso-surface at VALUE, data units), texture.
+    #[arg(long, default_value = "emission")]
+    pub shading: String,
+    /// Starting working image (PNG of the output size), composited behind the volume.
+    #[arg(long)]
+    pub background: Option<PathBuf>,
+    /// Compositing direction (default back-to-front; a pipe's views impose theirs).
+    #[arg(long, value_enum)]
+    pub order: Option<OrderArg>,
+    /// Stream the volume a few sheets at a time instead of loading it: a raw file (with --dims and
+    /// --type), an NRRD with raw encoding or an uncompressed MetaImage; `-` reads raw z-slices from
+    /// standard input in file order (needs --dims and --type).
+    #[arg(long)]
+    pub stream: Option<PathBuf>,
+    /// Write a JSON summary here.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+    /// Raw volumes: dimensions X,Y,Z.
+    #[arg(long, value_parser = parse_dims)]
+    pub dims: Option<[usize; 3]>,
+    /// Raw volumes: sample type (u8, i8, u16, i16, u32, i32, f32, f64).
+    #[arg(long = "type")]
+    pub sample_type: Option<String>,
+    /// Raw volumes: byte order.
+    #[arg(long, default_value = "little")]
+    pub endian: String,
+    /// Raw volumes: spacing X,Y,Z in world units.
+    #[arg(long, default_value = "1,1,1", value_parser = parse_list::<3>)]
+    pub spacing: [f32; 3],
+    /// Output image (PNG). `render` defaults to footprint.png; `verify` writes one only if asked.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
+fn parse_dims(s: &str) -> Result<[usize; 3], String> {
+    let v: Vec<&str> = s.split(',').collect();
+    if v.len() != 3 {
+        return Err("expected X,Y,Z".into());
+    }
+    let mut out = [0usize; 3];
+    for (o, p) in out.iter_mut().zip(v) {
+        *o = p
+            .trim()
+            .parse()
+            .map_err(|_| format!("'{p}' is not a whole number"))?;
+    }
+    Ok(out)
+}
+
+/// `render`'s flags from a list of arguments (as on the command line after `render`), for
+/// programs that drive the harness (benches, charts).
+pub fn parse_args(args: &[&str]) -> Result<RenderArgs, CliError> {
+    #[derive(clap::Parser)]
+    struct Wrapper {
+        #[command(flatten)]
+        render: RenderArgs,
+    }
+    use clap::Parser as _;
+    Wrapper::try_parse_from(std::iter::once("render").chain(args.iter().copied()))
+        .map(|w| w.render)
+        .map_err(|e| CliError::input(e.to_string()))
+}
+
+#[derive(Args, Debug, Clone)]
+pub struct SplatArgs {
+    #[command(flatten)]
+    pub footprint: FootprintArgs,
+    /// Voxel spacing along i,j,k in world units.
+    #[arg(long, default_value = "1,1,1", value_parser = parse_list::<3>)]
+    pub spacing: [f32; 3],
+    /// General grid-to-world matrix, nine numbers row-major (overrides --spacing).
+    #[arg(long, value_parser = parse_list::<9>, allow_hyphen_values = true)]
+    pub grid_matrix: Option<[f32; 9]>,
+    /// World-to-screen matrix, nine numbers row-major (pixels per world unit). Default identity.
+    #[arg(long, value_parser = parse_list::<9>, allow_hyphen_values = true)]
+    pub view_matrix: Option<[f32; 9]>,
+    /// Rotation about the screen x axis composed onto the view, degrees.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub rotate_x: f32,
+    /// Rotation about the screen y axis composed onto the view, degrees.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub rotate_y: f32,
+    /// Rotation about the view direction (screen z) composed onto the view, degrees; positive
+    /// turns +x toward +y (clockwise on screen, y pointing down).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub rotate_z: f32,
+    /// Image size, WxH pixels.
+    #[arg(long, default_value = "256x256", value_parser = parse_size)]
+    pub size: (usize, usize),
+    /// Voxel position on screen, pixels (default: the image centre W/2,H/2).
+    #[arg(long, value_parser = parse_list::<2>, allow_hyphen_values = true)]
+    pub center: Option<[f32; 2]>,
+    /// Output: .pfm (float32 weights) or .png (8-bit, normalised to the peak).
+    #[arg(long)]
+    pub out: PathBuf,
+}

@@ -1,0 +1,332 @@
+//! Drawing the charts with plotters: the trade-off scatter with its Pareto frontier and the three
+//! stability panels, each written as SVG and PNG. Text uses a bundled DejaVu Sans, so the PNGs need
+//! no system fonts.
+
+use super::stability::Curve;
+use super::sweep::Measured;
+use crate::args::{AccumArg, LookupArg, MethodArg};
+use crate::io;
+use crate::pipeline::config::{accum_name, lookup_name, method_name, Config};
+use crate::CliError;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::path::Path;
+
+static FONT: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
+
+pub fn register_font() -> Result<(), CliError> {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    let mut ok = true;
+    ONCE.call_once(|| {
+        ok = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT).is_ok();
+    });
+    if ok {
+        Ok(())
+    } else {
+        Err(CliError::input(
+            "the bundled chart font could not be loaded",
+        ))
+    }
+}
+
+fn plot_err<E: std::fmt::Display>(e: E) -> CliError {
+    CliError::input(format!("chart: {e}"))
+}
+
+const COLOURS: [RGBColor; 4] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+];
+
+fn series_colour(c: &Config) -> RGBColor {
+    let i = match (c.method, c.accum) {
+        (MethodArg::Direct, AccumArg::Float) => 1,
+        (MethodArg::Direct, AccumArg::Fixed) => 3,
+        (_, AccumArg::Float) => 0,
+        (_, AccumArg::Fixed) => 2,
+    };
+    COLOURS[i]
+}
+
+/// Draws the trade-off chart on `root`.
+fn draw_tradeoff<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    rows: &[Measured],
+    title: &str,
+) -> Result<(), CliError>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE).map_err(plot_err)?;
+    let (plot, side) = root.split_horizontally(root.dim_in_pixel().0 * 72 / 100);
+    let finite: Vec<&Measured> = rows.iter().filter(|r| r.psnr_db.is_finite()).collect();
+    let (t0, t1) = finite.iter().fold((f64::MAX, 0.0f64), |(a, b), r| {
+        (a.min(r.min_s), b.max(r.max_s))
+    });
+    let (q0, q1) = finite.iter().fold((f64::MAX, f64::MIN), |(a, b), r| {
+        (a.min(r.psnr_db), b.max(r.psnr_db))
+    });
+    let ms = |s: f64| s * 1e3;
+    let mut chart = ChartBuilder::on(&plot)
+        .caption(title, ("sans-serif", 20))
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(55)
+        .build_cartesian_2d(
+            (ms(t0) * 0.9)..(ms(t1) * 1.08),
+            (q0 - 3.0).floor()..(q1 + 3.0).ceil(),
+        )
+        .map_err(plot_err)?;
+    chart
+        .configure_mesh()
+        .x_desc("frame time, ms (median; bar: min-max)")
+        .y_desc("PSNR vs f64 reference, dB")
+        .label_style(("sans-serif", 13))
+        .draw()
+        .map_err(plot_err)?;
+    // The frontier, fastest first.
+    let mut front: Vec<&Measured> = finite.iter().copied().filter(|r| r.pareto).collect();
+    front.sort_by(|a, b| a.median_s.total_cmp(&b.median_s));
+    chart
+        .draw_series(LineSeries::new(
+            front.iter().map(|r| (ms(r.median_s), r.psnr_db)),
+            BLACK.stroke_width(2),
+        ))
+        .map_err(plot_err)?
+        .label("Pareto frontier")
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], BLACK.stroke_width(2)));
+    for r in &finite {
+        let col = series_colour(&r.config);
+        let (x, y) = (ms(r.median_s), r.psnr_db);
+        chart
+            .draw_series(std::iter::once(PathElement::new(
+                vec![(ms(r.min_s), y), (ms(r.max_s), y)],
+                col.mix(0.6),
+            )))
+            .map_err(plot_err)?;
+        let label = format!("{}", r.config.table);
+        let style = if r.config.lookup == LookupArg::Bilinear {
+            col.filled()
+        } else {
+            col.stroke_width(2)
+        };
+        chart
+            .draw_series(std::iter::once(
+                EmptyElement::at((x, y))
+                    + Circle::new((0, 0), 4, style)
+                    + Text::new(label, (5, -12), ("sans-serif", 11).into_font()),
+            ))
+            .map_err(plot_err)?;
+    }
+    for (i, name) in [
+        "view, float",
+        "direct, float",
+        "view, fixed",
+        "direct, fixed",
+    ]
+    .iter()
+    .enumerate()
+    {
+        let col = COLOURS[i];
+        chart
+            .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
+            .map_err(plot_err)?
+            .label(*name)
+            .legend(move |(x, y)| Circle::new((x + 9, y), 4, col.filled()));
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::LowerRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 13))
+        .draw()
+        .map_err(plot_err)?;
+    // The side panel: the key and the frontier's members.
+    let mut lines = vec![
+        "Labels: table size N.".to_string(),
+        "Filled: bilinear lookup;".to_string(),
+        "ring: nearest.".to_string(),
+        String::new(),
+        "Pareto frontier (fastest first):".to_string(),
+    ];
+    for r in &front {
+        lines.push(format!(
+            "{} {} {} n={}",
+            method_name(r.config.method),
+            lookup_name(r.config.lookup),
+            accum_name(r.config.accum),
+            r.config.table
+        ));
+        lines.push(format!("   {:.0} ms, {:.1} dB", ms(r.median_s), r.psnr_db));
+    }
+    for (i, l) in lines.iter().enumerate() {
+        side.draw(&Text::new(
+            l.as_str(),
+            (8, 40 + 17 * i as i32),
+            ("sans-serif", 13).into_font(),
+        ))
+        .map_err(plot_err)?;
+    }
+    root.present().map_err(plot_err)?;
+    Ok(())
+}
+
+fn draw_stability<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    curves: &[Vec<Curve>; 3],
+) -> Result<(), CliError>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE).map_err(plot_err)?;
+    let panels = root.split_evenly((1, 3));
+    let specs = [
+        ("(a) rotation about the view axis", "degrees", false),
+        ("(b) anisotropy (grid r:1:1)", "ratio r", true),
+        ("(c) footprint size", "pixels across", true),
+    ];
+    for ((panel, set), (title, xdesc, logx)) in panels.iter().zip(curves).zip(specs) {
+        let xs: Vec<f64> = set[0].points.iter().map(|p| p.0).collect();
+        let (x0, x1) = (xs[0], xs[xs.len() - 1]);
+        let ylo = 1e-5f64;
+        let yhi = 1.0f64;
+        let mut builder = ChartBuilder::on(panel);
+        builder
+            .caption(title, ("sans-serif", 16))
+            .margin(10)
+            .x_label_area_size(38)
+            .y_label_area_size(60);
+        let fail_y = yhi * 0.8;
+        macro_rules! body {
+            ($chart:expr) => {{
+                let mut chart = $chart;
+                chart
+                    .configure_mesh()
+                    .x_desc(xdesc)
+                    .y_desc("max error / reference peak")
+                    .y_label_formatter(&|v: &f64| format!("{v:.0e}"))
+                    .label_style(("sans-serif", 12))
+                    .draw()
+                    .map_err(plot_err)?;
+                for (i, c) in set.iter().enumerate() {
+                    let col = COLOURS[i];
+                    // Draw each unbroken run of successes as a line.
+                    let mut run: Vec<(f64, f64)> = Vec::new();
+                    let mut runs = Vec::new();
+                    for &(x, e) in &c.points {
+                        match e {
+                            Some(e) => run.push((x, e.max(ylo))),
+                            None => {
+                                if !run.is_empty() {
+                                    runs.push(std::mem::take(&mut run));
+                                }
+                            }
+                        }
+                    }
+                    if !run.is_empty() {
+                        runs.push(run);
+                    }
+                    for (k, r) in runs.into_iter().enumerate() {
+                        let s = chart
+                            .draw_series(LineSeries::new(r, col.stroke_width(2)))
+                            .map_err(plot_err)?;
+                        if k == 0 {
+                            s.label(c.name).legend(move |(x, y)| {
+                                PathElement::new(vec![(x, y), (x + 18, y)], col.stroke_width(2))
+                            });
+                        }
+                    }
+                    let fails: Vec<f64> = c
+                        .points
+                        .iter()
+                        .filter(|p| p.1.is_none())
+                        .map(|p| p.0)
+                        .collect();
+                    if !fails.is_empty() {
+                        chart
+                            .draw_series(
+                                fails
+                                    .iter()
+                                    .map(|&x| Cross::new((x, fail_y), 6, col.stroke_width(2))),
+                            )
+                            .map_err(plot_err)?
+                            .label(format!("{}: failed ({} points)", c.name, fails.len()))
+                            .legend(move |(x, y)| Cross::new((x + 9, y), 5, col.stroke_width(2)));
+                    }
+                }
+                chart
+                    .configure_series_labels()
+                    .position(SeriesLabelPosition::UpperLeft)
+                    .background_style(WHITE.mix(0.85))
+                    .border_style(BLACK)
+                    .label_font(("sans-serif", 12))
+                    .draw()
+                    .map_err(plot_err)?;
+            }};
+        }
+        if logx {
+            body!(builder
+                .build_cartesian_2d((x0..x1).log_scale(), (ylo..yhi).log_scale())
+                .map_err(plot_err)?);
+        } else {
+            body!(builder
+                .build_cartesian_2d(x0..x1, (ylo..yhi).log_scale())
+                .map_err(plot_err)?);
+        }
+    }
+    root.present().map_err(plot_err)?;
+    Ok(())
+}
+
+fn write_svg_png(
+    dir: &Path,
+    stem: &str,
+    size: (u32, u32),
+    draw: impl Fn(&DrawingArea<SVGBackend<'_>, Shift>) -> Result<(), CliError>,
+    draw_png: impl Fn(&DrawingArea<BitMapBackend<'_>, Shift>) -> Result<(), CliError>,
+) -> Result<(), CliError> {
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+        draw(&root)?;
+    }
+    io::write_atomic(&dir.join(format!("{stem}.svg")), svg.as_bytes())?;
+    let mut rgb = vec![0u8; size.0 as usize * size.1 as usize * 3];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
+        draw_png(&root)?;
+    }
+    let rgba: Vec<[f32; 4]> = rgb
+        .chunks_exact(3)
+        .map(|p| [p[0], p[1], p[2]].map(|v| f32::from(v) / 255.0))
+        .map(|[r, g, b]| [r, g, b, 1.0])
+        .collect();
+    let png = io::image::encode_png_rgb(&rgba, size.0 as usize, size.1 as usize)?;
+    io::write_atomic(&dir.join(format!("{stem}.png")), &png)?;
+    Ok(())
+}
+
+/// `DIR/tradeoff.svg` and `.png`.
+pub fn write_tradeoff(dir: &Path, rows: &[Measured], title: &str) -> Result<(), CliError> {
+    write_svg_png(
+        dir,
+        "tradeoff",
+        (1100, 650),
+        |r| draw_tradeoff(r, rows, title),
+        |r| draw_tradeoff(r, rows, title),
+    )
+}
+
+/// `DIR/stability.svg` and `.png`.
+pub fn write_stability(dir: &Path, curves: &[Vec<Curve>; 3]) -> Result<(), CliError> {
+    write_svg_png(
+        dir,
+        "stability",
+        (1500, 520),
+        |r| draw_stability(r, curves),
+        |r| draw_stability(r, curves),
+    )
+}

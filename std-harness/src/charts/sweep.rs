@@ -1,0 +1,177 @@
+//! The trade-off sweep: every configuration rendered and measured against the f64 reference.
+
+use crate::args::RenderArgs;
+use crate::metrics::compare;
+use crate::pipeline::config::{accum_name, lookup_name, method_name, Config};
+use crate::pipeline::{prepare, quality, render_core_with, render_ref};
+use crate::CliError;
+
+/// One measured configuration.
+#[derive(Clone, Debug)]
+pub struct Measured {
+    pub config: Config,
+    /// Frame seconds: median, min, max over the runs.
+    pub median_s: f64,
+    pub min_s: f64,
+    pub max_s: f64,
+    /// Overall RGB PSNR against the f64 reference, dB (infinite if identical).
+    pub psnr_db: f64,
+    /// Max abs RGB error against the reference.
+    pub max_abs: f64,
+    /// The `--quality` model's footprint error for this configuration at this view.
+    pub footprint_error: f64,
+    pub pareto: bool,
+}
+
+impl Measured {
+    /// PSNR + 20·log₁₀(footprint error): what the `--quality` model calls K, for this row.
+    pub fn k_db(&self) -> f64 {
+        self.psnr_db + 20.0 * self.footprint_error.log10()
+    }
+}
+
+/// Renders the scene of `base` with every configuration in `configs`, `runs` times each, and
+/// measures it against the f64 reference. Prints one line per configuration.
+pub fn sweep(
+    base: &RenderArgs,
+    configs: &[Config],
+    runs: usize,
+) -> Result<Vec<Measured>, CliError> {
+    let p = prepare(base)?;
+    let (reference, ref_s) = render_ref(&p)?;
+    crate::say!(
+        "{}: {}x{}, reference {:.2} s; {} configurations x {runs} runs",
+        p.name,
+        base.size.0,
+        base.size.1,
+        ref_s,
+        configs.len()
+    );
+    // One untimed render first, so the first configuration is not timed with cold caches.
+    if let Some(c) = configs.first() {
+        render_core_with(&p, &c.apply(base), c.accum)?;
+    }
+    let mut out = Vec::new();
+    for c in configs {
+        let args = c.apply(base);
+        let mut times = Vec::with_capacity(runs);
+        let mut image = Vec::new();
+        for _ in 0..runs.max(1) {
+            let (img, _, secs) = render_core_with(&p, &args, c.accum)?;
+            times.push(secs);
+            image = img;
+        }
+        times.sort_by(f64::total_cmp);
+        let (_, overall) = compare(&image, &reference);
+        let footprint_error = quality::footprint_error(&p, c)?;
+        let m = Measured {
+            footprint_error,
+            config: *c,
+            median_s: times[times.len() / 2],
+            min_s: times[0],
+            max_s: times[times.len() - 1],
+            psnr_db: overall.psnr_db,
+            max_abs: overall.max_abs,
+            pareto: false,
+        };
+        crate::say!(
+            "{:<36} {:>8.3} s ({:.3}–{:.3})  {:>7.2} dB  max {:.2e}",
+            c.label(),
+            m.median_s,
+            m.min_s,
+            m.max_s,
+            m.psnr_db,
+            m.max_abs
+        );
+        out.push(m);
+    }
+    mark_pareto(&mut out);
+    Ok(out)
+}
+
+/// Marks the configurations no other beats in both time (median) and PSNR.
+pub fn mark_pareto(rows: &mut [Measured]) {
+    let snapshot: Vec<(f64, f64)> = rows.iter().map(|r| (r.median_s, r.psnr_db)).collect();
+    for (i, r) in rows.iter_mut().enumerate() {
+        let (t, q) = snapshot[i];
+        r.pareto = !snapshot
+            .iter()
+            .enumerate()
+            .any(|(j, &(tj, qj))| j != i && tj <= t && qj >= q && (tj < t || qj > q));
+    }
+}
+
+/// The trade-off CSV: one row per configuration.
+pub fn csv(rows: &[Measured]) -> String {
+    let mut s = String::from(
+        "config,table,lookup,method,accum,backend,median_s,min_s,max_s,psnr_db,max_abs,footprint_error,k_db,pareto\n",
+    );
+    for r in rows {
+        let c = &r.config;
+        s.push_str(&format!(
+            "{},{},{},{},{},{},{:.6},{:.6},{:.6},{:.3},{:.4e},{:.4e},{:.3},{}\n",
+            c.label(),
+            c.table,
+            lookup_name(c.lookup),
+            method_name(c.method),
+            accum_name(c.accum),
+            footprint::math::BACKEND,
+            r.median_s,
+            r.min_s,
+            r.max_s,
+            r.psnr_db,
+            r.max_abs,
+            r.footprint_error,
+            r.k_db(),
+            r.pareto
+        ));
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(t: f64, q: f64) -> Measured {
+        Measured {
+            config: Config::all()[0],
+            median_s: t,
+            min_s: t,
+            max_s: t,
+            psnr_db: q,
+            max_abs: 0.0,
+            footprint_error: 0.1,
+            pareto: false,
+        }
+    }
+
+    #[test]
+    fn pareto_keeps_exactly_the_undominated() {
+        // (time, PSNR): b dominates c (faster and better); a and d trade off; e ties a.
+        let mut rows = vec![
+            row(1.0, 40.0),
+            row(2.0, 60.0),
+            row(2.5, 55.0),
+            row(3.0, 70.0),
+            row(1.0, 40.0),
+        ];
+        mark_pareto(&mut rows);
+        let front: Vec<bool> = rows.iter().map(|r| r.pareto).collect();
+        assert_eq!(front, [true, true, false, true, true]);
+    }
+
+    #[test]
+    fn every_configuration_once_with_bench_names() {
+        let all = Config::all();
+        assert_eq!(all.len(), 56);
+        let mut labels: Vec<String> = all.iter().map(Config::label).collect();
+        labels.sort();
+        labels.dedup();
+        assert_eq!(labels.len(), 56);
+        assert!(labels.contains(&format!(
+            "n=33/bilinear/direct/fixed/{}",
+            footprint::math::BACKEND
+        )));
+    }
+}

@@ -1,0 +1,28 @@
+//! Generic footprint tables on disk, in the core's byte format (`footprint tables` writes them,
+//! `--table-file` reads them).
+
+use crate::{io, with_table_size, CliError};
+use footprint::{GenericTable, Kernel};
+
+/// Builds a table and returns its serialised bytes.
+pub fn table_bytes(kernel: &Kernel, size: usize) -> Result<Vec<u8>, CliError> {
+    with_table_size!(size, N => {
+        let table = Box::new(GenericTable::<N>::build(*kernel));
+        let mut bytes = vec![0u8; table.serialized_len()];
+        let len = table.write_bytes(&mut bytes)?;
+        bytes.truncate(len);
+        bytes
+    })
+}
+
+/// Loads a table file for a `GenericTable<N>`, with the path in any error.
+pub fn load_table<const N: usize>(
+    path: &std::path::Path,
+) -> Result<Box<GenericTable<N>>, CliError> {
+    let bytes = io::read_file(path)?;
+    let mut table = Box::new(GenericTable::<N>::zeroed(Kernel::PAPER_GAUSSIAN));
+    table
+        .load_into(&bytes)
+        .map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
+    Ok(table)
+}

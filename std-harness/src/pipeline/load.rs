@@ -1,0 +1,181 @@
+//! Where a render's voxels come from: a volume file loaded whole, a file streamed a few sheets at a
+//! time, standard input, or the built-in scene; and the optional background image.
+
+use crate::args::RenderArgs;
+use crate::io::formats::{self, raw::RawOptions};
+use crate::io::stream::{file_range, is_stdin, Layout};
+use crate::io::volume::{SampleType, Volume};
+use crate::{io, scene, CliError};
+use glam::{Mat3, Vec3};
+
+/// Where the voxels come from.
+pub enum Voxels {
+    /// Loaded whole.
+    Memory(Volume),
+    /// Streamed from a seekable file.
+    File(Layout),
+    /// Streamed from standard input, z-slices in file order.
+    Stdin {
+        dims: [usize; 3],
+        ty: SampleType,
+        big_endian: bool,
+    },
+}
+
+/// The raw-file options from `--dims`, `--type`, `--endian`, `--spacing`, if `--dims` was given.
+pub fn raw_options(args: &RenderArgs) -> Result<Option<RawOptions>, CliError> {
+    let Some(dims) = args.dims else {
+        return Ok(None);
+    };
+    let ty = args
+        .sample_type
+        .as_deref()
+        .ok_or_else(|| CliError::input("raw volumes need --type"))?;
+    let ty = SampleType::parse(ty).ok_or_else(|| {
+        CliError::input(format!(
+            "--type '{ty}' is not a sample type (u8, i8, u16, i16, u32, i32, f32, f64)"
+        ))
+    })?;
+    let big_endian = match args.endian.as_str() {
+        "little" => false,
+        "big" => true,
+        e => {
+            return Err(CliError::input(format!(
+                "--endian '{e}': expected little or big"
+            )))
+        }
+    };
+    Ok(Some(RawOptions {
+        dims,
+        ty,
+        big_endian,
+        spacing: args.spacing,
+    }))
+}
+
+/// What `prepare` learns about the voxels before rendering.
+pub(crate) struct Loaded {
+    pub(crate) voxels: Voxels,
+    pub(crate) name: String,
+    pub(crate) dims: [usize; 3],
+    pub(crate) grid: Mat3,
+    /// The data's finite range, if it could be read without a second pass over a pipe.
+    pub(crate) range: Option<(f32, f32)>,
+}
+
+pub(crate) fn load_voxels(args: &RenderArgs) -> Result<Loaded, CliError> {
+    let raw = raw_options(args)?;
+    let Some(stream) = &args.stream else {
+        let (volume, name) = match &args.volume {
+            Some(path) => (
+                formats::load(path, raw.as_ref())?,
+                path.display().to_string(),
+            ),
+            None => (
+                scene::default_volume(),
+                "built-in electron-density scene".to_string(),
+            ),
+        };
+        let (dims, grid, range) = (volume.dims, volume.grid_to_world(), Some(volume.range()));
+        return Ok(Loaded {
+            voxels: Voxels::Memory(volume),
+            name,
+            dims,
+            grid,
+            range,
+        });
+    };
+    if args.volume.is_some() {
+        return Err(CliError::input(
+            "give the volume either as VOLUME or with --stream, not both",
+        ));
+    }
+    let name = stream.display().to_string();
+    if is_stdin(stream) {
+        let o = raw.ok_or_else(|| {
+            CliError::input("--stream - (standard input) needs --dims and --type")
+        })?;
+        crate::io::volume::byte_len(o.dims, o.ty)
+            .map_err(|e| CliError::input(format!("standard input: {e}")))?;
+        crate::io::volume::check_spacing(o.spacing)
+            .map_err(|e| CliError::input(format!("standard input: {e}")))?;
+        let grid = Mat3::from_diagonal(Vec3::from_array(o.spacing));
+        let voxels = Voxels::Stdin {
+            dims: o.dims,
+            ty: o.ty,
+            big_endian: o.big_endian,
+        };
+        return Ok(Loaded {
+            voxels,
+            name: "standard input".into(),
+            dims: o.dims,
+            grid,
+            range: None,
+        });
+    }
+    let lower = name.to_ascii_lowercase();
+    let (layout, spacing, directions) = if let Some(o) = &raw {
+        let layout = Layout {
+            path: stream.clone(),
+            offset: 0,
+            dims: o.dims,
+            ty: o.ty,
+            big_endian: o.big_endian,
+        };
+        crate::io::volume::check_spacing(o.spacing)
+            .map_err(|e| crate::io::volume::at(stream, e))?;
+        (layout, o.spacing, crate::io::volume::AXIS_ALIGNED)
+    } else if lower.ends_with(".nrrd") || lower.ends_with(".nhdr") {
+        let s = formats::nrrd::raw_layout(stream)?;
+        (s.layout, s.spacing, s.directions)
+    } else if lower.ends_with(".mha") || lower.ends_with(".mhd") {
+        let s = formats::metaimage::raw_layout(stream)?;
+        (s.layout, s.spacing, s.directions)
+    } else {
+        return Err(crate::io::volume::at(stream, "streaming reads raw files (with --dims and --type), NRRD with raw encoding, or uncompressed MetaImage"));
+    };
+    let file_len = std::fs::metadata(&layout.path)
+        .map_err(|e| crate::io::volume::at(&layout.path, format!("cannot read: {e}")))?
+        .len();
+    let need = crate::io::volume::byte_len(layout.dims, layout.ty)
+        .map_err(|e| crate::io::volume::at(&layout.path, e))? as u64;
+    if raw.is_some() && file_len != need {
+        return Err(crate::io::volume::at(
+            &layout.path,
+            format!("expected {need} bytes for --dims/--type, found {file_len}"),
+        ));
+    }
+    let col = |c: usize| Vec3::from_array(directions[c]) * spacing[c];
+    let grid = Mat3::from_cols(col(0), col(1), col(2));
+    let range = if args.window.is_none() {
+        Some(file_range(&layout)?)
+    } else {
+        None
+    };
+    Ok(Loaded {
+        dims: layout.dims,
+        voxels: Voxels::File(layout),
+        name,
+        grid,
+        range,
+    })
+}
+
+pub(crate) fn load_background(
+    path: &std::path::Path,
+    size: (usize, usize),
+) -> Result<Vec<[f32; 4]>, CliError> {
+    let bytes = io::read_file(path)?;
+    let img = crate::io::image::decode_png_rgba(&bytes, &path.display().to_string())?;
+    if (img.0, img.1) != size {
+        return Err(CliError::input(format!(
+            "{}: background is {}x{}, the image is {}x{}",
+            path.display(),
+            img.0,
+            img.1,
+            size.0,
+            size.1
+        )));
+    }
+    Ok(img.2)
+}

@@ -1,0 +1,27 @@
+//! The render pipeline every command shares, owned by none of them. Data flows one way through it:
+//!
+//! ```text
+//! load (voxels: file, stream, stdin, built-in)  ─┐
+//! prepare (grid, view, frame, transfer function, ├─▶ run (tables, the core's sheet loop) ─▶ image
+//!          shading, order, background)          ─┘   reference (f64, no tables)          ─▶ image
+//! ```
+//!
+//! - [`load`]: where the voxels come from.
+//! - [`prepare`]: [`Prepared`], a render set up and ready to run.
+//! - [`run`]: the core's render (float or fixed, view table or direct) and the f64 reference.
+//! - [`config`]: one table configuration (size, lookup, method, accumulation).
+//! - [`quality`]: `--quality`, the cheapest configuration predicted to reach a PSNR.
+//! - [`single`]: one voxel rendered on its own (`footprint splat`, the stability charts).
+//!
+//! It reads the shared argument structs of [`crate::args`] and calls down into [`crate::io`],
+//! [`crate::reference`] and the core; it imports no command.
+
+pub mod config;
+pub mod load;
+pub mod prepare;
+pub mod quality;
+pub mod run;
+pub mod single;
+
+pub use prepare::{describe, prepare, Prepared};
+pub use run::{render_core, render_core_with, render_ref};

@@ -1,0 +1,253 @@
+//! A render set up and ready to run ([`Prepared`]): the volume, its frame for this view, the
+//! transfer function and shading, the compositing order.
+//!
+//! View: `--view AZ,EL,ROLL` (degrees) builds V = zoom · Rz(roll) · Rx(el) · Ry(az): azimuth turns
+//! the volume about the screen's vertical axis, elevation about its horizontal axis, roll about
+//! the view direction. With AZ = EL = ROLL = 0 the viewer looks along +k with +i to the right and
+//! +j down. The zoom that fits the volume's bounding box into 90 % of the image is multiplied by
+//! `--zoom`. `--view-matrix` gives V (world → screen, pixels per world unit) explicitly instead.
+
+use super::load::{load_background, load_voxels, Loaded, Voxels};
+use crate::args::RenderArgs;
+use crate::io::json::Json;
+use crate::io::volume::{SampleType, Volume};
+use crate::{tf, CliError};
+use footprint::frame::{FrameSetup, Order};
+use footprint::geometry::FootprintOptions;
+use footprint::shade::{Phong, Shader, Shading, TransferFunction};
+use footprint::{Grid, Kernel, View};
+use glam::{Mat3, Vec3};
+
+/// Parses `--shading`; iso-surfaces are `1.5 × min_spacing` thick (world units).
+pub fn parse_shading(s: &str, min_spacing: f32) -> Result<Shading, CliError> {
+    let phong = Phong::default();
+    Ok(match s {
+        "emission" => Shading::Emission,
+        "phong" => Shading::Phong(phong),
+        "texture" => Shading::Texture(phong),
+        _ => match s.strip_prefix("iso:").map(str::parse::<f32>) {
+            Some(Ok(value)) if value.is_finite() => Shading::Iso {
+                value,
+                opacity: 0.9,
+                thickness: 1.5 * min_spacing,
+                phong,
+            },
+            _ => {
+                return Err(CliError::input(format!(
+                    "--shading '{s}': expected emission, phong, iso:VALUE or texture"
+                )))
+            }
+        },
+    })
+}
+
+/// A render, set up and ready to run: the volume, the frame, the shading.
+pub struct Prepared {
+    pub voxels: Voxels,
+    pub name: String,
+    pub kernel: Kernel,
+    pub frame: FrameSetup,
+    pub lut: Vec<[f32; 4]>,
+    pub window: [f32; 2],
+    pub shading: Shading,
+    pub tf_name: String,
+    pub background: Option<Vec<[f32; 4]>>,
+    pub order: Order,
+    pub options: FootprintOptions,
+}
+
+impl Prepared {
+    /// The shader over this render's lookup table.
+    pub fn shader(&self) -> Shader<'_> {
+        Shader {
+            tf: TransferFunction {
+                lut: &self.lut,
+                lo: self.window[0],
+                hi: self.window[1],
+            },
+            shading: self.shading,
+        }
+    }
+
+    /// The volume, when it is in memory (not streamed).
+    pub fn volume(&self) -> Option<&Volume> {
+        match &self.voxels {
+            Voxels::Memory(v) => Some(v),
+            _ => None,
+        }
+    }
+}
+
+/// V for `--view`/`--zoom` (fitted to a volume of `dims` on grid `g`) or `--view-matrix`.
+pub fn view_matrix(args: &RenderArgs, dims: [usize; 3], g: Mat3) -> Mat3 {
+    if let Some(m) = args.view_matrix {
+        return Mat3::from_cols_array(&m).transpose();
+    }
+    let [az, el, roll] = args.view.map(f32::to_radians);
+    let r = Mat3::from_rotation_z(roll) * Mat3::from_rotation_x(el) * Mat3::from_rotation_y(az);
+    // Half-extents on screen of the volume's box (voxel centres ± half a voxel), in world space
+    // through its grid-to-world matrix.
+    let half = Vec3::new(dims[0] as f32, dims[1] as f32, dims[2] as f32) * 0.5;
+    let mut ext = Vec3::ZERO;
+    for corner in 0..8 {
+        let c = Vec3::new(
+            if corner & 1 == 0 { -half.x } else { half.x },
+            if corner & 2 == 0 { -half.y } else { half.y },
+            if corner & 4 == 0 { -half.z } else { half.z },
+        );
+        ext = ext.max((r * (g * c)).abs());
+    }
+    let (w, h) = (args.size.0 as f32, args.size.1 as f32);
+    let fit = 0.9 * (w / (2.0 * ext.x)).min(h / (2.0 * ext.y));
+    r * (fit * args.zoom)
+}
+
+/// Loads and sets up everything `args` describes.
+pub fn prepare(args: &RenderArgs) -> Result<Prepared, CliError> {
+    let kernel = args.footprint.kernel()?;
+    let Loaded {
+        voxels,
+        name,
+        dims,
+        grid,
+        range,
+    } = load_voxels(args)?;
+    let grid = Grid::from_matrix(grid).map_err(|e| CliError::input(format!("{name}: {e}")))?;
+    let view = View::new(view_matrix(args, dims, grid.to_world()))
+        .map_err(|e| CliError::input(format!("view: {e}")))?;
+    let mapping = args.footprint.mapping()?;
+    let options = FootprintOptions {
+        mapping,
+        min_radius_px: args.footprint.min_radius,
+    };
+    let frame = FrameSetup::new(
+        dims,
+        &grid,
+        &view,
+        &kernel,
+        options,
+        [args.size.0, args.size.1],
+    )?;
+    let order = match &voxels {
+        Voxels::Stdin { .. } => {
+            if frame.sheet_axis != 2 {
+                return Err(CliError::input(format!(
+                    "standard input delivers z-slices in file order, but this view's sheets run along {}: \
+                     only views looking within 45° of the z axis work from a pipe (for example --view 0,0,0, \
+                     --view 180,0,0 or --view 30,20,0); stream a file to render any view",
+                    ["x", "y", "z"][frame.sheet_axis]
+                )));
+            }
+            let needed = frame.order_for_ascending();
+            if let Some(asked) = args.order.map(Order::from) {
+                if asked != needed {
+                    return Err(CliError::input(format!(
+                        "from a pipe this view composites {needed:?} (file order runs {} the viewer); drop --order",
+                        if frame.ascending_recedes { "away from" } else { "toward" }
+                    )));
+                }
+            }
+            needed
+        }
+        _ => args.order.map_or(Order::BackToFront, Order::from),
+    };
+    let tf_name = args.tf.clone().unwrap_or_else(|| {
+        if args.volume.is_none() && args.stream.is_none() {
+            "density"
+        } else {
+            "grey"
+        }
+        .into()
+    });
+    let lut = tf::lut(&tf::load(&tf_name)?);
+    let window = match args.window {
+        Some(w) => w,
+        None => {
+            let (lo, hi) = match (range, &voxels) {
+                (Some(r), _) => r,
+                (
+                    None,
+                    Voxels::Stdin {
+                        ty: SampleType::U8, ..
+                    },
+                ) => (0.0, 255.0),
+                (
+                    None,
+                    Voxels::Stdin {
+                        ty: SampleType::I8, ..
+                    },
+                ) => (-128.0, 127.0),
+                (None, _) => {
+                    return Err(CliError::input(
+                        "standard input cannot be read twice: give --window LO,HI",
+                    ))
+                }
+            };
+            if !(hi > lo) {
+                return Err(CliError::input(format!(
+                    "{name}: the data are constant ({lo}); give --window"
+                )));
+            }
+            [lo, hi]
+        }
+    };
+    if !(window[1] > window[0]) {
+        return Err(CliError::input(format!(
+            "--window {},{}: HI must exceed LO",
+            window[0], window[1]
+        )));
+    }
+    let shading = parse_shading(
+        &args.shading,
+        frame.spacing.iter().copied().fold(f32::INFINITY, f32::min),
+    )?;
+    let background = args
+        .background
+        .as_ref()
+        .map(|p| load_background(p, args.size))
+        .transpose()?;
+    Ok(Prepared {
+        voxels,
+        name,
+        kernel,
+        frame,
+        lut,
+        window,
+        shading,
+        tf_name,
+        background,
+        order,
+        options,
+    })
+}
+
+/// The JSON fields every render and verify summary share.
+pub fn describe(p: &Prepared, args: &RenderArgs) -> Json {
+    let f = &p.frame;
+    Json::object()
+        .str("volume", &p.name)
+        .arr_usize("dims", &p.frame.dims)
+        .arr_f64("spacing", &p.frame.spacing.map(f64::from))
+        .arr_usize("size", &[args.size.0, args.size.1])
+        .str("kernel", &p.kernel.to_string())
+        .num("table", args.footprint.table as f64)
+        .str(
+            "lookup",
+            &format!("{:?}", args.footprint.lookup).to_lowercase(),
+        )
+        .str(
+            "method",
+            &format!("{:?}", args.footprint.method).to_lowercase(),
+        )
+        .str("order", &format!("{:?}", p.order).to_lowercase())
+        .str("accum", &format!("{:?}", args.accum).to_lowercase())
+        .bool("streamed", p.volume().is_none())
+        .str("shading", &args.shading)
+        .str("tf", &p.tf_name)
+        .arr_f64("window", &p.window.map(f64::from))
+        .str("sheet_axis", ["i", "j", "k"][f.sheet_axis])
+        .arr_f64(
+            "footprint_half_extent_px",
+            &f.footprint.half_extent.map(f64::from),
+        )
+}

@@ -1,0 +1,200 @@
+//! Running a prepared render: the core's sheet loop (float or fixed, any table method), driven
+//! through a [`SheetRing`] as a streaming source would drive it, and the f64 reference.
+
+use super::load::Voxels;
+use super::prepare::Prepared;
+use crate::args::{AccumArg, MethodArg, RenderArgs};
+use crate::io::stream::{FileSource, MemorySource, PipeSource};
+use crate::reference::render::{render_reference, ReferenceScene};
+use crate::{with_table_size, CliError};
+use footprint::fixed::{self, FixedTable};
+use footprint::render::{
+    FixedPath, FloatPath, Precision, RenderBuffers, RenderStats, SheetRenderer, SheetRing,
+};
+use footprint::source::{render_from, SheetSource};
+use footprint::splat::Direct;
+use footprint::{composite::RowSpan, Lookup, ViewTable};
+use std::io::IsTerminal;
+use std::time::Instant;
+
+/// Shows `sheet n/N` on stderr when it is a terminal.
+pub fn progress(label: &'static str) -> impl FnMut(usize, usize) {
+    let tty = std::io::stderr().is_terminal();
+    move |n, total| {
+        if tty {
+            use std::io::Write as _;
+            let end = if n == total { "\n" } else { "" };
+            let _ = write!(
+                std::io::stderr().lock(),
+                "\r{label}: sheet {n}/{total}{end}"
+            );
+        }
+    }
+}
+
+/// The core's render of `p` with `args`' table, method and accumulation: premultiplied RGBA
+/// (fixed-point output converted exactly to f32), counts, seconds.
+pub fn render_core(
+    p: &Prepared,
+    args: &RenderArgs,
+) -> Result<(Vec<[f32; 4]>, RenderStats, f64), CliError> {
+    render_core_with(p, args, args.accum)
+}
+
+/// [`render_core`] with the accumulation given explicitly.
+pub fn render_core_with(
+    p: &Prepared,
+    args: &RenderArgs,
+    accum: AccumArg,
+) -> Result<(Vec<[f32; 4]>, RenderStats, f64), CliError> {
+    let fa = &args.footprint;
+    let lookup = Lookup::from(fa.lookup);
+    let fixed_range =
+        |e: fixed::FixedError| CliError::input(format!("{}: --accum fixed: {e}", p.name));
+    with_table_size!(fa.table, N => {
+        let generic = fa.generic_table::<N>(&p.kernel)?;
+        let start = Instant::now();
+        // Each path gets its own monomorphised sheet loop: no virtual call per pixel.
+        let (image, stats) = match (accum, fa.method) {
+            (AccumArg::Float, MethodArg::Direct) => {
+                let sampler = Direct { footprint: p.frame.footprint, table: &*generic, lookup };
+                run_sheets(p, FloatPath { sampler: &sampler }, p.background.as_deref())?
+            }
+            (AccumArg::Float, _) => {
+                let table = Box::new(ViewTable::<N>::build(&p.frame.footprint, &generic, lookup, lookup));
+                run_sheets(p, FloatPath { sampler: &*table }, p.background.as_deref())?
+            }
+            (AccumArg::Fixed, method) => {
+                let mut table = Box::new(FixedTable::<N>::zeroed());
+                match method {
+                    MethodArg::Direct => table.build_direct(&p.frame, &generic, lookup),
+                    _ => table.build_view(&p.frame, &generic, lookup, lookup),
+                }
+                .map_err(fixed_range)?;
+                let path = FixedPath::new(&p.frame, &*table).map_err(fixed_range)?;
+                let bg: Option<Vec<[u32; 4]>> =
+                    p.background.as_ref().map(|b| b.iter().map(|&c| fixed::quantise(c)).collect());
+                let (img, stats) = run_sheets(p, path, bg.as_deref())?;
+                (img.into_iter().map(fixed::to_f32).collect(), stats)
+            }
+        };
+        (image, stats, start.elapsed().as_secs_f64())
+    })
+}
+
+/// Drives the core renderer through a [`SheetRing`], as a streaming source would.
+fn run_sheets<P: Precision>(
+    p: &Prepared,
+    path: P,
+    background: Option<&[P::Pixel]>,
+) -> Result<(Vec<P::Pixel>, RenderStats), CliError> {
+    let f = &p.frame;
+    let n = f.image_len();
+    let (mut accum, mut image, mut rows) = (
+        vec![P::ACC_ZERO; n],
+        vec![P::CLEAR; n],
+        vec![RowSpan::EMPTY; f.size[1]],
+    );
+    let buffers = RenderBuffers {
+        accumulator: &mut accum,
+        image: &mut image,
+        rows: &mut rows,
+    };
+    let mut renderer = SheetRenderer::with_path(f, path, p.shader(), p.order, buffers, background)?;
+    let mut storage = vec![0.0f32; 3 * f.sheet_shape().0];
+    let mut ring = SheetRing::new(&mut storage, f, p.order)?;
+    let mut show = Progress {
+        inner: progress("render"),
+        count: f.sheet_count(),
+        done: 0,
+    };
+    match &p.voxels {
+        Voxels::Memory(v) => {
+            render_from(&mut renderer, &mut ring, &mut show.wrap(MemorySource(v)))?
+        }
+        Voxels::File(layout) => render_from(
+            &mut renderer,
+            &mut ring,
+            &mut show.wrap(FileSource::open(layout.clone())?),
+        )?,
+        Voxels::Stdin {
+            dims,
+            ty,
+            big_endian,
+        } => {
+            let stdin = std::io::stdin().lock();
+            let src = PipeSource::new(
+                std::io::BufReader::with_capacity(1 << 20, stdin),
+                *dims,
+                *ty,
+                *big_endian,
+                "standard input",
+            );
+            render_from(&mut renderer, &mut ring, &mut show.wrap(src))?
+        }
+    }
+    let stats = renderer.finish();
+    Ok((image, stats))
+}
+
+/// Shows progress as a source delivers sheets.
+struct Progress<F> {
+    inner: F,
+    count: usize,
+    done: usize,
+}
+
+/// A source that reports each sheet read.
+struct Reporting<'p, S, F> {
+    source: S,
+    progress: &'p mut Progress<F>,
+}
+
+impl<F: FnMut(usize, usize)> Progress<F> {
+    fn wrap<S>(&mut self, source: S) -> Reporting<'_, S, F> {
+        Reporting {
+            source,
+            progress: self,
+        }
+    }
+}
+
+impl<S: SheetSource<Sample = f32, Error = CliError>, F: FnMut(usize, usize)> SheetSource
+    for Reporting<'_, S, F>
+{
+    type Sample = f32;
+    type Error = CliError;
+    fn read_sheet(&mut self, axis: usize, index: usize, out: &mut [f32]) -> Result<(), CliError> {
+        self.source.read_sheet(axis, index, out)?;
+        let p = &mut *self.progress;
+        p.done += 1;
+        (p.inner)(p.done, p.count);
+        Ok(())
+    }
+    fn sequential_axis(&self) -> Option<usize> {
+        self.source.sequential_axis()
+    }
+}
+
+/// The f64 reference render of `p` and its seconds (the volume must be in memory).
+pub fn render_ref(p: &Prepared) -> Result<(Vec<[f64; 4]>, f64), CliError> {
+    let volume = p.volume().ok_or_else(|| {
+        CliError::input("the f64 reference needs the volume in memory: drop --stream")
+    })?;
+    let start = Instant::now();
+    let scene = ReferenceScene {
+        frame: &p.frame,
+        kernel: &p.kernel,
+        min_radius_px: p.options.min_radius_px,
+        shader: p.shader(),
+        order: p.order,
+        background: p.background.as_deref(),
+    };
+    let axis = p.frame.sheet_axis;
+    let img = render_reference(
+        &scene,
+        |s, out| volume.sheet_into(axis, s, out),
+        progress("reference"),
+    )?;
+    Ok((img, start.elapsed().as_secs_f64()))
+}

@@ -1,0 +1,310 @@
+//! The harness's layers, checked from its source: data flows one way (cli → commands → charts →
+//! pipeline → args/metrics → scene/tf → io/reference/dispatch → core), no command imports another,
+//! nothing imports `cli`, and files stay small enough to read (issue 16's "must show" 1 and 2).
+//!
+//! A module's dependencies are the `crate::…` and `super::…` paths in its code (`use` lines and
+//! inline paths alike; unit tests after `#[cfg(test)]` are not counted). Modules are the top-level
+//! ones, with `commands`, `pipeline` and `charts` split into their files; a group's `mod.rs`
+//! declaring and re-exporting its own files is not a dependency.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+const GROUPS: [&str; 3] = ["commands", "pipeline", "charts"];
+
+/// Largest file anywhere in `core/src` and `std-harness/src`, unless it says why it stays whole.
+const MAX_LINES: usize = 600;
+/// Largest command file: a command is a thin adapter.
+const MAX_COMMAND_LINES: usize = 300;
+/// A module doc line starting with this states why a file over `MAX_LINES` stays whole.
+const WHOLE_MARKER: &str = "//! Why one file:";
+
+fn rs_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for entry in std::fs::read_dir(dir).expect("readable source folder") {
+        let path = entry.expect("directory entry").path();
+        if path.is_dir() {
+            rs_files(&path, out);
+        } else if path.extension().is_some_and(|e| e == "rs") {
+            out.push(path);
+        }
+    }
+}
+
+/// The module path of a file under `src`: `commands/render.rs` → [commands, render],
+/// `pipeline/mod.rs` → [pipeline], `lib.rs` → [].
+fn module_path(src: &Path, file: &Path) -> Vec<String> {
+    let rel = file.strip_prefix(src).expect("file under src");
+    let mut parts: Vec<String> = rel
+        .iter()
+        .map(|p| p.to_string_lossy().into_owned())
+        .collect();
+    let last = parts.pop().expect("a file name");
+    let stem = last.trim_end_matches(".rs");
+    if !matches!(stem, "mod" | "lib" | "main") {
+        parts.push(stem.to_string());
+    }
+    parts
+}
+
+/// The layer node of an absolute module path (`None` for the crate root's own items).
+fn node(path: &[String], files: &BTreeSet<Vec<String>>) -> Option<String> {
+    let first = path.first()?;
+    if !files.contains(&vec![first.clone()]) {
+        return None; // an item of the crate root: CliError, say!, with_table_size!
+    }
+    if GROUPS.contains(&first.as_str()) && path.len() > 1 {
+        let sub = vec![first.clone(), path[1].clone()];
+        if files.contains(&sub) {
+            return Some(format!("{first}/{}", path[1]));
+        }
+    }
+    Some(first.clone())
+}
+
+fn rank(node: &str) -> u32 {
+    match node.split('/').next().unwrap_or(node) {
+        "cli" => 7,
+        "commands" => 6,
+        "charts" => 5,
+        "pipeline" => 4,
+        "args" | "metrics" => 3,
+        "scene" | "tf" => 2,
+        "io" | "reference" | "dispatch" => 1,
+        other => panic!("module '{other}' has no layer: add it to tests/layering.rs"),
+    }
+}
+
+fn is_ident(c: char) -> bool {
+    c.is_ascii_alphanumeric() || c == '_'
+}
+
+/// Every path that follows `prefix` in `code`, as identifier lists, expanding one level of
+/// `{a, b::c}` groups.
+fn paths_after(code: &str, prefix: &str) -> Vec<Vec<String>> {
+    let mut out = Vec::new();
+    let mut rest = code;
+    while let Some(i) = rest.find(prefix) {
+        let before_ok = rest[..i].chars().next_back().is_none_or(|c| !is_ident(c));
+        rest = &rest[i + prefix.len()..];
+        if !before_ok {
+            continue;
+        }
+        if let Some(group) = rest.strip_prefix('{') {
+            let end = group.find('}').unwrap_or(group.len());
+            for item in group[..end].split(',') {
+                out.push(idents(item.trim()));
+            }
+        } else {
+            out.push(idents(rest));
+        }
+    }
+    out.retain(|p| !p.is_empty());
+    out
+}
+
+/// `a::b::c…` at the start of `s` as [a, b, c].
+fn idents(s: &str) -> Vec<String> {
+    let mut v = Vec::new();
+    let mut s = s;
+    loop {
+        let end = s.find(|c: char| !is_ident(c)).unwrap_or(s.len());
+        if end == 0 {
+            break;
+        }
+        v.push(s[..end].to_string());
+        match s[end..].strip_prefix("::") {
+            Some(r) if !r.starts_with('{') => s = r,
+            Some(r) => {
+                // `a::{b, c}`: the module `a` is what matters for the layer.
+                let _ = r;
+                break;
+            }
+            None => break,
+        }
+    }
+    v
+}
+
+/// Code of a file without comments and without its unit tests.
+fn code_of(text: &str) -> String {
+    let body = text.split("#[cfg(test)]").next().unwrap_or(text);
+    body.lines()
+        .filter(|l| !l.trim_start().starts_with("//"))
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+struct Harness {
+    /// node → nodes it depends on.
+    edges: BTreeMap<String, BTreeSet<String>>,
+}
+
+fn harness() -> Harness {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let src = root.join("std-harness/src");
+    let mut files = Vec::new();
+    rs_files(&src, &mut files);
+    let paths: BTreeSet<Vec<String>> = files.iter().map(|f| module_path(&src, f)).collect();
+    let mut edges: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+    for file in &files {
+        if file
+            .file_name()
+            .is_some_and(|n| n == "main.rs" || n == "lib.rs")
+        {
+            continue;
+        }
+        let me_path = module_path(&src, file);
+        let Some(me) = node(&me_path, &paths) else {
+            continue;
+        };
+        let is_mod_rs = file.file_name().is_some_and(|n| n == "mod.rs");
+        let code = code_of(&std::fs::read_to_string(file).expect("readable file"));
+        let mut targets: Vec<Vec<String>> = paths_after(&code, "crate::");
+        // `super::x` from `a/b.rs` is `a::x`; from `a/b/mod.rs` it is `a::x` as well.
+        let parent: Vec<String> = me_path[..me_path.len().saturating_sub(1)].to_vec();
+        for p in paths_after(&code, "super::") {
+            let mut abs = parent.clone();
+            abs.extend(p);
+            targets.push(abs);
+        }
+        for t in targets {
+            let Some(to) = node(&t, &paths) else {
+                continue;
+            };
+            // A group's mod.rs declaring or re-exporting its own files is not a dependency.
+            let own_child = is_mod_rs && to.starts_with(&format!("{me}/"));
+            if to != me && !own_child {
+                edges.entry(me.clone()).or_default().insert(to);
+            }
+        }
+        edges.entry(me).or_default();
+    }
+    Harness { edges }
+}
+
+#[test]
+fn data_flows_one_way() {
+    let h = harness();
+    let mut wrong = Vec::new();
+    for (from, tos) in &h.edges {
+        for to in tos {
+            let same_group = from.split('/').next() == to.split('/').next();
+            let ok = if same_group {
+                // Within a group (pipeline's files, io's formats) only commands are barred from
+                // each other; cycles are caught below.
+                !from.starts_with("commands/")
+            } else {
+                rank(to) < rank(from)
+            };
+            if !ok {
+                wrong.push(format!("{from} → {to}"));
+            }
+        }
+    }
+    assert!(
+        wrong.is_empty(),
+        "imports against the layers (cli → commands → charts → pipeline → args/metrics → scene/tf → io/…):\n{}",
+        wrong.join("\n")
+    );
+    assert!(
+        h.edges.contains_key("pipeline/run") && h.edges.contains_key("commands/render"),
+        "the scan found the harness's modules: {:?}",
+        h.edges.keys().collect::<Vec<_>>()
+    );
+}
+
+#[test]
+fn no_import_cycle() {
+    let h = harness();
+    // Depth-first search with colours; report the first cycle found.
+    fn visit(
+        n: &str,
+        h: &Harness,
+        state: &mut BTreeMap<String, u8>,
+        stack: &mut Vec<String>,
+    ) -> Option<Vec<String>> {
+        match state.get(n) {
+            Some(2) => return None,
+            Some(1) => {
+                let at = stack.iter().position(|s| s == n).unwrap_or(0);
+                let mut cycle = stack[at..].to_vec();
+                cycle.push(n.to_string());
+                return Some(cycle);
+            }
+            _ => {}
+        }
+        state.insert(n.to_string(), 1);
+        stack.push(n.to_string());
+        for m in h.edges.get(n).into_iter().flatten() {
+            if let Some(c) = visit(m, h, state, stack) {
+                return Some(c);
+            }
+        }
+        stack.pop();
+        state.insert(n.to_string(), 2);
+        None
+    }
+    let mut state = BTreeMap::new();
+    for n in h.edges.keys() {
+        let mut stack = Vec::new();
+        if let Some(cycle) = visit(n, &h, &mut state, &mut stack) {
+            panic!("import cycle: {}", cycle.join(" → "));
+        }
+    }
+}
+
+#[test]
+fn nothing_imports_the_command_line_or_another_command() {
+    let h = harness();
+    for (from, tos) in &h.edges {
+        assert!(!tos.contains("cli"), "{from} imports cli");
+        if from.starts_with("commands/") {
+            let others: Vec<&String> = tos.iter().filter(|t| t.starts_with("commands")).collect();
+            assert!(others.is_empty(), "{from} imports {others:?}");
+        }
+    }
+}
+
+#[test]
+fn the_checker_sees_a_planted_cycle() {
+    // The scan itself: a command that imported another, and an upward import, would be seen.
+    let code = "use crate::commands::render::run;\nuse super::{prepare::Prepared, load};\nfn f() { crate::io::read_file(p); }";
+    let found = paths_after(code, "crate::");
+    assert_eq!(found[0], ["commands", "render", "run"]);
+    assert_eq!(found[1], ["io", "read_file"]);
+    let sup = paths_after(code, "super::");
+    assert_eq!(sup, [vec!["prepare", "Prepared"], vec!["load"]]);
+}
+
+#[test]
+fn files_stay_readable() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut long = Vec::new();
+    for dir in ["core/src", "std-harness/src"] {
+        let mut files = Vec::new();
+        rs_files(&root.join(dir), &mut files);
+        assert!(!files.is_empty(), "{dir} has Rust files");
+        for f in files {
+            let text = std::fs::read_to_string(&f).expect("readable file");
+            let lines = text.lines().count();
+            let rel = f
+                .strip_prefix(root)
+                .expect("under the root")
+                .display()
+                .to_string();
+            let command = rel.starts_with("std-harness/src/commands/");
+            if command && lines > MAX_COMMAND_LINES {
+                long.push(format!(
+                    "{rel}: {lines} lines (a command file may have {MAX_COMMAND_LINES})"
+                ));
+            }
+            let states_why = text.lines().take(40).any(|l| l.starts_with(WHOLE_MARKER));
+            if lines > MAX_LINES && !states_why {
+                long.push(format!(
+                    "{rel}: {lines} lines (over {MAX_LINES} without a '{WHOLE_MARKER}' line)"
+                ));
+            }
+        }
+    }
+    assert!(long.is_empty(), "{}", long.join("\n"));
+}
