@@ -19,6 +19,14 @@ pub trait Sampler {
     fn footprint(&self) -> &Footprint;
     /// Weight, px⁻², at offset `q` pixels from the voxel's projected centre (x right, y down).
     fn weight(&self, q: [f32; 2]) -> f32;
+    /// Weights of `out.len()` consecutive pixels of one row: `out[k]` at offset
+    /// `(qx0 + k, qy)`. The splat's inner loop; samplers override it to step through their table.
+    #[inline]
+    fn row_weights(&self, qx0: f32, qy: f32, out: &mut [f32]) {
+        for (k, w) in out.iter_mut().enumerate() {
+            *w = self.weight([qx0 + k as f32, qy]);
+        }
+    }
 }
 
 impl<const M: usize> Sampler for ViewTable<M> {
@@ -28,6 +36,10 @@ impl<const M: usize> Sampler for ViewTable<M> {
     #[inline]
     fn weight(&self, q: [f32; 2]) -> f32 {
         ViewTable::weight(self, q)
+    }
+    #[inline]
+    fn row_weights(&self, qx0: f32, qy: f32, out: &mut [f32]) {
+        ViewTable::row_weights(self, qx0, qy, out)
     }
 }
 
@@ -210,12 +222,6 @@ pub struct SplatStats {
     pub pixels_updated: u32,
 }
 
-/// Inclusive pixel index range whose centres lie within [c − e, c + e], unclipped, clamped to
-/// ±2³¹ so later clipping stays exact.
-fn pixel_span(c: f32, e: f32) -> (i64, i64) {
-    pixel_range(c - e, c + e)
-}
-
 /// Spreads `value` (e.g. premultiplied RGBA) of a voxel projected to screen position `center`
 /// (pixels, absolute) into `image`, using `sampler`'s footprint. Only pixels whose centres lie
 /// inside the footprint's support ([`Footprint::row_span`]) are visited. See the module docs.
@@ -228,8 +234,20 @@ pub fn splat<S: Sampler + ?Sized, P: Pixel>(
     splat_rows(sampler, center, value, image, |_, _, _| {})
 }
 
+/// Pixels per batch of row weights (a stack buffer; longer rows are done in several batches).
+const BATCH: usize = 64;
+
+/// Largest number of pixel centres a renormalised footprint spans along x or y: half-extents
+/// ≤ [`crate::geometry::RENORMALISE_BELOW_PX`] (4 px) cover at most 9 centres; one spare.
+const SMALL: usize = 10;
+
 /// [`splat`], also calling `touched(y, x0, x1)` for every image row it visits with the inclusive
 /// pixel range it visited there (so a caller can composite only what a sheet covered).
+///
+/// Cost: per image row one square root ([`Footprint::row_span`]) and two floors; per pixel one
+/// [`Sampler::row_weights`] entry and one multiply-add per channel. A renormalised (small)
+/// footprint keeps its weights in a 10×10 stack buffer between the sum and the deposit, so the
+/// table is read once.
 pub fn splat_rows<S: Sampler + ?Sized, P: Pixel>(
     sampler: &S,
     center: [f32; 2],
@@ -241,80 +259,163 @@ pub fn splat_rows<S: Sampler + ?Sized, P: Pixel>(
         return Err(BufferError::NonFiniteCenter);
     }
     let fp = sampler.footprint();
-    let (y0, y1) = pixel_span(center[1], fp.half_extent[1]);
-    let mut factor = 1.0;
-    if fp.renormalise {
-        // Small footprint (at most 9×9 pixels): sum its sampled weights over the unclipped
-        // support so the voxel deposits exactly one unit, less what falls off-screen.
-        let mut sum = 0.0f32;
-        for_each_in_support(fp, center, y0, y1, i64::MIN, i64::MAX, |_, _, q| {
-            sum += sampler.weight(q)
-        });
-        if sum > 0.0 {
-            factor = 1.0 / sum;
-        } else {
-            // No pixel centre saw the footprint (a table too coarse to resolve it): put the whole
-            // voxel in the pixel that contains its centre rather than lose it.
-            return Ok(deposit_whole(center, value, image, touched));
-        }
-    }
-    let mut stats = SplatStats::default();
+    let (y0, y1) = pixel_range(center[1] - fp.half_extent[1], center[1] + fp.half_extent[1]);
     let (w, h) = (image.width as i64, image.height as i64);
+    if y1 < 0 || y0 >= h {
+        // Entirely above or below the image (or the band it is): nothing to do. (A renormalised
+        // footprint's fallback pixel, the one holding its centre, lies inside its box too.)
+        return Ok(SplatStats::default());
+    }
     let stride = image.stride;
     let data = &mut *image.data;
-    let mut row = (-1i64, 0i64, 0i64);
-    for_each_in_support(fp, center, y0.max(0), y1.min(h - 1), 0, w - 1, |x, y, q| {
-        stats.pixels_visited += 1;
-        if y != row.0 {
-            if row.0 >= 0 {
-                touched(row.0 as usize, row.1 as usize, row.2 as usize);
+    let mut stats = SplatStats::default();
+    if fp.renormalise {
+        let (x0, x1) = pixel_range(center[0] - fp.half_extent[0], center[0] + fp.half_extent[0]);
+        if y1 - y0 < SMALL as i64 && x1 - x0 < SMALL as i64 {
+            return Ok(splat_small(
+                sampler,
+                center,
+                value,
+                (x0, y0),
+                ((x1 - x0 + 1) as usize, (y1 - y0 + 1) as usize),
+                image,
+                touched,
+            ));
+        }
+    }
+    let mut batch = [0.0f32; BATCH];
+    for y in y0.max(0)..=y1.min(h - 1) {
+        let qy = y as f32 + 0.5 - center[1];
+        let Some((x0, x1)) = row_pixels(fp, center[0], qy) else {
+            continue;
+        };
+        let (lo, hi) = (x0.max(0), x1.min(w - 1));
+        if lo > hi {
+            continue;
+        }
+        let row_start = y as usize * stride;
+        let mut x = lo;
+        while x <= hi {
+            let n = ((hi - x + 1) as usize).min(BATCH);
+            let ws = &mut batch[..n];
+            sampler.row_weights(x as f32 + 0.5 - center[0], qy, ws);
+            let start = row_start + x as usize;
+            let px = &mut data[start..start + n];
+            for (d, &wt) in px.iter_mut().zip(ws.iter()) {
+                d.add_weighted(value, wt);
+                stats.pixels_updated += u32::from(wt != 0.0);
             }
-            row = (y, x, x);
+            x += n as i64;
         }
-        row.2 = x;
-        let weight = sampler.weight(q);
-        if weight != 0.0 {
-            // x, y are within the clipped image, so the index is in the buffer ImageMut checked.
-            data[y as usize * stride + x as usize].add_weighted(value, weight * factor);
-            stats.pixels_updated += 1;
-        }
-    });
-    if row.0 >= 0 {
-        touched(row.0 as usize, row.1 as usize, row.2 as usize);
+        stats.pixels_visited += (hi - lo + 1) as u32;
+        touched(y as usize, lo as usize, hi as usize);
     }
     Ok(stats)
 }
 
-/// Calls `f(x, y, q)` for every pixel (x, y) with y in `y0..=y1`, x in `xmin..=xmax`, whose centre
-/// lies inside the footprint's support; q is the centre's offset from `center`, pixels.
+/// A small (renormalised) footprint whose box `origin`, `size` (≤ 10×10 pixels, unclipped) is
+/// known: its weights over the whole box are sampled once into a stack buffer, pixels outside the
+/// support are zeroed (|A q|² > 1, the same test as [`Footprint::row_span`]), the sum is taken so
+/// the voxel deposits exactly one unit (less what falls off-screen), then the on-screen part is
+/// added.
 #[inline]
-fn for_each_in_support(
-    fp: &Footprint,
+fn splat_small<S: Sampler + ?Sized, P: Pixel>(
+    sampler: &S,
     center: [f32; 2],
-    y0: i64,
-    y1: i64,
-    xmin: i64,
-    xmax: i64,
-    mut f: impl FnMut(i64, i64, [f32; 2]),
-) {
-    for y in y0..=y1 {
-        let qy = y as f32 + 0.5 - center[1];
-        let Some((lo, hi)) = fp.row_span(qy) else {
-            continue;
-        };
-        let (x0, x1) = pixel_range(center[0] + lo, center[0] + hi);
-        for x in x0.max(xmin)..=x1.min(xmax) {
-            f(x, y, [x as f32 + 0.5 - center[0], qy]);
+    value: &P,
+    (x0, y0): (i64, i64),
+    (nx, ny): (usize, usize),
+    image: &mut ImageMut<'_, P>,
+    mut touched: impl FnMut(usize, usize, usize),
+) -> SplatStats {
+    let fp = sampler.footprint();
+    let mut weights = [[0.0f32; SMALL]; SMALL];
+    let qx0 = x0 as f32 + 0.5 - center[0];
+    let radial = matches!(fp.shape, crate::kernel::Shape::Radial);
+    let a = &fp.to_unit;
+    let mut sum = 0.0f32;
+    for (k, row) in weights.iter_mut().enumerate().take(ny) {
+        let qy = (y0 + k as i64) as f32 + 0.5 - center[1];
+        let row = &mut row[..nx];
+        sampler.row_weights(qx0, qy, row);
+        for (i, w) in row.iter_mut().enumerate() {
+            let q = [qx0 + i as f32, qy];
+            let u = [
+                a[0][0] * q[0] + a[0][1] * q[1],
+                a[1][0] * q[0] + a[1][1] * q[1],
+            ];
+            let inside = if radial {
+                u[0] * u[0] + u[1] * u[1] <= 1.0
+            } else {
+                math::abs(u[0]) <= 1.0 && math::abs(u[1]) <= 1.0
+            };
+            if !inside {
+                *w = 0.0;
+            }
+            sum += *w;
         }
     }
+    if !(sum > 0.0) {
+        // No pixel centre saw the footprint (a table too coarse to resolve it): put the whole
+        // voxel in the pixel that contains its centre rather than lose it.
+        return deposit_whole(center, value, image, touched);
+    }
+    let factor = 1.0 / sum;
+    let (w, h) = (image.width as i64, image.height as i64);
+    let stride = image.stride;
+    let mut stats = SplatStats::default();
+    let (lo, hi) = (x0.max(0), (x0 + nx as i64 - 1).min(w - 1));
+    if lo > hi {
+        return stats;
+    }
+    for (k, row) in weights.iter().enumerate().take(ny) {
+        let y = y0 + k as i64;
+        if y < 0 || y >= h {
+            continue;
+        }
+        let ws = &row[(lo - x0) as usize..=(hi - x0) as usize];
+        let start = y as usize * stride + lo as usize;
+        // Clipped to the image, so the range is inside the buffer ImageMut checked.
+        let px = &mut image.data[start..start + ws.len()];
+        let mut span: Option<(usize, usize)> = None;
+        for (i, (d, &wt)) in px.iter_mut().zip(ws).enumerate() {
+            if wt != 0.0 {
+                d.add_weighted(value, wt * factor);
+                stats.pixels_updated += 1;
+                span = Some(span.map_or((i, i), |(s, _)| (s, i)));
+            }
+        }
+        if let Some((s, e)) = span {
+            stats.pixels_visited += (e - s + 1) as u32;
+            touched(y as usize, lo as usize + s, lo as usize + e);
+        }
+    }
+    stats
 }
 
-/// Inclusive range of pixel indices whose centres lie in [lo, hi] (screen pixels).
+/// The inclusive pixel range of image row offset `qy` (pixels from the centre) whose centres lie
+/// inside the footprint's support, unclipped; `None` if the row misses it.
+#[inline]
+fn row_pixels(fp: &Footprint, cx: f32, qy: f32) -> Option<(i64, i64)> {
+    let (lo, hi) = fp.row_span(qy)?;
+    let (x0, x1) = pixel_range(cx + lo, cx + hi);
+    (x0 <= x1).then_some((x0, x1))
+}
+
+/// Inclusive range of pixel indices whose centres lie in [lo, hi] (screen pixels), clamped to
+/// ±2³¹ so later clipping stays exact.
+#[inline]
 fn pixel_range(lo: f32, hi: f32) -> (i64, i64) {
-    let first = -math::floor(-(lo - 0.5)); // ceil
-    let last = math::floor(hi - 0.5);
-    let clamp = |v: f32| v.clamp(-2_147_483_648.0, 2_147_483_647.0) as i64;
-    (clamp(first), clamp(last))
+    (-floor_i64(-(lo - 0.5)), floor_i64(hi - 0.5))
+}
+
+/// ⌊x⌋ for finite x, clamped to ±2³¹ (NaN gives 0); inline, without a libm call. `as i64`
+/// truncates toward zero, so a negative non-integer is one too high.
+#[inline]
+fn floor_i64(x: f32) -> i64 {
+    let x = x.clamp(-2_147_483_648.0, 2_147_483_647.0);
+    let t = x as i64;
+    t - i64::from((t as f32) > x)
 }
 
 fn deposit_whole<P: Pixel>(

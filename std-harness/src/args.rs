@@ -206,6 +206,10 @@ pub struct RenderArgs {
     /// Accumulation: float, or fixed (integer splat, accumulator and compositing; bit-exact).
     #[arg(long, value_enum, default_value_t = AccumArg::Float)]
     pub accum: AccumArg,
+    /// Threads (bands of image rows) for the core's render; 0 = every core. The image is
+    /// byte-identical for any number. A streamed volume renders on one thread.
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
     /// Target PSNR against the f64 reference, dB: choose the cheapest table size, lookup, method
     /// and accumulation predicted to reach it for this scene and view (overrides those flags).
     #[arg(long, conflicts_with_all = ["table", "lookup", "method", "accum", "table_file"])]
@@ -264,6 +268,16 @@ fn parse_dims(s: &str) -> Result<[usize; 3], String> {
             .map_err(|_| format!("'{p}' is not a whole number"))?;
     }
     Ok(out)
+}
+
+impl RenderArgs {
+    /// `--threads`, with 0 resolved to the number of cores.
+    pub fn thread_count(&self) -> usize {
+        match self.threads {
+            0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
+            n => n,
+        }
+    }
 }
 
 /// `render`'s flags from a list of arguments (as on the command line after `render`), for

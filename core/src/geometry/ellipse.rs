@@ -70,6 +70,10 @@ pub struct Footprint {
     pub sheet_axis: usize,
     /// Radial (ellipse support) or separable (parallelogram support).
     pub shape: Shape,
+    /// Radial support per image row, precomputed so a row costs one square root and no division:
+    /// the row at offset qy spans qx ∈ m·qy ± √(c₀ + c₂·qy²), as `[m, c₀, c₂]` (see
+    /// [`Footprint::row_span`]). Unused for separable shapes.
+    pub row_coefficients: [f32; 3],
 }
 
 impl Footprint {
@@ -89,6 +93,7 @@ impl Footprint {
         },
         sheet_axis: 2,
         shape: Shape::Radial,
+        row_coefficients: [0.0, -1.0, 0.0],
     };
 
     /// Sets up the footprint of `kernel` for `grid_to_screen` = V·G (see [`View::grid_to_screen`](super::View::grid_to_screen)).
@@ -180,6 +185,12 @@ impl Footprint {
                 half_extent_px: largest,
             });
         }
+        // |A q|² = P_xx qx² + 2 P_xy qx qy + P_yy qy² ≤ 1 with P = AᵀA, solved for qx:
+        // qx = (−P_xy qy ± √((P_xy² − P_xx P_yy) qy² + P_xx)) / P_xx.
+        let pxx = sq(to_unit[0][0]) + sq(to_unit[1][0]);
+        let pxy = to_unit[0][0] * to_unit[0][1] + to_unit[1][0] * to_unit[1][1];
+        let pyy = sq(to_unit[0][1]) + sq(to_unit[1][1]);
+        let row_coefficients = [-pxy / pxx, 1.0 / pxx, (sq(pxy) - pxx * pyy) / sq(pxx)];
         Ok(Footprint {
             to_unit,
             half_extent,
@@ -190,6 +201,7 @@ impl Footprint {
             covariance: cov,
             sheet_axis: axis,
             shape: kernel.shape(),
+            row_coefficients,
         })
     }
 
@@ -203,16 +215,13 @@ impl Footprint {
         let a = &self.to_unit;
         match self.shape {
             Shape::Radial => {
-                // |A q|² = P_xx qx² + 2 P_xy qx qy + P_yy qy² ≤ 1 with P = AᵀA: solve for qx.
-                let pxx = sq(a[0][0]) + sq(a[1][0]);
-                let pxy = a[0][0] * a[0][1] + a[1][0] * a[1][1];
-                let pyy = sq(a[0][1]) + sq(a[1][1]);
-                let mid = -pxy * qy / pxx;
-                let disc = sq(pxy * qy) - pxx * (pyy * qy * qy - 1.0);
+                let [m, c0, c2] = self.row_coefficients;
+                let disc = c0 + c2 * qy * qy;
                 if !(disc > 0.0) {
                     return None;
                 }
-                let half = math::sqrt(disc) / pxx;
+                let half = math::sqrt(disc);
+                let mid = m * qy;
                 Some((mid - half, mid + half))
             }
             Shape::Separable => {

@@ -22,18 +22,20 @@
 
 mod precision;
 mod sheets;
+mod visible;
 
 pub use precision::{FixedPath, FloatPath, Precision};
 pub use sheets::{gradient, SheetRing, SheetWindow};
+pub use visible::{classify_sheet, VisibleSheet, VisibleVoxel};
 
 use crate::composite::RowSpan;
 use crate::frame::{FrameSetup, Order};
-use crate::shade::{Lighting, Sample, Shader};
+use crate::shade::{Lighting, OpacityTable, Sample, Shader};
 use crate::splat::{BufferError, ImageMut, Sampler};
 use core::fmt;
 
 /// Why a render step was refused.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
 pub enum RenderError {
     /// A caller buffer has the wrong size.
@@ -54,6 +56,17 @@ pub enum RenderError {
     },
     /// More sheets pushed into a [`SheetRing`] than the volume has.
     TooManySheets,
+    /// A band of rows that is not inside the image.
+    Band {
+        /// First row asked for.
+        start: usize,
+        /// One past the last row asked for.
+        end: usize,
+        /// Image height, rows.
+        height: usize,
+    },
+    /// A transfer function that cannot classify.
+    TransferFunction(crate::shade::TransferFunctionError),
 }
 
 impl fmt::Display for RenderError {
@@ -65,11 +78,24 @@ impl fmt::Display for RenderError {
             }
             Self::SheetIndex { index, count } => write!(f, "sheet {index} is outside 0..{count}"),
             Self::TooManySheets => f.write_str("more sheets than the volume has"),
+            Self::Band { start, end, height } => {
+                write!(
+                    f,
+                    "band of rows {start}..{end} is not inside an image {height} rows high"
+                )
+            }
+            Self::TransferFunction(e) => e.fmt(f),
         }
     }
 }
 
 impl core::error::Error for RenderError {}
+
+impl From<crate::shade::TransferFunctionError> for RenderError {
+    fn from(e: crate::shade::TransferFunctionError) -> Self {
+        RenderError::TransferFunction(e)
+    }
+}
 
 impl From<BufferError> for RenderError {
     fn from(e: BufferError) -> Self {
@@ -107,12 +133,22 @@ pub struct RenderStats {
 
 /// Renders sheets into caller-owned buffers, with float or fixed-point accumulation
 /// ([`Precision`]).
+///
+/// **Bands.** A renderer may own only a band of image rows ([`SheetRenderer::with_band`]): its
+/// buffers then hold just those rows, voxels are splatted only where they reach them, and every
+/// pixel receives exactly the additions, in exactly the order, that a whole-image render gives it.
+/// Renderers of disjoint bands can therefore run on separate cores (each fed the same sheets) and
+/// their bands put together are bit-identical to one whole-image render, whatever the number of
+/// bands.
 pub struct SheetRenderer<'a, P: Precision> {
     frame: &'a FrameSetup,
     path: P,
     shader: Shader<'a>,
     lighting: Lighting,
+    opacity: Option<OpacityTable<'a>>,
     order: Order,
+    /// First image row of the band and its number of rows.
+    band: (usize, usize),
     buffers: RenderBuffers<'a, P::Acc, P::Pixel>,
     background: Option<&'a [P::Pixel]>,
     stats: RenderStats,
@@ -152,7 +188,38 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
         buffers: RenderBuffers<'a, P::Acc, P::Pixel>,
         background: Option<&'a [P::Pixel]>,
     ) -> Result<Self, RenderError> {
-        let n = frame.image_len();
+        Self::with_band(
+            frame,
+            path,
+            shader,
+            order,
+            buffers,
+            background,
+            0..frame.size[1],
+        )
+    }
+
+    /// [`SheetRenderer::with_path`] for the image rows `rows` only: `buffers` (and `background`)
+    /// hold `rows.len()` rows of `frame.size[0]` pixels, row `rows.start` first (`rows` one entry
+    /// per band row). See the type's docs for what bands guarantee.
+    pub fn with_band(
+        frame: &'a FrameSetup,
+        path: P,
+        shader: Shader<'a>,
+        order: Order,
+        buffers: RenderBuffers<'a, P::Acc, P::Pixel>,
+        background: Option<&'a [P::Pixel]>,
+        rows: core::ops::Range<usize>,
+    ) -> Result<Self, RenderError> {
+        if rows.start > rows.end || rows.end > frame.size[1] {
+            return Err(RenderError::Band {
+                start: rows.start,
+                end: rows.end,
+                height: frame.size[1],
+            });
+        }
+        let band_rows = rows.end - rows.start;
+        let n = frame.size[0] * band_rows;
         for len in [
             buffers.accumulator.len(),
             buffers.image.len(),
@@ -166,26 +233,22 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
                 .into());
             }
         }
-        if buffers.rows.len() < frame.size[1] {
+        if buffers.rows.len() < band_rows {
             return Err(BufferError::TooSmall {
-                needed: frame.size[1],
+                needed: band_rows,
                 got: buffers.rows.len(),
             }
             .into());
         }
-        if shader.tf.lut.len() < 2 || !(shader.tf.hi > shader.tf.lo) {
-            return Err(BufferError::TooSmall {
-                needed: 2,
-                got: shader.tf.lut.len(),
-            }
-            .into());
-        }
+        shader.tf.check()?;
         let r = SheetRenderer {
             frame,
             path,
             shader,
             lighting: Lighting::new(frame),
+            opacity: None,
             order,
+            band: (rows.start, band_rows),
             buffers,
             background,
             stats: RenderStats::default(),
@@ -194,8 +257,16 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
             (Order::BackToFront, Some(bg)) => r.buffers.image[..n].copy_from_slice(&bg[..n]),
             _ => r.buffers.image[..n].fill(P::CLEAR),
         }
-        r.buffers.rows[..frame.size[1]].fill(RowSpan::EMPTY);
+        r.buffers.rows[..band_rows].fill(RowSpan::EMPTY);
         Ok(r)
+    }
+
+    /// Reads the frame's opacity correction from a table built in `buffer` (see
+    /// [`OpacityTable`]: [`OPACITY_TABLE_LEN`](crate::shade::OPACITY_TABLE_LEN) entries keep it
+    /// within 3·10⁻⁶ of the exact power) instead of computing a power per voxel.
+    pub fn with_opacity_table(mut self, buffer: &'a mut [f32]) -> Result<Self, RenderError> {
+        self.opacity = Some(OpacityTable::build(&self.lighting, buffer)?);
+        Ok(self)
     }
 
     /// The frame being rendered.
@@ -206,6 +277,11 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
     /// The compositing order.
     pub fn order(&self) -> Order {
         self.order
+    }
+
+    /// The image rows this renderer owns.
+    pub fn band(&self) -> core::ops::Range<usize> {
+        self.band.0..self.band.0 + self.band.1
     }
 
     /// Counts so far.
@@ -226,11 +302,12 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
             window.lower.map(<[T]>::len),
             window.upper.map(<[T]>::len),
         ];
-        let path = &self.path;
+        let (path, opacity) = (&self.path, self.opacity);
         let shade = |u: usize, v: usize| {
             let value = window.current[v * na + u].to_f32();
-            path.value(shader.shade(
+            path.value(shader.shade_with(
                 &lighting,
+                opacity.as_ref(),
                 value,
                 || gradient(f, &window, u, v),
                 f.grid_index(index, u, v),
@@ -240,6 +317,7 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
         Self::splat_sheet(
             f,
             &self.path,
+            self.band,
             &mut self.buffers,
             &mut self.stats,
             index,
@@ -247,6 +325,86 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
             shade,
         )?;
         self.composite_sheet();
+        Ok(())
+    }
+
+    /// [`SheetRenderer::render_sheet`] from the sheet's visible voxels (see [`classify_sheet`]):
+    /// the same image, bit for bit, without visiting transparent voxels.
+    pub fn render_visible_sheet(
+        &mut self,
+        index: usize,
+        visible: VisibleSheet<'_>,
+    ) -> Result<(), RenderError> {
+        self.splat_visible_sheet(index, visible)?;
+        self.composite_sheet();
+        Ok(())
+    }
+
+    /// The splatting half of [`SheetRenderer::render_visible_sheet`]; call
+    /// [`SheetRenderer::composite_sheet`] after it (the two are separate so a caller can time
+    /// them).
+    pub fn splat_visible_sheet(
+        &mut self,
+        index: usize,
+        visible: VisibleSheet<'_>,
+    ) -> Result<(), RenderError> {
+        let count = self.frame.sheet_count();
+        if index >= count {
+            return Err(RenderError::SheetIndex { index, count });
+        }
+        let needs_gradient = self.shader.shading.needs_gradient();
+        if needs_gradient && visible.gradients.len() < visible.voxels.len() {
+            return Err(BufferError::TooSmall {
+                needed: visible.voxels.len(),
+                got: visible.gradients.len(),
+            }
+            .into());
+        }
+        let (f, shader, lighting, opacity) = (self.frame, self.shader, self.lighting, self.opacity);
+        let (w, h) = (f.size[0], self.band.1);
+        let mut image = ImageMut::new(&mut *self.buffers.accumulator, w, h, w)?;
+        let rows = &mut *self.buffers.rows;
+        let (na, nb) = (f.sheet_shape().1, f.sheet_shape().2);
+        for (k, vox) in visible.voxels.iter().enumerate() {
+            let (u, v) = (usize::from(vox.u), usize::from(vox.v));
+            if u >= na || v >= nb {
+                return Err(RenderError::SheetLength {
+                    expected: na * nb,
+                    got: v * na + u + 1,
+                });
+            }
+            let g = || {
+                if needs_gradient {
+                    glam::Vec3::from_array(visible.gradients[k])
+                } else {
+                    glam::Vec3::ZERO
+                }
+            };
+            let value = self.path.value(shader.shade_with(
+                &lighting,
+                opacity.as_ref(),
+                vox.value,
+                g,
+                f.grid_index(index, u, v),
+                f.dims,
+            ));
+            self.stats.voxels += 1;
+            if P::is_transparent(&value) {
+                continue;
+            }
+            let s = self.path.splat(
+                f,
+                index,
+                (u, v),
+                self.band.0,
+                &value,
+                &mut image,
+                |y, x0, x1| rows[y].include(x0, x1),
+            )?;
+            self.stats.voxels_splatted += u64::from(s.pixels_visited > 0);
+            self.stats.pixel_updates += u64::from(s.pixels_updated);
+        }
+        self.stats.sheets += 1;
         Ok(())
     }
 
@@ -264,6 +422,7 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
         Self::splat_sheet(
             self.frame,
             path,
+            self.band,
             &mut self.buffers,
             &mut self.stats,
             index,
@@ -285,6 +444,7 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
         Self::splat_sheet(
             self.frame,
             &self.path,
+            self.band,
             &mut self.buffers,
             &mut self.stats,
             index,
@@ -297,9 +457,11 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
 
     /// Checks sheet `index` and the given sheet `lengths`, then splats the value that
     /// `shade(u, v)` gives for every voxel (skipping transparent ones).
+    #[allow(clippy::too_many_arguments)]
     fn splat_sheet(
         f: &FrameSetup,
         path: &P,
+        band: (usize, usize),
         buffers: &mut RenderBuffers<'a, P::Acc, P::Pixel>,
         stats: &mut RenderStats,
         index: usize,
@@ -314,7 +476,7 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
         if let Some(got) = lengths.into_iter().flatten().find(|&l| l != len) {
             return Err(RenderError::SheetLength { expected: len, got });
         }
-        let mut image = ImageMut::new(&mut *buffers.accumulator, f.size[0], f.size[1], f.size[0])?;
+        let mut image = ImageMut::new(&mut *buffers.accumulator, f.size[0], band.1, f.size[0])?;
         let rows = &mut *buffers.rows;
         for v in 0..nb {
             for u in 0..na {
@@ -323,10 +485,10 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
                 if P::is_transparent(&value) {
                     continue;
                 }
-                let s = path.splat(f, index, (u, v), &value, &mut image, |y, x0, x1| {
+                let s = path.splat(f, index, (u, v), band.0, &value, &mut image, |y, x0, x1| {
                     rows[y].include(x0, x1)
                 })?;
-                stats.voxels_splatted += 1;
+                stats.voxels_splatted += u64::from(s.pixels_visited > 0);
                 stats.pixel_updates += u64::from(s.pixels_updated);
             }
         }
@@ -335,14 +497,12 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
     }
 
     /// Composites the accumulated sheet into the working image over the rows it touched, and
-    /// clears what it used.
-    fn composite_sheet(&mut self) {
+    /// clears what it used. [`SheetRenderer::render_sheet`] and its siblings call it; a caller of
+    /// [`SheetRenderer::splat_visible_sheet`] calls it after each sheet.
+    pub fn composite_sheet(&mut self) {
         let w = self.frame.size[0];
         let (acc, img) = (&mut *self.buffers.accumulator, &mut *self.buffers.image);
-        for (y, span) in self.buffers.rows[..self.frame.size[1]]
-            .iter_mut()
-            .enumerate()
-        {
+        for (y, span) in self.buffers.rows[..self.band.1].iter_mut().enumerate() {
             if span.is_empty() {
                 continue;
             }
@@ -358,7 +518,7 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
     /// counts.
     pub fn finish(self) -> RenderStats {
         if let (Order::FrontToBack, Some(bg)) = (self.order, self.background) {
-            let n = self.frame.image_len();
+            let n = self.frame.size[0] * self.band.1;
             self.path.over_row(&mut self.buffers.image[..n], &bg[..n]);
         }
         self.stats

@@ -23,12 +23,15 @@ pub trait Precision {
     fn value(&self, rgba: [f32; 4]) -> Self::Value;
     /// Whether a value is fully transparent (such voxels are skipped).
     fn is_transparent(value: &Self::Value) -> bool;
-    /// Splats voxel (u, v) of sheet `sheet` of `frame` into `acc`, reporting touched rows.
+    /// Splats voxel (u, v) of sheet `sheet` of `frame` into `acc`, whose first row is image row
+    /// `row0` (a band; 0 for the whole image), reporting touched rows (relative to `acc`).
+    #[allow(clippy::too_many_arguments)]
     fn splat(
         &self,
         frame: &FrameSetup,
         sheet: usize,
         uv: (usize, usize),
+        row0: usize,
         value: &Self::Value,
         acc: &mut ImageMut<'_, Self::Acc>,
         touched: impl FnMut(usize, usize, usize),
@@ -46,6 +49,14 @@ pub struct FloatPath<'a, S: ?Sized> {
     /// The footprint sampler.
     pub sampler: &'a S,
 }
+
+impl<S: ?Sized> Clone for FloatPath<'_, S> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<S: ?Sized> Copy for FloatPath<'_, S> {}
 
 impl<S: Sampler + ?Sized> Precision for FloatPath<'_, S> {
     type Value = [f32; 4];
@@ -70,6 +81,7 @@ impl<S: Sampler + ?Sized> Precision for FloatPath<'_, S> {
         f: &FrameSetup,
         sheet: usize,
         (u, v): (usize, usize),
+        row0: usize,
         value: &[f32; 4],
         acc: &mut ImageMut<'_, [f32; 4]>,
         touched: impl FnMut(usize, usize, usize),
@@ -81,7 +93,9 @@ impl<S: Sampler + ?Sized> Precision for FloatPath<'_, S> {
             + cols.col(a) * u as f32
             + cols.col(b) * v as f32;
         let value = value.map(|c| c * f.cell_area);
-        splat_rows(self.sampler, [p.x, p.y], &value, acc, touched)
+        // Subtracting a whole number of rows is exact here (|p.y| < 2²⁴), so every pixel of a
+        // band sees the offsets, and so the weights, of a whole-image render.
+        splat_rows(self.sampler, [p.x, p.y - row0 as f32], &value, acc, touched)
     }
 
     fn composite_row(&self, acc: &mut [[f32; 4]], image: &mut [[f32; 4]], order: Order) {
@@ -144,11 +158,13 @@ impl<const M: usize> Precision for FixedPath<'_, M> {
         _: &FrameSetup,
         sheet: usize,
         (u, v): (usize, usize),
+        row0: usize,
         value: &[u32; 4],
         acc: &mut ImageMut<'_, [i64; 4]>,
         touched: impl FnMut(usize, usize, usize),
     ) -> Result<SplatStats, BufferError> {
-        let center = self.place.at(sheet, u, v);
+        let mut center = self.place.at(sheet, u, v);
+        center[1] -= (row0 as i64) << fixed::POS_FRAC;
         Ok(fixed::splat::splat(self.table, center, value, acc, touched))
     }
 

@@ -82,6 +82,59 @@ impl<const M: usize> ViewTable<M> {
         ];
         sample_nodes(self.as_slice(), M, t, self.lookup)
     }
+
+    /// Weights of consecutive pixels along one row, `out[k]` at offset `(qx0 + k, qy)`: what
+    /// [`ViewTable::weight`] gives there, with the row's table line and fraction found once and
+    /// the column stepped per pixel in 16.16 fixed point (integer adds and shifts instead of a
+    /// float-to-integer conversion per pixel; the column's position is rounded to 2⁻¹⁶ of a node).
+    /// Bilinear weights are blended across the two table rows first, then along the row.
+    #[inline]
+    pub fn row_weights(&self, qx0: f32, qy: f32, out: &mut [f32]) {
+        const ONE: f32 = 65536.0;
+        let [ex, ey] = self.footprint.half_extent;
+        let last = (M - 1) as f32;
+        let ty = (qy + ey) * self.nodes_per_px[1];
+        let tx0 = (qx0 + ex) * self.nodes_per_px[0];
+        let tx_end = tx0 + out.len() as f32 * self.nodes_per_px[0];
+        // The row must be on the table, and the fixed-point walk must stay within ±2³¹ nodes.
+        if !(ty >= 0.0 && ty <= last && tx0 > -4096.0 && tx_end < 4096.0 + last) {
+            out.fill(0.0);
+            return;
+        }
+        let last_fx = ((M - 1) as i64) << 16;
+        let step = (self.nodes_per_px[0] * ONE + 0.5) as i64;
+        let mut t = (tx0 * ONE + 0.5 * tx0.signum()) as i64;
+        match self.lookup {
+            Lookup::Nearest => {
+                let row = &self.data[((ty + 0.5) as usize).min(M - 1)];
+                for w in out.iter_mut() {
+                    *w = if (0..=last_fx).contains(&t) {
+                        row[(((t + 0x8000) >> 16) as usize).min(M - 1)]
+                    } else {
+                        0.0
+                    };
+                    t += step;
+                }
+            }
+            Lookup::Bilinear => {
+                let r = (ty as usize).min(M - 2);
+                let fy = ty - r as f32;
+                let (a, b) = (&self.data[r], &self.data[r + 1]);
+                for w in out.iter_mut() {
+                    *w = if (0..=last_fx).contains(&t) {
+                        let c = ((t >> 16) as usize).min(M - 2);
+                        let fx = (t - ((c as i64) << 16)) as f32 * (1.0 / ONE);
+                        let left = a[c] + fy * (b[c] - a[c]);
+                        let right = a[c + 1] + fy * (b[c + 1] - a[c + 1]);
+                        left + fx * (right - left)
+                    } else {
+                        0.0
+                    };
+                    t += step;
+                }
+            }
+        }
+    }
 }
 
 /// Calls `set(node, T)` for every node of an M×M table over `footprint`'s screen box (node

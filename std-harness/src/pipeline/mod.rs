@@ -9,6 +9,8 @@
 //! - [`load`]: where the voxels come from.
 //! - [`prepare`]: [`Prepared`], a render set up and ready to run.
 //! - [`run`]: the core's render (float or fixed, view table or direct) and the f64 reference.
+//! - [`visible`]: visible-voxel lists, classified once and kept across frames ([`visible::FrameCache`]).
+//! - [`bands`]: a frame split into bands of rows, one per thread, byte-identical for any count.
 //! - [`config`]: one table configuration (size, lookup, method, accumulation).
 //! - [`quality`]: `--quality`, the cheapest configuration predicted to reach a PSNR.
 //! - [`single`]: one voxel rendered on its own (`footprint splat`, the stability charts).
@@ -16,12 +18,14 @@
 //! It reads the shared argument structs of [`crate::args`] and calls down into [`crate::io`],
 //! [`crate::reference`] and the core; it imports no command.
 
+pub mod bands;
 pub mod config;
 pub mod load;
 pub mod prepare;
 pub mod quality;
 pub mod run;
 pub mod single;
+pub mod visible;
 
 pub use prepare::{describe, prepare, Prepared};
-pub use run::{render_core, render_core_with, render_ref};
+pub use run::{render_core, render_core_with, render_frame, render_ref, CoreFrame};

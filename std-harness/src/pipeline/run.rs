@@ -1,8 +1,11 @@
-//! Running a prepared render: the core's sheet loop (float or fixed, any table method), driven
-//! through a [`SheetRing`] as a streaming source would drive it, and the f64 reference.
+//! Running a prepared render: the core's sheet loop (float or fixed, any table method) over the
+//! visible voxels of a volume in memory, on several cores ([`super::bands`]), or driven through a
+//! [`SheetRing`] as a streaming source would drive it; and the f64 reference.
 
+use super::bands::{run_bands, Phases};
 use super::load::Voxels;
 use super::prepare::Prepared;
+use super::visible::FrameCache;
 use crate::args::{AccumArg, MethodArg, RenderArgs};
 use crate::io::stream::{FileSource, MemorySource, PipeSource};
 use crate::reference::render::{render_reference, ReferenceScene};
@@ -11,6 +14,7 @@ use footprint::fixed::{self, FixedTable};
 use footprint::render::{
     FixedPath, FloatPath, Precision, RenderBuffers, RenderStats, SheetRenderer, SheetRing,
 };
+use footprint::shade::OPACITY_TABLE_LEN;
 use footprint::source::{render_from, SheetSource};
 use footprint::splat::Direct;
 use footprint::{composite::RowSpan, Lookup, ViewTable};
@@ -32,6 +36,25 @@ pub fn progress(label: &'static str) -> impl FnMut(usize, usize) {
     }
 }
 
+/// One frame rendered by the core.
+#[derive(Clone, Debug)]
+pub struct CoreFrame {
+    /// Premultiplied RGBA, linear, row-major, top row first (fixed-point output converted
+    /// exactly to f32).
+    pub image: Vec<[f32; 4]>,
+    /// Counts (summed over bands).
+    pub stats: RenderStats,
+    /// Wall-clock seconds for the whole frame: tables, classification (unless cached), splat,
+    /// composite.
+    pub seconds: f64,
+    /// Where the time went.
+    pub phases: Phases,
+    /// Threads (bands) used.
+    pub threads: usize,
+    /// Visible voxels in the lists the frame rendered (`None` when streamed).
+    pub visible: Option<usize>,
+}
+
 /// The core's render of `p` with `args`' table, method and accumulation: premultiplied RGBA
 /// (fixed-point output converted exactly to f32), counts, seconds.
 pub fn render_core(
@@ -47,22 +70,40 @@ pub fn render_core_with(
     args: &RenderArgs,
     accum: AccumArg,
 ) -> Result<(Vec<[f32; 4]>, RenderStats, f64), CliError> {
+    let f = render_frame(p, args, accum, &mut FrameCache::default())?;
+    Ok((f.image, f.stats, f.seconds))
+}
+
+/// Renders one frame of `p` with `args`' table, method, accumulation and `--threads`, reusing
+/// (and filling) `cache`'s visible-voxel lists when the volume is in memory. A streamed volume
+/// renders on one thread, straight from its sheets.
+pub fn render_frame(
+    p: &Prepared,
+    args: &RenderArgs,
+    accum: AccumArg,
+    cache: &mut FrameCache,
+) -> Result<CoreFrame, CliError> {
     let fa = &args.footprint;
     let lookup = Lookup::from(fa.lookup);
+    let threads = args.thread_count();
     let fixed_range =
         |e: fixed::FixedError| CliError::input(format!("{}: --accum fixed: {e}", p.name));
+    let start = Instant::now();
     with_table_size!(fa.table, N => {
         let generic = fa.generic_table::<N>(&p.kernel)?;
-        let start = Instant::now();
         // Each path gets its own monomorphised sheet loop: no virtual call per pixel.
-        let (image, stats) = match (accum, fa.method) {
+        let (image, stats, mut phases, visible) = match (accum, fa.method) {
             (AccumArg::Float, MethodArg::Direct) => {
                 let sampler = Direct { footprint: p.frame.footprint, table: &*generic, lookup };
-                run_sheets(p, FloatPath { sampler: &sampler }, p.background.as_deref())?
+                let tables = start.elapsed().as_secs_f64();
+                let r = run_path(p, FloatPath { sampler: &sampler }, p.background.as_deref(), cache, threads)?;
+                (r.0, r.1, Phases { tables, ..r.2 }, r.3)
             }
             (AccumArg::Float, _) => {
                 let table = Box::new(ViewTable::<N>::build(&p.frame.footprint, &generic, lookup, lookup));
-                run_sheets(p, FloatPath { sampler: &*table }, p.background.as_deref())?
+                let tables = start.elapsed().as_secs_f64();
+                let r = run_path(p, FloatPath { sampler: &*table }, p.background.as_deref(), cache, threads)?;
+                (r.0, r.1, Phases { tables, ..r.2 }, r.3)
             }
             (AccumArg::Fixed, method) => {
                 let mut table = Box::new(FixedTable::<N>::zeroed());
@@ -72,14 +113,68 @@ pub fn render_core_with(
                 }
                 .map_err(fixed_range)?;
                 let path = FixedPath::new(&p.frame, &*table).map_err(fixed_range)?;
+                let tables = start.elapsed().as_secs_f64();
                 let bg: Option<Vec<[u32; 4]>> =
                     p.background.as_ref().map(|b| b.iter().map(|&c| fixed::quantise(c)).collect());
-                let (img, stats) = run_sheets(p, path, bg.as_deref())?;
-                (img.into_iter().map(fixed::to_f32).collect(), stats)
+                let (img, stats, phases, visible) = run_path(p, path, bg.as_deref(), cache, threads)?;
+                (img.into_iter().map(fixed::to_f32).collect(), stats, Phases { tables, ..phases }, visible)
             }
         };
-        (image, stats, start.elapsed().as_secs_f64())
+        phases.tables = phases.tables.max(0.0);
+        CoreFrame {
+            image,
+            stats,
+            seconds: start.elapsed().as_secs_f64(),
+            phases,
+            threads: if visible.is_some() { threads.clamp(1, p.frame.size[1]) } else { 1 },
+            visible,
+        }
     })
+}
+
+type PathResult<X> = (Vec<X>, RenderStats, Phases, Option<usize>);
+
+/// Runs one precision path: in memory, through the visible lists on `threads` bands; streamed,
+/// through a sheet ring on one thread.
+fn run_path<P>(
+    p: &Prepared,
+    path: P,
+    background: Option<&[P::Pixel]>,
+    cache: &mut FrameCache,
+    threads: usize,
+) -> Result<PathResult<P::Pixel>, CliError>
+where
+    P: Precision + Copy + Send + Sync,
+    P::Pixel: Send + Sync,
+    P::Acc: Send,
+{
+    match &p.voxels {
+        Voxels::Memory(volume) => {
+            let t0 = Instant::now();
+            let (lists, fresh) = cache.lists(p, volume, threads)?;
+            let classify = if fresh {
+                t0.elapsed().as_secs_f64()
+            } else {
+                0.0
+            };
+            let (image, stats, phases) = run_bands(p, path, background, lists, threads)?;
+            Ok((
+                image,
+                stats,
+                Phases { classify, ..phases },
+                Some(lists.len()),
+            ))
+        }
+        _ => {
+            let t0 = Instant::now();
+            let (image, stats) = run_sheets(p, path, background)?;
+            let phases = Phases {
+                splat: t0.elapsed().as_secs_f64(),
+                ..Phases::default()
+            };
+            Ok((image, stats, phases, None))
+        }
+    }
 }
 
 /// Drives the core renderer through a [`SheetRing`], as a streaming source would.
@@ -100,7 +195,9 @@ fn run_sheets<P: Precision>(
         image: &mut image,
         rows: &mut rows,
     };
-    let mut renderer = SheetRenderer::with_path(f, path, p.shader(), p.order, buffers, background)?;
+    let mut opacity = vec![0.0f32; OPACITY_TABLE_LEN];
+    let mut renderer = SheetRenderer::with_path(f, path, p.shader(), p.order, buffers, background)?
+        .with_opacity_table(&mut opacity)?;
     let mut storage = vec![0.0f32; 3 * f.sheet_shape().0];
     let mut ring = SheetRing::new(&mut storage, f, p.order)?;
     let mut show = Progress {

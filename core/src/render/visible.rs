@@ -1,0 +1,112 @@
+//! Classification once, rendering many times: the voxels of a sheet that can be seen at all (their
+//! opacity is above zero before the per-view correction), kept by the caller so that the next
+//! frame of the same volume and transfer function visits only those. The list depends on the
+//! sheet axis (a view whose sheets run along another axis needs its own list), not on the rest of
+//! the view: the per-view opacity correction, lighting and placement are applied when the list is
+//! rendered. This is the splatting counterpart of the run-length encoded, pre-classified volume of
+//! shear-warp renderers.
+
+use super::sheets::{gradient, SheetWindow};
+use super::RenderError;
+use crate::frame::FrameSetup;
+use crate::shade::{Sample, Shader};
+use crate::splat::BufferError;
+
+/// A voxel of a sheet that can be seen: its in-sheet position (u along the first in-sheet axis,
+/// v along the second, as in [`FrameSetup::sheet_shape`]) and its sample.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VisibleVoxel {
+    /// Index along the sheet's first in-sheet axis.
+    pub u: u16,
+    /// Index along the sheet's second in-sheet axis.
+    pub v: u16,
+    /// The sample, in data units.
+    pub value: f32,
+}
+
+/// The visible voxels of one sheet, in the order the renderer visits a sheet (v outer, u inner),
+/// and, for shadings that need it, each one's world-space gradient (value units per world unit).
+#[derive(Clone, Copy, Debug)]
+pub struct VisibleSheet<'s> {
+    /// The voxels.
+    pub voxels: &'s [VisibleVoxel],
+    /// One gradient per voxel when the shading needs gradients; may be empty otherwise.
+    pub gradients: &'s [[f32; 3]],
+}
+
+/// Writes the visible voxels of sheet `index` (with its neighbours in `window`, for gradients)
+/// into `voxels`, and their gradients into `gradients` when `shader` needs them, in render
+/// order; returns how many. `voxels` (and `gradients`, when needed) must hold a whole sheet's
+/// worth in the worst case (`dims[a] × dims[b]`); sheets wider than 65 536 voxels along an axis
+/// are refused.
+pub fn classify_sheet<T: Sample>(
+    frame: &FrameSetup,
+    shader: &Shader<'_>,
+    index: usize,
+    window: SheetWindow<'_, T>,
+    voxels: &mut [VisibleVoxel],
+    gradients: &mut [[f32; 3]],
+) -> Result<usize, RenderError> {
+    let count = frame.sheet_count();
+    if index >= count {
+        return Err(RenderError::SheetIndex { index, count });
+    }
+    let (len, na, nb) = frame.sheet_shape();
+    if na > 1 << 16 || nb > 1 << 16 {
+        return Err(BufferError::TooLarge {
+            width: na,
+            height: nb,
+        }
+        .into());
+    }
+    for got in [
+        Some(window.current.len()),
+        window.lower.map(<[T]>::len),
+        window.upper.map(<[T]>::len),
+    ]
+    .into_iter()
+    .flatten()
+    {
+        if got != len {
+            return Err(RenderError::SheetLength { expected: len, got });
+        }
+    }
+    let needs_gradient = shader.shading.needs_gradient();
+    let room = if needs_gradient {
+        voxels.len().min(gradients.len())
+    } else {
+        voxels.len()
+    };
+    if room < len {
+        return Err(BufferError::TooSmall {
+            needed: len,
+            got: room,
+        }
+        .into());
+    }
+    let mut n = 0;
+    for v in 0..nb {
+        for u in 0..na {
+            let value = window.current[v * na + u].to_f32();
+            let mut g = glam::Vec3::ZERO;
+            let seen = shader.visible(value, || {
+                g = gradient(frame, &window, u, v);
+                g
+            });
+            if !seen {
+                continue;
+            }
+            voxels[n] = VisibleVoxel {
+                u: u as u16,
+                v: v as u16,
+                value,
+            };
+            if needs_gradient {
+                // Emission never asks for the gradient; every other shading computed it above.
+                gradients[n] = g.to_array();
+            }
+            n += 1;
+        }
+    }
+    Ok(n)
+}

@@ -1,0 +1,170 @@
+//! Visible-voxel lists: each sheet's voxels that can be seen at all, classified once per volume,
+//! transfer function, shading and sheet axis, then reused by every later frame whose sheets run
+//! along the same axis (the re-render path; see the core's `render::classify_sheet`).
+
+use super::prepare::Prepared;
+use crate::io::volume::Volume;
+use crate::CliError;
+use footprint::render::{classify_sheet, SheetWindow, VisibleSheet, VisibleVoxel};
+
+/// The visible voxels of every sheet along one axis, in sheet index order.
+#[derive(Clone, Debug, Default)]
+pub struct VisibleLists {
+    /// The sheet axis (0 = i, 1 = j, 2 = k).
+    pub axis: usize,
+    /// `voxels[offsets[s]..offsets[s + 1]]` are sheet s's.
+    pub offsets: Vec<usize>,
+    /// All visible voxels.
+    pub voxels: Vec<VisibleVoxel>,
+    /// Their world-space gradients, when the shading needs them (else empty).
+    pub gradients: Vec<[f32; 3]>,
+}
+
+impl VisibleLists {
+    /// Sheet `s`'s visible voxels.
+    pub fn sheet(&self, s: usize) -> VisibleSheet<'_> {
+        let (a, b) = (self.offsets[s], self.offsets[s + 1]);
+        VisibleSheet {
+            voxels: &self.voxels[a..b],
+            gradients: if self.gradients.is_empty() {
+                &[]
+            } else {
+                &self.gradients[a..b]
+            },
+        }
+    }
+
+    /// Number of visible voxels.
+    pub fn len(&self) -> usize {
+        self.voxels.len()
+    }
+
+    /// Whether no voxel is visible.
+    pub fn is_empty(&self) -> bool {
+        self.voxels.is_empty()
+    }
+}
+
+/// Per-volume state kept across frames of one volume, transfer function and shading: the visible
+/// lists of each sheet axis met so far. A caller that changes the transfer function, window or
+/// shading must start a new cache.
+#[derive(Debug, Default)]
+pub struct FrameCache {
+    lists: [Option<VisibleLists>; 3],
+}
+
+impl FrameCache {
+    /// The lists for `p`'s sheet axis, classified now (on `threads` threads) if this cache has
+    /// none yet; and whether they were classified now.
+    pub fn lists(
+        &mut self,
+        p: &Prepared,
+        volume: &Volume,
+        threads: usize,
+    ) -> Result<(&VisibleLists, bool), CliError> {
+        let axis = p.frame.sheet_axis;
+        let fresh = self.lists[axis].is_none();
+        if fresh {
+            self.lists[axis] = Some(classify(p, volume, threads)?);
+        }
+        Ok((self.lists[axis].as_ref().expect("just filled"), fresh))
+    }
+}
+
+/// Classifies every sheet of `p`'s axis, contiguous ranges of sheets on `threads` threads, the
+/// results joined in sheet order (so the lists are the same for any thread count).
+pub fn classify(p: &Prepared, volume: &Volume, threads: usize) -> Result<VisibleLists, CliError> {
+    let f = &p.frame;
+    let count = f.sheet_count();
+    let threads = threads.clamp(1, count.max(1));
+    let per = count.div_ceil(threads);
+    let parts: Vec<Result<VisibleLists, CliError>> = std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..threads)
+            .map(|t| {
+                let range = (t * per).min(count)..((t + 1) * per).min(count);
+                scope.spawn(move || classify_range(p, volume, range))
+            })
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().expect("a classification thread panicked"))
+            .collect()
+    });
+    let mut out = VisibleLists {
+        axis: f.sheet_axis,
+        offsets: vec![0],
+        ..Default::default()
+    };
+    for part in parts {
+        let part = part?;
+        let base = out.voxels.len();
+        out.offsets
+            .extend(part.offsets[1..].iter().map(|&o| o + base));
+        out.voxels.extend_from_slice(&part.voxels);
+        out.gradients.extend_from_slice(&part.gradients);
+    }
+    Ok(out)
+}
+
+/// Classifies sheets `range` of `p`'s axis (offsets relative to the range's first sheet).
+fn classify_range(
+    p: &Prepared,
+    volume: &Volume,
+    range: std::ops::Range<usize>,
+) -> Result<VisibleLists, CliError> {
+    let f = &p.frame;
+    let shader = p.shader();
+    let needs_gradient = shader.shading.needs_gradient();
+    let (len, axis, count) = (f.sheet_shape().0, f.sheet_axis, f.sheet_count());
+    let read = |s: usize| {
+        let mut buf = vec![0.0f32; len];
+        volume.sheet_into(axis, s, &mut buf);
+        buf
+    };
+    let mut out = VisibleLists {
+        axis,
+        offsets: vec![0],
+        ..Default::default()
+    };
+    let mut voxels = vec![
+        VisibleVoxel {
+            u: 0,
+            v: 0,
+            value: 0.0
+        };
+        len
+    ];
+    let mut gradients = vec![[0.0f32; 3]; if needs_gradient { len } else { 0 }];
+    // The window of neighbours slides along the range (read only when gradients need them).
+    let mut lower: Option<Vec<f32>> = None;
+    let mut current = range.clone().next().map(read);
+    let mut upper: Option<Vec<f32>> = None;
+    for s in range.clone() {
+        let cur = current.take().expect("the sheet was read");
+        if needs_gradient {
+            if s > 0 && lower.is_none() {
+                lower = Some(read(s - 1));
+            }
+            upper = (s + 1 < count).then(|| read(s + 1));
+        }
+        let window = SheetWindow {
+            lower: lower.as_deref(),
+            current: &cur,
+            upper: upper.as_deref(),
+        };
+        let n = classify_sheet(f, &shader, s, window, &mut voxels, &mut gradients)?;
+        out.voxels.extend_from_slice(&voxels[..n]);
+        if needs_gradient {
+            out.gradients.extend_from_slice(&gradients[..n]);
+        }
+        out.offsets.push(out.voxels.len());
+        if s + 1 < range.end {
+            current = Some(match upper.take() {
+                Some(next) => next,
+                None => read(s + 1),
+            });
+            lower = needs_gradient.then_some(cur);
+        }
+    }
+    Ok(out)
+}
