@@ -15,6 +15,7 @@
 //! - [`geometry`]: grid, view, the screen ellipse, its extent and its map to the unit circle
 //!   (`ellipse.rs`), and the paper's θ decomposition (`paper.rs`).
 //! - [`table`]: generic and view tables, lookup, the table byte format.
+//! - [`stencil`]: a view's footprint sampled per sub-pixel phase, for fast small splats.
 //! - [`splat`](mod@splat): spreading one voxel into a caller-owned image.
 //! - [`frame`]: one view of one volume: placement, sheet axis and order, buffer sizes.
 //! - [`shade`]: transfer functions, Phong, Levoy iso-surfaces, grid-coordinate texture.
@@ -65,6 +66,7 @@ pub mod render;
 pub mod shade;
 pub mod source;
 pub mod splat;
+pub mod stencil;
 pub mod table;
 
 pub use geometry::{Footprint, FootprintOptions, GeometryError, Grid, Mapping, View};

@@ -30,6 +30,9 @@ pub enum Command {
     /// Sweep table size, lookup, method and accumulation on one scene: frame time against error
     /// (tradeoff.csv/.svg/.png with the Pareto frontier) and stability (stability.svg/.png).
     Chart(commands::chart::ChartArgs),
+    /// Frame times of one volume loaded once: frame 1 fresh, later frames turned by --orbit and
+    /// reusing cached state (first_ms, median_ms, phases_ms; --json).
+    Bench(commands::bench::BenchArgs),
 }
 
 /// Runs the command line `args` (program name first); returns the process exit code: 0 success,
@@ -54,6 +57,7 @@ where
         Command::Tables(a) => commands::tables::run(&a),
         Command::Compare(a) => commands::compare::run(&a),
         Command::Chart(a) => commands::chart::run(&a),
+        Command::Bench(a) => commands::bench::run(&a),
     };
     match result {
         Ok(()) => 0,

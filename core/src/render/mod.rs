@@ -24,7 +24,7 @@ mod precision;
 mod sheets;
 mod visible;
 
-pub use precision::{FixedPath, FloatPath, Precision};
+pub use precision::{FixedPath, FloatPath, Precision, StencilPath};
 pub use sheets::{gradient, SheetRing, SheetWindow};
 pub use visible::{classify_sheet, VisibleSheet, VisibleVoxel};
 
@@ -365,6 +365,16 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
         let mut image = ImageMut::new(&mut *self.buffers.accumulator, w, h, w)?;
         let rows = &mut *self.buffers.rows;
         let (na, nb) = (f.sheet_shape().1, f.sheet_shape().2);
+        // A band renders only the voxels whose footprint can reach its rows: screen y of voxel
+        // (u, v) is affine in u and v. The test is conservative by a pixel and more, so it never
+        // drops a voxel that a whole-image render would splat into these rows.
+        let cols = f.grid_to_screen;
+        let (ia, ib) = f.in_sheet;
+        let y_sheet = f.origin.y + cols.col(f.sheet_axis).y * index as f32;
+        let (ya, yb) = (cols.col(ia).y, cols.col(ib).y);
+        let reach = f.footprint.half_extent[1] + 2.0;
+        let (top, bottom) = (self.band.0 as f32, (self.band.0 + self.band.1) as f32);
+        let whole = self.band.0 == 0 && self.band.1 == f.size[1];
         for (k, vox) in visible.voxels.iter().enumerate() {
             let (u, v) = (usize::from(vox.u), usize::from(vox.v));
             if u >= na || v >= nb {
@@ -372,6 +382,12 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
                     expected: na * nb,
                     got: v * na + u + 1,
                 });
+            }
+            if !whole {
+                let y = y_sheet + ya * u as f32 + yb * v as f32;
+                if y + reach < top || y - reach > bottom {
+                    continue;
+                }
             }
             let g = || {
                 if needs_gradient {

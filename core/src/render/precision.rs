@@ -6,6 +6,7 @@ use crate::composite::{clamp_unit, over};
 use crate::fixed::{self, FixedError, FixedTable, Placement};
 use crate::frame::{FrameSetup, Order};
 use crate::splat::{splat_rows, BufferError, ImageMut, Sampler, SplatStats};
+use crate::stencil::Stencils;
 
 /// What a [`SheetRenderer`](super::SheetRenderer) splats with and accumulates into.
 pub trait Precision {
@@ -86,34 +87,109 @@ impl<S: Sampler + ?Sized> Precision for FloatPath<'_, S> {
         acc: &mut ImageMut<'_, [f32; 4]>,
         touched: impl FnMut(usize, usize, usize),
     ) -> Result<SplatStats, BufferError> {
-        let cols = f.grid_to_screen;
-        let (a, b) = f.in_sheet;
-        let p = f.origin
-            + cols.col(f.sheet_axis) * sheet as f32
-            + cols.col(a) * u as f32
-            + cols.col(b) * v as f32;
+        let p = float_position(f, sheet, u, v);
         let value = value.map(|c| c * f.cell_area);
         // Subtracting a whole number of rows is exact here (|p.y| < 2²⁴), so every pixel of a
         // band sees the offsets, and so the weights, of a whole-image render.
-        splat_rows(self.sampler, [p.x, p.y - row0 as f32], &value, acc, touched)
+        splat_rows(
+            self.sampler,
+            [p[0], p[1] - row0 as f32],
+            &value,
+            acc,
+            touched,
+        )
     }
 
     fn composite_row(&self, acc: &mut [[f32; 4]], image: &mut [[f32; 4]], order: Order) {
-        for (a, i) in acc.iter_mut().zip(image.iter_mut()) {
-            let s = clamp_unit(*a);
-            *a = [0.0; 4];
-            *i = match order {
-                Order::BackToFront => over(s, *i),
-                Order::FrontToBack => over(*i, s),
-            };
-        }
+        float_composite_row(acc, image, order);
     }
 
     fn over_row(&self, front: &mut [[f32; 4]], back: &[[f32; 4]]) {
-        for (i, b) in front.iter_mut().zip(back) {
-            *i = over(*i, *b);
-        }
+        float_over_row(front, back);
     }
+}
+
+/// The float paths' compositing: clamp the accumulated sheet to [0, 1], over or under the image,
+/// clear the accumulator.
+fn float_composite_row(acc: &mut [[f32; 4]], image: &mut [[f32; 4]], order: Order) {
+    for (a, i) in acc.iter_mut().zip(image.iter_mut()) {
+        let s = clamp_unit(*a);
+        *a = [0.0; 4];
+        *i = match order {
+            Order::BackToFront => over(s, *i),
+            Order::FrontToBack => over(*i, s),
+        };
+    }
+}
+
+fn float_over_row(front: &mut [[f32; 4]], back: &[[f32; 4]]) {
+    for (i, b) in front.iter_mut().zip(back) {
+        *i = over(*i, *b);
+    }
+}
+
+/// Float accumulation through a view's phase stencils ([`Stencils`]): the view table sampled once
+/// per sub-pixel phase, so a splat is multiply-adds only. Same accumulator, image and compositing
+/// as [`FloatPath`].
+#[derive(Clone, Copy, Debug)]
+pub struct StencilPath<'a> {
+    /// The view's stencils.
+    pub stencils: &'a Stencils<'a>,
+}
+
+impl Precision for StencilPath<'_> {
+    type Value = [f32; 4];
+    type Acc = [f32; 4];
+    type Pixel = [f32; 4];
+    const ACC_ZERO: [f32; 4] = [0.0; 4];
+    const CLEAR: [f32; 4] = [0.0; 4];
+
+    #[inline]
+    fn value(&self, rgba: [f32; 4]) -> [f32; 4] {
+        rgba
+    }
+
+    #[inline]
+    fn is_transparent(value: &[f32; 4]) -> bool {
+        !(value[3] > 0.0)
+    }
+
+    #[inline]
+    fn splat(
+        &self,
+        f: &FrameSetup,
+        sheet: usize,
+        (u, v): (usize, usize),
+        row0: usize,
+        value: &[f32; 4],
+        acc: &mut ImageMut<'_, [f32; 4]>,
+        touched: impl FnMut(usize, usize, usize),
+    ) -> Result<SplatStats, BufferError> {
+        let p = float_position(f, sheet, u, v);
+        let value = value.map(|c| c * f.cell_area);
+        self.stencils
+            .splat([p[0], p[1] - row0 as f32], &value, acc, touched)
+    }
+
+    fn composite_row(&self, acc: &mut [[f32; 4]], image: &mut [[f32; 4]], order: Order) {
+        float_composite_row(acc, image, order);
+    }
+
+    fn over_row(&self, front: &mut [[f32; 4]], back: &[[f32; 4]]) {
+        float_over_row(front, back);
+    }
+}
+
+/// Screen position (pixels) of voxel (u, v) of sheet `sheet`.
+#[inline]
+fn float_position(f: &FrameSetup, sheet: usize, u: usize, v: usize) -> [f32; 2] {
+    let cols = f.grid_to_screen;
+    let (a, b) = f.in_sheet;
+    let p = f.origin
+        + cols.col(f.sheet_axis) * sheet as f32
+        + cols.col(a) * u as f32
+        + cols.col(b) * v as f32;
+    [p.x, p.y]
 }
 
 /// Fixed-point accumulation (see [`crate::fixed`]): an integer M×M table, Q24 voxel placement,

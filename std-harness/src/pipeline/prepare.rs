@@ -46,6 +46,8 @@ pub struct Prepared {
     pub voxels: Voxels,
     pub name: String,
     pub kernel: Kernel,
+    /// The volume's grid (voxel index → world).
+    pub grid: Grid,
     pub frame: FrameSetup,
     pub lut: Vec<[f32; 4]>,
     pub window: [f32; 2],
@@ -57,6 +59,23 @@ pub struct Prepared {
 }
 
 impl Prepared {
+    /// The same volume, transfer function and shading seen with `args`' view (`--view`, `--zoom`,
+    /// `--view-matrix`, `--size`): only the frame is set up again, nothing is loaded. The
+    /// compositing order stays as prepared.
+    pub fn reframe(&mut self, args: &RenderArgs) -> Result<(), CliError> {
+        let view = View::new(view_matrix(args, self.frame.dims, self.grid.to_world()))
+            .map_err(|e| CliError::input(format!("view: {e}")))?;
+        self.frame = FrameSetup::new(
+            self.frame.dims,
+            &self.grid,
+            &view,
+            &self.kernel,
+            self.options,
+            [args.size.0, args.size.1],
+        )?;
+        Ok(())
+    }
+
     /// The shader over this render's lookup table.
     pub fn shader(&self) -> Shader<'_> {
         Shader {
@@ -210,6 +229,7 @@ pub fn prepare(args: &RenderArgs) -> Result<Prepared, CliError> {
         voxels,
         name,
         kernel,
+        grid,
         frame,
         lut,
         window,

@@ -13,10 +13,12 @@ use crate::{with_table_size, CliError};
 use footprint::fixed::{self, FixedTable};
 use footprint::render::{
     FixedPath, FloatPath, Precision, RenderBuffers, RenderStats, SheetRenderer, SheetRing,
+    StencilPath,
 };
 use footprint::shade::OPACITY_TABLE_LEN;
 use footprint::source::{render_from, SheetSource};
 use footprint::splat::Direct;
+use footprint::stencil::Stencils;
 use footprint::{composite::RowSpan, Lookup, ViewTable};
 use std::io::IsTerminal;
 use std::time::Instant;
@@ -101,9 +103,23 @@ pub fn render_frame(
             }
             (AccumArg::Float, _) => {
                 let table = Box::new(ViewTable::<N>::build(&p.frame.footprint, &generic, lookup, lookup));
-                let tables = start.elapsed().as_secs_f64();
-                let r = run_path(p, FloatPath { sampler: &*table }, p.background.as_deref(), cache, threads)?;
-                (r.0, r.1, Phases { tables, ..r.2 }, r.3)
+                let len = (args.phases > 0)
+                    .then(|| Stencils::len_for(&p.frame.footprint, args.phases))
+                    .flatten();
+                let r = if let Some(len) = len {
+                    // Small and middling footprints: the view table sampled once per phase.
+                    let mut buffer = vec![0.0f32; len];
+                    let stencils = Stencils::build(&*table, args.phases, &mut buffer)?;
+                    let tables = start.elapsed().as_secs_f64();
+                    let path = StencilPath { stencils: &stencils };
+                    let r = run_path(p, path, p.background.as_deref(), cache, threads)?;
+                    (r.0, r.1, Phases { tables, ..r.2 }, r.3)
+                } else {
+                    let tables = start.elapsed().as_secs_f64();
+                    let r = run_path(p, FloatPath { sampler: &*table }, p.background.as_deref(), cache, threads)?;
+                    (r.0, r.1, Phases { tables, ..r.2 }, r.3)
+                };
+                r
             }
             (AccumArg::Fixed, method) => {
                 let mut table = Box::new(FixedTable::<N>::zeroed());

@@ -1,0 +1,171 @@
+#!/usr/bin/env bash
+# Footprint side by side with the renderers a user would pick instead, on one machine, run
+# alternately (these machines are shared and noisy: only ratios measured in one session mean much).
+#
+#   benches/peers.sh [--reps N] [--frames N] [--quick]
+#
+# Installs what it needs (Debian: libvolpack1-dev, libosmesa6, libegl-mesa0; a Python venv with vtk,
+# numpy, pillow, matplotlib under target/peers/), builds ../shared/peers/vp_bench.c, and renders at
+# 512x512, azimuth 30 / elevation 20, orthographic, emission, grey ramp, on:
+#   - the 256^3 blobs of ../shared/peers/make_volumes.py;
+#   - ../shared/data/walnut and headsq, quantised once to u8 over their full range (VolPack reads u8
+#     only, so all three renderers get the same u8 file).
+# The camera is VTK's (Azimuth, Elevation, the bounding sphere fitted to the image height): the
+# script reads it from VTK's JSON and hands Footprint the same world-to-screen matrix
+# (--view-matrix), so coverage matches; a side-by-side picture per volume goes to
+# docs/images/peers-*.png to check by eye. Opacity is per world unit in all three (VTK's
+# --opacity-unit-distance 1; VolPack's per-slice opacity equals it at unit spacing).
+#
+# Per volume and repetition, in this order: Footprint float 1 thread, float 2 threads, fixed 1
+# thread (each `footprint bench --frames N --orbit 2`: first_ms = fresh volume, median_ms =
+# re-render), VTK vtkFixedPointVolumeRayCastMapper 1 and 2 threads, VolPack pre-classified. The
+# medians over the repetitions go to docs/performance.md as ratios; the raw rows to
+# docs/perf/peers.csv. Then the scaling runs (Footprint only): frame time against image size
+# (128^2 ... 2048^2, blobs) and against volume size (64^3 ... 512^3, synthetic blobs), charted in
+# docs/charts/perf-scaling.svg/.png with docs/perf/scaling.csv.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+cd "$root"
+reps=5
+frames=10
+quick=0
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --reps) reps=$2; shift 2 ;;
+    --frames) frames=$2; shift 2 ;;
+    --quick) quick=1; reps=1; frames=3; shift ;;
+    *) echo "usage: $0 [--reps N] [--frames N] [--quick]"; exit 2 ;;
+  esac
+done
+peers=$root/../shared/peers
+data=$root/../shared/data
+work=$root/target/peers
+mkdir -p "$work/out" docs/perf docs/charts docs/images
+
+echo "== set-up"
+if ! dpkg -s libvolpack1-dev libosmesa6 libegl-mesa0 >/dev/null 2>&1; then
+  apt-get update -qq && apt-get install -y -qq libosmesa6 libegl-mesa0 libvolpack1-dev >/dev/null
+fi
+[ -x "$work/venv/bin/python" ] || python3 -m venv "$work/venv"
+"$work/venv/bin/pip" install -q vtk numpy pillow matplotlib
+py=$work/venv/bin/python
+gcc -O2 -o "$work/vp_bench" "$peers/vp_bench.c" -lvolpack -lm
+cargo build -q --release -p footprint-harness
+fp=$root/target/release/footprint
+
+echo "== volumes"
+[ -s "$peers/data/blobs256_u8.raw" ] && cp "$peers/data/blobs256_u8.raw" "$work/" 2>/dev/null || true
+if [ ! -s "$work/blobs256_u8.raw" ]; then
+  (cd "$work" && cp "$peers/make_volumes.py" . && "$py" make_volumes.py >/dev/null && cp data/blobs256_u8.raw .)
+fi
+"$py" - "$data" "$work" <<'PY'
+import sys, numpy as np
+data, work = sys.argv[1], sys.argv[2]
+for name, path, dt, dims in [
+    ("walnut", f"{data}/walnut/walnut.raw", "<u2", (114, 96, 128)),
+    ("headsq", f"{data}/headsq/headsq_64x64x93_int16_le.raw", "<i2", (93, 64, 64)),
+]:
+    v = np.fromfile(path, dt).astype(np.float64).reshape(dims)
+    u8 = np.round(255 * (v - v.min()) / (v.max() - v.min())).astype(np.uint8)
+    u8.tofile(f"{work}/{name}_u8.raw")
+PY
+
+# name | dims (x y z) | spacing | ramp LO HI (u8 units)
+volumes=(
+  "blobs|256 256 256|1 1 1|80 255"
+  "walnut|128 96 114|1 1 1|40 255"
+  "headsq|64 64 93|3.2 3.2 1.5|60 255"
+)
+[ "$quick" = 1 ] && volumes=("${volumes[1]}")
+
+csv=docs/perf/peers.csv
+echo "volume,rep,renderer,threads,accum,first_ms,median_ms" > "$csv"
+for spec in "${volumes[@]}"; do
+  IFS='|' read -r name dims spacing ramp <<<"$spec"
+  read -r nx ny nz <<<"$dims"; read -r sx sy sz <<<"$spacing"; read -r lo hi <<<"$ramp"
+  raw=$work/${name}_u8.raw; [ "$name" = blobs ] && raw=$work/blobs256_u8.raw
+  vtk() {
+    VTK_DEFAULT_OPENGL_WINDOW=vtkEGLRenderWindow "$py" "$peers/vtk_render.py" "$raw" "$nx" "$ny" "$nz" \
+      --spacing "$sx" "$sy" "$sz" --size 512 512 --tf "$lo" "$hi" --azimuth 30 --elevation 20 \
+      --opacity-unit-distance 1 --mapper fixedpoint --threads "$1" --frames "$frames" --out "$work/out/vtk-$name" >/dev/null
+  }
+  vtk 1
+  # VTK's camera as Footprint's world-to-screen matrix (rows right, down, away; pixels per unit).
+  vm=$("$py" - "$work/out/vtk-$name.json" <<'PY'
+import json, sys, numpy as np
+v = json.load(open(sys.argv[1]))["view"]
+pos, foc, up = (np.array(v[k], float) for k in ("camera_position", "focal_point", "view_up"))
+d = foc - pos; d /= np.linalg.norm(d)
+right = np.cross(d, up); right /= np.linalg.norm(right)
+upo = np.cross(right, d)
+s = 512 / (2 * v["parallel_scale"])
+print(",".join(f"{x:.9g}" for x in (s * np.array([right, -upo, d])).ravel()))
+PY
+)
+  common=("$raw" --dims "$nx,$ny,$nz" --type u8 --spacing "$sx,$sy,$sz" --window "$lo,$hi" --tf grey
+          --size 512x512 --view-matrix "$vm" --frames "$frames" --orbit 2)
+  "$fp" render "$raw" --dims "$nx,$ny,$nz" --type u8 --spacing "$sx,$sy,$sz" --window "$lo,$hi" --tf grey \
+    --size 512x512 --view-matrix "$vm" --out "$work/out/fp-$name.png" >/dev/null
+  "$work/vp_bench" "$raw" "$nx" "$ny" "$nz" "$sx" "$sy" "$sz" 512 512 30 20 "$lo" "$hi" 3 "$work/out/vp-$name" classified grey >/dev/null
+  "$py" - "$work/out" "$name" "docs/images/peers-$name.png" <<'PY'
+import sys, numpy as np
+from PIL import Image
+out, name, dest = sys.argv[1:]
+fp = np.asarray(Image.open(f"{out}/fp-{name}.png").convert("RGB"))
+vt = np.asarray(Image.open(f"{out}/vtk-{name}.png").convert("RGB"))
+vp = np.asarray(Image.open(f"{out}/vp-{name}.ppm").convert("RGB"))
+print(f"{name}: mean RGB  footprint {fp.mean():.2f}  vtk {vt.mean():.2f}  volpack {vp.mean():.2f}")
+Image.fromarray(np.concatenate([fp, vt, vp], 1)).resize((768, 256)).save(dest)
+PY
+  for rep in $(seq 1 "$reps"); do
+    for cfg in "1 float" "2 float" "1 fixed"; do
+      read -r th acc <<<"$cfg"
+      "$fp" bench "${common[@]}" --threads "$th" --accum "$acc" --json "$work/b.json" >/dev/null
+      "$py" -c "import json,sys; j=json.load(open('$work/b.json')); print(f'$name,$rep,footprint,$th,$acc,{j[\"first_ms\"]:.3f},{j[\"median_ms\"]:.3f}')" >> "$csv"
+    done
+    for th in 1 2; do
+      vtk "$th"
+      "$py" -c "import json; j=json.load(open('$work/out/vtk-$name.json'))['seconds']; print(f'$name,$rep,vtk,$th,-,{j[\"warmup_total\"]*1e3:.3f},{j[\"frame\"][\"median\"]*1e3:.3f}')" >> "$csv"
+    done
+    "$work/vp_bench" "$raw" "$nx" "$ny" "$nz" "$sx" "$sy" "$sz" 512 512 30 20 "$lo" "$hi" "$frames" "$work/out/vp-$name" classified grey >/dev/null
+    "$py" -c "import json; j=json.load(open('$work/out/vp-$name.json'))['seconds']; print(f'$name,$rep,volpack,1,-,{(j[\"preprocess\"]+j[\"first_frame\"])*1e3:.3f},{j[\"frame\"][\"median\"]*1e3:.3f}')" >> "$csv"
+  done
+  echo "$name: $reps repetitions done"
+done
+
+echo "== scaling (Footprint only, blobs, float, 1 thread)"
+scsv=docs/perf/scaling.csv
+echo "kind,size,first_ms,median_ms,pixel_updates_hint" > "$scsv"
+sizes=(128 256 512 1024 2048); [ "$quick" = 1 ] && sizes=(128 256)
+for s in "${sizes[@]}"; do
+  "$fp" bench "$work/blobs256_u8.raw" --dims 256,256,256 --type u8 --window 80,255 --tf grey --size "${s}x$s" \
+    --view 30,20,0 --frames "$frames" --orbit 2 --threads 1 --json "$work/s.json" >/dev/null
+  "$py" -c "import json; j=json.load(open('$work/s.json')); print(f'image,$s,{j[\"first_ms\"]:.3f},{j[\"median_ms\"]:.3f},')" >> "$scsv"
+done
+vsizes=(64 128 256 512); [ "$quick" = 1 ] && vsizes=(64)
+for n in "${vsizes[@]}"; do
+  "$py" - "$n" "$work/blobs${n}.raw" <<'PY'
+import sys, numpy as np
+n, path = int(sys.argv[1]), sys.argv[2]
+# The same scene at every size: a spherical shell and three Gaussian blobs, x fastest, u8.
+c = (np.arange(n, dtype=np.float32) - (n - 1) / 2) / ((n - 1) / 2)
+out = np.memmap(path, np.uint8, "w+", shape=(n, n, n))
+Y, X = np.meshgrid(c, c, indexing="ij")
+for k in range(n):
+    Z = c[k]
+    r = np.sqrt(X * X + Y * Y + Z * Z)
+    v = 0.6 * np.exp(-((r - 0.8) ** 2) / (2 * 0.03 ** 2))
+    for (bx, by, bz, s) in [(0.3, 0.1, -0.2, 0.15), (-0.35, -0.2, 0.1, 0.12), (0.0, 0.4, 0.3, 0.1)]:
+        v += np.exp(-((X - bx) ** 2 + (Y - by) ** 2 + (Z - bz) ** 2) / (2 * s * s))
+    out[k] = np.clip(np.round(v / 1.6 * 255), 0, 255).astype(np.uint8)
+out.flush()
+PY
+  "$fp" bench "$work/blobs${n}.raw" --dims "$n,$n,$n" --type u8 --window 80,255 --tf grey --size 512x512 \
+    --view 30,20,0 --frames "$frames" --orbit 2 --threads 1 --json "$work/s.json" >/dev/null
+  "$py" -c "import json; j=json.load(open('$work/s.json')); print(f'volume,$n,{j[\"first_ms\"]:.3f},{j[\"median_ms\"]:.3f},')" >> "$scsv"
+  [ "$n" = 512 ] && rm -f "$work/blobs512.raw"
+done
+
+echo "== docs/performance.md"
+"$py" "$root/benches/peers_report.py" "$csv" "$scsv" docs/performance.md docs/charts/perf-scaling
+echo "wrote docs/performance.md, docs/perf/*.csv, docs/charts/perf-scaling.{svg,png}, docs/images/peers-*.png"

@@ -1,0 +1,137 @@
+//! `footprint bench`: frame times of one volume, loaded once. Frame 1 renders from the freshly
+//! loaded volume (tables and classification included, loading excluded); each later frame turns
+//! `--orbit` degrees of azimuth further (a user turning the volume around) and may reuse what the
+//! earlier frames cached (the visible-voxel lists of each sheet axis).
+//!
+//! Prints and writes (`--json`): `first_ms`, `median_ms`, `min_ms`, `max_ms` (over frames 2…N;
+//! null when N = 1), `threads`, `phases_ms` (frame 1: `classify`, `tables`, `splat`,
+//! `composite`), `rerender_phases_ms` (the same, medians over frames 2…N), `frames_ms` (every
+//! frame), `frames`, `orbit_deg`, and the render summary's fields.
+
+use crate::args::RenderArgs;
+use crate::io::{self, json::Json};
+use crate::pipeline::bands::Phases;
+use crate::pipeline::quality::{apply_quality, quality_json};
+use crate::pipeline::visible::FrameCache;
+use crate::pipeline::{describe, prepare, render_frame};
+use crate::CliError;
+use clap::Args;
+
+#[derive(Args, Debug, Clone)]
+pub struct BenchArgs {
+    /// The scene and every render flag (`--out` writes frame 1's image, if given).
+    #[command(flatten)]
+    pub render: RenderArgs,
+    /// Frames to render (at least 1).
+    #[arg(long, default_value_t = 10)]
+    pub frames: usize,
+    /// Azimuth added per frame, degrees.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub orbit: f32,
+}
+
+fn median(v: &[f64]) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    let mut s = v.to_vec();
+    s.sort_by(f64::total_cmp);
+    s[s.len() / 2]
+}
+
+fn phases_json(p: &Phases) -> Json {
+    Json::object()
+        .num("classify", p.classify * 1e3)
+        .num("tables", p.tables * 1e3)
+        .num("splat", p.splat * 1e3)
+        .num("composite", p.composite * 1e3)
+}
+
+pub fn run(args: &BenchArgs) -> Result<(), CliError> {
+    if args.frames == 0 {
+        return Err(CliError::input("--frames must be at least 1"));
+    }
+    if !args.orbit.is_finite() {
+        return Err(CliError::input(
+            "--orbit must be a finite number of degrees",
+        ));
+    }
+    let mut p = prepare(&args.render)?;
+    let (base, choice) = apply_quality(&p, &args.render)?;
+    let mut cache = FrameCache::default();
+    let mut times = Vec::with_capacity(args.frames);
+    let mut phases = Vec::with_capacity(args.frames);
+    let mut first_image = None;
+    let mut threads = 1;
+    for k in 0..args.frames {
+        let mut a = base.clone();
+        let turn = args.orbit * k as f32;
+        a.view[0] += turn;
+        if let Some(m) = a.view_matrix {
+            // V · Ry(turn): the same turn of the volume about its vertical axis as --view's azimuth.
+            let v = glam::Mat3::from_cols_array(&m).transpose()
+                * glam::Mat3::from_rotation_y(turn.to_radians());
+            a.view_matrix = Some(v.transpose().to_cols_array());
+        }
+        if k > 0 {
+            p.reframe(&a)?;
+        }
+        let f = render_frame(&p, &a, a.accum, &mut cache)?;
+        crate::say!(
+            "frame {:>3}: {:8.2} ms (classify {:.2}, tables {:.2}, splat {:.2}, composite {:.2}); sheets along {}",
+            k + 1,
+            f.seconds * 1e3,
+            f.phases.classify * 1e3,
+            f.phases.tables * 1e3,
+            f.phases.splat * 1e3,
+            f.phases.composite * 1e3,
+            ["i", "j", "k"][p.frame.sheet_axis]
+        );
+        times.push(f.seconds * 1e3);
+        phases.push(f.phases);
+        threads = f.threads;
+        if k == 0 {
+            first_image = Some(f.image);
+        }
+    }
+    let later = &times[1..];
+    let (first, med) = (times[0], median(later));
+    let (min, max) = later
+        .iter()
+        .fold((f64::NAN, f64::NAN), |(lo, hi), &t| (lo.min(t), hi.max(t)));
+    let rerender = Phases {
+        classify: median(&phases[1..].iter().map(|p| p.classify).collect::<Vec<_>>()),
+        tables: median(&phases[1..].iter().map(|p| p.tables).collect::<Vec<_>>()),
+        splat: median(&phases[1..].iter().map(|p| p.splat).collect::<Vec<_>>()),
+        composite: median(&phases[1..].iter().map(|p| p.composite).collect::<Vec<_>>()),
+    };
+    crate::say!(
+        "{}: {} frames on {threads} thread(s): first {first:.2} ms; frames 2..: median {med:.2} ms (min {min:.2}, max {max:.2})",
+        p.name,
+        args.frames
+    );
+    if let Some(out) = &base.out {
+        let img = first_image.expect("frame 1 was rendered");
+        let png = io::image::encode_png_rgb(&img, base.size.0, base.size.1)?;
+        io::write_atomic(out, &png)?;
+    }
+    if let Some(j) = &base.json {
+        let mut summary = describe(&p, &base)
+            .str("command", "bench")
+            .num("frames", args.frames as f64)
+            .num("orbit_deg", f64::from(args.orbit))
+            .num("threads", threads as f64)
+            .num("first_ms", first)
+            .num("median_ms", med)
+            .num("min_ms", min)
+            .num("max_ms", max)
+            .obj("phases_ms", phases_json(&phases[0]))
+            .obj("rerender_phases_ms", phases_json(&rerender))
+            .arr_f64("frames_ms", &times);
+        if let Some(c) = &choice {
+            summary = summary.obj("quality", quality_json(c));
+        }
+        io::write_atomic(j, summary.finish().as_bytes())?;
+    }
+    Ok(())
+}

@@ -1,0 +1,190 @@
+//! Threads, visible-voxel lists and `footprint bench`: the image does not depend on the number of
+//! threads (bit for bit, float and fixed), rendering the cached visible lists gives the image of a
+//! full scan of every voxel, and `bench` writes the keys the issue names.
+
+use footprint_harness::args::parse_args;
+use footprint_harness::pipeline::visible::FrameCache;
+use footprint_harness::pipeline::{prepare, render_frame};
+use std::path::PathBuf;
+
+fn tmpdir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("fp-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// The core's image of the built-in scene with `extra` flags on `threads` threads, as bits.
+fn image(extra: &[&str], threads: usize) -> Vec<[u32; 4]> {
+    let t = threads.to_string();
+    let mut a = vec!["--size", "97x61", "--threads", &t];
+    a.extend_from_slice(extra);
+    let args = parse_args(&a).unwrap();
+    let p = prepare(&args).unwrap();
+    let f = render_frame(&p, &args, args.accum, &mut FrameCache::default()).unwrap();
+    assert_eq!(f.threads, threads, "bands used");
+    f.image.iter().map(|c| c.map(f32::to_bits)).collect()
+}
+
+#[test]
+fn every_thread_count_gives_the_same_bits() {
+    // Stencil splats (small footprints), the per-pixel table walk (--phases 0), the direct
+    // method, fixed point; phong needs gradients; front to back composites under; a view whose
+    // sheets run along i.
+    let cases: [&[&str]; 7] = [
+        &["--view", "30,20,0"],
+        &["--view", "30,20,0", "--phases", "0"],
+        &[
+            "--view",
+            "75,-40,20",
+            "--method",
+            "direct",
+            "--shading",
+            "phong",
+        ],
+        &["--view", "30,20,0", "--accum", "fixed"],
+        &[
+            "--view",
+            "75,-40,20",
+            "--accum",
+            "fixed",
+            "--shading",
+            "phong",
+        ],
+        &[
+            "--view",
+            "10,5,0",
+            "--order",
+            "front-to-back",
+            "--zoom",
+            "0.4",
+        ],
+        &["--view", "80,0,0", "--accum", "fixed", "--zoom", "3"],
+    ];
+    for case in cases {
+        let one = image(case, 1);
+        assert!(
+            one.iter().any(|p| p[3] != 0),
+            "{case:?}: the scene is visible"
+        );
+        for threads in [2, 3, 7] {
+            let many = image(case, threads);
+            let differ = one.iter().zip(&many).filter(|(a, b)| a != b).count();
+            assert_eq!(
+                differ, 0,
+                "{case:?}: {threads} threads differ in {differ} pixels"
+            );
+        }
+    }
+}
+
+#[test]
+fn cached_lists_render_what_a_full_scan_renders() {
+    // A streamed volume is scanned voxel by voxel through a sheet ring; a loaded one renders its
+    // visible lists (the re-render path). Same bits.
+    let d = tmpdir("lists");
+    let raw = d.join("v.raw");
+    // A 24×20×16 u8 volume: a ramp with a hollow, so some voxels are transparent.
+    let mut bytes = Vec::new();
+    for k in 0..16u32 {
+        for j in 0..20u32 {
+            for i in 0..24u32 {
+                let r2 = (i as i32 - 12).pow(2) + (j as i32 - 10).pow(2) + (k as i32 - 8).pow(2);
+                bytes.push(if r2 < 20 {
+                    0
+                } else {
+                    ((i * 7 + j * 5 + k * 3) % 256) as u8
+                });
+            }
+        }
+    }
+    std::fs::write(&raw, &bytes).unwrap();
+    let r = raw.to_str().unwrap();
+    for accum in ["float", "fixed"] {
+        for shading in ["emission", "phong"] {
+            let common = [
+                "--dims",
+                "24,20,16",
+                "--type",
+                "u8",
+                "--window",
+                "40,255",
+                "--size",
+                "80x64",
+                "--view",
+                "30,20,0",
+                "--accum",
+                accum,
+                "--shading",
+                shading,
+            ];
+            let mut loaded = vec![r];
+            loaded.extend_from_slice(&common);
+            let mut streamed = vec!["--stream", r];
+            streamed.extend_from_slice(&common);
+            let render = |a: &[&str]| {
+                let args = parse_args(a).unwrap();
+                let p = prepare(&args).unwrap();
+                let f = render_frame(&p, &args, args.accum, &mut FrameCache::default()).unwrap();
+                (
+                    f.image
+                        .iter()
+                        .map(|c| c.map(f32::to_bits))
+                        .collect::<Vec<_>>(),
+                    f.visible,
+                )
+            };
+            let (a, visible) = render(&loaded);
+            let (b, none) = render(&streamed);
+            assert!(visible.is_some_and(|n| n > 0) && none.is_none());
+            assert!(a == b, "{accum} {shading}: lists and full scan differ");
+        }
+    }
+}
+
+#[test]
+fn bench_writes_the_named_keys() {
+    let d = tmpdir("bench");
+    let json = d.join("b.json");
+    let code = footprint_harness::run([
+        "footprint",
+        "bench",
+        "--size",
+        "64x64",
+        "--view",
+        "30,20,0",
+        "--frames",
+        "4",
+        "--orbit",
+        "30",
+        "--threads",
+        "1",
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0);
+    let j = std::fs::read_to_string(&json).unwrap();
+    for key in [
+        "\"first_ms\"",
+        "\"median_ms\"",
+        "\"min_ms\"",
+        "\"max_ms\"",
+        "\"threads\": 1",
+        "\"phases_ms\"",
+        "\"classify\"",
+        "\"tables\"",
+        "\"splat\"",
+        "\"composite\"",
+        "\"frames_ms\"",
+    ] {
+        assert!(j.contains(key), "{key} missing from {j}");
+    }
+    // Frame 1 classifies; turning 30° per frame switches the sheet axis at least once, so a later
+    // frame classifies again, and the others reuse the lists.
+    assert!(!j.contains("\"median_ms\": null"));
+    assert_eq!(
+        footprint_harness::run(["footprint", "bench", "--frames", "0"]),
+        2,
+        "--frames 0 is refused"
+    );
+}
