@@ -15,6 +15,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.ticker  # noqa: E402,F401
 
 peers_csv, scaling_csv, out_md, stem = sys.argv[1:5]
 rows = list(csv.DictReader(open(peers_csv)))
@@ -88,6 +89,7 @@ for ax, kind, xlabel, title in [
     xs = [p[0] for p in pts]
     ax.loglog(xs, [p[1] for p in pts], "o-", label="fresh (frame 1)")
     ax.loglog(xs, [p[2] for p in pts], "s-", label="re-render (median of later frames)")
+    ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
     ax.set_xticks(xs)
     ax.set_xticklabels([str(x) for x in xs])
     ax.set_xlabel(xlabel)
