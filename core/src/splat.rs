@@ -234,6 +234,33 @@ pub fn splat<S: Sampler + ?Sized, P: Pixel>(
     splat_rows(sampler, center, value, image, |_, _, _| {})
 }
 
+/// What a float render spreads a voxel with: any footprint [`Sampler`] (row by row, through
+/// [`splat_rows`]) or a view's phase stencils ([`crate::stencil::Stencils`]).
+pub trait Splatter {
+    /// Spreads `value` of a voxel projected to `center` (pixels, absolute) into `image`, calling
+    /// `touched(y, x0, x1)` for each row it visited.
+    fn splat_voxel<P: Pixel>(
+        &self,
+        center: [f32; 2],
+        value: &P,
+        image: &mut ImageMut<'_, P>,
+        touched: impl FnMut(usize, usize, usize),
+    ) -> Result<SplatStats, BufferError>;
+}
+
+impl<S: Sampler + ?Sized> Splatter for S {
+    #[inline]
+    fn splat_voxel<P: Pixel>(
+        &self,
+        center: [f32; 2],
+        value: &P,
+        image: &mut ImageMut<'_, P>,
+        touched: impl FnMut(usize, usize, usize),
+    ) -> Result<SplatStats, BufferError> {
+        splat_rows(self, center, value, image, touched)
+    }
+}
+
 /// Pixels per batch of row weights (a stack buffer; longer rows are done in several batches).
 const BATCH: usize = 64;
 
@@ -331,25 +358,13 @@ fn splat_small<S: Sampler + ?Sized, P: Pixel>(
     let fp = sampler.footprint();
     let mut weights = [[0.0f32; SMALL]; SMALL];
     let qx0 = x0 as f32 + 0.5 - center[0];
-    let radial = matches!(fp.shape, crate::kernel::Shape::Radial);
-    let a = &fp.to_unit;
     let mut sum = 0.0f32;
     for (k, row) in weights.iter_mut().enumerate().take(ny) {
         let qy = (y0 + k as i64) as f32 + 0.5 - center[1];
         let row = &mut row[..nx];
         sampler.row_weights(qx0, qy, row);
         for (i, w) in row.iter_mut().enumerate() {
-            let q = [qx0 + i as f32, qy];
-            let u = [
-                a[0][0] * q[0] + a[0][1] * q[1],
-                a[1][0] * q[0] + a[1][1] * q[1],
-            ];
-            let inside = if radial {
-                u[0] * u[0] + u[1] * u[1] <= 1.0
-            } else {
-                math::abs(u[0]) <= 1.0 && math::abs(u[1]) <= 1.0
-            };
-            if !inside {
+            if !fp.contains([qx0 + i as f32, qy]) {
                 *w = 0.0;
             }
             sum += *w;
@@ -412,7 +427,7 @@ fn pixel_range(lo: f32, hi: f32) -> (i64, i64) {
 /// ⌊x⌋ for finite x, clamped to ±2³¹ (NaN gives 0); inline, without a libm call. `as i64`
 /// truncates toward zero, so a negative non-integer is one too high.
 #[inline]
-fn floor_i64(x: f32) -> i64 {
+pub(crate) fn floor_i64(x: f32) -> i64 {
     let x = x.clamp(-2_147_483_648.0, 2_147_483_647.0);
     let t = x as i64;
     t - i64::from((t as f32) > x)

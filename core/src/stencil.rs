@@ -22,9 +22,8 @@
 //! side used, B = [`MAX_STENCIL_SIDE`].
 
 use crate::geometry::Footprint;
-use crate::kernel::Shape;
 use crate::math;
-use crate::splat::{BufferError, ImageMut, Pixel, Sampler, SplatStats};
+use crate::splat::{floor_i64, BufferError, ImageMut, Pixel, Sampler, SplatStats, Splatter};
 
 /// Phases per pixel the harness uses.
 pub const DEFAULT_PHASES: usize = 32;
@@ -83,8 +82,6 @@ impl<'a> Stencils<'a> {
             });
         }
         let reach = (side / 2) as i64;
-        let a = &fp.to_unit;
-        let radial = matches!(fp.shape, Shape::Radial);
         let cells = side * side;
         for (k, stencil) in buffer[..len].chunks_exact_mut(cells).enumerate() {
             let (pa, pb) = (k % (phases + 1), k / (phases + 1));
@@ -94,16 +91,11 @@ impl<'a> Stencils<'a> {
                 let qy = (my as i64 - reach) as f32 + 0.5 - phase[1];
                 for (mx, w) in row.iter_mut().enumerate() {
                     let q = [(mx as i64 - reach) as f32 + 0.5 - phase[0], qy];
-                    let u = [
-                        a[0][0] * q[0] + a[0][1] * q[1],
-                        a[1][0] * q[0] + a[1][1] * q[1],
-                    ];
-                    let inside = if radial {
-                        u[0] * u[0] + u[1] * u[1] <= 1.0
+                    *w = if fp.contains(q) {
+                        sampler.weight(q)
                     } else {
-                        math::abs(u[0]) <= 1.0 && math::abs(u[1]) <= 1.0
+                        0.0
                     };
-                    *w = if inside { sampler.weight(q) } else { 0.0 };
                     sum += *w;
                 }
             }
@@ -204,10 +196,15 @@ impl<'a> Stencils<'a> {
     }
 }
 
-/// ⌊x⌋ for finite x, clamped to ±2³¹.
-#[inline]
-fn floor_i64(x: f32) -> i64 {
-    let x = x.clamp(-2_147_483_648.0, 2_147_483_647.0);
-    let t = x as i64;
-    t - i64::from((t as f32) > x)
+impl Splatter for Stencils<'_> {
+    #[inline]
+    fn splat_voxel<P: Pixel>(
+        &self,
+        center: [f32; 2],
+        value: &P,
+        image: &mut ImageMut<'_, P>,
+        touched: impl FnMut(usize, usize, usize),
+    ) -> Result<SplatStats, BufferError> {
+        self.splat(center, value, image, touched)
+    }
 }

@@ -205,6 +205,17 @@ impl Footprint {
         })
     }
 
+    /// Whether screen offset `q` (pixels from the centre) lies in the footprint's support:
+    /// |A q| ≤ 1 for a radial kernel, |A q|∞ ≤ 1 for a separable one.
+    #[inline]
+    pub fn contains(&self, q: [f32; 2]) -> bool {
+        let u = mul2(&self.to_unit, q);
+        match self.shape {
+            Shape::Radial => u[0] * u[0] + u[1] * u[1] <= 1.0,
+            Shape::Separable => math::abs(u[0]) <= 1.0 && math::abs(u[1]) <= 1.0,
+        }
+    }
+
     /// The range of screen x offsets (pixels, relative to the voxel's projected centre) where the
     /// footprint's support meets the row at y offset `qy`: the ellipse `|A q| ≤ 1` (radial) or
     /// the parallelogram `|A q|∞ ≤ 1` (separable), A = [`Footprint::to_unit`]. `None` if the row

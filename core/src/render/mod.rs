@@ -17,21 +17,21 @@
 //!
 //! # Precision
 //! The renderer is generic over a [`Precision`]: [`FloatPath`] (f32 accumulator and image, any
-//! [`Sampler`]) or [`FixedPath`] (integer table, `i64` accumulator, Q24 image; see
+//! [`Splatter`]: a footprint sampler or phase stencils) or [`FixedPath`] (integer table, `i64` accumulator, Q24 image; see
 //! [`crate::fixed`]). One build holds both, so they can be compared on the same frame.
 
 mod precision;
 mod sheets;
 mod visible;
 
-pub use precision::{FixedPath, FloatPath, Precision, StencilPath};
+pub use precision::{FixedPath, FloatPath, Precision};
 pub use sheets::{gradient, SheetRing, SheetWindow};
 pub use visible::{classify_sheet, VisibleSheet, VisibleVoxel};
 
 use crate::composite::RowSpan;
 use crate::frame::{FrameSetup, Order};
 use crate::shade::{Lighting, OpacityTable, Sample, Shader};
-use crate::splat::{BufferError, ImageMut, Sampler};
+use crate::splat::{BufferError, ImageMut, Splatter};
 use core::fmt;
 
 /// Why a render step was refused.
@@ -154,8 +154,8 @@ pub struct SheetRenderer<'a, P: Precision> {
     stats: RenderStats,
 }
 
-impl<'a, S: Sampler + ?Sized> SheetRenderer<'a, FloatPath<'a, S>> {
-    /// Starts a float frame through `sampler` (a view table or the direct method); see
+impl<'a, S: Splatter + ?Sized> SheetRenderer<'a, FloatPath<'a, S>> {
+    /// Starts a float frame through `sampler` (a view table, the direct method or phase stencils); see
     /// [`SheetRenderer::with_path`].
     pub fn new(
         frame: &'a FrameSetup,

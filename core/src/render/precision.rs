@@ -5,8 +5,7 @@
 use crate::composite::{clamp_unit, over};
 use crate::fixed::{self, FixedError, FixedTable, Placement};
 use crate::frame::{FrameSetup, Order};
-use crate::splat::{splat_rows, BufferError, ImageMut, Sampler, SplatStats};
-use crate::stencil::Stencils;
+use crate::splat::{BufferError, ImageMut, SplatStats, Splatter};
 
 /// What a [`SheetRenderer`](super::SheetRenderer) splats with and accumulates into.
 pub trait Precision {
@@ -44,7 +43,8 @@ pub trait Precision {
     fn over_row(&self, front: &mut [Self::Pixel], back: &[Self::Pixel]);
 }
 
-/// Float accumulation through any [`Sampler`] (view table or direct).
+/// Float accumulation through any [`Splatter`]: a footprint [`Sampler`](crate::Sampler) (view
+/// table or direct) or a view's phase stencils ([`crate::stencil::Stencils`]).
 #[derive(Debug)]
 pub struct FloatPath<'a, S: ?Sized> {
     /// The footprint sampler.
@@ -59,7 +59,7 @@ impl<S: ?Sized> Clone for FloatPath<'_, S> {
 
 impl<S: ?Sized> Copy for FloatPath<'_, S> {}
 
-impl<S: Sampler + ?Sized> Precision for FloatPath<'_, S> {
+impl<S: Splatter + ?Sized> Precision for FloatPath<'_, S> {
     type Value = [f32; 4];
     type Acc = [f32; 4];
     type Pixel = [f32; 4];
@@ -91,13 +91,8 @@ impl<S: Sampler + ?Sized> Precision for FloatPath<'_, S> {
         let value = value.map(|c| c * f.cell_area);
         // Subtracting a whole number of rows is exact here (|p.y| < 2²⁴), so every pixel of a
         // band sees the offsets, and so the weights, of a whole-image render.
-        splat_rows(
-            self.sampler,
-            [p[0], p[1] - row0 as f32],
-            &value,
-            acc,
-            touched,
-        )
+        self.sampler
+            .splat_voxel([p[0], p[1] - row0 as f32], &value, acc, touched)
     }
 
     fn composite_row(&self, acc: &mut [[f32; 4]], image: &mut [[f32; 4]], order: Order) {
@@ -125,58 +120,6 @@ fn float_composite_row(acc: &mut [[f32; 4]], image: &mut [[f32; 4]], order: Orde
 fn float_over_row(front: &mut [[f32; 4]], back: &[[f32; 4]]) {
     for (i, b) in front.iter_mut().zip(back) {
         *i = over(*i, *b);
-    }
-}
-
-/// Float accumulation through a view's phase stencils ([`Stencils`]): the view table sampled once
-/// per sub-pixel phase, so a splat is multiply-adds only. Same accumulator, image and compositing
-/// as [`FloatPath`].
-#[derive(Clone, Copy, Debug)]
-pub struct StencilPath<'a> {
-    /// The view's stencils.
-    pub stencils: &'a Stencils<'a>,
-}
-
-impl Precision for StencilPath<'_> {
-    type Value = [f32; 4];
-    type Acc = [f32; 4];
-    type Pixel = [f32; 4];
-    const ACC_ZERO: [f32; 4] = [0.0; 4];
-    const CLEAR: [f32; 4] = [0.0; 4];
-
-    #[inline]
-    fn value(&self, rgba: [f32; 4]) -> [f32; 4] {
-        rgba
-    }
-
-    #[inline]
-    fn is_transparent(value: &[f32; 4]) -> bool {
-        !(value[3] > 0.0)
-    }
-
-    #[inline]
-    fn splat(
-        &self,
-        f: &FrameSetup,
-        sheet: usize,
-        (u, v): (usize, usize),
-        row0: usize,
-        value: &[f32; 4],
-        acc: &mut ImageMut<'_, [f32; 4]>,
-        touched: impl FnMut(usize, usize, usize),
-    ) -> Result<SplatStats, BufferError> {
-        let p = float_position(f, sheet, u, v);
-        let value = value.map(|c| c * f.cell_area);
-        self.stencils
-            .splat([p[0], p[1] - row0 as f32], &value, acc, touched)
-    }
-
-    fn composite_row(&self, acc: &mut [[f32; 4]], image: &mut [[f32; 4]], order: Order) {
-        float_composite_row(acc, image, order);
-    }
-
-    fn over_row(&self, front: &mut [[f32; 4]], back: &[[f32; 4]]) {
-        float_over_row(front, back);
     }
 }
 

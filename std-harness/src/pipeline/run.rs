@@ -13,7 +13,6 @@ use crate::{with_table_size, CliError};
 use footprint::fixed::{self, FixedTable};
 use footprint::render::{
     FixedPath, FloatPath, Precision, RenderBuffers, RenderStats, SheetRenderer, SheetRing,
-    StencilPath,
 };
 use footprint::shade::OPACITY_TABLE_LEN;
 use footprint::source::{render_from, SheetSource};
@@ -111,7 +110,7 @@ pub fn render_frame(
                     let mut buffer = vec![0.0f32; len];
                     let stencils = Stencils::build(&*table, args.phases, &mut buffer)?;
                     let tables = start.elapsed().as_secs_f64();
-                    let path = StencilPath { stencils: &stencils };
+                    let path = FloatPath { sampler: &stencils };
                     let r = run_path(p, path, p.background.as_deref(), cache, threads)?;
                     (r.0, r.1, Phases { tables, ..r.2 }, r.3)
                 } else {
