@@ -166,6 +166,48 @@ fn setups<const N: usize>(c: &mut Criterion) {
     g.finish();
 }
 
+/// A thin oblique footprint (a 30:1:1 grid turned 45° in the screen, about 68 px long and 3 px
+/// wide, n = 129, bilinear): the view table over the screen box (the paper's layout, 7.6 % of peak
+/// off the exact footprint), over the unit square (the layout such footprints get, 0.27 %), and
+/// the direct method (0.27 %). The layout choice in `footprint::table::ViewLayout` rests on this.
+fn thin(c: &mut Criterion) {
+    use footprint::table::ViewLayout;
+    let generic = Box::new(GenericTable::<129>::build(Kernel::PAPER_GAUSSIAN));
+    let view = Mat3::from_rotation_z(core::f32::consts::FRAC_PI_4);
+    let f = FrameSetup::new(
+        [1, 1, 1],
+        &Grid::from_spacing([30.0, 1.0, 1.0]).unwrap(),
+        &View::new(view).unwrap(),
+        &Kernel::PAPER_GAUSSIAN,
+        FootprintOptions::default(),
+        [128, 128],
+    )
+    .unwrap();
+    let mut g = c.benchmark_group("thin");
+    let be = math::BACKEND;
+    let mut table = Box::new(ViewTable::<129>::zeroed(f.footprint));
+    for (layout, name) in [(ViewLayout::ScreenBox, "box"), (ViewLayout::Unit, "unit")] {
+        let l = Lookup::Bilinear;
+        table.build_laid_out(&f.footprint, &generic, l, l, layout);
+        float_splat(
+            &mut g,
+            &format!("n=129/bilinear/view-{name}/float/{be}"),
+            &*table,
+        );
+    }
+    let direct = Direct {
+        footprint: f.footprint,
+        table: &*generic,
+        lookup: Lookup::Bilinear,
+    };
+    float_splat(
+        &mut g,
+        &format!("n=129/bilinear/direct/float/{be}"),
+        &direct,
+    );
+    g.finish();
+}
+
 fn per_splat(c: &mut Criterion) {
     for_sizes!(splats, c);
 }
@@ -252,6 +294,6 @@ fn quick() -> Criterion {
 criterion_group! {
     name = splat_benches;
     config = quick();
-    targets = per_splat, per_view, frames
+    targets = thin, per_splat, per_view, frames
 }
 criterion_main!(splat_benches);

@@ -72,7 +72,7 @@ pub mod table;
 pub use geometry::{Footprint, FootprintOptions, GeometryError, Grid, Mapping, View};
 pub use kernel::{Kernel, KernelSpecError};
 pub use splat::{splat, BufferError, ImageMut, Sampler};
-pub use table::{GenericTable, Lookup, TableError, ViewTable};
+pub use table::{GenericTable, Lookup, TableError, ViewLayout, ViewTable};
 
 use core::fmt;
 

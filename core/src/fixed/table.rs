@@ -5,7 +5,7 @@ use super::{MAX_ENTRY_FRAC, POS_FRAC};
 use crate::frame::FrameSetup;
 use crate::kernel::Shape;
 use crate::math;
-use crate::table::{for_each_view_node, GenericTable, Lookup};
+use crate::table::{for_each_view_node, GenericTable, Lookup, ViewLayout};
 use core::fmt;
 
 /// Largest screen coordinate, footprint half-extent or table coordinate the fixed path accepts,
@@ -89,9 +89,9 @@ impl<const M: usize> FixedTable<M> {
         }
     }
 
-    /// The two-stage method: the view table of [`crate::ViewTable::build`] (M×M nodes over the
-    /// footprint's screen box, read from `generic` with `build` lookup), scaled by `frame`'s cell
-    /// area and quantised; pixels read it with `sample` lookup.
+    /// The two-stage method: the view table of [`crate::ViewTable::build`] (M×M nodes in the
+    /// footprint's [`ViewLayout`], read from `generic` with `build` lookup), scaled by `frame`'s
+    /// cell area and quantised; pixels read it with `sample` lookup.
     pub fn build_view<const N: usize>(
         &mut self,
         frame: &FrameSetup,
@@ -105,15 +105,21 @@ impl<const M: usize> FixedTable<M> {
         // A view-table value interpolates generic values, so this bounds every entry.
         let bound = fp.scale * frame.cell_area * max_abs(generic.as_slice());
         let scale = self.set_maps(frame, bound)?;
-        for_each_view_node(fp, generic, build, &mut self.data, |e, t| {
+        let layout = ViewLayout::for_footprint(fp);
+        for_each_view_node(fp, generic, build, layout, &mut self.data, |e, t| {
             *e = quantise(t * scale)
         });
         let half = 0.5 * steps;
-        let npp = [steps / (2.0 * ex), steps / (2.0 * ey)];
-        self.t_map = [
-            [q24(npp[0], "view table resolution")?, 0],
-            [0, q24(npp[1], "view table resolution")?],
-        ];
+        self.t_map = match layout {
+            ViewLayout::ScreenBox => {
+                let npp = [steps / (2.0 * ex), steps / (2.0 * ey)];
+                [
+                    [q24(npp[0], "view table resolution")?, 0],
+                    [0, q24(npp[1], "view table resolution")?],
+                ]
+            }
+            ViewLayout::Unit => q24_mat(&fp.to_unit, half)?,
+        };
         self.t0 = [q24(half, "table size")?; 2];
         self.lookup = sample;
         Ok(())

@@ -22,7 +22,7 @@ mod view;
 pub use format::{crc32, Crc32, TableError, FORMAT_VERSION, MAGIC};
 pub use generic::GenericTable;
 pub(crate) use view::for_each_view_node;
-pub use view::ViewTable;
+pub use view::{box_fill, ViewLayout, ViewTable, MIN_BOX_FILL};
 
 /// How a table is read between its nodes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -13,7 +13,7 @@ pub fn run(args: &SplatArgs) -> Result<(), CliError> {
     let fa = &args.footprint;
     crate::say!(
         "{}: {:?} {}x{} table, footprint half-extent {:.3} x {:.3} px, sheet axis {}, \
-         sum of weights {:.6}, peak {:.6e} px^-2{}{}, {:.3} ms",
+         {}sum of weights {:.6}, peak {:.6e} px^-2{}{}, {:.3} ms",
         args.out.display(),
         fa.method,
         fa.table,
@@ -21,6 +21,11 @@ pub fn run(args: &SplatArgs) -> Result<(), CliError> {
         r.half_extent[0],
         r.half_extent[1],
         ["i", "j", "k"][r.sheet_axis],
+        match r.layout {
+            Some(footprint::ViewLayout::ScreenBox) => "view table over the screen box, ",
+            Some(footprint::ViewLayout::Unit) => "view table over the unit square (thin oblique), ",
+            None => "",
+        },
         r.sum,
         r.peak,
         if r.clamped {
@@ -29,7 +34,7 @@ pub fn run(args: &SplatArgs) -> Result<(), CliError> {
             ""
         },
         if r.cheated {
-            ", paper 0.01° cheat applied"
+            ", paper cheat applied"
         } else {
             ""
         },

@@ -25,8 +25,10 @@ pub struct SplatReport {
     pub sheet_axis: usize,
     /// A semi-axis was widened to --min-radius.
     pub clamped: bool,
-    /// The paper method needed its 0.01° cheat.
+    /// The paper method needed its cheat.
     pub cheated: bool,
+    /// Where the view table's nodes lay (`None` for the direct and reference methods).
+    pub layout: Option<footprint::ViewLayout>,
     /// Σ of all pixel weights (≈ 1 when the footprint is on screen).
     pub sum: f64,
     /// Largest weight, px⁻².
@@ -92,6 +94,7 @@ pub fn splat_image(args: &SplatArgs) -> Result<(GreyImage, SplatReport), CliErro
             sheet_axis: fp.sheet_axis,
             clamped: reference.clamped,
             cheated: false,
+            layout: None,
             sum: out.iter().sum(),
             peak: img.peak(),
             seconds,
@@ -128,6 +131,7 @@ pub fn splat_image(args: &SplatArgs) -> Result<(GreyImage, SplatReport), CliErro
         sheet_axis: fp.sheet_axis,
         clamped: fp.clamped,
         cheated: fp.cheated,
+        layout: (fa.method != MethodArg::Direct).then(|| footprint::ViewLayout::for_footprint(&fp)),
         sum: img.data.iter().map(|&v| f64::from(v)).sum(),
         peak: img.peak(),
         seconds,
