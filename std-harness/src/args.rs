@@ -69,7 +69,7 @@ pub struct FootprintArgs {
     #[arg(long, value_enum, default_value_t = MethodArg::Robust)]
     pub method: MethodArg,
     /// Smallest footprint semi-axis, pixels (sub-pixel footprints are widened to it).
-    #[arg(long, default_value_t = footprint::geometry::DEFAULT_MIN_RADIUS_PX)]
+    #[arg(long, default_value_t = footprint::geometry::DEFAULT_MIN_RADIUS_PX, value_parser = parse_min_radius)]
     pub min_radius: f32,
     /// `--method paper` only: how close to 45° (degrees) the paper's rotation cheat nudges θ;
     /// 0 disables it, and the singular angle becomes a typed error.
@@ -145,6 +145,42 @@ pub fn parse_list<const N: usize>(s: &str) -> Result<[f32; N], String> {
     Ok(out)
 }
 
+/// Parses `X,Y,Z` voxel spacing: three positive finite numbers (world units).
+pub fn parse_spacing(s: &str) -> Result<[f32; 3], String> {
+    let v = parse_list::<3>(s)?;
+    if let Some(bad) = v.iter().find(|x| !(**x > 0.0)) {
+        return Err(format!(
+            "spacing {bad} is not positive (expected X,Y,Z > 0)"
+        ));
+    }
+    Ok(v)
+}
+
+/// Parses a positive finite number (a zoom factor).
+pub fn parse_positive(s: &str) -> Result<f32, String> {
+    let v: f32 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{s}' is not a number"))?;
+    if !(v.is_finite() && v > 0.0) {
+        return Err(format!("{v} is not a positive finite number"));
+    }
+    Ok(v)
+}
+
+/// Parses `--min-radius`: a finite number of pixels, at least the geometry's smallest.
+pub fn parse_min_radius(s: &str) -> Result<f32, String> {
+    let v: f32 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{s}' is not a number"))?;
+    let least = footprint::geometry::MIN_MIN_RADIUS_PX;
+    if !(v.is_finite() && v >= least) {
+        return Err(format!("{v} px is outside [{least}, ∞) px"));
+    }
+    Ok(v)
+}
+
 /// Parses `WxH` (each 1 … 16384).
 pub fn parse_size(s: &str) -> Result<(usize, usize), String> {
     let (w, h) = s
@@ -193,7 +229,7 @@ pub struct RenderArgs {
     #[arg(long, default_value = "0,0,0", value_parser = parse_list::<3>, allow_hyphen_values = true)]
     pub view: [f32; 3],
     /// Multiplies the zoom that fits the volume into the image.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, value_parser = parse_positive)]
     pub zoom: f32,
     /// Explicit world-to-screen matrix, nine numbers row-major, pixels per world unit (overrides
     /// --view and --zoom).
@@ -244,7 +280,7 @@ pub struct RenderArgs {
     #[arg(long)]
     pub json: Option<PathBuf>,
     /// Raw volumes: dimensions X,Y,Z.
-    #[arg(long, value_parser = parse_dims)]
+    #[arg(long, value_parser = parse_dims, allow_hyphen_values = true)]
     pub dims: Option<[usize; 3]>,
     /// Raw volumes: sample type (u8, i8, u16, i16, u32, i32, f32, f64).
     #[arg(long = "type")]
@@ -253,9 +289,12 @@ pub struct RenderArgs {
     #[arg(long, default_value = "little")]
     pub endian: String,
     /// Raw volumes: spacing X,Y,Z in world units.
-    #[arg(long, default_value = "1,1,1", value_parser = parse_list::<3>)]
+    #[arg(long, default_value = "1,1,1", value_parser = parse_spacing, allow_hyphen_values = true)]
     pub spacing: [f32; 3],
-    /// Output image (PNG). `render` defaults to footprint.png; `verify` writes one only if asked.
+    /// Output image: `.png` (8-bit RGB, linear premultiplied colour over the background, clamped)
+    /// or `.pfm` (float32 RGB, the same values unclamped); other extensions are refused. `render`
+    /// defaults to footprint.png; `verify` writes one only if asked. Every output is checked
+    /// before rendering, and none is written unless all are.
     #[arg(long)]
     pub out: Option<PathBuf>,
 }
@@ -304,7 +343,7 @@ pub struct SplatArgs {
     #[command(flatten)]
     pub footprint: FootprintArgs,
     /// Voxel spacing along i,j,k in world units.
-    #[arg(long, default_value = "1,1,1", value_parser = parse_list::<3>)]
+    #[arg(long, default_value = "1,1,1", value_parser = parse_spacing, allow_hyphen_values = true)]
     pub spacing: [f32; 3],
     /// General grid-to-world matrix, nine numbers row-major (overrides --spacing).
     #[arg(long, value_parser = parse_list::<9>, allow_hyphen_values = true)]

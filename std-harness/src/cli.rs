@@ -17,21 +17,28 @@ pub struct Cli {
 #[derive(Subcommand, Debug)]
 pub enum Command {
     /// Render a volume (or, with no volume, the built-in scene) to a PNG.
+    #[command(allow_negative_numbers = true)]
     Render(RenderArgs),
     /// Render one voxel (value 1) and write its raw footprint weights (px⁻²).
+    #[command(allow_negative_numbers = true)]
     Splat(SplatArgs),
     /// Render with the core and with the f64 reference (no tables) and report PSNR, RMSE and max
     /// error; exit 1 below --min-psnr.
+    #[command(allow_negative_numbers = true)]
     Verify(commands::verify::VerifyArgs),
     /// Precompute a generic footprint table and save it (the paper's preprocessor).
+    #[command(allow_negative_numbers = true)]
     Tables(commands::tables::TablesArgs),
     /// Compare two single-channel PFM images: max |A − B| relative to B's peak.
+    #[command(allow_negative_numbers = true)]
     Compare(commands::compare::CompareArgs),
     /// Sweep table size, lookup, method and accumulation on one scene: frame time against error
     /// (tradeoff.csv/.svg/.png with the Pareto frontier) and stability (stability.svg/.png).
+    #[command(allow_negative_numbers = true)]
     Chart(commands::chart::ChartArgs),
     /// Frame times of one volume loaded once: frame 1 fresh, later frames turned by --orbit and
     /// reusing cached state (first_ms, median_ms, phases_ms; --json).
+    #[command(allow_negative_numbers = true)]
     Bench(commands::bench::BenchArgs),
 }
 
@@ -44,10 +51,20 @@ where
 {
     let cli = match Cli::try_parse_from(args) {
         Ok(cli) => cli,
-        Err(e) => {
-            let code = if e.use_stderr() { 2 } else { 0 };
+        Err(e) if !e.use_stderr() => {
+            // --help and --version.
             let _ = e.print();
-            return code;
+            return 0;
+        }
+        Err(e) => {
+            // One line, as every other error: clap's first line without its "error: " prefix
+            // (the usage and tips that follow are what --help prints).
+            let text = e.render().to_string();
+            let line = text.lines().next().unwrap_or("bad arguments");
+            let line = line.strip_prefix("error: ").unwrap_or(line);
+            use std::io::Write as _;
+            let _ = writeln!(std::io::stderr().lock(), "footprint: {line} (see --help)");
+            return 2;
         }
     };
     let result = match cli.command {

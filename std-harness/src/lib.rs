@@ -38,6 +38,15 @@ macro_rules! say {
     }};
 }
 
+/// Prints a warning to standard error: `footprint: warning: …`, one line. The command goes on.
+#[macro_export]
+macro_rules! warn {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr().lock(), "footprint: warning: {}", format_args!($($arg)*));
+    }};
+}
+
 pub mod args;
 pub mod charts;
 pub mod cli;

@@ -56,6 +56,7 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
             "--orbit must be a finite number of degrees",
         ));
     }
+    io::outputs::check_image_and_json(args.render.out.as_deref(), args.render.json.as_deref())?;
     let mut p = prepare(&args.render)?;
     let (base, choice) = apply_quality(&p, &args.render)?;
     let mut cache = FrameCache::default();
@@ -110,10 +111,13 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
         p.name,
         args.frames
     );
+    let mut files: Vec<(&std::path::Path, Vec<u8>)> = Vec::new();
     if let Some(out) = &base.out {
         let img = first_image.expect("frame 1 was rendered");
-        let png = io::image::encode_png_rgb(&img, base.size.0, base.size.1)?;
-        io::write_atomic(out, &png)?;
+        files.push((
+            out.as_path(),
+            io::image::encode_rgb_for(out, &img, base.size.0, base.size.1)?,
+        ));
     }
     if let Some(j) = &base.json {
         let mut summary = describe(&p, &base)
@@ -131,7 +135,10 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
         if let Some(c) = &choice {
             summary = summary.obj("quality", quality_json(c));
         }
-        io::write_atomic(j, summary.finish().as_bytes())?;
+        files.push((j.as_path(), summary.finish().into_bytes()));
     }
+    let files: Vec<(&std::path::Path, &[u8])> =
+        files.iter().map(|(p, b)| (*p, b.as_slice())).collect();
+    io::outputs::write_all(&files)?;
     Ok(())
 }

@@ -2,13 +2,31 @@
 //! PNG (see [`crate::pipeline::prepare`] for the view conventions).
 
 use crate::args::{MethodArg, RenderArgs};
-use crate::io::{self, image::encode_png_rgb};
+use crate::io::image::{encode_rgb_for, RGB_EXTENSIONS};
+use crate::io::outputs::{self, Planned};
 use crate::pipeline::quality::{apply_quality, quality_json};
 use crate::pipeline::{describe, prepare, render_core, render_ref};
 use crate::CliError;
 use std::path::PathBuf;
 
 pub fn run(args: &RenderArgs) -> Result<(), CliError> {
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("footprint.png"));
+    let mut planned = vec![Planned {
+        flag: "--out",
+        path: &out,
+        extensions: &RGB_EXTENSIONS,
+    }];
+    if let Some(j) = &args.json {
+        planned.push(Planned {
+            flag: "--json",
+            path: j,
+            extensions: &[],
+        });
+    }
+    outputs::check(&planned)?;
     let p = prepare(args)?;
     let (args, choice) = apply_quality(&p, args)?;
     let args = &args;
@@ -44,21 +62,13 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         Some(c) => summary.obj("quality", quality_json(c)),
         None => summary,
     };
-    let out = args
-        .out
-        .clone()
-        .unwrap_or_else(|| PathBuf::from("footprint.png"));
-    let png = encode_png_rgb(&rgb, args.size.0, args.size.1)?;
-    io::write_atomic(&out, &png)?;
+    let image = encode_rgb_for(&out, &rgb, args.size.0, args.size.1)?;
+    let summary = summary.str("out", &out.display().to_string()).finish();
+    let mut files = vec![(out.as_path(), image.as_slice())];
     if let Some(j) = &args.json {
-        io::write_atomic(
-            j,
-            summary
-                .str("out", &out.display().to_string())
-                .finish()
-                .as_bytes(),
-        )?;
+        files.push((j.as_path(), summary.as_bytes()));
     }
+    outputs::write_all(&files)?;
     crate::say!("wrote {}", out.display());
     Ok(())
 }

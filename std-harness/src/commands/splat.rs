@@ -8,6 +8,11 @@ use crate::pipeline::single::splat_image;
 use crate::CliError;
 
 pub fn run(args: &SplatArgs) -> Result<(), CliError> {
+    crate::io::outputs::check(&[crate::io::outputs::Planned {
+        flag: "--out",
+        path: &args.out,
+        extensions: &crate::io::image::GREY_EXTENSIONS,
+    }])?;
     let (img, r) = splat_image(args)?;
     save_grey(&img, &args.out)?;
     let fa = &args.footprint;

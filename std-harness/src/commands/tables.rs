@@ -22,6 +22,11 @@ pub struct TablesArgs {
 pub fn run(args: &TablesArgs) -> Result<(), CliError> {
     let kernel = Kernel::parse(&args.kernel)
         .map_err(|e| CliError::input(format!("--kernel '{}': {e}", args.kernel)))?;
+    io::outputs::check(&[io::outputs::Planned {
+        flag: "--out",
+        path: &args.out,
+        extensions: &[],
+    }])?;
     let start = std::time::Instant::now();
     let bytes = table_bytes(&kernel, args.size)?;
     io::write_atomic(&args.out, &bytes)?;

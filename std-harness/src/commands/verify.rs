@@ -5,7 +5,9 @@
 //! background (transparent black if none); the measures are [`crate::metrics`]'.
 
 use crate::args::{AccumArg, MethodArg, RenderArgs};
-use crate::io::{self, image::encode_png_rgb, json::Json};
+use crate::io::image::{encode_rgb_for, RGB_EXTENSIONS};
+use crate::io::json::Json;
+use crate::io::outputs::{self, Planned};
 use crate::metrics::compare;
 use crate::pipeline::quality::{apply_quality, quality_json};
 use crate::pipeline::{describe, prepare, render_core, render_core_with, render_ref};
@@ -20,7 +22,7 @@ pub struct VerifyArgs {
     /// Exit with code 1 if the overall PSNR is below this, dB.
     #[arg(long)]
     pub min_psnr: Option<f64>,
-    /// Also write the reference render (PNG) here.
+    /// Also write the reference render here (`.png` or `.pfm`, as `--out`).
     #[arg(long)]
     pub reference_out: Option<PathBuf>,
 }
@@ -32,6 +34,21 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
             "verify compares a table method with the reference: choose robust, paper or direct",
         ));
     }
+    let mut planned = Vec::new();
+    for (flag, path, extensions) in [
+        ("--out", &r.out, &RGB_EXTENSIONS[..]),
+        ("--reference-out", &args.reference_out, &RGB_EXTENSIONS[..]),
+        ("--json", &r.json, &[][..]),
+    ] {
+        if let Some(path) = path {
+            planned.push(Planned {
+                flag,
+                path,
+                extensions,
+            });
+        }
+    }
+    outputs::check(&planned)?;
     let p = prepare(r)?;
     let (chosen, choice) = apply_quality(&p, r)?;
     let r = &chosen;
@@ -76,12 +93,13 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
     } else {
         None
     };
+    let mut files: Vec<(&std::path::Path, Vec<u8>)> = Vec::new();
     if let Some(out) = &r.out {
-        io::write_atomic(out, &encode_png_rgb(&core, r.size.0, r.size.1)?)?;
+        files.push((out, encode_rgb_for(out, &core, r.size.0, r.size.1)?));
     }
     if let Some(out) = &args.reference_out {
         let img: Vec<[f32; 4]> = reference.iter().map(|c| c.map(|x| x as f32)).collect();
-        io::write_atomic(out, &encode_png_rgb(&img, r.size.0, r.size.1)?)?;
+        files.push((out, encode_rgb_for(out, &img, r.size.0, r.size.1)?));
     }
     let pass = args.min_psnr.is_none_or(|m| overall.psnr_db >= m);
     if let Some(j) = &r.json {
@@ -105,8 +123,11 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
             .obj("channels", channels)
             .num("min_psnr_db", args.min_psnr.unwrap_or(f64::NAN))
             .bool("pass", pass);
-        io::write_atomic(j, summary.finish().as_bytes())?;
+        files.push((j, summary.finish().into_bytes()));
     }
+    let files: Vec<(&std::path::Path, &[u8])> =
+        files.iter().map(|(p, b)| (*p, b.as_slice())).collect();
+    outputs::write_all(&files)?;
     if pass {
         Ok(())
     } else {

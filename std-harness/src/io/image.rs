@@ -156,6 +156,46 @@ pub fn encode_png_rgb(rgba: &[[f32; 4]], width: usize, height: usize) -> Result<
     Ok(out)
 }
 
+/// Extensions a colour image output may have: `.png` (8-bit, [`encode_png_rgb`]) or `.pfm` (float,
+/// [`encode_pfm_rgb`]).
+pub const RGB_EXTENSIONS: [&str; 2] = ["png", "pfm"];
+
+/// Extensions a single-channel output may have ([`save_grey`]).
+pub const GREY_EXTENSIONS: [&str; 2] = ["pfm", "png"];
+
+/// Encodes a colour PFM (`PF`, scale −1: little-endian float32 RGB, rows bottom to top): the
+/// premultiplied colour channels as they are (linear, not clamped), for measuring.
+pub fn encode_pfm_rgb(rgba: &[[f32; 4]], width: usize, height: usize) -> Vec<u8> {
+    let mut out = format!("PF\n{width} {height}\n-1.0\n").into_bytes();
+    out.reserve(rgba.len() * 12);
+    for row in rgba.chunks(width.max(1)).rev() {
+        for p in row {
+            for v in &p[..3] {
+                out.extend_from_slice(&v.to_le_bytes());
+            }
+        }
+    }
+    out
+}
+
+/// `rgba` encoded as the colour image type `path`'s extension names (see [`RGB_EXTENSIONS`];
+/// commands check the extension before rendering).
+pub fn encode_rgb_for(
+    path: &Path,
+    rgba: &[[f32; 4]],
+    width: usize,
+    height: usize,
+) -> Result<Vec<u8>, CliError> {
+    match super::outputs::extension(path).as_deref() {
+        Some("pfm") => Ok(encode_pfm_rgb(rgba, width, height)),
+        Some("png") => encode_png_rgb(rgba, width, height),
+        _ => Err(CliError::input(format!(
+            "{}: cannot write this image type (use .png or .pfm)",
+            path.display()
+        ))),
+    }
+}
+
 /// Decodes an 8-bit grey, grey+alpha, RGB or RGBA PNG into premultiplied RGBA f32 (linear, as
 /// stored). Returns (width, height, pixels).
 pub fn decode_png_rgba(

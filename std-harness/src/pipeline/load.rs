@@ -24,13 +24,28 @@ pub enum Voxels {
 
 /// The raw-file options from `--dims`, `--type`, `--endian`, `--spacing`, if `--dims` was given.
 pub fn raw_options(args: &RenderArgs) -> Result<Option<RawOptions>, CliError> {
+    let given = args.dims.is_some() || args.sample_type.is_some();
+    let file = args.volume.as_ref().or(args.stream.as_ref());
+    if let Some(format) = file.and_then(|f| crate::io::formats::header_format(f)) {
+        if given {
+            return Err(CliError::input(format!(
+                "{}: --dims and --type are for headerless raw files; this {format} file's header \
+                 gives its size and type (drop the flags)",
+                file.map_or(String::new(), |f| f.display().to_string())
+            )));
+        }
+    }
     let Some(dims) = args.dims else {
+        if args.sample_type.is_some() {
+            return Err(CliError::input(
+                "--type is for headerless raw files, which also need --dims X,Y,Z",
+            ));
+        }
         return Ok(None);
     };
-    let ty = args
-        .sample_type
-        .as_deref()
-        .ok_or_else(|| CliError::input("raw volumes need --type"))?;
+    let ty = args.sample_type.as_deref().ok_or_else(|| {
+        CliError::input("headerless raw files need --type as well as --dims (e.g. --type u8)")
+    })?;
     let ty = SampleType::parse(ty).ok_or_else(|| {
         CliError::input(format!(
             "--type '{ty}' is not a sample type (u8, i8, u16, i16, u32, i32, f32, f64)"

@@ -41,6 +41,33 @@ pub fn parse_shading(s: &str, min_spacing: f32) -> Result<Shading, CliError> {
     })
 }
 
+/// The warnings for an iso value outside the data's range `[lo, hi]` (no surface can show) and
+/// for a `--window` that misses that range entirely (every voxel maps to one end of the transfer
+/// function). `prepare` prints them (`footprint: warning: …`) and goes on.
+pub fn outside_data_warnings(
+    shading: &Shading,
+    window: Option<[f32; 2]>,
+    (lo, hi): (f32, f32),
+) -> Vec<String> {
+    let mut out = Vec::new();
+    if let Shading::Iso { value, .. } = shading {
+        if !(*value >= lo && *value <= hi) {
+            out.push(format!(
+                "iso value {value} lies outside the data's range [{lo}, {hi}]: no surface will show"
+            ));
+        }
+    }
+    if let Some([a, b]) = window {
+        if b < lo || a > hi {
+            out.push(format!(
+                "--window {a},{b} lies outside the data's range [{lo}, {hi}]: every voxel maps to \
+                 one end of the transfer function"
+            ));
+        }
+    }
+    out
+}
+
 /// A render, set up and ready to run: the volume, the frame, the shading.
 pub struct Prepared {
     pub voxels: Voxels,
@@ -220,6 +247,11 @@ pub fn prepare(args: &RenderArgs) -> Result<Prepared, CliError> {
         &args.shading,
         frame.spacing.iter().copied().fold(f32::INFINITY, f32::min),
     )?;
+    if let Some((lo, hi)) = range {
+        for w in outside_data_warnings(&shading, args.window, (lo, hi)) {
+            crate::warn!("{w}");
+        }
+    }
     let background = args
         .background
         .as_ref()

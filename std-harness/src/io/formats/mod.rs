@@ -122,8 +122,30 @@ pub fn raw_data_at(path: &Path, h: RawHeader<'_>) -> Result<Streamable, CliError
 pub const EXTENSIONS: &str =
     ".nrrd, .nhdr, .vti, .vtk, .mhd, .mha, .nii, .nii.gz, or raw with --dims and --type";
 
+/// The format `path`'s extension names, if it is one with a header (NRRD, VTK XML image data,
+/// legacy VTK, MetaImage, NIfTI-1); `None` for anything else (raw data, unknown).
+pub fn header_format(path: &Path) -> Option<&'static str> {
+    let name = path
+        .file_name()
+        .and_then(|n| n.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    match name.rsplit('.').next().unwrap_or("") {
+        "nrrd" | "nhdr" => Some("NRRD"),
+        "vti" => Some("VTK XML image data"),
+        "vtk" => Some("legacy VTK"),
+        "mhd" | "mha" => Some("MetaImage"),
+        "nii" => Some("NIfTI-1"),
+        "gz" if name.ends_with(".nii.gz") => Some("NIfTI-1"),
+        _ => None,
+    }
+}
+
 /// Loads `path` by its extension; `raw` options (from `--dims`/`--type`) make it headerless raw.
 pub fn load(path: &Path, raw: Option<&raw::RawOptions>) -> Result<Volume, CliError> {
+    if path.is_dir() {
+        return Err(at(path, "is a directory, expected a volume file"));
+    }
     if let Some(o) = raw {
         return raw::load(path, o);
     }

@@ -1,0 +1,180 @@
+//! A command's output files: checked before any work, written all together or not at all.
+//!
+//! [`check`] runs first (before a volume is read or a frame rendered) and refuses an output whose
+//! folder is missing or not writable, a path that is a folder, an extension the file's kind does
+//! not support (`--out x.jpg` is refused, not filled with PNG bytes), and two outputs naming the
+//! same file. [`write_all`] writes every file to a temporary name beside its target (synced), and
+//! only when all of them are written renames them into place; if any write fails, every
+//! temporary is removed and no output appears. A rename can fail only if the file system changes
+//! under the command (a folder removed or made read-only between the check and the rename); the
+//! files renamed before it then stay, and the error names the one that failed.
+
+use crate::CliError;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// One output a command will write: the flag that named it (for messages), its path and the
+/// extensions its kind may have (empty: any).
+#[derive(Clone, Copy, Debug)]
+pub struct Planned<'a> {
+    /// The flag, e.g. `--out`.
+    pub flag: &'a str,
+    /// Where it goes.
+    pub path: &'a Path,
+    /// Lower-case extensions accepted, e.g. `["png", "pfm"]`; empty accepts any.
+    pub extensions: &'a [&'a str],
+}
+
+/// The lower-case extension of `path`, if any.
+pub fn extension(path: &Path) -> Option<String> {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+}
+
+fn folder(path: &Path) -> &Path {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    }
+}
+
+/// The temporary name `path` is written under before its rename.
+fn temporary(path: &Path) -> Result<PathBuf, CliError> {
+    let name = path
+        .file_name()
+        .ok_or_else(|| CliError::input(format!("{}: not a file name", path.display())))?;
+    Ok(folder(path).join(format!(
+        ".{}.tmp-{}",
+        name.to_string_lossy(),
+        std::process::id()
+    )))
+}
+
+/// Checks every planned output before any work is done (see the module docs).
+pub fn check(outputs: &[Planned<'_>]) -> Result<(), CliError> {
+    for (i, o) in outputs.iter().enumerate() {
+        let shown = o.path.display();
+        let flag = o.flag;
+        if o.path.is_dir() {
+            return Err(CliError::input(format!(
+                "{flag} {shown}: is a directory, expected a file name"
+            )));
+        }
+        if o.path.file_name().is_none() {
+            return Err(CliError::input(format!("{flag} {shown}: not a file name")));
+        }
+        if !o.extensions.is_empty() {
+            let ext = extension(o.path);
+            if !ext.as_deref().is_some_and(|e| o.extensions.contains(&e)) {
+                let list: Vec<String> = o.extensions.iter().map(|e| format!(".{e}")).collect();
+                return Err(CliError::input(format!(
+                    "{flag} {shown}: cannot write {} files (use {})",
+                    ext.map_or("extension-less".to_string(), |e| format!(".{e}")),
+                    list.join(" or ")
+                )));
+            }
+        }
+        let dir = folder(o.path);
+        if !dir.is_dir() {
+            return Err(CliError::input(format!(
+                "{flag} {shown}: directory {} does not exist",
+                dir.display()
+            )));
+        }
+        // Probe: the same temporary name the write will use, created and removed.
+        let tmp = temporary(o.path)?;
+        std::fs::File::create(&tmp)
+            .and_then(|_| std::fs::remove_file(&tmp))
+            .map_err(|e| {
+                CliError::input(format!(
+                    "{flag} {shown}: cannot write in {}: {e}",
+                    dir.display()
+                ))
+            })?;
+        for other in &outputs[..i] {
+            if same_file(other.path, o.path) {
+                return Err(CliError::input(format!(
+                    "{} and {flag} both name {shown}",
+                    other.flag
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+fn same_file(a: &Path, b: &Path) -> bool {
+    let canon =
+        |p: &Path| -> Option<PathBuf> { Some(folder(p).canonicalize().ok()?.join(p.file_name()?)) };
+    a == b || matches!((canon(a), canon(b)), (Some(x), Some(y)) if x == y)
+}
+
+/// Writes every `(path, bytes)` all-or-nothing (see the module docs).
+pub fn write_all(files: &[(&Path, &[u8])]) -> Result<(), CliError> {
+    let mut written: Vec<(PathBuf, &Path)> = Vec::with_capacity(files.len());
+    let cleanup = |written: &[(PathBuf, &Path)]| {
+        for (tmp, _) in written {
+            let _ = std::fs::remove_file(tmp);
+        }
+    };
+    for &(path, bytes) in files {
+        let tmp = match temporary(path) {
+            Ok(t) => t,
+            Err(e) => {
+                cleanup(&written);
+                return Err(e);
+            }
+        };
+        let result = (|| {
+            let mut f = std::fs::File::create(&tmp)?;
+            f.write_all(bytes)?;
+            f.sync_all()
+        })();
+        if let Err(e) = result {
+            let _ = std::fs::remove_file(&tmp);
+            cleanup(&written);
+            return Err(CliError::input(format!(
+                "{}: cannot write: {e} (no output written)",
+                path.display()
+            )));
+        }
+        written.push((tmp, path));
+    }
+    for (k, (tmp, path)) in written.iter().enumerate() {
+        if let Err(e) = std::fs::rename(tmp, path) {
+            cleanup(&written[k..]);
+            return Err(CliError::input(format!(
+                "{}: cannot write: {e}",
+                path.display()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Writes one file atomically (temporary beside it, then rename).
+pub fn write_one(path: &Path, bytes: &[u8]) -> Result<(), CliError> {
+    write_all(&[(path, bytes)])
+}
+
+/// [`check`] for the usual pair: a colour image (`--out`, `.png` or `.pfm`) and a JSON summary
+/// (`--json`), either optional.
+pub fn check_image_and_json(out: Option<&Path>, json: Option<&Path>) -> Result<(), CliError> {
+    let mut planned = Vec::new();
+    if let Some(path) = out {
+        planned.push(Planned {
+            flag: "--out",
+            path,
+            extensions: &super::image::RGB_EXTENSIONS,
+        });
+    }
+    if let Some(path) = json {
+        planned.push(Planned {
+            flag: "--json",
+            path,
+            extensions: &[],
+        });
+    }
+    check(&planned)
+}

@@ -1,0 +1,204 @@
+//! The command's outputs: checked before any rendering, written all together or not at all, and
+//! only in the format their extension names; messages that name the flag or the cause.
+
+use footprint_harness::io::outputs::{self, Planned};
+use footprint_harness::pipeline::prepare::{outside_data_warnings, parse_shading};
+use std::path::{Path, PathBuf};
+
+fn tmpdir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("fp-out-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn run(args: &[&str]) -> i32 {
+    footprint_harness::run(std::iter::once("footprint").chain(args.iter().copied()))
+}
+
+/// Files in `d` (temporaries included).
+fn listing(d: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn a_failed_output_means_no_outputs() {
+    let d = tmpdir("none");
+    let png = d.join("x.png");
+    let p = png.to_str().unwrap();
+    // The case: a JSON path that cannot be written leaves no image.
+    for args in [
+        vec![
+            "render",
+            "--size",
+            "32x32",
+            "--json",
+            "/nonexistent/x.json",
+            "--out",
+            p,
+        ],
+        vec![
+            "verify",
+            "--size",
+            "32x32",
+            "--json",
+            "/nonexistent/x.json",
+            "--out",
+            p,
+        ],
+        vec![
+            "bench",
+            "--size",
+            "32x32",
+            "--frames",
+            "1",
+            "--json",
+            "/nonexistent/x.json",
+            "--out",
+            p,
+        ],
+        vec!["render", "--size", "32x32", "--out", "/nonexistent/dir/x.png"],
+        vec!["render", "--size", "32x32", "--out", p, "--json", p],
+        vec!["render", "--size", "32x32", "--out", d.to_str().unwrap()],
+        vec!["splat", "--out", "/nonexistent/dir/x.pfm"],
+        vec!["tables", "--size", "9", "--out", "/nonexistent/dir/t.bin"],
+    ] {
+        assert_eq!(run(&args), 2, "{args:?}");
+        assert!(listing(&d).is_empty(), "{args:?} left {:?}", listing(&d));
+    }
+    // The writer itself: the second file cannot be written, so the first is not either, and no
+    // temporary stays behind.
+    let good = d.join("a.json");
+    let err = outputs::write_all(&[
+        (good.as_path(), b"{}"),
+        (Path::new("/nonexistent/dir/b.json"), b"{}"),
+    ])
+    .unwrap_err();
+    assert!(err.message.contains("no output written"), "{}", err.message);
+    assert!(listing(&d).is_empty(), "left {:?}", listing(&d));
+    // Both written when both can be.
+    let other = d.join("b.json");
+    outputs::write_all(&[(good.as_path(), b"1"), (other.as_path(), b"2")]).unwrap();
+    assert_eq!(listing(&d), ["a.json", "b.json"]);
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn an_extension_is_written_in_its_format_or_refused() {
+    let d = tmpdir("ext");
+    let jpg = d.join("x.jpg");
+    assert_eq!(
+        run(&["render", "--size", "16x16", "--out", jpg.to_str().unwrap()]),
+        2
+    );
+    assert!(!jpg.exists(), "PNG bytes in a .jpg");
+    let err = outputs::check(&[Planned {
+        flag: "--out",
+        path: &jpg,
+        extensions: &["png", "pfm"],
+    }])
+    .unwrap_err();
+    assert!(
+        err.message.contains("--out") && err.message.contains(".jpg"),
+        "{}",
+        err.message
+    );
+    // .png is a PNG, .pfm a colour PFM of the same pixels (float, unclamped).
+    let (png, pfm) = (d.join("x.png"), d.join("x.pfm"));
+    for out in [&png, &pfm] {
+        assert_eq!(
+            run(&["render", "--size", "16x12", "--out", out.to_str().unwrap()]),
+            0
+        );
+    }
+    assert_eq!(&std::fs::read(&png).unwrap()[1..4], b"PNG");
+    let bytes = std::fs::read(&pfm).unwrap();
+    assert!(bytes.starts_with(b"PF\n16 12\n-1.0\n"));
+    assert_eq!(bytes.len(), "PF\n16 12\n-1.0\n".len() + 16 * 12 * 12);
+    // Upper-case extensions are the same formats.
+    let upper = d.join("y.PNG");
+    assert_eq!(
+        run(&["render", "--size", "8x8", "--out", upper.to_str().unwrap()]),
+        0
+    );
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn messages_name_the_flag_or_the_cause() {
+    let d = tmpdir("msg");
+    // Values that clap used to take for unknown flags reach their parsers (exit 2, no output).
+    let out = d.join("x.png");
+    let o = out.to_str().unwrap();
+    for bad in [
+        vec!["--zoom", "0"],
+        vec!["--zoom", "-1"],
+        vec!["--min-radius", "-1"],
+        vec!["--spacing", "-1,1,1"],
+        vec!["--dims", "-64,64,64", "--type", "u8"],
+    ] {
+        let mut args = vec!["render", "--size", "16x16", "--out", o];
+        args.extend(bad.iter().copied());
+        assert_eq!(run(&args), 2, "{bad:?}");
+        assert!(!out.exists());
+    }
+    let parsed = footprint_harness::args::parse_args(&["--zoom", "0"]).unwrap_err();
+    assert!(parsed.message.contains("--zoom"), "{}", parsed.message);
+    let parsed = footprint_harness::args::parse_args(&["--spacing", "-1,1,1"]).unwrap_err();
+    assert!(parsed.message.contains("--spacing"), "{}", parsed.message);
+    // A header format with the raw-file flags.
+    let nhdr = d.join("v.nhdr");
+    std::fs::write(
+        &nhdr,
+        "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\ndata file: v.raw\n",
+    )
+    .unwrap();
+    std::fs::write(d.join("v.raw"), [0u8, 9, 9, 9, 9, 9, 9, 9]).unwrap();
+    let args = footprint_harness::args::parse_args(&[
+        nhdr.to_str().unwrap(),
+        "--dims",
+        "2,2,2",
+        "--type",
+        "u8",
+    ])
+    .unwrap();
+    let msg = match footprint_harness::pipeline::prepare(&args) {
+        Err(e) => e.message,
+        Ok(_) => panic!("--dims with an .nhdr was accepted"),
+    };
+    assert!(
+        msg.contains("headerless raw") && msg.contains("NRRD"),
+        "{msg}"
+    );
+    // A directory as the volume.
+    let args = footprint_harness::args::parse_args(&[d.to_str().unwrap()]).unwrap();
+    let msg = match footprint_harness::pipeline::prepare(&args) {
+        Err(e) => e.message,
+        Ok(_) => panic!("a directory was accepted"),
+    };
+    assert!(msg.contains("is a directory"), "{msg}");
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn values_outside_the_data_are_warned_about() {
+    let iso = |v: f32| parse_shading(&format!("iso:{v}"), 1.0).unwrap();
+    let range = (0.0f32, 255.0f32);
+    let w = outside_data_warnings(&iso(99999.0), None, range);
+    assert_eq!(w.len(), 1);
+    assert!(w[0].contains("99999") && w[0].contains("outside"), "{w:?}");
+    assert!(outside_data_warnings(&iso(100.0), None, range).is_empty());
+    let emission = parse_shading("emission", 1.0).unwrap();
+    assert_eq!(
+        outside_data_warnings(&emission, Some([300.0, 400.0]), range).len(),
+        1
+    );
+    // A window wider than the data, or overlapping it, is legitimate.
+    assert!(outside_data_warnings(&emission, Some([-100.0, 1000.0]), range).is_empty());
+    assert!(outside_data_warnings(&emission, Some([200.0, 400.0]), range).is_empty());
+}
