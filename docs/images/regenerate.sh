@@ -4,14 +4,14 @@
 #   docs/images/regenerate.sh [--bless] [FOOTPRINT_BINARY]
 # Without --bless a changed image fails (exit 1) and its new version is left in a temporary folder
 # to look at; with --bless the committed files are replaced: a changed picture is a reviewed
-# decision, never an accident. Needs ../shared/data beside the checkout (headsq, heart).
+# decision, never an accident. The volumes are the repository's own (tests/data).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 bless=0
 if [ "${1:-}" = --bless ]; then bless=1; shift; fi
 fp=${1:-target/release/footprint}
 [ -x "$fp" ] || { echo "build first: cargo build --release -p footprint-harness"; exit 2; }
-data=../shared/data
+data=tests/data
 out=$(mktemp -d)
 # One line per picture: the file name, then the footprint arguments the README shows for it.
 while IFS='|' read -r name cmd; do
@@ -20,9 +20,9 @@ while IFS='|' read -r name cmd; do
   "$fp" "$@" --out "$out/$name" >/dev/null
 done <<LIST
 default-scene.png|render
-headsq-phong.png|render $data/headsq/headsq_64x64x93_int16_le.nhdr --tf ct-bone-skin --shading phong --view 0,90,180
-headsq-iso.png|render $data/headsq/headsq_64x64x93_int16_le.nhdr --tf ct-bone-skin --shading iso:1900 --view 30,100,180
-heart-texture.png|render $data/heart/heart_32x32x12_float32_le.nhdr --tf density --shading texture --view 30,20,0
+headsq-phong.png|render $data/headsq_64x64x93_int16_le.nhdr --tf ct-bone-skin --shading phong --view 0,90,180
+headsq-iso.png|render $data/headsq_64x64x93_int16_le.nhdr --tf ct-bone-skin --shading iso:1900 --view 30,100,180
+heart-texture.png|render $data/heart_32x32x12_float32_le.nhdr --tf density --shading texture --view 30,20,0
 splat-gaussian-60-30-30.png|splat --spacing 60,30,30 --rotate-z 30 --rotate-x 20 --table 65
 splat-bilinear-sheared.png|splat --kernel bilinear --spacing 40,40,40 --rotate-x 40 --rotate-y 35 --table 65
 splat-bilinear-sheared-paper.png|splat --kernel bilinear --spacing 40,40,40 --rotate-x 40 --rotate-y 35 --table 65 --method paper
