@@ -24,6 +24,8 @@
 //! - [`render`]: the sheet renderer (`mod.rs`), its float and fixed precisions (`precision.rs`),
 //!   and the sheet window, ring and gradient (`sheets.rs`).
 //! - [`source`]: the `SheetSource` interface for voxels streamed from outside, and its driver.
+//! - [`volume`]: a volume already in memory (`&[T]`, x fastest) as a `SheetSource`.
+//! - [`output`]: the result as 8-bit sRGB RGBA or RGB565 pixels.
 //!
 //! ## Conventions (kept everywhere)
 //! - world = G·(i, j, k), G the grid-to-world matrix (diagonal = spacing, world units such as mm);
@@ -31,7 +33,36 @@
 //!   y down, z away from the viewer; pixel (x, y) has its centre at (x + 0.5, y + 0.5);
 //! - a footprint weight is a density in px⁻² that integrates to one over the screen plane.
 //!
-//! ## Example
+//! ## Rendering a volume that is in memory
+//! A 16³ `u8` volume (x fastest) to 64×64 sRGB pixels, in caller-owned buffers (20 lines, then
+//! two checks):
+//! ```
+//! use footprint::{composite::RowSpan, frame::*, render::*, shade::*, source::render_from};
+//! use footprint::{volume::MemoryVolume, FootprintOptions, GenericTable, Grid, Kernel, Lookup, View, ViewTable};
+//! let (dims, size) = ([16; 3], [64, 64]);
+//! let data: Vec<u8> = (0..16 * 16 * 16).map(|i: u32| ((i * 37) % 256) as u8).collect();
+//! let mut volume = MemoryVolume::new(&data, dims).unwrap();
+//! let grid = Grid::from_spacing([1.0, 1.0, 2.0]).unwrap();
+//! let view = View::from_angles([30.0, 20.0, 0.0], 1.0, dims, &grid, size).unwrap();
+//! let frame = FrameSetup::new(dims, &grid, &view, &Kernel::PAPER_GAUSSIAN, FootprintOptions::default(), size).unwrap();
+//! let generic = GenericTable::<33>::build(Kernel::PAPER_GAUSSIAN);
+//! let table = ViewTable::<33>::build(&frame.footprint, &generic, Lookup::Bilinear, Lookup::Bilinear);
+//! let lut = [[0.0; 4], [1.0, 0.9, 0.8, 0.2]];
+//! let shader = Shader { tf: TransferFunction { lut: &lut, lo: 0.0, hi: 255.0 }, shading: Shading::Emission };
+//! let (mut acc, mut image, mut rows) = (vec![[0.0; 4]; 64 * 64], vec![[0.0; 4]; 64 * 64], vec![RowSpan::EMPTY; 64]);
+//! let buffers = RenderBuffers { accumulator: &mut acc, image: &mut image, rows: &mut rows };
+//! let mut renderer = SheetRenderer::new(&frame, &table, shader, Order::BackToFront, buffers, None).unwrap();
+//! let mut sheets = vec![0u8; 3 * frame.sheet_shape().0];
+//! let mut ring = SheetRing::new(&mut sheets, &frame, Order::BackToFront).unwrap();
+//! render_from(&mut renderer, &mut ring, &mut volume).unwrap();
+//! let stats = renderer.finish();
+//! let pixels: Vec<[u8; 4]> = image.iter().map(|p| footprint::output::srgb8(*p)).collect();
+//! assert_eq!(stats.sheets, 16);
+//! assert!(pixels.iter().any(|p| p[3] > 0));
+//! ```
+//! `core/examples/in_memory.rs` is the same as a program.
+//!
+//! ## One footprint
 //! ```
 //! use footprint::{geometry::*, kernel::Kernel, splat::*, table::*};
 //! let kernel = Kernel::parse("gaussian:spread=1.6,sigmas=2.5").unwrap();
@@ -62,12 +93,17 @@ pub mod frame;
 pub mod geometry;
 pub mod kernel;
 pub mod math;
+pub mod output;
 pub mod render;
 pub mod shade;
 pub mod source;
 pub mod splat;
 pub mod stencil;
 pub mod table;
+pub mod volume;
+
+/// The `glam` the core's API speaks (`Mat3`, `Vec3`), re-exported so callers use the same version.
+pub use glam;
 
 pub use geometry::{Footprint, FootprintOptions, GeometryError, Grid, Mapping, View};
 pub use kernel::{Kernel, KernelSpecError};
@@ -94,6 +130,8 @@ pub enum Error {
     Render(render::RenderError),
     /// A view outside the fixed-point path's range.
     Fixed(fixed::FixedError),
+    /// A slice that is not a volume of the dimensions given.
+    Volume(volume::VolumeError),
 }
 
 impl fmt::Display for Error {
@@ -106,6 +144,7 @@ impl fmt::Display for Error {
             Error::Frame(e) => e.fmt(f),
             Error::Render(e) => e.fmt(f),
             Error::Fixed(e) => e.fmt(f),
+            Error::Volume(e) => e.fmt(f),
         }
     }
 }
@@ -120,6 +159,7 @@ impl core::error::Error for Error {
             Error::Frame(e) => Some(e),
             Error::Render(e) => Some(e),
             Error::Fixed(e) => Some(e),
+            Error::Volume(e) => Some(e),
         }
     }
 }
@@ -140,5 +180,6 @@ from_error!(
     Buffer(BufferError),
     Frame(frame::FrameError),
     Render(render::RenderError),
-    Fixed(fixed::FixedError)
+    Fixed(fixed::FixedError),
+    Volume(volume::VolumeError)
 );

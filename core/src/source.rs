@@ -81,8 +81,6 @@ where
             renderer.render_sheet(ring.sheet_index(done), ring.window(done))?;
         }
     }
-    if let Some(last) = ring.last() {
-        renderer.render_sheet(ring.sheet_index(last), ring.window(last))?;
-    }
+    ring.finish(renderer)?;
     Ok(())
 }

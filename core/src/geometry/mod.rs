@@ -102,6 +102,13 @@ pub enum GeometryError {
         /// θ in degrees where it failed.
         theta_deg: f32,
     },
+    /// A zoom factor that is not a positive finite number ([`View::from_angles`]).
+    BadZoom {
+        /// The value given.
+        value: f32,
+    },
+    /// Nothing to fit: a zero volume dimension or image side ([`View::from_angles`]).
+    EmptyFit,
 }
 
 impl fmt::Display for GeometryError {
@@ -129,6 +136,10 @@ impl fmt::Display for GeometryError {
             Self::PaperSingular { theta_deg } => {
                 write!(f, "paper θ decomposition is singular at θ = {theta_deg}°")
             }
+            Self::BadZoom { value } => {
+                write!(f, "zoom must be a positive finite number, got {value}")
+            }
+            Self::EmptyFit => f.write_str("cannot fit a view to a zero-sized volume or image"),
         }
     }
 }
@@ -211,6 +222,47 @@ impl View {
         Ok(View {
             to_screen: world_to_screen,
         })
+    }
+
+    /// The view the CLI's `--view AZ,EL,ROLL` and `--zoom` build, fitted to an image: rotation
+    /// R = Rz(roll)·Rx(elevation)·Ry(azimuth) (degrees; azimuth turns the volume about the screen's
+    /// vertical axis, elevation about its horizontal axis, roll about the view direction; all zero
+    /// looks along +k with +i to the right and +j down), scaled so the volume's box (voxel centres
+    /// ± half a voxel, `dims` voxels on `grid`) fills 90 % of the tighter image side, times `zoom`.
+    /// The renderer centres the volume on the image.
+    pub fn from_angles(
+        [azimuth, elevation, roll]: [f32; 3],
+        zoom: f32,
+        dims: [usize; 3],
+        grid: &Grid,
+        image: [usize; 2],
+    ) -> Result<Self, GeometryError> {
+        if !(zoom.is_finite() && zoom > 0.0) {
+            return Err(GeometryError::BadZoom { value: zoom });
+        }
+        if !(azimuth.is_finite() && elevation.is_finite() && roll.is_finite()) {
+            return Err(GeometryError::NonFinite);
+        }
+        if dims.contains(&0) || image.contains(&0) {
+            return Err(GeometryError::EmptyFit);
+        }
+        let rad = core::f32::consts::PI / 180.0;
+        let r = Mat3::from_rotation_z(roll * rad)
+            * Mat3::from_rotation_x(elevation * rad)
+            * Mat3::from_rotation_y(azimuth * rad);
+        let half = Vec3::new(dims[0] as f32, dims[1] as f32, dims[2] as f32) * 0.5;
+        let mut ext = Vec3::ZERO;
+        for corner in 0..8 {
+            let c = Vec3::new(
+                if corner & 1 == 0 { -half.x } else { half.x },
+                if corner & 2 == 0 { -half.y } else { half.y },
+                if corner & 4 == 0 { -half.z } else { half.z },
+            );
+            ext = ext.max((r * (grid.to_world * c)).abs());
+        }
+        let (w, h) = (image[0] as f32, image[1] as f32);
+        let fit = 0.9 * (w / (2.0 * ext.x)).min(h / (2.0 * ext.y));
+        View::new(r * (fit * zoom))
     }
 
     /// From nine entries in row-major order (m00, m01, m02, m10, …), as the CLI's `--view-matrix`.
@@ -300,4 +352,7 @@ mod ellipse;
 mod paper;
 
 pub use ellipse::{cauchy_binet_det, conic_of, covariance, mul2, Footprint, Mat2, Sym2};
-pub use paper::{paper_decomposition, PaperDecomposition, PAPER_SINGULAR_COS2};
+pub use paper::{
+    paper_decomposition, PaperDecomposition, PAPER_MAX_CHEAT_DEG, PAPER_ROUND_CONIC,
+    PAPER_SINGULAR_COS2,
+};

@@ -56,6 +56,13 @@ pub enum RenderError {
     },
     /// More sheets pushed into a [`SheetRing`] than the volume has.
     TooManySheets,
+    /// [`SheetRing::finish`] before every sheet of the frame was pushed.
+    MissingSheets {
+        /// Sheets pushed.
+        delivered: usize,
+        /// Sheets the frame has.
+        expected: usize,
+    },
     /// A band of rows that is not inside the image.
     Band {
         /// First row asked for.
@@ -78,6 +85,13 @@ impl fmt::Display for RenderError {
             }
             Self::SheetIndex { index, count } => write!(f, "sheet {index} is outside 0..{count}"),
             Self::TooManySheets => f.write_str("more sheets than the volume has"),
+            Self::MissingSheets {
+                delivered,
+                expected,
+            } => write!(
+                f,
+                "the frame ended after {delivered} of its {expected} sheets were delivered"
+            ),
             Self::Band { start, end, height } => {
                 write!(
                     f,

@@ -139,6 +139,32 @@ impl<'a, T: Copy> SheetRing<'a, T> {
         })
     }
 
+    /// Ends the delivery: renders the last sheet (which no later push completes) through
+    /// `renderer`, and refuses a frame whose sheets were not all pushed
+    /// ([`RenderError::MissingSheets`]) rather than leave it silently short. Call it after the
+    /// last [`SheetRing::push`] (each push's completed sheet rendered), then
+    /// [`super::SheetRenderer::finish`].
+    pub fn finish<P: super::Precision>(
+        &self,
+        renderer: &mut super::SheetRenderer<'_, P>,
+    ) -> Result<(), RenderError>
+    where
+        T: Sample,
+    {
+        match self.last() {
+            Some(last) => renderer.render_sheet(self.sheet_index(last), self.window(last)),
+            None => Err(RenderError::MissingSheets {
+                delivered: self.pushed,
+                expected: self.total,
+            }),
+        }
+    }
+
+    /// Sheets pushed so far.
+    pub fn delivered(&self) -> usize {
+        self.pushed
+    }
+
     /// The last sequence position, once every sheet has been pushed.
     pub fn last(&self) -> Option<usize> {
         (self.pushed == self.total && self.total > 0).then(|| self.total - 1)

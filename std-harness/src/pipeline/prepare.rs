@@ -16,7 +16,6 @@ use footprint::frame::{FrameSetup, Order};
 use footprint::geometry::FootprintOptions;
 use footprint::shade::{Phong, Shader, Shading, TransferFunction};
 use footprint::{Grid, Kernel, View};
-use glam::{Mat3, Vec3};
 
 /// Parses `--shading`; iso-surfaces are `1.5 × min_spacing` thick (world units).
 pub fn parse_shading(s: &str, min_spacing: f32) -> Result<Shading, CliError> {
@@ -90,8 +89,7 @@ impl Prepared {
     /// `--view-matrix`, `--size`): only the frame is set up again, nothing is loaded. The
     /// compositing order stays as prepared.
     pub fn reframe(&mut self, args: &RenderArgs) -> Result<(), CliError> {
-        let view = View::new(view_matrix(args, self.frame.dims, self.grid.to_world()))
-            .map_err(|e| CliError::input(format!("view: {e}")))?;
+        let view = view_for(args, self.frame.dims, &self.grid)?;
         self.frame = FrameSetup::new(
             self.frame.dims,
             &self.grid,
@@ -124,28 +122,15 @@ impl Prepared {
     }
 }
 
-/// V for `--view`/`--zoom` (fitted to a volume of `dims` on grid `g`) or `--view-matrix`.
-pub fn view_matrix(args: &RenderArgs, dims: [usize; 3], g: Mat3) -> Mat3 {
-    if let Some(m) = args.view_matrix {
-        return Mat3::from_cols_array(&m).transpose();
-    }
-    let [az, el, roll] = args.view.map(f32::to_radians);
-    let r = Mat3::from_rotation_z(roll) * Mat3::from_rotation_x(el) * Mat3::from_rotation_y(az);
-    // Half-extents on screen of the volume's box (voxel centres ± half a voxel), in world space
-    // through its grid-to-world matrix.
-    let half = Vec3::new(dims[0] as f32, dims[1] as f32, dims[2] as f32) * 0.5;
-    let mut ext = Vec3::ZERO;
-    for corner in 0..8 {
-        let c = Vec3::new(
-            if corner & 1 == 0 { -half.x } else { half.x },
-            if corner & 2 == 0 { -half.y } else { half.y },
-            if corner & 4 == 0 { -half.z } else { half.z },
-        );
-        ext = ext.max((r * (g * c)).abs());
-    }
-    let (w, h) = (args.size.0 as f32, args.size.1 as f32);
-    let fit = 0.9 * (w / (2.0 * ext.x)).min(h / (2.0 * ext.y));
-    r * (fit * args.zoom)
+/// The view for `--view`/`--zoom` (fitted to a volume of `dims` on `grid`, the core's
+/// [`View::from_angles`]) or `--view-matrix`.
+pub fn view_for(args: &RenderArgs, dims: [usize; 3], grid: &Grid) -> Result<View, CliError> {
+    let view = match args.view_matrix {
+        Some(m) => View::from_rows(m).map_err(|e| CliError::input(format!("--view-matrix: {e}"))),
+        None => View::from_angles(args.view, args.zoom, dims, grid, [args.size.0, args.size.1])
+            .map_err(|e| CliError::input(format!("--view/--zoom: {e}"))),
+    }?;
+    Ok(view)
 }
 
 /// Loads and sets up everything `args` describes.
@@ -159,8 +144,7 @@ pub fn prepare(args: &RenderArgs) -> Result<Prepared, CliError> {
         range,
     } = load_voxels(args)?;
     let grid = Grid::from_matrix(grid).map_err(|e| CliError::input(format!("{name}: {e}")))?;
-    let view = View::new(view_matrix(args, dims, grid.to_world()))
-        .map_err(|e| CliError::input(format!("view: {e}")))?;
+    let view = view_for(args, dims, &grid)?;
     let mapping = args.footprint.mapping()?;
     let options = FootprintOptions {
         mapping,

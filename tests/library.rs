@@ -1,0 +1,285 @@
+//! The core as a library: an in-memory volume source, the view helper, output conversions, typed
+//! errors for bad transfer functions, and a ring that refuses a frame it was not given whole.
+
+use footprint::composite::RowSpan;
+use footprint::frame::{FrameSetup, Order};
+use footprint::output::{rgb565, srgb8, srgb_encode};
+use footprint::render::{RenderBuffers, RenderError, SheetRenderer, SheetRing};
+use footprint::shade::{Shader, Shading, TransferFunction, TransferFunctionError};
+use footprint::source::{render_from, SheetSource};
+use footprint::volume::{MemoryVolume, VolumeError};
+use footprint::{FootprintOptions, GenericTable, Grid, Kernel, Lookup, View, ViewTable};
+
+/// A `dims` volume whose sample at (i, j, k) is f(i, j, k), x fastest.
+fn volume<T>(dims: [usize; 3], f: impl Fn(usize, usize, usize) -> T) -> Vec<T> {
+    let mut v = Vec::with_capacity(dims.iter().product());
+    for k in 0..dims[2] {
+        for j in 0..dims[1] {
+            for i in 0..dims[0] {
+                v.push(f(i, j, k));
+            }
+        }
+    }
+    v
+}
+
+/// Every sheet of every axis, against indexing by hand: element (u, v) of sheet s along `axis` is
+/// the voxel with index s on `axis`, u on the lower in-sheet axis, v on the upper.
+fn check_sheets<T: footprint::shade::Sample + PartialEq + std::fmt::Debug>(
+    dims: [usize; 3],
+    f: impl Fn(usize, usize, usize) -> T + Copy,
+) {
+    let data = volume(dims, f);
+    let mut vol = MemoryVolume::new(&data, dims).unwrap();
+    for axis in 0..3 {
+        let (a, b) = footprint::geometry::in_sheet_axes(axis);
+        let mut out = vec![f(0, 0, 0); dims[a] * dims[b]];
+        for s in 0..dims[axis] {
+            vol.read_sheet(axis, s, &mut out).unwrap();
+            for v in 0..dims[b] {
+                for u in 0..dims[a] {
+                    let mut idx = [0; 3];
+                    idx[axis] = s;
+                    idx[a] = u;
+                    idx[b] = v;
+                    assert_eq!(
+                        out[v * dims[a] + u],
+                        f(idx[0], idx[1], idx[2]),
+                        "axis {axis} sheet {s} ({u}, {v})"
+                    );
+                }
+            }
+        }
+        // Wrong sheet length and index are typed errors.
+        let mut short = vec![f(0, 0, 0); dims[a] * dims[b] - 1];
+        assert!(matches!(
+            vol.read_sheet(axis, 0, &mut short),
+            Err(RenderError::SheetLength { .. })
+        ));
+        assert!(matches!(
+            vol.read_sheet(axis, dims[axis], &mut out),
+            Err(RenderError::SheetIndex { .. })
+        ));
+    }
+}
+
+#[test]
+fn memory_volumes_deliver_every_sheet_of_every_axis() {
+    let dims = [5, 3, 4];
+    check_sheets(dims, |i, j, k| (i + 10 * j + 100 * k) as u8);
+    check_sheets(dims, |i, j, k| {
+        (i as i16) - (j as i16) * 7 + (k as i16) * 300
+    });
+    check_sheets(dims, |i, j, k| (i * 65_000 + j * 3 + k) as u32);
+    check_sheets(dims, |i, j, k| i as f32 * 0.5 - j as f32 + k as f32 * 1e3);
+    check_sheets(dims, |i, j, k| (i + j + k) as f64 / 3.0);
+    check_sheets([1, 1, 1], |_, _, _| 7i8);
+}
+
+#[test]
+fn memory_volume_errors_are_typed() {
+    let data = [0u8; 24];
+    assert_eq!(
+        MemoryVolume::new(&data, [2, 3, 5]).unwrap_err(),
+        VolumeError::Length {
+            dims: [2, 3, 5],
+            got: 24
+        }
+    );
+    assert!(matches!(
+        MemoryVolume::new(&data, [0, 3, 8]),
+        Err(VolumeError::EmptyDimension { .. })
+    ));
+    assert!(matches!(
+        MemoryVolume::new(&data, [usize::MAX, 2, 2]),
+        Err(VolumeError::Length { .. })
+    ));
+    let v = MemoryVolume::new(&data, [2, 3, 4]).unwrap();
+    assert_eq!(v.range(), Some((0.0, 0.0)));
+    let nan = [f32::NAN, 2.0, -1.0, f32::INFINITY];
+    assert_eq!(
+        MemoryVolume::new(&nan, [4, 1, 1]).unwrap().range(),
+        Some((-1.0, 2.0))
+    );
+}
+
+/// The helper is the CLI's `--view` convention: at zero angles +i runs right and +j down; the
+/// fitted box fills 90 % of the tighter side; azimuth 90° turns +k to the right.
+#[test]
+fn view_from_angles_is_the_cli_convention() {
+    let grid = Grid::from_spacing([1.0, 1.0, 1.0]).unwrap();
+    let v = View::from_angles([0.0; 3], 1.0, [10, 20, 5], &grid, [200, 100]).unwrap();
+    let m = v.to_screen();
+    // Box 10 × 20 (half 5 × 10): the height is tighter: 0.9 · 100 / 20 = 4.5 px per unit.
+    assert!((m.x_axis.x - 4.5).abs() < 1e-5 && m.x_axis.y.abs() < 1e-6);
+    assert!((m.y_axis.y - 4.5).abs() < 1e-5 && m.y_axis.x.abs() < 1e-6);
+    let v = View::from_angles([90.0, 0.0, 0.0], 2.0, [10, 10, 10], &grid, [100, 100]).unwrap();
+    let m = v.to_screen();
+    let k_on_screen = m.z_axis;
+    assert!(k_on_screen.x.abs() > 0.99 * k_on_screen.length(), "{m:?}");
+    // The harness builds its views with it: same matrix for the same flags.
+    let args = footprint_harness::args::parse_args(&[
+        "--view", "30,20,10", "--zoom", "1.5", "--size", "64x48",
+    ])
+    .unwrap();
+    let via_cli = footprint_harness::pipeline::prepare::view_for(&args, [10, 20, 5], &grid)
+        .unwrap()
+        .to_screen();
+    let direct = View::from_angles([30.0, 20.0, 10.0], 1.5, [10, 20, 5], &grid, [64, 48])
+        .unwrap()
+        .to_screen();
+    assert_eq!(via_cli, direct);
+    assert!(View::from_angles([0.0; 3], 0.0, [2; 3], &grid, [8, 8]).is_err());
+    assert!(View::from_angles([f32::NAN, 0.0, 0.0], 1.0, [2; 3], &grid, [8, 8]).is_err());
+    assert!(View::from_angles([0.0; 3], 1.0, [0, 2, 2], &grid, [8, 8]).is_err());
+    // glam is the core's own, re-exported.
+    let _: footprint::glam::Mat3 = m;
+}
+
+#[test]
+fn output_conversions_match_the_srgb_curve() {
+    let exact = |c: f64| {
+        let c = c.clamp(0.0, 1.0);
+        if c <= 0.003_130_8 {
+            12.92 * c
+        } else {
+            1.055 * c.powf(1.0 / 2.4) - 0.055
+        }
+    };
+    let mut worst = 0.0f64;
+    for n in 0..=20_000 {
+        let c = n as f32 / 20_000.0;
+        let e = exact(f64::from(c));
+        worst = worst.max((f64::from(srgb_encode(c)) - e).abs());
+        let code = srgb8([c, c, c, c])[0];
+        assert!(
+            (f64::from(code) - e * 255.0).abs() <= 1.0,
+            "{c}: code {code}, exact {}",
+            e * 255.0
+        );
+        let p = rgb565([c, 0.0, 0.0, 1.0]);
+        assert!(
+            (f64::from(p >> 11) - e * 31.0).abs() <= 1.0,
+            "{c}: {p:#06x}"
+        );
+    }
+    // The backend's stated power error (micromath's is larger), times the curve's 1.055.
+    let bound = 2e-4 + 1.055 * f64::from(footprint::math::ERROR_BOUNDS.powf_unit_abs);
+    assert!(worst < bound, "sRGB curve off by {worst}, bound {bound}");
+    assert_eq!(srgb8([0.0; 4]), [0, 0, 0, 0]);
+    assert_eq!(srgb8([1.0; 4]), [255; 4]);
+    assert_eq!(srgb8([2.0, -1.0, f32::NAN, 0.5]), [255, 0, 0, 128]);
+    assert_eq!(rgb565([1.0, 1.0, 1.0, 1.0]), 0xffff);
+    assert_eq!(rgb565([0.0, 1.0, 0.0, 1.0]), 0x07e0);
+    assert_eq!(rgb565([0.0, 0.0, 1.0, 1.0]), 0x001f);
+    assert_eq!(rgb565([f32::NAN, 0.0, 0.0, 1.0]), 0);
+}
+
+/// Renders `dims` (value = i + j + k) with `tf`'s LUT and window, pushing `push` sheets by hand.
+fn ring_render(
+    lut: &[[f32; 4]],
+    lo: f32,
+    hi: f32,
+    push: Option<usize>,
+) -> Result<(u32, Vec<[f32; 4]>), RenderError> {
+    let dims = [6, 5, 8];
+    let grid = Grid::from_spacing([1.0; 3]).unwrap();
+    let view = View::from_angles([0.0; 3], 1.0, dims, &grid, [24, 24]).unwrap();
+    let frame = FrameSetup::new(
+        dims,
+        &grid,
+        &view,
+        &Kernel::PAPER_GAUSSIAN,
+        FootprintOptions::default(),
+        [24, 24],
+    )
+    .unwrap();
+    let generic = GenericTable::<17>::build(Kernel::PAPER_GAUSSIAN);
+    let table = ViewTable::<17>::build(
+        &frame.footprint,
+        &generic,
+        Lookup::Bilinear,
+        Lookup::Bilinear,
+    );
+    let shader = Shader {
+        tf: TransferFunction { lut, lo, hi },
+        shading: Shading::Emission,
+    };
+    let n = frame.image_len();
+    let (mut acc, mut img, mut rows) = (
+        vec![[0.0f32; 4]; n],
+        vec![[0.0f32; 4]; n],
+        vec![RowSpan::EMPTY; 24],
+    );
+    let buffers = RenderBuffers {
+        accumulator: &mut acc,
+        image: &mut img,
+        rows: &mut rows,
+    };
+    let order = Order::BackToFront;
+    let mut r = SheetRenderer::new(&frame, &table, shader, order, buffers, None)?;
+    let data = volume(dims, |i, j, k| (i + j + k) as u8);
+    let mut vol = MemoryVolume::new(&data, dims).unwrap();
+    let mut storage = vec![0u8; 3 * frame.sheet_shape().0];
+    let mut ring = SheetRing::new(&mut storage, &frame, order)?;
+    match push {
+        None => render_from(&mut r, &mut ring, &mut vol)?,
+        Some(count) => {
+            for step in 0..count {
+                let s = ring.sheet_index(step);
+                let done = ring.push_with(|slot| vol.read_sheet(frame.sheet_axis, s, slot))?;
+                if let Some(done) = done {
+                    r.render_sheet(ring.sheet_index(done), ring.window(done))?;
+                }
+            }
+            ring.finish(&mut r)?;
+        }
+    }
+    let stats = r.finish();
+    Ok((stats.sheets, img))
+}
+
+#[test]
+fn rings_refuse_a_frame_they_were_not_given_whole() {
+    let lut = [[0.0; 4], [1.0, 1.0, 1.0, 0.3]];
+    let (sheets, full) = ring_render(&lut, 0.0, 16.0, None).unwrap();
+    assert_eq!(sheets, 8);
+    // By hand, every sheet pushed and the ring finished: the same image as the driver.
+    let (sheets, by_hand) = ring_render(&lut, 0.0, 16.0, Some(8)).unwrap();
+    assert_eq!((sheets, &by_hand), (8, &full));
+    // The last sheet never pushed: refused, not 7 of 8 rendered in silence.
+    assert_eq!(
+        ring_render(&lut, 0.0, 16.0, Some(7)).unwrap_err(),
+        RenderError::MissingSheets {
+            delivered: 7,
+            expected: 8
+        }
+    );
+}
+
+#[test]
+fn bad_transfer_functions_are_typed_errors() {
+    let lut = [[0.0; 4], [1.0; 4]];
+    let window = ring_render(&lut, 5.0, 5.0, None).unwrap_err();
+    assert!(
+        matches!(
+            window,
+            RenderError::TransferFunction(TransferFunctionError::Window { .. })
+        ),
+        "{window:?}"
+    );
+    assert!(window.to_string().contains('5'), "{window}");
+    let empty = ring_render(&[], 0.0, 1.0, None).unwrap_err();
+    assert!(
+        matches!(
+            empty,
+            RenderError::TransferFunction(TransferFunctionError::TooFewEntries { len: 0 })
+        ),
+        "{empty:?}"
+    );
+    let bad = ring_render(&[[0.0; 4], [2.0, 0.0, 0.0, 1.0]], 0.0, 1.0, None).unwrap_err();
+    assert!(matches!(
+        bad,
+        RenderError::TransferFunction(TransferFunctionError::Entry { index: 1 })
+    ));
+}
