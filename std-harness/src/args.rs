@@ -181,6 +181,26 @@ pub fn parse_min_radius(s: &str) -> Result<f32, String> {
     Ok(v)
 }
 
+/// `--supersample`: `auto`, or a fixed factor.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Supersample {
+    /// k from the footprint's natural size (1 when no widening is needed).
+    Auto,
+    /// This factor (1 = off).
+    Fixed(usize),
+}
+
+/// Parses `auto` or a whole number 1 … 8.
+pub fn parse_supersample(s: &str) -> Result<Supersample, String> {
+    if s == "auto" {
+        return Ok(Supersample::Auto);
+    }
+    match s.parse::<usize>() {
+        Ok(k @ 1..=8) => Ok(Supersample::Fixed(k)),
+        _ => Err(format!("'{s}': expected auto or a whole number 1..=8")),
+    }
+}
+
 /// Parses `WxH` (each 1 … 16384).
 pub fn parse_size(s: &str) -> Result<(usize, usize), String> {
     let (w, h) = s
@@ -247,6 +267,11 @@ pub struct RenderArgs {
     /// `stencil` module); 0 walks the view table per pixel instead.
     #[arg(long, default_value_t = footprint::stencil::DEFAULT_PHASES)]
     pub phases: usize,
+    /// Supersampling: `auto` renders at k× the size and averages k×k blocks when voxels project
+    /// too close for the smallest footprint (removes the brightness bias of minified renders; see
+    /// the harness's `pipeline::supersample`); a number fixes k (1 = off).
+    #[arg(long, default_value = "auto", value_parser = parse_supersample)]
+    pub supersample: Supersample,
     /// Threads (bands of image rows) for the core's render; 0 = every core. The image is
     /// byte-identical for any number. A streamed volume renders on one thread.
     #[arg(long, default_value_t = 0)]

@@ -38,10 +38,14 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     } else {
         let (img, stats, secs) = render_core(&p, args)?;
         crate::say!(
-            "{}: {}x{} in {:.3} s; {} sheets along {}, {} voxels ({} splatted), {} pixel updates, {} composites",
+            "{}: {}x{}{} in {:.3} s; {} sheets along {}, {} voxels ({} splatted), {} pixel updates, {} composites",
             p.name,
             args.size.0,
             args.size.1,
+            match p.supersample {
+                1 => String::new(),
+                k => format!(" (supersampled {k}x: voxels project closer than --min-radius)"),
+            },
             secs,
             stats.sheets,
             ["i", "j", "k"][p.frame.sheet_axis],

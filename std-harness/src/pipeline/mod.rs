@@ -25,6 +25,7 @@ pub mod prepare;
 pub mod quality;
 pub mod run;
 pub mod single;
+pub mod supersample;
 pub mod visible;
 
 pub use prepare::{describe, prepare, Prepared};

@@ -8,6 +8,7 @@
 //! `--zoom`. `--view-matrix` gives V (world → screen, pixels per world unit) explicitly instead.
 
 use super::load::{load_background, load_voxels, Loaded, Voxels};
+use super::supersample;
 use crate::args::RenderArgs;
 use crate::io::json::Json;
 use crate::io::volume::{SampleType, Volume};
@@ -79,9 +80,16 @@ pub struct Prepared {
     pub window: [f32; 2],
     pub shading: Shading,
     pub tf_name: String,
+    /// The background at the frame's (internal) size.
     pub background: Option<Vec<[f32; 4]>>,
+    /// The background at the output size, as loaded.
+    pub background_out: Option<Vec<[f32; 4]>>,
     pub order: Order,
     pub options: FootprintOptions,
+    /// The frame is set up at `supersample` × the output size (see [`super::supersample`]).
+    pub supersample: usize,
+    /// The output size, pixels.
+    pub out_size: [usize; 2],
 }
 
 impl Prepared {
@@ -89,15 +97,20 @@ impl Prepared {
     /// `--view-matrix`, `--size`): only the frame is set up again, nothing is loaded. The
     /// compositing order stays as prepared.
     pub fn reframe(&mut self, args: &RenderArgs) -> Result<(), CliError> {
-        let view = view_for(args, self.frame.dims, &self.grid)?;
-        self.frame = FrameSetup::new(
+        let (frame, k) = setup_frame(
+            args,
             self.frame.dims,
             &self.grid,
-            &view,
             &self.kernel,
             self.options,
-            [args.size.0, args.size.1],
         )?;
+        self.frame = frame;
+        self.supersample = k;
+        self.out_size = [args.size.0, args.size.1];
+        self.background = self
+            .background_out
+            .as_ref()
+            .map(|b| supersample::upsample(b, args.size, k));
         Ok(())
     }
 
@@ -133,6 +146,28 @@ pub fn view_for(args: &RenderArgs, dims: [usize; 3], grid: &Grid) -> Result<View
     Ok(view)
 }
 
+/// The frame for `args`' view, at the output size or, when [`supersample::factor`] asks for it,
+/// at k× that size (the view scaled by k, so the picture is the same); returns it and k.
+pub fn setup_frame(
+    args: &RenderArgs,
+    dims: [usize; 3],
+    grid: &Grid,
+    kernel: &Kernel,
+    options: FootprintOptions,
+) -> Result<(FrameSetup, usize), CliError> {
+    let view = view_for(args, dims, grid)?;
+    let size = [args.size.0, args.size.1];
+    let frame = FrameSetup::new(dims, grid, &view, kernel, options, size)?;
+    let k = supersample::factor(args.supersample, &frame, kernel, options);
+    if k == 1 {
+        return Ok((frame, 1));
+    }
+    let view = View::new(view.to_screen() * k as f32)
+        .map_err(|e| CliError::input(format!("view: {e}")))?;
+    let frame = FrameSetup::new(dims, grid, &view, kernel, options, size.map(|n| n * k))?;
+    Ok((frame, k))
+}
+
 /// Loads and sets up everything `args` describes.
 pub fn prepare(args: &RenderArgs) -> Result<Prepared, CliError> {
     let kernel = args.footprint.kernel()?;
@@ -144,20 +179,12 @@ pub fn prepare(args: &RenderArgs) -> Result<Prepared, CliError> {
         range,
     } = load_voxels(args)?;
     let grid = Grid::from_matrix(grid).map_err(|e| CliError::input(format!("{name}: {e}")))?;
-    let view = view_for(args, dims, &grid)?;
     let mapping = args.footprint.mapping()?;
     let options = FootprintOptions {
         mapping,
         min_radius_px: args.footprint.min_radius,
     };
-    let frame = FrameSetup::new(
-        dims,
-        &grid,
-        &view,
-        &kernel,
-        options,
-        [args.size.0, args.size.1],
-    )?;
+    let (frame, supersample) = setup_frame(args, dims, &grid, &kernel, options)?;
     let order = match &voxels {
         Voxels::Stdin { .. } => {
             if frame.sheet_axis != 2 {
@@ -236,11 +263,14 @@ pub fn prepare(args: &RenderArgs) -> Result<Prepared, CliError> {
             crate::warn!("{w}");
         }
     }
-    let background = args
+    let background_out = args
         .background
         .as_ref()
         .map(|p| load_background(p, args.size))
         .transpose()?;
+    let background = background_out
+        .as_ref()
+        .map(|b| supersample::upsample(b, args.size, supersample));
     Ok(Prepared {
         voxels,
         name,
@@ -252,8 +282,11 @@ pub fn prepare(args: &RenderArgs) -> Result<Prepared, CliError> {
         shading,
         tf_name,
         background,
+        background_out,
         order,
         options,
+        supersample,
+        out_size: [args.size.0, args.size.1],
     })
 }
 
@@ -284,6 +317,9 @@ pub fn describe(p: &Prepared, args: &RenderArgs) -> Json {
         .str("sheet_axis", ["i", "j", "k"][f.sheet_axis])
         .arr_f64(
             "footprint_half_extent_px",
-            &f.footprint.half_extent.map(f64::from),
+            &f.footprint
+                .half_extent
+                .map(|e| f64::from(e) / p.supersample as f64),
         )
+        .num("supersample", p.supersample as f64)
 }

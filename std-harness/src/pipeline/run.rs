@@ -5,6 +5,7 @@
 use super::bands::{run_bands, Phases};
 use super::load::Voxels;
 use super::prepare::Prepared;
+use super::supersample::downsample;
 use super::visible::FrameCache;
 use crate::args::{AccumArg, MethodArg, RenderArgs};
 use crate::io::stream::{FileSource, MemorySource, PipeSource};
@@ -136,6 +137,11 @@ pub fn render_frame(
             }
         };
         phases.tables = phases.tables.max(0.0);
+        // Supersampled: the mean of each k×k block (timed with the frame: it is part of it).
+        let image = match p.supersample {
+            1 => image,
+            k => downsample(&image, (p.out_size[0], p.out_size[1]), k, |v| v as f32),
+        };
         CoreFrame {
             image,
             stats,
@@ -308,5 +314,9 @@ pub fn render_ref(p: &Prepared) -> Result<(Vec<[f64; 4]>, f64), CliError> {
         |s, out| volume.sheet_into(axis, s, out),
         progress("reference"),
     )?;
+    let img = match p.supersample {
+        1 => img,
+        k => downsample(&img, (p.out_size[0], p.out_size[1]), k, |v| v),
+    };
     Ok((img, start.elapsed().as_secs_f64()))
 }
