@@ -323,3 +323,51 @@ fn non_finite_samples_are_transparent() {
     assert_eq!(range, (0.0, 0.7));
     std::fs::remove_dir_all(&d).unwrap();
 }
+
+/// `compare` cannot pass NaN: an image holding a non-finite value fails the check (exit 1) with or
+/// without `--max-diff`, and a non-finite `--max-diff` is refused (exit 2).
+#[test]
+fn compare_fails_on_non_finite_images() {
+    use footprint_harness::io::image::{encode_pfm, GreyImage};
+    let d = tmpdir("compare-nan");
+    let img = |v: Vec<f32>| {
+        encode_pfm(&GreyImage {
+            width: 2,
+            height: 2,
+            data: v,
+        })
+    };
+    let (good, nan, inf) = (d.join("good.pfm"), d.join("nan.pfm"), d.join("inf.pfm"));
+    std::fs::write(&good, img(vec![0.1, 0.2, 0.3, 0.4])).unwrap();
+    std::fs::write(&nan, img(vec![0.1, f32::NAN, 0.3, 0.4])).unwrap();
+    std::fs::write(&inf, img(vec![0.1, 0.2, f32::INFINITY, 0.4])).unwrap();
+    let compare = |args: &[&str]| {
+        footprint_harness::run(["footprint", "compare"].iter().chain(args).copied())
+    };
+    let (g, n, i) = (
+        good.to_str().unwrap(),
+        nan.to_str().unwrap(),
+        inf.to_str().unwrap(),
+    );
+    assert_eq!(compare(&[g, g, "--max-diff", "0.1"]), 0);
+    assert_eq!(compare(&[n, g, "--max-diff", "0.1"]), 1);
+    assert_eq!(compare(&[g, n, "--max-diff", "0.1"]), 1);
+    assert_eq!(compare(&[i, g]), 1);
+    assert_eq!(compare(&[n, g]), 1);
+    assert_eq!(compare(&[g, g, "--max-diff", "nan"]), 2);
+    assert_eq!(compare(&[g, g, "--max-diff", "-1"]), 2);
+    let a = GreyImage {
+        width: 1,
+        height: 1,
+        data: vec![f32::NAN],
+    };
+    let b = GreyImage {
+        width: 1,
+        height: 1,
+        data: vec![1.0],
+    };
+    assert!(footprint_harness::metrics::max_rel_diff(&a, &b)
+        .unwrap()
+        .is_nan());
+    std::fs::remove_dir_all(&d).unwrap();
+}

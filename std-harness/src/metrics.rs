@@ -55,7 +55,10 @@ pub fn compare(core: &[[f32; 4]], reference: &[[f64; 4]]) -> ([ErrorStats; 4], E
         for ch in 0..4 {
             let d = (f64::from(c[ch]) - r[ch]).abs();
             sq[ch] += d * d;
-            mx[ch] = mx[ch].max(d);
+            // NaN propagates (f64::max would drop it): a non-finite pixel is never "close".
+            if d.is_nan() || d > mx[ch] {
+                mx[ch] = d;
+            }
         }
     }
     let n = core.len().max(1);
@@ -64,13 +67,17 @@ pub fn compare(core: &[[f32; 4]], reference: &[[f64; 4]]) -> ([ErrorStats; 4], E
     (per, overall)
 }
 
-/// max |a − b| / max(b), the "normalised footprint" difference used throughout the tests.
+/// max |a − b| / max(b), the "normalised footprint" difference used throughout the tests. NaN if
+/// either image holds a non-finite value (so no threshold passes it).
 pub fn max_rel_diff(a: &GreyImage, b: &GreyImage) -> Result<f64, CliError> {
     if (a.width, a.height) != (b.width, b.height) {
         return Err(CliError::input(format!(
             "images differ in size: {}x{} vs {}x{}",
             a.width, a.height, b.width, b.height
         )));
+    }
+    if a.data.iter().chain(&b.data).any(|v| !v.is_finite()) {
+        return Ok(f64::NAN);
     }
     let peak = f64::from(b.peak());
     if peak <= 0.0 {

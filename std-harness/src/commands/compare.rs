@@ -17,13 +17,32 @@ pub struct CompareArgs {
     pub max_diff: Option<f64>,
 }
 
+/// Exit 1 (a failed check) when the difference exceeds `--max-diff` or either image holds a
+/// non-finite value (NaN or infinity: no comparison with it means anything), whether or not
+/// `--max-diff` is given.
 pub fn run(args: &CompareArgs) -> Result<(), CliError> {
+    if let Some(limit) = args.max_diff {
+        if !(limit.is_finite() && limit >= 0.0) {
+            return Err(CliError::input(format!(
+                "--max-diff {limit}: expected a finite number >= 0"
+            )));
+        }
+    }
     let load = |p: &PathBuf| decode_pfm(&io::read_file(p)?, &p.display().to_string());
     let (a, b) = (load(&args.a)?, load(&args.b)?);
+    for (name, img) in [(&args.a, &a), (&args.b, &b)] {
+        let bad = img.data.iter().filter(|v| !v.is_finite()).count();
+        if bad > 0 {
+            return Err(CliError::check(format!(
+                "{}: {bad} non-finite value(s) (NaN or infinity)",
+                name.display()
+            )));
+        }
+    }
     let d = max_rel_diff(&a, &b)?;
     crate::say!("max |A-B| / peak(B) = {d:.6} ({:.4} %)", d * 100.0);
     match args.max_diff {
-        Some(limit) if d.is_nan() || d > limit => Err(CliError::check(format!(
+        Some(limit) if !(d <= limit) => Err(CliError::check(format!(
             "difference {d:.6} exceeds --max-diff {limit}"
         ))),
         _ => Ok(()),
