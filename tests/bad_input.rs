@@ -371,3 +371,32 @@ fn compare_fails_on_non_finite_images() {
         .is_nan());
     std::fs::remove_dir_all(&d).unwrap();
 }
+
+/// XML nested 20 000 deep is refused before the (recursive) parser sees it; real nesting, quoted
+/// '>' in attributes, comments, CDATA and self-closing tags do not count against the limit.
+#[test]
+fn deeply_nested_xml_is_refused_without_recursion() {
+    use footprint_harness::io::formats::vti::{check_depth, MAX_XML_DEPTH};
+    let d = tmpdir("deep-xml");
+    let n = 20_000;
+    let deep = format!(
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\">{}{}</VTKFile>\n",
+        "<a>".repeat(n),
+        "</a>".repeat(n)
+    );
+    let path = d.join("deep.vti");
+    std::fs::write(&path, &deep).unwrap();
+    let out = d.join("out.png");
+    assert_eq!(
+        run(&[path.to_str().unwrap(), "--out", out.to_str().unwrap()]),
+        2
+    );
+    assert!(!out.exists());
+    let msg = formats::load(&path, None).unwrap_err().message;
+    assert!(msg.contains("nested deeper"), "{msg}");
+    let ok = "<a x=\"1>2\"><!-- <b><b><b> --><c/><d><![CDATA[<e><e>]]></d></a>";
+    assert!(check_depth(ok, 2).is_ok());
+    assert!(check_depth("<a><b><c></c></b></a>", 2).is_err());
+    assert!(check_depth(&"<a>".repeat(MAX_XML_DEPTH), MAX_XML_DEPTH).is_ok());
+    std::fs::remove_dir_all(&d).unwrap();
+}

@@ -108,9 +108,65 @@ fn split_appended(bytes: &[u8]) -> Result<(String, Option<Appended<'_>>), String
     }
 }
 
+/// Deepest element nesting a `.vti` may have. VTK writes 5 levels (VTKFile, ImageData, Piece,
+/// PointData, DataArray); the XML parser recurses per level, so a file nested thousands deep
+/// would exhaust the stack. Checked by [`check_depth`] before parsing.
+pub const MAX_XML_DEPTH: usize = 64;
+
+/// Refuses XML nested deeper than `limit` elements, by a linear scan that never recurses: start
+/// tags (`<name …>`, not `</…>`, `<?…?>`, `<!…>` or self-closing `…/>`) open a level, end tags
+/// close one; quoted attribute values, comments and CDATA are skipped.
+pub fn check_depth(xml: &str, limit: usize) -> Result<(), String> {
+    let b = xml.as_bytes();
+    let (mut i, mut depth) = (0usize, 0usize);
+    while i < b.len() {
+        if b[i] != b'<' {
+            i += 1;
+            continue;
+        }
+        let rest = &xml[i..];
+        if rest.starts_with("<!--") {
+            i += rest.find("-->").map_or(b.len() - i, |e| e + 3);
+            continue;
+        }
+        if rest.starts_with("<![CDATA[") {
+            i += rest.find("]]>").map_or(b.len() - i, |e| e + 3);
+            continue;
+        }
+        let closing = rest.starts_with("</");
+        let special = rest.starts_with("<?") || rest.starts_with("<!");
+        // Find this tag's '>' outside quotes.
+        let mut j = i + 1;
+        let mut quote = 0u8;
+        while j < b.len() {
+            match (quote, b[j]) {
+                (0, b'"' | b'\'') => quote = b[j],
+                (q, c) if q != 0 && c == q => quote = 0,
+                (0, b'>') => break,
+                _ => {}
+            }
+            j += 1;
+        }
+        let self_closing = j > i && b[j - 1] == b'/';
+        if closing {
+            depth = depth.saturating_sub(1);
+        } else if !special && !self_closing {
+            depth += 1;
+            if depth > limit {
+                return Err(format!(
+                    "XML nested deeper than {limit} elements (a VTK image file needs 5)"
+                ));
+            }
+        }
+        i = j + 1;
+    }
+    Ok(())
+}
+
 /// Parses the XML of a `.vti` (the appended section, if any, is returned separately).
 pub fn parse_header(bytes: &[u8]) -> Result<(Header, Option<Appended<'_>>), String> {
     let (xml, appended) = split_appended(bytes)?;
+    check_depth(&xml, MAX_XML_DEPTH)?;
     let doc = roxmltree::Document::parse(&xml).map_err(|e| format!("not valid XML: {e}"))?;
     let root = doc.root_element();
     if root.tag_name().name() != "VTKFile" || root.attribute("type") != Some("ImageData") {
