@@ -400,3 +400,57 @@ fn deeply_nested_xml_is_refused_without_recursion() {
     assert!(check_depth(&"<a>".repeat(MAX_XML_DEPTH), MAX_XML_DEPTH).is_ok());
     std::fs::remove_dir_all(&d).unwrap();
 }
+
+/// A 400 KB PNG declaring 12000×12000 as `--background` is refused from its header, before any
+/// decoding (it would inflate to 432 MB).
+#[test]
+fn a_huge_png_background_is_refused_before_decoding() {
+    use std::io::Write;
+    let chunk = |t: &[u8], d: &[u8]| {
+        let mut body = t.to_vec();
+        body.extend_from_slice(d);
+        let mut c = (d.len() as u32).to_be_bytes().to_vec();
+        c.extend_from_slice(&body);
+        c.extend_from_slice(&footprint::table::crc32(&body).to_be_bytes());
+        c
+    };
+    let (w, h) = (12_000u32, 12_000u32);
+    let mut z = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::best());
+    let row = vec![0u8; 1 + 3 * w as usize];
+    for _ in 0..h {
+        z.write_all(&row).unwrap();
+    }
+    let mut ihdr = w.to_be_bytes().to_vec();
+    ihdr.extend_from_slice(&h.to_be_bytes());
+    ihdr.extend_from_slice(&[8, 2, 0, 0, 0]);
+    let png = [
+        b"\x89PNG\r\n\x1a\n".to_vec(),
+        chunk(b"IHDR", &ihdr),
+        chunk(b"IDAT", &z.finish().unwrap()),
+        chunk(b"IEND", &[]),
+    ]
+    .concat();
+    let d = tmpdir("huge-png");
+    let bg = d.join("bg.png");
+    std::fs::write(&bg, &png).unwrap();
+    let out = d.join("out.png");
+    let start = std::time::Instant::now();
+    assert_eq!(
+        run(&[
+            "--background",
+            bg.to_str().unwrap(),
+            "--size",
+            "16x16",
+            "--out",
+            out.to_str().unwrap()
+        ]),
+        2
+    );
+    assert!(!out.exists());
+    let msg = footprint_harness::io::image::decode_png_rgba_sized(&png, "bg", (16, 16))
+        .unwrap_err()
+        .message;
+    assert!(msg.contains("12000x12000"), "{msg}");
+    eprintln!("refused in {:?}", start.elapsed());
+    std::fs::remove_dir_all(&d).unwrap();
+}

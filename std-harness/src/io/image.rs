@@ -205,9 +205,40 @@ pub fn decode_png_rgba(
     let bad = |e: String| CliError::input(format!("{name}: {e}"));
     let mut decoder = png::Decoder::new(std::io::Cursor::new(bytes));
     decoder.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
-    let mut reader = decoder
+    let reader = decoder
         .read_info()
         .map_err(|e| bad(format!("not a readable PNG: {e}")))?;
+    decode_png_checked(reader, name)
+}
+
+/// [`decode_png_rgba`] of a PNG that must be `width × height`: the size in its header is checked
+/// before anything is decoded, so a small file declaring a huge image costs nothing.
+pub fn decode_png_rgba_sized(
+    bytes: &[u8],
+    name: &str,
+    (width, height): (usize, usize),
+) -> Result<(usize, usize, Vec<[f32; 4]>), CliError> {
+    let bad = |e: String| CliError::input(format!("{name}: {e}"));
+    let mut decoder = png::Decoder::new(std::io::Cursor::new(bytes));
+    decoder.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
+    let reader = decoder
+        .read_info()
+        .map_err(|e| bad(format!("not a readable PNG: {e}")))?;
+    let info = reader.info();
+    if (info.width as usize, info.height as usize) != (width, height) {
+        return Err(bad(format!(
+            "background is {}x{}, the image is {width}x{height}",
+            info.width, info.height
+        )));
+    }
+    decode_png_checked(reader, name)
+}
+
+fn decode_png_checked(
+    mut reader: png::Reader<std::io::Cursor<&[u8]>>,
+    name: &str,
+) -> Result<(usize, usize, Vec<[f32; 4]>), CliError> {
+    let bad = |e: String| CliError::input(format!("{name}: {e}"));
     let size = reader
         .output_buffer_size()
         .ok_or_else(|| bad("PNG too large".into()))?;

@@ -181,16 +181,6 @@ pub(crate) fn load_background(
     size: (usize, usize),
 ) -> Result<Vec<[f32; 4]>, CliError> {
     let bytes = io::read_file(path)?;
-    let img = crate::io::image::decode_png_rgba(&bytes, &path.display().to_string())?;
-    if (img.0, img.1) != size {
-        return Err(CliError::input(format!(
-            "{}: background is {}x{}, the image is {}x{}",
-            path.display(),
-            img.0,
-            img.1,
-            size.0,
-            size.1
-        )));
-    }
+    let img = crate::io::image::decode_png_rgba_sized(&bytes, &path.display().to_string(), size)?;
     Ok(img.2)
 }
