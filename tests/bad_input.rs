@@ -454,3 +454,46 @@ fn a_huge_png_background_is_refused_before_decoding() {
     eprintln!("refused in {:?}", start.elapsed());
     std::fs::remove_dir_all(&d).unwrap();
 }
+
+/// A FIFO (no writer) or a device as a volume, a detached data file or a background is refused
+/// from `stat`, before anything opens it (opening a FIFO blocks until a writer comes).
+#[cfg(unix)]
+#[test]
+fn special_files_are_refused_without_blocking() {
+    let d = tmpdir("fifo");
+    let fifo = d.join("fifo.raw");
+    let ok = std::process::Command::new("mkfifo").arg(&fifo).status();
+    if !ok.is_ok_and(|s| s.success()) {
+        eprintln!("mkfifo unavailable: skipped");
+        return;
+    }
+    let nhdr = d.join("v.nhdr");
+    std::fs::write(
+        &nhdr,
+        "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\ndata file: fifo.raw\n",
+    )
+    .unwrap();
+    let out = d.join("out.png");
+    let o = out.to_str().unwrap();
+    let f = fifo.to_str().unwrap();
+    let cases: Vec<Vec<&str>> = vec![
+        vec![nhdr.to_str().unwrap(), "--out", o],
+        vec![f, "--dims", "2,2,2", "--type", "u8", "--out", o],
+        vec!["--stream", f, "--dims", "2,2,2", "--type", "u8", "--out", o],
+        vec!["/dev/zero", "--dims", "2,2,2", "--type", "u8", "--out", o],
+        vec!["--background", f, "--size", "8x8", "--out", o],
+    ];
+    for args in cases {
+        let start = std::time::Instant::now();
+        assert_eq!(run(&args), 2, "{args:?}");
+        assert!(
+            start.elapsed().as_secs() < 5,
+            "{args:?} took {:?}",
+            start.elapsed()
+        );
+        assert!(!out.exists());
+    }
+    let msg = footprint_harness::io::read_file(&fifo).unwrap_err().message;
+    assert!(msg.contains("not a regular file"), "{msg}");
+    std::fs::remove_dir_all(&d).unwrap();
+}

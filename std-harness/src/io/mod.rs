@@ -17,14 +17,32 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), CliError> {
     outputs::write_one(path, bytes)
 }
 
-/// Reads a whole file, with the path in the error.
-pub fn read_file(path: &Path) -> Result<Vec<u8>, CliError> {
-    if path.is_dir() {
+/// The length of `path` if it is a regular file. A directory, and a FIFO, device or socket (whose
+/// `open` or `read` can block forever, or never end), are refused up front, from `stat` alone,
+/// before anything opens them: every volume, data file, table and image is read from a regular
+/// file; a pipe is read only as standard input (`--stream -`).
+pub fn regular_file_len(path: &Path) -> Result<u64, CliError> {
+    let meta = std::fs::metadata(path)
+        .map_err(|e| CliError::input(format!("{}: cannot read: {e}", path.display())))?;
+    if meta.is_dir() {
         return Err(CliError::input(format!(
             "{}: is a directory, expected a file",
             path.display()
         )));
     }
+    if !meta.is_file() {
+        return Err(CliError::input(format!(
+            "{}: not a regular file (a FIFO, device or socket) — refused, as reading it could \
+             block forever; pipe data through standard input with --stream - instead",
+            path.display()
+        )));
+    }
+    Ok(meta.len())
+}
+
+/// Reads a whole file, with the path in the error.
+pub fn read_file(path: &Path) -> Result<Vec<u8>, CliError> {
+    regular_file_len(path)?;
     std::fs::read(path)
         .map_err(|e| CliError::input(format!("{}: cannot read: {e}", path.display())))
 }
@@ -32,12 +50,7 @@ pub fn read_file(path: &Path) -> Result<Vec<u8>, CliError> {
 /// Reads at most `limit` bytes from the start of a file (for headers of files that may be huge).
 pub fn read_prefix(path: &Path, limit: usize) -> Result<Vec<u8>, CliError> {
     use std::io::Read;
-    if path.is_dir() {
-        return Err(CliError::input(format!(
-            "{}: is a directory, expected a file",
-            path.display()
-        )));
-    }
+    regular_file_len(path)?;
     let f = std::fs::File::open(path)
         .map_err(|e| CliError::input(format!("{}: cannot read: {e}", path.display())))?;
     let mut out = Vec::new();

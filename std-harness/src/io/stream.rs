@@ -89,6 +89,7 @@ impl FileSource {
         let err = |e: std::io::Error| {
             CliError::input(format!("{}: cannot read: {e}", layout.path.display()))
         };
+        super::regular_file_len(&layout.path)?;
         let file = std::fs::File::open(&layout.path).map_err(err)?;
         let len = file.metadata().map_err(err)?.len();
         let need = crate::io::volume::byte_len(layout.dims, layout.ty)

@@ -149,9 +149,7 @@ pub(crate) fn load_voxels(args: &RenderArgs) -> Result<Loaded, CliError> {
     } else {
         return Err(crate::io::volume::at(stream, "streaming reads raw files (with --dims and --type), NRRD with raw encoding, or uncompressed MetaImage"));
     };
-    let file_len = std::fs::metadata(&layout.path)
-        .map_err(|e| crate::io::volume::at(&layout.path, format!("cannot read: {e}")))?
-        .len();
+    let file_len = crate::io::regular_file_len(&layout.path)?;
     let need = crate::io::volume::byte_len(layout.dims, layout.ty)
         .map_err(|e| crate::io::volume::at(&layout.path, e))? as u64;
     if raw.is_some() && file_len != need {

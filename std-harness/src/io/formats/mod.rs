@@ -83,9 +83,7 @@ pub fn raw_data_at(path: &Path, h: RawHeader<'_>) -> Result<Streamable, CliError
         None => path.to_path_buf(),
     };
     let need = byte_len(dims, ty).map_err(|e| at(path, e))? as u64;
-    let len = std::fs::metadata(&source)
-        .map_err(|e| at(&source, format!("cannot read: {e}")))?
-        .len();
+    let len = crate::io::regular_file_len(&source)?;
     let start = if data_file.is_some() {
         0
     } else {
