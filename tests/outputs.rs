@@ -208,3 +208,29 @@ fn values_outside_the_data_are_warned_about() {
     assert!(outside_data_warnings(&emission, Some([-100.0, 1000.0]), range).is_empty());
     assert!(outside_data_warnings(&emission, Some([200.0, 400.0]), range).is_empty());
 }
+
+/// What a SIGKILL between a temporary's creation and its rename leaves (`.NAME.tmp-PID` of a dead
+/// process) is removed by the next run that writes NAME; a live process's temporary is kept.
+#[test]
+fn leftovers_of_killed_runs_are_removed() {
+    let d = tmpdir("leftovers");
+    let out = d.join("x.png");
+    // PID 1 always runs; 4194304 is above Linux's largest PID.
+    let dead = d.join(".x.png.tmp-4194304");
+    let live = d.join(".x.png.tmp-1");
+    let other = d.join(".y.png.tmp-4194304");
+    for f in [&dead, &live, &other] {
+        std::fs::write(f, b"partial").unwrap();
+    }
+    assert_eq!(
+        run(&["render", "--size", "8x8", "--out", out.to_str().unwrap()]),
+        0
+    );
+    assert!(out.exists());
+    if std::path::Path::new("/proc/self").exists() {
+        assert!(!dead.exists(), "a dead run's temporary stayed");
+        assert!(live.exists(), "a live process's temporary was removed");
+    }
+    assert!(other.exists(), "another output's temporary was touched");
+    std::fs::remove_dir_all(&d).unwrap();
+}

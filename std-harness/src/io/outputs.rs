@@ -8,6 +8,11 @@
 //! temporary is removed and no output appears. A rename can fail only if the file system changes
 //! under the command (a folder removed or made read-only between the check and the rename); the
 //! files renamed before it then stay, and the error names the one that failed.
+//!
+//! **After SIGKILL.** A kill between a temporary's creation and its rename leaves
+//! `.NAME.tmp-PID` beside the output (never a partial `NAME`). The next run that writes `NAME`
+//! removes such leftovers ([`clean_leftovers`]): those whose process no longer runs (on Linux,
+//! no `/proc/PID`), or, where that cannot be told, that are more than a day old.
 
 use crate::CliError;
 use std::io::Write;
@@ -51,8 +56,52 @@ fn temporary(path: &Path) -> Result<PathBuf, CliError> {
     )))
 }
 
-/// Checks every planned output before any work is done (see the module docs).
+/// Removes `.NAME.tmp-PID` files that a killed run left beside `path` (see the module docs);
+/// returns how many. Errors are ignored: this is tidying, not a precondition.
+pub fn clean_leftovers(path: &Path) -> usize {
+    let Some(name) = path.file_name().map(|n| n.to_string_lossy().into_owned()) else {
+        return 0;
+    };
+    let prefix = format!(".{name}.tmp-");
+    let Ok(entries) = std::fs::read_dir(folder(path)) else {
+        return 0;
+    };
+    let own = std::process::id();
+    let proc_fs = Path::new("/proc/self").exists();
+    let mut removed = 0;
+    for e in entries.flatten() {
+        let file = e.file_name().to_string_lossy().into_owned();
+        let Some(pid) = file
+            .strip_prefix(&prefix)
+            .and_then(|p| p.parse::<u32>().ok())
+        else {
+            continue;
+        };
+        if pid == own {
+            continue;
+        }
+        let stale = if proc_fs {
+            !Path::new(&format!("/proc/{pid}")).exists()
+        } else {
+            e.metadata()
+                .and_then(|m| m.modified())
+                .ok()
+                .and_then(|t| t.elapsed().ok())
+                .is_some_and(|age| age.as_secs() > 86_400)
+        };
+        if stale && std::fs::remove_file(e.path()).is_ok() {
+            removed += 1;
+        }
+    }
+    removed
+}
+
+/// Checks every planned output before any work is done (see the module docs), and removes
+/// leftovers of killed runs beside each ([`clean_leftovers`]).
 pub fn check(outputs: &[Planned<'_>]) -> Result<(), CliError> {
+    for o in outputs {
+        clean_leftovers(o.path);
+    }
     for (i, o) in outputs.iter().enumerate() {
         let shown = o.path.display();
         let flag = o.flag;
