@@ -497,3 +497,22 @@ fn special_files_are_refused_without_blocking() {
     assert!(msg.contains("not a regular file"), "{msg}");
     std::fs::remove_dir_all(&d).unwrap();
 }
+
+/// Space is reserved only for what the data can fill: an ASCII NRRD declaring 1600³ floats and
+/// holding three numbers is one error line, with no 16 GB reservation first; image buffers that
+/// cannot be had are errors naming their size (`try_reserve`), not aborts.
+#[test]
+fn declared_sizes_do_not_reserve_memory_the_data_cannot_fill() {
+    let d = tmpdir("declared");
+    let nhdr = d.join("a.nhdr");
+    std::fs::write(
+        &nhdr,
+        "NRRD0004\ntype: float\ndimension: 3\nsizes: 1600 1600 1600\nencoding: ascii\n\n1 2 3\n",
+    )
+    .unwrap();
+    let msg = formats::load(&nhdr, None).unwrap_err().message;
+    assert!(msg.contains("found 3"), "{msg}");
+    let err = footprint_harness::io::try_filled(usize::MAX / 8, 0u64, "a test buffer").unwrap_err();
+    assert!(err.message.contains("cannot allocate"), "{}", err.message);
+    std::fs::remove_dir_all(&d).unwrap();
+}

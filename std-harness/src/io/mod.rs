@@ -40,6 +40,22 @@ pub fn regular_file_len(path: &Path) -> Result<u64, CliError> {
     Ok(meta.len())
 }
 
+/// `n` copies of `value` in a vector whose allocation failing is an error naming `what` and the
+/// bytes it needed, not an abort (`try_reserve_exact`; under an address-space limit, or with
+/// overcommit off, a request larger than memory fails here).
+pub fn try_filled<T: Clone>(n: usize, value: T, what: &str) -> Result<Vec<T>, CliError> {
+    let bytes = n.saturating_mul(std::mem::size_of::<T>());
+    let mut v = Vec::new();
+    v.try_reserve_exact(n).map_err(|_| {
+        CliError::input(format!(
+            "cannot allocate {bytes} bytes ({:.1} GiB) for {what}",
+            bytes as f64 / (1u64 << 30) as f64
+        ))
+    })?;
+    v.resize(n, value);
+    Ok(v)
+}
+
 /// Reads a whole file, with the path in the error.
 pub fn read_file(path: &Path) -> Result<Vec<u8>, CliError> {
     regular_file_len(path)?;

@@ -210,7 +210,9 @@ pub fn decode(bytes: &[u8], ty: SampleType, big_endian: bool) -> Samples {
 /// Parses whitespace-separated numbers (ASCII data) as samples of `ty`; exactly `count` of them.
 pub fn decode_ascii(text: &[u8], ty: SampleType, count: usize) -> Result<Samples, String> {
     let text = std::str::from_utf8(text).map_err(|_| "ASCII data is not text".to_string())?;
-    let mut values = Vec::with_capacity(count);
+    // Reserve only what the text can hold (a number and a separator take at least two bytes), so
+    // a header declaring far more samples than the file has costs nothing.
+    let mut values = Vec::with_capacity(count.min(text.len() / 2 + 1));
     for word in text
         .split(|c: char| c.is_ascii_whitespace() || c == ',')
         .filter(|w| !w.is_empty())

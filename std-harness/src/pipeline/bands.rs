@@ -51,7 +51,7 @@ where
     let f = &p.frame;
     let [w, h] = f.size;
     let bands = threads.clamp(1, h);
-    let mut image = vec![P::CLEAR; w * h];
+    let mut image = crate::io::try_filled(w * h, P::CLEAR, "the image")?;
     let mut chunks: Vec<&mut [P::Pixel]> = Vec::with_capacity(bands);
     let mut rest: &mut [P::Pixel] = &mut image;
     for t in 0..bands {
@@ -100,7 +100,7 @@ fn render_band<P: Precision>(
 ) -> Result<(RenderStats, Phases), CliError> {
     let f = &p.frame;
     let n = f.size[0] * rows.len();
-    let mut acc = vec![P::ACC_ZERO; n];
+    let mut acc = crate::io::try_filled(n, P::ACC_ZERO, "a band's sheet accumulator")?;
     let mut spans = vec![RowSpan::EMPTY; rows.len()];
     let mut opacity = vec![0.0f32; OPACITY_TABLE_LEN];
     let buffers = RenderBuffers {

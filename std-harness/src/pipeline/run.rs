@@ -9,6 +9,7 @@ use super::supersample::downsample;
 use super::visible::FrameCache;
 use crate::args::{AccumArg, MethodArg, RenderArgs};
 use crate::io::stream::{FileSource, MemorySource, PipeSource};
+use crate::io::try_filled;
 use crate::reference::render::{render_reference, ReferenceScene};
 use crate::{with_table_size, CliError};
 use footprint::fixed::{self, FixedTable};
@@ -207,8 +208,8 @@ fn run_sheets<P: Precision>(
     let f = &p.frame;
     let n = f.image_len();
     let (mut accum, mut image, mut rows) = (
-        vec![P::ACC_ZERO; n],
-        vec![P::CLEAR; n],
+        try_filled(n, P::ACC_ZERO, "the sheet accumulator")?,
+        try_filled(n, P::CLEAR, "the image")?,
         vec![RowSpan::EMPTY; f.size[1]],
     );
     let buffers = RenderBuffers {
@@ -219,7 +220,11 @@ fn run_sheets<P: Precision>(
     let mut opacity = vec![0.0f32; OPACITY_TABLE_LEN];
     let mut renderer = SheetRenderer::with_path(f, path, p.shader(), p.order, buffers, background)?
         .with_opacity_table(&mut opacity)?;
-    let mut storage = vec![0.0f32; 3 * f.sheet_shape().0];
+    let mut storage = try_filled(
+        3usize.saturating_mul(f.sheet_shape().0),
+        0.0f32,
+        "three sheets of the volume",
+    )?;
     let mut ring = SheetRing::new(&mut storage, f, p.order)?;
     let mut show = Progress {
         inner: progress("render"),

@@ -363,7 +363,9 @@ fn block_stream(b: &[u8], h: &Header, need: usize) -> Result<Vec<u8>, String> {
         ));
     }
     let mut at = (3 + blocks) * size;
-    let mut out = Vec::with_capacity(need);
+    // Grows as blocks inflate (each checked against its declared size): no reservation of a
+    // declared total the data may not hold.
+    let mut out = Vec::with_capacity(need.min(1 << 28));
     for k in 0..blocks {
         let c = word(b, 3 + k, h)?;
         let chunk = b
