@@ -202,13 +202,19 @@ pub fn decode_png_rgba(
     bytes: &[u8],
     name: &str,
 ) -> Result<(usize, usize, Vec<[f32; 4]>), CliError> {
-    let bad = |e: String| CliError::input(format!("{name}: {e}"));
+    decode_png_checked(open_png(bytes, name)?, name)
+}
+
+/// A PNG reader past the header (size and colour type known, nothing decoded yet).
+fn open_png<'a>(
+    bytes: &'a [u8],
+    name: &str,
+) -> Result<png::Reader<std::io::Cursor<&'a [u8]>>, CliError> {
     let mut decoder = png::Decoder::new(std::io::Cursor::new(bytes));
     decoder.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
-    let reader = decoder
+    decoder
         .read_info()
-        .map_err(|e| bad(format!("not a readable PNG: {e}")))?;
-    decode_png_checked(reader, name)
+        .map_err(|e| CliError::input(format!("{name}: not a readable PNG: {e}")))
 }
 
 /// [`decode_png_rgba`] of a PNG that must be `width × height`: the size in its header is checked
@@ -219,11 +225,7 @@ pub fn decode_png_rgba_sized(
     (width, height): (usize, usize),
 ) -> Result<(usize, usize, Vec<[f32; 4]>), CliError> {
     let bad = |e: String| CliError::input(format!("{name}: {e}"));
-    let mut decoder = png::Decoder::new(std::io::Cursor::new(bytes));
-    decoder.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
-    let reader = decoder
-        .read_info()
-        .map_err(|e| bad(format!("not a readable PNG: {e}")))?;
+    let reader = open_png(bytes, name)?;
     let info = reader.info();
     if (info.width as usize, info.height as usize) != (width, height) {
         return Err(bad(format!(
