@@ -3,32 +3,17 @@
 //! larger-than-the-image footprints, a thousand opaque sheets, typed range errors, and
 //! bit-identical output on every run and thread.
 
-use footprint::composite::RowSpan;
 use footprint::fixed::{self, composite, FixedError, FixedTable, ONE};
 use footprint::frame::{FrameSetup, Order};
 use footprint::geometry::FootprintOptions;
-use footprint::render::{FixedPath, Precision, RenderBuffers, SheetRenderer};
-use footprint::shade::{Shader, Shading, TransferFunction};
+use footprint::render::FixedPath;
 use footprint::splat::ImageMut;
 use footprint::{GenericTable, Grid, Kernel, Lookup, View, ViewTable};
-use footprint_suite::assert_le;
+use footprint_suite::{assert_le, render_with};
 use glam::Mat3;
 
 /// One in the fixed path's value and image format, as f64.
 const Q: f64 = ONE as f64;
-
-const LUT: [[f32; 4]; 2] = [[0.0; 4], [1.0; 4]];
-
-fn shader() -> Shader<'static> {
-    Shader {
-        tf: TransferFunction {
-            lut: &LUT,
-            lo: 0.0,
-            hi: 1.0,
-        },
-        shading: Shading::Emission,
-    }
-}
 
 fn frame(dims: [usize; 3], zoom: f32, size: usize) -> FrameSetup {
     let view = View::new(Mat3::from_rotation_z(0.3) * zoom).unwrap();
@@ -41,33 +26,6 @@ fn frame(dims: [usize; 3], zoom: f32, size: usize) -> FrameSetup {
         [size, size],
     )
     .unwrap()
-}
-
-/// Renders pre-shaded sheets (`sheet(s)` gives sheet s's premultiplied RGBA) with `path`.
-fn render_with<P: Precision>(
-    f: &FrameSetup,
-    path: P,
-    order: Order,
-    sheet: &dyn Fn(usize) -> Vec<[f32; 4]>,
-) -> Vec<P::Pixel> {
-    let n = f.image_len();
-    let (mut acc, mut img, mut rows) = (
-        vec![P::ACC_ZERO; n],
-        vec![P::CLEAR; n],
-        vec![RowSpan::EMPTY; f.size[1]],
-    );
-    let buffers = RenderBuffers {
-        accumulator: &mut acc,
-        image: &mut img,
-        rows: &mut rows,
-    };
-    let mut r = SheetRenderer::with_path(f, path, shader(), order, buffers, None).unwrap();
-    for step in 0..f.sheet_count() {
-        let s = f.sheet_at(order, step);
-        r.render_shaded_sheet(s, &sheet(s)).unwrap();
-    }
-    r.finish();
-    img
 }
 
 /// The float (view table) and fixed (view table, same size and lookup) renders, both as f32.

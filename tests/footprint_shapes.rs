@@ -5,16 +5,14 @@
 //! at 45° was 7.6 % of peak off and a 1000:1 one 82 %; the box layout spends its nodes on the
 //! empty corners of the screen box.
 
-use footprint::composite::RowSpan;
 use footprint::fixed::{FixedTable, ONE};
 use footprint::frame::{FrameSetup, Order};
 use footprint::geometry::{FootprintOptions, Mapping};
-use footprint::render::{Precision, RenderBuffers, SheetRenderer};
-use footprint::shade::{Shader, Shading, TransferFunction};
+use footprint::render::Precision;
 use footprint::table::{box_fill, ViewLayout};
 use footprint::{Footprint, GenericTable, Grid, Kernel, Lookup, View, ViewTable};
 use footprint_harness::args::MethodArg;
-use footprint_suite::{assert_le, max_rel_diff, splat_args, view, with_reference};
+use footprint_suite::{assert_le, max_rel_diff, render_with, splat_args, view, with_reference};
 use glam::Mat3;
 
 const ANISOTROPIES: [f32; 9] = [1.0, 2.0, 4.0, 10.0, 30.0, 100.0, 200.0, 500.0, 1000.0];
@@ -169,32 +167,40 @@ fn render_one_voxel<P: Precision>(
     path: P,
     alpha: impl Fn(&P::Pixel) -> f64,
 ) -> Vec<f64> {
-    const LUT: [[f32; 4]; 2] = [[0.0; 4], [1.0; 4]];
-    let shader = Shader {
-        tf: TransferFunction {
-            lut: &LUT,
-            lo: 0.0,
-            hi: 1.0,
-        },
-        shading: Shading::Emission,
-    };
-    let n = f.image_len();
-    let (mut acc, mut img, mut rows) = (
-        vec![P::ACC_ZERO; n],
-        vec![P::CLEAR; n],
-        vec![RowSpan::EMPTY; f.size[1]],
-    );
-    let buffers = RenderBuffers {
-        accumulator: &mut acc,
-        image: &mut img,
-        rows: &mut rows,
-    };
-    let mut r =
-        SheetRenderer::with_path(f, path, shader, Order::BackToFront, buffers, None).unwrap();
-    r.render_shaded_sheet(0, &[[0.25, 0.25, 0.25, 0.5]])
-        .unwrap();
-    r.finish();
+    let img = render_with(f, path, Order::BackToFront, &|_| {
+        vec![[0.25, 0.25, 0.25, 0.5]]
+    });
     img.iter().map(alpha).collect()
+}
+
+/// `natural_minor_px` is the shorter semi-axis before widening: the kernel's radius (1.6 for the
+/// paper Gaussian) times the screen scale, clamped or not, along the thin axis of an anisotropic
+/// grid too.
+#[test]
+fn the_natural_minor_semi_axis_is_reported_before_widening() {
+    let fp = |spacing: [f32; 3], scale: f32| {
+        let g = Grid::from_spacing(spacing).unwrap();
+        let v = View::new(Mat3::from_rotation_z(0.4) * scale).unwrap();
+        Footprint::new(
+            &Kernel::PAPER_GAUSSIAN,
+            &v.grid_to_screen(&g),
+            FootprintOptions::default(),
+        )
+        .unwrap()
+    };
+    for (spacing, scale, minor, clamped) in [
+        ([1.0; 3], 0.3f32, 0.48f32, true),
+        ([1.0; 3], 2.0, 3.2, false),
+        ([10.0, 1.0, 1.0], 0.5, 0.8, true),
+    ] {
+        let f = fp(spacing, scale);
+        assert_eq!(f.clamped, clamped, "{spacing:?} × {scale}");
+        assert!(
+            (f.natural_minor_px - minor).abs() < 1e-4 * minor,
+            "{spacing:?} × {scale}: {} px, expected {minor}",
+            f.natural_minor_px
+        );
+    }
 }
 
 /// The paper's θ/Sx/Sy method renders at every anisotropy and angle (its cheat applies wherever

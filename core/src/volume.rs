@@ -117,18 +117,37 @@ impl<T: Sample> SheetSource for MemoryVolume<'_, T> {
                 got: out.len(),
             });
         }
-        let stride = [1, self.dims[0], self.dims[0] * self.dims[1]];
-        let base = index * stride[axis];
-        for (v, row) in out.chunks_exact_mut(na).enumerate() {
-            let start = base + v * stride[b];
-            if stride[a] == 1 {
-                row.copy_from_slice(&self.data[start..start + na]);
-            } else {
-                for (u, o) in row.iter_mut().enumerate() {
-                    *o = self.data[start + u * stride[a]];
-                }
+        copy_sheet(self.data, self.dims, axis, index, out, |x| x);
+        Ok(())
+    }
+}
+
+/// Copies sheet `index` along grid axis `axis` of `data` (a `dims` volume, x fastest) into the
+/// first `dims[a] × dims[b]` entries of `out`, row-major over the in-sheet axes (a, b) =
+/// [`in_sheet_axes`]`(axis)` with a fastest, converting each sample with `convert`. Panics if
+/// `index` or `out` does not fit (callers check: [`MemoryVolume`] returns typed errors).
+pub fn copy_sheet<T: Copy, U>(
+    data: &[T],
+    dims: [usize; 3],
+    axis: usize,
+    index: usize,
+    out: &mut [U],
+    convert: impl Fn(T) -> U,
+) {
+    let (a, b) = in_sheet_axes(axis);
+    let (na, nb) = (dims[a], dims[b]);
+    let stride = [1, dims[0], dims[0] * dims[1]];
+    let base = index * stride[axis];
+    for (v, row) in out[..na * nb].chunks_exact_mut(na).enumerate() {
+        let start = base + v * stride[b];
+        if stride[a] == 1 {
+            for (o, &x) in row.iter_mut().zip(&data[start..start + na]) {
+                *o = convert(x);
+            }
+        } else {
+            for (u, o) in row.iter_mut().enumerate() {
+                *o = convert(data[start + u * stride[a]]);
             }
         }
-        Ok(())
     }
 }

@@ -158,11 +158,8 @@ pub fn parse_spacing(s: &str) -> Result<[f32; 3], String> {
 
 /// Parses a positive finite number (a zoom factor).
 pub fn parse_positive(s: &str) -> Result<f32, String> {
-    let v: f32 = s
-        .trim()
-        .parse()
-        .map_err(|_| format!("'{s}' is not a number"))?;
-    if !(v.is_finite() && v > 0.0) {
+    let [v] = parse_list::<1>(s)?;
+    if !(v > 0.0) {
         return Err(format!("{v} is not a positive finite number"));
     }
     Ok(v)
@@ -170,12 +167,9 @@ pub fn parse_positive(s: &str) -> Result<f32, String> {
 
 /// Parses `--min-radius`: a finite number of pixels, at least the geometry's smallest.
 pub fn parse_min_radius(s: &str) -> Result<f32, String> {
-    let v: f32 = s
-        .trim()
-        .parse()
-        .map_err(|_| format!("'{s}' is not a number"))?;
+    let [v] = parse_list::<1>(s)?;
     let least = footprint::geometry::MIN_MIN_RADIUS_PX;
-    if !(v.is_finite() && v >= least) {
+    if !(v >= least) {
         return Err(format!("{v} px is outside [{least}, ∞) px"));
     }
     Ok(v)

@@ -127,3 +127,45 @@ pub fn proptest_config(cases: u32) -> proptest::test_runner::Config {
         ..Default::default()
     }
 }
+
+/// One in value and opacity: the transfer function of [`render_with`] (pre-shaded sheets do not
+/// use it, but the renderer checks one).
+const UNIT_LUT: [[f32; 4]; 2] = [[0.0; 4], [1.0; 4]];
+
+/// Renders pre-shaded sheets (`sheet(s)` gives sheet s's premultiplied RGBA) of frame `f` with
+/// `path` in `order`, emission, caller-free buffers; returns the image.
+pub fn render_with<P: footprint::render::Precision>(
+    f: &footprint::frame::FrameSetup,
+    path: P,
+    order: footprint::frame::Order,
+    sheet: &dyn Fn(usize) -> Vec<[f32; 4]>,
+) -> Vec<P::Pixel> {
+    use footprint::render::{RenderBuffers, SheetRenderer};
+    use footprint::shade::{Shader, Shading, TransferFunction};
+    let shader = Shader {
+        tf: TransferFunction {
+            lut: &UNIT_LUT,
+            lo: 0.0,
+            hi: 1.0,
+        },
+        shading: Shading::Emission,
+    };
+    let n = f.image_len();
+    let (mut acc, mut img, mut rows) = (
+        vec![P::ACC_ZERO; n],
+        vec![P::CLEAR; n],
+        vec![footprint::composite::RowSpan::EMPTY; f.size[1]],
+    );
+    let buffers = RenderBuffers {
+        accumulator: &mut acc,
+        image: &mut img,
+        rows: &mut rows,
+    };
+    let mut r = SheetRenderer::with_path(f, path, shader, order, buffers, None).unwrap();
+    for step in 0..f.sheet_count() {
+        let s = f.sheet_at(order, step);
+        r.render_shaded_sheet(s, &sheet(s)).unwrap();
+    }
+    r.finish();
+    img
+}

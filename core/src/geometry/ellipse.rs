@@ -62,6 +62,10 @@ pub struct Footprint {
     pub renormalise: bool,
     /// Whether a semi-axis was lengthened to `min_radius_px`.
     pub clamped: bool,
+    /// The shorter semi-axis before any lengthening, px (0 for a singular footprint): how far
+    /// below `min_radius_px` the voxels project when [`Footprint::clamped`] (a caller can render
+    /// that much larger instead).
+    pub natural_minor_px: f32,
     /// Whether the paper method needed its rotation cheat.
     pub cheated: bool,
     /// Screen covariance Σ of the (clamped) footprint region, px².
@@ -94,6 +98,7 @@ impl Footprint {
         sheet_axis: 2,
         shape: Shape::Radial,
         row_coefficients: [0.0, -1.0, 0.0],
+        natural_minor_px: 0.0,
     };
 
     /// Sets up the footprint of `kernel` for `grid_to_screen` = V·G (see [`View::grid_to_screen`](super::View::grid_to_screen)).
@@ -137,7 +142,7 @@ impl Footprint {
                 ];
             }
         }
-        let clamped = clamp_min_radius(&mut n, mr * mr);
+        let (clamped, natural_minor_sq) = clamp_min_radius(&mut n, mr * mr);
         let cov = covariance(&n);
         let det = cauchy_binet_det(&n);
         if !(det > 0.0) || !det.is_finite() {
@@ -197,6 +202,7 @@ impl Footprint {
             scale,
             renormalise: largest <= RENORMALISE_BELOW_PX,
             clamped,
+            natural_minor_px: math::sqrt(natural_minor_sq),
             cheated,
             covariance: cov,
             sheet_axis: axis,
@@ -293,19 +299,19 @@ fn cholesky_map(cov: &Sym2, det: f32) -> Mat2 {
 
 /// Lengthens every semi-axis (singular value) of the 2×ncols map `n` shorter than √`min_r2` to it,
 /// keeping the ellipse's orientation: n ← K n with K = U diag(max(1, r/sᵢ)) Uᵀ, Σ = U S² Uᵀ.
-/// Returns whether anything changed.
-fn clamp_min_radius(n: &mut [[f32; 3]; 2], min_r2: f32) -> bool {
+/// Returns whether anything changed, and the smaller squared semi-axis before (0 when singular).
+fn clamp_min_radius(n: &mut [[f32; 3]; 2], min_r2: f32) -> (bool, f32) {
     let cov = covariance(n);
     let det = cauchy_binet_det(n);
     let half_tr = 0.5 * (cov.xx + cov.yy);
     let disc = math::sqrt(sq(0.5 * (cov.xx - cov.yy)) + sq(cov.xy));
     let l1 = half_tr + disc;
     if !(det > 0.0) || !l1.is_finite() {
-        return false; // Singular or non-finite: rejected by the caller.
+        return (false, 0.0); // Singular or non-finite: rejected by the caller.
     }
     let l2 = det / l1; // The smaller eigenvalue, without cancellation.
     if l2 >= min_r2 {
-        return false;
+        return (false, l2);
     }
     // Unit eigenvector of l1; for a circle any direction will do.
     let (vx, vy) = if cov.xx >= cov.yy {
@@ -335,5 +341,5 @@ fn clamp_min_radius(n: &mut [[f32; 3]; 2], min_r2: f32) -> bool {
         n[0][c] = k[0][0] * old[0][c] + k[0][1] * old[1][c];
         n[1][c] = k[1][0] * old[0][c] + k[1][1] * old[1][c];
     }
-    true
+    (true, l2)
 }

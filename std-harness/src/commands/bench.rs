@@ -137,8 +137,6 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
         }
         files.push((j.as_path(), summary.finish().into_bytes()));
     }
-    let files: Vec<(&std::path::Path, &[u8])> =
-        files.iter().map(|(p, b)| (*p, b.as_slice())).collect();
     io::outputs::write_all(&files)?;
     Ok(())
 }

@@ -125,8 +125,6 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
             .bool("pass", pass);
         files.push((j, summary.finish().into_bytes()));
     }
-    let files: Vec<(&std::path::Path, &[u8])> =
-        files.iter().map(|(p, b)| (*p, b.as_slice())).collect();
     outputs::write_all(&files)?;
     if pass {
         Ok(())

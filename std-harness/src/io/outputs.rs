@@ -160,14 +160,15 @@ fn same_file(a: &Path, b: &Path) -> bool {
 }
 
 /// Writes every `(path, bytes)` all-or-nothing (see the module docs).
-pub fn write_all(files: &[(&Path, &[u8])]) -> Result<(), CliError> {
+pub fn write_all<B: AsRef<[u8]>>(files: &[(&Path, B)]) -> Result<(), CliError> {
     let mut written: Vec<(PathBuf, &Path)> = Vec::with_capacity(files.len());
     let cleanup = |written: &[(PathBuf, &Path)]| {
         for (tmp, _) in written {
             let _ = std::fs::remove_file(tmp);
         }
     };
-    for &(path, bytes) in files {
+    for (path, bytes) in files {
+        let (path, bytes) = (*path, bytes.as_ref());
         let tmp = match temporary(path) {
             Ok(t) => t,
             Err(e) => {

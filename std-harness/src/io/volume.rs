@@ -138,39 +138,17 @@ impl Volume {
     /// Copies sheet `s` of `axis` (row-major over the other two axes, lower axis fastest) into `out`
     /// as f32.
     pub fn sheet_into(&self, axis: usize, s: usize, out: &mut [f32]) {
-        fn copy<T: Copy>(
-            data: &[T],
-            to_f32: impl Fn(T) -> f32,
-            (base, sa, sb, na): (usize, usize, usize, usize),
-            out: &mut [f32],
-        ) {
-            for (v, row) in out.chunks_exact_mut(na).enumerate() {
-                let start = base + v * sb;
-                if sa == 1 {
-                    for (o, &x) in row.iter_mut().zip(&data[start..start + na]) {
-                        *o = to_f32(x);
-                    }
-                } else {
-                    for (u, o) in row.iter_mut().enumerate() {
-                        *o = to_f32(data[start + u * sa]);
-                    }
-                }
-            }
-        }
-        let (a, b) = footprint::geometry::in_sheet_axes(axis);
-        let stride = [1, self.dims[0], self.dims[0] * self.dims[1]];
-        let (na, nb) = (self.dims[a], self.dims[b]);
-        let out = &mut out[..na * nb];
-        let geometry = (s * stride[axis], stride[a], stride[b], na);
+        use footprint::volume::copy_sheet;
+        let (d, a) = (self.dims, axis);
         match &self.samples {
-            Samples::U8(v) => copy(v, f32::from, geometry, out),
-            Samples::I8(v) => copy(v, f32::from, geometry, out),
-            Samples::U16(v) => copy(v, f32::from, geometry, out),
-            Samples::I16(v) => copy(v, f32::from, geometry, out),
-            Samples::U32(v) => copy(v, |x| x as f32, geometry, out),
-            Samples::I32(v) => copy(v, |x| x as f32, geometry, out),
-            Samples::F32(v) => copy(v, |x| x, geometry, out),
-            Samples::F64(v) => copy(v, |x| x as f32, geometry, out),
+            Samples::U8(v) => copy_sheet(v, d, a, s, out, f32::from),
+            Samples::I8(v) => copy_sheet(v, d, a, s, out, f32::from),
+            Samples::U16(v) => copy_sheet(v, d, a, s, out, f32::from),
+            Samples::I16(v) => copy_sheet(v, d, a, s, out, f32::from),
+            Samples::U32(v) => copy_sheet(v, d, a, s, out, |x| x as f32),
+            Samples::I32(v) => copy_sheet(v, d, a, s, out, |x| x as f32),
+            Samples::F32(v) => copy_sheet(v, d, a, s, out, |x| x),
+            Samples::F64(v) => copy_sheet(v, d, a, s, out, |x| x as f32),
         }
     }
 }

@@ -88,8 +88,6 @@ pub struct Prepared {
     pub options: FootprintOptions,
     /// The frame is set up at `supersample` × the output size (see [`super::supersample`]).
     pub supersample: usize,
-    /// The output size, pixels.
-    pub out_size: [usize; 2],
 }
 
 impl Prepared {
@@ -106,12 +104,19 @@ impl Prepared {
         )?;
         self.frame = frame;
         self.supersample = k;
-        self.out_size = [args.size.0, args.size.1];
         self.background = self
             .background_out
             .as_ref()
             .map(|b| supersample::upsample(b, args.size, k));
         Ok(())
+    }
+
+    /// The output image's width and height, pixels: the frame's, divided by the supersampling.
+    pub fn out_size(&self) -> (usize, usize) {
+        (
+            self.frame.size[0] / self.supersample,
+            self.frame.size[1] / self.supersample,
+        )
     }
 
     /// The shader over this render's lookup table.
@@ -158,7 +163,7 @@ pub fn setup_frame(
     let view = view_for(args, dims, grid)?;
     let size = [args.size.0, args.size.1];
     let frame = FrameSetup::new(dims, grid, &view, kernel, options, size)?;
-    let k = supersample::factor(args.supersample, &frame, kernel, options);
+    let k = supersample::factor(args.supersample, &frame, options);
     if k == 1 {
         return Ok((frame, 1));
     }
@@ -286,7 +291,6 @@ pub fn prepare(args: &RenderArgs) -> Result<Prepared, CliError> {
         order,
         options,
         supersample,
-        out_size: [args.size.0, args.size.1],
     })
 }
 

@@ -141,7 +141,7 @@ pub fn render_frame(
         // Supersampled: the mean of each k×k block (timed with the frame: it is part of it).
         let image = match p.supersample {
             1 => image,
-            k => downsample(&image, (p.out_size[0], p.out_size[1]), k, |v| v as f32),
+            k => downsample(&image, p.out_size(), k, |v| v as f32),
         };
         CoreFrame {
             image,
@@ -321,7 +321,7 @@ pub fn render_ref(p: &Prepared) -> Result<(Vec<[f64; 4]>, f64), CliError> {
     )?;
     let img = match p.supersample {
         1 => img,
-        k => downsample(&img, (p.out_size[0], p.out_size[1]), k, |v| v),
+        k => downsample(&img, p.out_size(), k, |v| v),
     };
     Ok((img, start.elapsed().as_secs_f64()))
 }

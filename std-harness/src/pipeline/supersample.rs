@@ -14,8 +14,7 @@
 
 use crate::args::Supersample;
 use footprint::frame::FrameSetup;
-use footprint::geometry::{FootprintOptions, MIN_MIN_RADIUS_PX};
-use footprint::{Footprint, Kernel};
+use footprint::geometry::FootprintOptions;
 
 /// Largest factor `auto` picks (k² more pixels; beyond 4 the voxels are far below a pixel and the
 /// bias left at k = 4 is under 0.1 % in the cases above).
@@ -25,42 +24,18 @@ pub const MAX_AUTO: usize = 4;
 pub const MAX_SIDE: usize = 16384;
 
 /// The factor for `frame` (set up at the output size): for `Auto`, ⌈min radius / natural minor
-/// semi-axis⌉ up to [`MAX_AUTO`] when the footprint was widened, else 1; never so large that a
-/// side exceeds [`MAX_SIDE`].
-pub fn factor(
-    choice: Supersample,
-    frame: &FrameSetup,
-    kernel: &Kernel,
-    options: FootprintOptions,
-) -> usize {
+/// semi-axis⌉ ([`footprint::Footprint::natural_minor_px`]) up to [`MAX_AUTO`] when the footprint
+/// was widened, else 1; never so large that a side exceeds [`MAX_SIDE`].
+pub fn factor(choice: Supersample, frame: &FrameSetup, options: FootprintOptions) -> usize {
     let wanted = match choice {
         Supersample::Fixed(k) => k,
         Supersample::Auto if !frame.footprint.clamped => 1,
         Supersample::Auto => {
-            // The natural size: the same footprint 1024× larger, so no minimum applies.
-            let scaled = frame.grid_to_screen * 1024.0;
-            let natural = Footprint::new(
-                kernel,
-                &scaled,
-                FootprintOptions {
-                    min_radius_px: MIN_MIN_RADIUS_PX,
-                    ..options
-                },
-            );
-            match natural {
-                Ok(fp) => {
-                    let c = fp.covariance;
-                    let m = 0.5 * (c.xx + c.yy);
-                    let d = (0.25 * (c.xx - c.yy).powi(2) + c.xy * c.xy).sqrt();
-                    let minor = (m - d).max(0.0).sqrt() / 1024.0;
-                    let k = (options.min_radius_px / minor).ceil();
-                    if k.is_finite() {
-                        (k as usize).clamp(1, MAX_AUTO)
-                    } else {
-                        MAX_AUTO
-                    }
-                }
-                Err(_) => 1,
+            let k = (options.min_radius_px / frame.footprint.natural_minor_px).ceil();
+            if k.is_finite() {
+                (k as usize).clamp(1, MAX_AUTO)
+            } else {
+                MAX_AUTO
             }
         }
     };

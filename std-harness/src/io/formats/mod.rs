@@ -141,9 +141,8 @@ pub fn header_format(path: &Path) -> Option<&'static str> {
 
 /// Loads `path` by its extension; `raw` options (from `--dims`/`--type`) make it headerless raw.
 pub fn load(path: &Path, raw: Option<&raw::RawOptions>) -> Result<Volume, CliError> {
-    if path.is_dir() {
-        return Err(at(path, "is a directory, expected a volume file"));
-    }
+    // Before the extension decides anything: a directory or a special file is named as such.
+    crate::io::regular_file_len(path)?;
     if let Some(o) = raw {
         return raw::load(path, o);
     }
