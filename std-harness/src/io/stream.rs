@@ -208,6 +208,11 @@ impl SheetSource for FileSource {
 }
 
 /// A pipe (or any reader) delivering z-slices in file order.
+///
+/// Memory follows the data: the first z-slice's bytes are read into a buffer that grows as they
+/// arrive ([`crate::io::read_growing`]), so a stream far shorter than `--dims` declare is refused
+/// having cost what it delivered. [`PipeSource::prime`] does that read before the renderer
+/// allocates its sheet buffers.
 pub struct PipeSource<R: Read> {
     reader: R,
     dims: [usize; 3],
@@ -215,6 +220,8 @@ pub struct PipeSource<R: Read> {
     big_endian: bool,
     next: usize,
     bytes: Vec<u8>,
+    /// `bytes` hold z-slice `next`, read by [`PipeSource::prime`].
+    primed: bool,
     name: String,
 }
 
@@ -228,8 +235,54 @@ impl<R: Read> PipeSource<R> {
             big_endian,
             next: 0,
             bytes: Vec::new(),
+            primed: false,
             name: name.into(),
         }
+    }
+
+    /// Reads the next z-slice's bytes now (before any sheet buffer exists): a stream that ends
+    /// first is an error here, having cost only the bytes it delivered.
+    pub fn prime(&mut self) -> Result<(), CliError> {
+        if self.primed {
+            return Ok(());
+        }
+        let len = self.dims[0]
+            .saturating_mul(self.dims[1])
+            .saturating_mul(self.ty.size());
+        let short = |got: usize, s: &Self| {
+            CliError::input(format!(
+                "{}: z-slice {} of {}: the stream ended after {got} of its {len} bytes (the \
+                 stream is shorter than --dims say)",
+                s.name, s.next, s.dims[2]
+            ))
+        };
+        if self.bytes.len() == len {
+            // Later slices reuse the first one's buffer.
+            let mut got = 0;
+            while got < len {
+                match self.reader.read(&mut self.bytes[got..]) {
+                    Ok(0) => return Err(short(got, self)),
+                    Ok(n) => got += n,
+                    Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+                    Err(e) => return Err(self.read_error(e)),
+                }
+            }
+        } else {
+            self.bytes = crate::io::read_growing(&mut self.reader, len as u64, "a z-slice")
+                .map_err(|e| self.read_error(e))?;
+            if self.bytes.len() < len {
+                return Err(short(self.bytes.len(), self));
+            }
+        }
+        self.primed = true;
+        Ok(())
+    }
+
+    fn read_error(&self, e: std::io::Error) -> CliError {
+        CliError::input(format!(
+            "{}: z-slice {} of {}: {e}",
+            self.name, self.next, self.dims[2]
+        ))
     }
 }
 
@@ -244,15 +297,9 @@ impl<R: Read> SheetSource for PipeSource<R> {
                 self.name
             )));
         }
-        let len = self.dims[0] * self.dims[1] * self.ty.size();
-        self.bytes.resize(len, 0);
-        self.reader.read_exact(&mut self.bytes).map_err(|e| {
-            CliError::input(format!(
-                "{}: z-slice {index} of {}: {e} (the stream is shorter than --dims say)",
-                self.name, self.dims[2]
-            ))
-        })?;
+        self.prime()?;
         decode_into(&self.bytes, self.ty, self.big_endian, out);
+        self.primed = false;
         self.next += 1;
         Ok(())
     }

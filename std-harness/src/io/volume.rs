@@ -153,44 +153,51 @@ impl Volume {
     }
 }
 
-/// Decodes `bytes` (exactly `count × size` long) as samples of `ty`.
-pub fn decode(bytes: &[u8], ty: SampleType, big_endian: bool) -> Samples {
+/// `n` values from `values` in a vector reserved fallibly (see [`crate::io::try_vec`]).
+fn collect_n<T>(n: usize, values: impl Iterator<Item = T>) -> Result<Vec<T>, String> {
+    let mut v = crate::io::try_vec(n, "the samples")?;
+    v.extend(values);
+    Ok(v)
+}
+
+/// Decodes `bytes` (exactly `count × size` long) as samples of `ty`; memory refusing the samples
+/// is an error naming the bytes, not an abort.
+pub fn decode(bytes: &[u8], ty: SampleType, big_endian: bool) -> Result<Samples, String> {
     macro_rules! conv {
         ($t:ty, $variant:ident) => {{
             const N: usize = std::mem::size_of::<$t>();
-            Samples::$variant(
-                bytes
-                    .chunks_exact(N)
-                    .map(|c| {
-                        let a: [u8; N] = c.try_into().expect("chunk of N bytes");
-                        if big_endian {
-                            <$t>::from_be_bytes(a)
-                        } else {
-                            <$t>::from_le_bytes(a)
-                        }
-                    })
-                    .collect(),
-            )
+            Samples::$variant(collect_n(
+                bytes.len() / N,
+                bytes.chunks_exact(N).map(|c| {
+                    let a: [u8; N] = c.try_into().expect("chunk of N bytes");
+                    if big_endian {
+                        <$t>::from_be_bytes(a)
+                    } else {
+                        <$t>::from_le_bytes(a)
+                    }
+                }),
+            )?)
         }};
     }
-    match ty {
-        SampleType::U8 => Samples::U8(bytes.to_vec()),
-        SampleType::I8 => Samples::I8(bytes.iter().map(|&b| b as i8).collect()),
+    Ok(match ty {
+        SampleType::U8 => Samples::U8(collect_n(bytes.len(), bytes.iter().copied())?),
+        SampleType::I8 => Samples::I8(collect_n(bytes.len(), bytes.iter().map(|&b| b as i8))?),
         SampleType::U16 => conv!(u16, U16),
         SampleType::I16 => conv!(i16, I16),
         SampleType::U32 => conv!(u32, U32),
         SampleType::I32 => conv!(i32, I32),
         SampleType::F32 => conv!(f32, F32),
         SampleType::F64 => conv!(f64, F64),
-    }
+    })
 }
 
 /// Parses whitespace-separated numbers (ASCII data) as samples of `ty`; exactly `count` of them.
+/// Memory is reserved for what the text can hold (a number and a separator take at least two
+/// bytes), never for the declared `count`, so a header declaring far more samples than the file
+/// has costs nothing; memory refusing is an error, not an abort.
 pub fn decode_ascii(text: &[u8], ty: SampleType, count: usize) -> Result<Samples, String> {
     let text = std::str::from_utf8(text).map_err(|_| "ASCII data is not text".to_string())?;
-    // Reserve only what the text can hold (a number and a separator take at least two bytes), so
-    // a header declaring far more samples than the file has costs nothing.
-    let mut values = Vec::with_capacity(count.min(text.len() / 2 + 1));
+    let mut values: Vec<f64> = crate::io::try_vec(count.min(text.len() / 2 + 1), "the samples")?;
     for word in text
         .split(|c: char| c.is_ascii_whitespace() || c == ',')
         .filter(|w| !w.is_empty())
@@ -198,22 +205,25 @@ pub fn decode_ascii(text: &[u8], ty: SampleType, count: usize) -> Result<Samples
         let v: f64 = word
             .parse()
             .map_err(|_| format!("'{word}' is not a number"))?;
-        values.push(v);
-        if values.len() > count {
+        if values.len() == count {
             return Err(format!("more than the {count} values the header states"));
         }
+        // Within the reservation: the text holds at most len / 2 + 1 words.
+        values.push(v);
     }
     if values.len() != count {
         return Err(format!("expected {count} values, found {}", values.len()));
     }
+    let n = values.len();
+    let it = values.iter();
     Ok(match ty {
-        SampleType::U8 => Samples::U8(values.iter().map(|&v| v as u8).collect()),
-        SampleType::I8 => Samples::I8(values.iter().map(|&v| v as i8).collect()),
-        SampleType::U16 => Samples::U16(values.iter().map(|&v| v as u16).collect()),
-        SampleType::I16 => Samples::I16(values.iter().map(|&v| v as i16).collect()),
-        SampleType::U32 => Samples::U32(values.iter().map(|&v| v as u32).collect()),
-        SampleType::I32 => Samples::I32(values.iter().map(|&v| v as i32).collect()),
-        SampleType::F32 => Samples::F32(values.iter().map(|&v| v as f32).collect()),
+        SampleType::U8 => Samples::U8(collect_n(n, it.map(|&v| v as u8))?),
+        SampleType::I8 => Samples::I8(collect_n(n, it.map(|&v| v as i8))?),
+        SampleType::U16 => Samples::U16(collect_n(n, it.map(|&v| v as u16))?),
+        SampleType::I16 => Samples::I16(collect_n(n, it.map(|&v| v as i16))?),
+        SampleType::U32 => Samples::U32(collect_n(n, it.map(|&v| v as u32))?),
+        SampleType::I32 => Samples::I32(collect_n(n, it.map(|&v| v as i32))?),
+        SampleType::F32 => Samples::F32(collect_n(n, it.map(|&v| v as f32))?),
         SampleType::F64 => Samples::F64(values),
     })
 }

@@ -206,6 +206,27 @@ fn run_sheets<P: Precision>(
     background: Option<&[P::Pixel]>,
 ) -> Result<(Vec<P::Pixel>, RenderStats), CliError> {
     let f = &p.frame;
+    // A pipe's first z-slice arrives before any buffer is allocated: a short stream costs only
+    // what it delivered.
+    let mut pipe = match &p.voxels {
+        Voxels::Stdin {
+            dims,
+            ty,
+            big_endian,
+        } => {
+            let stdin = std::io::stdin().lock();
+            let mut src = PipeSource::new(
+                std::io::BufReader::with_capacity(1 << 20, stdin),
+                *dims,
+                *ty,
+                *big_endian,
+                "standard input",
+            );
+            src.prime()?;
+            Some(src)
+        }
+        _ => None,
+    };
     let n = f.image_len();
     let (mut accum, mut image, mut rows) = (
         try_filled(n, P::ACC_ZERO, "the sheet accumulator")?,
@@ -240,19 +261,8 @@ fn run_sheets<P: Precision>(
             &mut ring,
             &mut show.wrap(FileSource::open(layout.clone())?),
         )?,
-        Voxels::Stdin {
-            dims,
-            ty,
-            big_endian,
-        } => {
-            let stdin = std::io::stdin().lock();
-            let src = PipeSource::new(
-                std::io::BufReader::with_capacity(1 << 20, stdin),
-                *dims,
-                *ty,
-                *big_endian,
-                "standard input",
-            );
+        Voxels::Stdin { .. } => {
+            let src = pipe.take().expect("made above for standard input");
             render_from(&mut renderer, &mut ring, &mut show.wrap(src))?
         }
     }

@@ -1,15 +1,24 @@
-//! gzip and zlib, with the output capped so a corrupt or hostile stream cannot allocate more than
-//! the header says the data holds.
+//! gzip and zlib. Output grows as the stream inflates ([`crate::io::read_growing`]) and stops one
+//! byte past what the header declares, so a stream that holds less costs only what it holds, a
+//! stream that holds more (a decompression bomb) is cut off after `expected + 1` bytes, and memory
+//! refusing is an error, not an abort.
 
 use flate2::read::{GzDecoder, ZlibDecoder};
 use std::io::Read;
 
+/// The message for a failed read from a decoder: memory refusing, or corrupt data.
+pub fn read_error(e: std::io::Error, what: &str) -> String {
+    if e.kind() == std::io::ErrorKind::OutOfMemory {
+        e.to_string()
+    } else {
+        format!("corrupt {what} data: {e}")
+    }
+}
+
 fn inflate(r: impl Read, expected: usize, what: &str) -> Result<Vec<u8>, String> {
-    let mut out = Vec::with_capacity(expected.min(1 << 28));
     // One byte more than expected, to tell "too long" from "exactly right".
-    r.take(expected as u64 + 1)
-        .read_to_end(&mut out)
-        .map_err(|e| format!("corrupt {what} data: {e}"))?;
+    let out = crate::io::read_growing(r, expected as u64 + 1, "the inflated data")
+        .map_err(|e| read_error(e, what))?;
     if out.len() != expected {
         return Err(format!(
             "{what} data decompresses to {}{} bytes, expected {expected}",
@@ -24,26 +33,14 @@ fn inflate(r: impl Read, expected: usize, what: &str) -> Result<Vec<u8>, String>
     Ok(out)
 }
 
-/// Inflates a gzip stream that must decompress to exactly `expected` bytes.
+/// Inflates a gzip stream that must decompress to exactly `expected` bytes (more is an error,
+/// found after inflating one byte past them).
 pub fn gunzip(bytes: &[u8], expected: usize) -> Result<Vec<u8>, String> {
     inflate(GzDecoder::new(bytes), expected, "gzip")
 }
 
-/// Inflates a zlib stream that must decompress to exactly `expected` bytes.
+/// Inflates a zlib stream that must decompress to exactly `expected` bytes (more is an error,
+/// found after inflating one byte past them).
 pub fn unzlib(bytes: &[u8], expected: usize) -> Result<Vec<u8>, String> {
     inflate(ZlibDecoder::new(bytes), expected, "zlib")
-}
-
-/// Inflates a gzip stream of unknown length, up to `limit` bytes (for `.nii.gz`, whose header is
-/// inside the stream).
-pub fn gunzip_limited(bytes: &[u8], limit: usize) -> Result<Vec<u8>, String> {
-    let mut out = Vec::new();
-    GzDecoder::new(bytes)
-        .take(limit as u64 + 1)
-        .read_to_end(&mut out)
-        .map_err(|e| format!("corrupt gzip data: {e}"))?;
-    if out.len() > limit {
-        return Err(format!("gzip data decompresses to more than {limit} bytes"));
-    }
-    Ok(out)
 }

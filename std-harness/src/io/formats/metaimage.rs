@@ -6,6 +6,7 @@
 use super::{compress, numbers};
 use crate::io::volume::{at, byte_len, check_spacing, decode, SampleType, Volume, AXIS_ALIGNED};
 use crate::CliError;
+use std::borrow::Cow;
 use std::path::{Path, PathBuf};
 
 /// A parsed MetaImage header.
@@ -146,20 +147,21 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
     })
 }
 
-fn data_bytes(path: &Path, h: &Header, file: &[u8]) -> Result<(PathBuf, Vec<u8>), CliError> {
-    let (source, owned);
-    let all: &[u8] = match &h.data_file {
+/// Where the data are and their bytes: the detached data file's (read whole), or the part of the
+/// header file after the header (borrowed, not copied).
+fn data_bytes<'a>(
+    path: &Path,
+    h: &Header,
+    file: &'a [u8],
+) -> Result<(PathBuf, Cow<'a, [u8]>), CliError> {
+    Ok(match &h.data_file {
         Some(name) => {
-            source = path.parent().unwrap_or(Path::new(".")).join(name);
-            owned = crate::io::read_file(&source)?;
-            &owned
+            let source = path.parent().unwrap_or(Path::new(".")).join(name);
+            let bytes = crate::io::read_file(&source)?;
+            (source, Cow::Owned(bytes))
         }
-        None => {
-            source = path.to_path_buf();
-            &file[h.header_len..]
-        }
-    };
-    Ok((source, all.to_vec()))
+        None => (path.to_path_buf(), Cow::Borrowed(&file[h.header_len..])),
+    })
 }
 
 /// Loads a MetaImage volume.
@@ -169,9 +171,9 @@ pub fn load(path: &Path) -> Result<Volume, CliError> {
     let (source, all) = data_bytes(path, &h, &bytes)?;
     let err = |e: String| at(&source, e);
     let need = byte_len(h.dims, h.ty).map_err(err)?;
-    let body: Vec<u8> = if h.compressed {
+    let body: Cow<[u8]> = if h.compressed {
         let skip = usize::try_from(h.header_size).unwrap_or(0);
-        compress::unzlib(all.get(skip..).unwrap_or(&[]), need).map_err(err)?
+        Cow::Owned(compress::unzlib(all.get(skip..).unwrap_or(&[]), need).map_err(err)?)
     } else {
         let body = if h.header_size == -1 {
             all.len().checked_sub(need).map(|s| &all[s..])
@@ -189,13 +191,13 @@ pub fn load(path: &Path) -> Result<Volume, CliError> {
                 body.len()
             )));
         }
-        body.to_vec()
+        Cow::Borrowed(body)
     };
     Ok(Volume {
         dims: h.dims,
         spacing: h.spacing,
         directions: h.directions,
-        samples: decode(&body, h.ty, h.big_endian),
+        samples: decode(&body, h.ty, h.big_endian).map_err(err)?,
     })
 }
 

@@ -166,21 +166,37 @@ pub fn parse_header(b: &[u8]) -> Result<Header, String> {
     })
 }
 
-/// Loads a `.nii` or `.nii.gz` volume.
+/// Loads a `.nii` or `.nii.gz` volume (gzip is recognised by its magic bytes, whatever the name).
+///
+/// Read as a stream, compressed or not: the 348-byte header first, then the bytes up to
+/// `vox_offset` (extensions, skipped), then exactly the samples the header declares, into memory
+/// that grows as they arrive. Anything after the samples is ignored and, in a `.nii.gz`, never
+/// inflated: a valid volume followed by gigabytes of trailing data costs what the volume costs.
 pub fn load(path: &Path) -> Result<Volume, CliError> {
-    let file = crate::io::read_file(path)?;
-    let gz = file.starts_with(&[0x1f, 0x8b]);
-    let bytes = if gz {
-        // The header is inside the stream: inflate up to the largest volume accepted.
-        compress::gunzip_limited(&file, crate::io::volume::MAX_VOXELS.saturating_mul(8))
-            .map_err(|e| at(path, e))?
+    use std::io::Read;
+    crate::io::regular_file_len(path)?;
+    let cannot = |e: std::io::Error| at(path, format!("cannot read: {e}"));
+    let mut file = std::io::BufReader::new(std::fs::File::open(path).map_err(cannot)?);
+    let gz = std::io::BufRead::fill_buf(&mut file)
+        .map_err(cannot)?
+        .starts_with(&[0x1f, 0x8b]);
+    let mut stream: Box<dyn Read> = if gz {
+        Box::new(flate2::bufread::MultiGzDecoder::new(file))
     } else {
-        file
+        Box::new(file)
     };
-    let h = parse_header(&bytes).map_err(|e| at(path, e))?;
+    let what = if gz { "gzip" } else { "NIfTI" };
+    let read_error = |e| at(path, compress::read_error(e, what));
+    let head = crate::io::read_growing(&mut stream, HEADER_LEN as u64, "the header")
+        .map_err(read_error)?;
+    let h = parse_header(&head).map_err(|e| at(path, e))?;
     let need = byte_len(h.dims, h.ty).map_err(|e| at(path, e))?;
-    let body = bytes.get(h.vox_offset..).unwrap_or(&[]);
-    if body.len() < need {
+    let gap = (h.vox_offset - HEADER_LEN) as u64;
+    let skipped =
+        std::io::copy(&mut (&mut stream).take(gap), &mut std::io::sink()).map_err(read_error)?;
+    let body =
+        crate::io::read_growing(&mut stream, need as u64, "the samples").map_err(read_error)?;
+    if skipped < gap || body.len() < need {
         return Err(at(
             path,
             format!(
@@ -190,10 +206,14 @@ pub fn load(path: &Path) -> Result<Volume, CliError> {
             ),
         ));
     }
-    let mut samples = decode(&body[..need], h.ty, h.big_endian);
+    let mut samples = decode(&body, h.ty, h.big_endian).map_err(|e| at(path, e))?;
+    drop(body);
     if let Some((slope, inter)) = h.scale {
         let v = Volume::new(h.dims, h.spacing, samples);
-        samples = Samples::F32((0..v.len()).map(|n| v.value(n) * slope + inter).collect());
+        let mut scaled =
+            crate::io::try_vec(v.len(), "the scaled samples").map_err(|e| at(path, e))?;
+        scaled.extend((0..v.len()).map(|n| v.value(n) * slope + inter));
+        samples = Samples::F32(scaled);
     }
     Ok(Volume {
         dims: h.dims,

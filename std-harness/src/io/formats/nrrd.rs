@@ -247,14 +247,14 @@ pub fn load(path: &Path) -> Result<Volume, CliError> {
                     body.len()
                 )));
             }
-            decode(body, h.ty, h.big_endian)
+            decode(body, h.ty, h.big_endian).map_err(err)?
         }
         Encoding::Gzip => {
             let data = skip_lines(all, h.line_skip).map_err(err)?;
             // Byte skip applies to the decompressed stream.
             let skip = usize::try_from(h.byte_skip).unwrap_or(0);
             let inflated = compress::gunzip(data, need + skip).map_err(err)?;
-            decode(&inflated[skip..], h.ty, h.big_endian)
+            decode(&inflated[skip..], h.ty, h.big_endian).map_err(err)?
         }
         Encoding::Ascii => {
             let data = skip_lines(all, h.line_skip).map_err(err)?;

@@ -39,6 +39,6 @@ pub fn load(path: &Path, o: &RawOptions) -> Result<Volume, CliError> {
     Ok(Volume::new(
         o.dims,
         o.spacing,
-        decode(&bytes, o.ty, o.big_endian),
+        decode(&bytes, o.ty, o.big_endian).map_err(|e| at(path, e))?,
     ))
 }

@@ -365,14 +365,17 @@ fn block_stream(b: &[u8], h: &Header, need: usize) -> Result<Vec<u8>, String> {
     let mut at = (3 + blocks) * size;
     // Grows as blocks inflate (each checked against its declared size): no reservation of a
     // declared total the data may not hold.
-    let mut out = Vec::with_capacity(need.min(1 << 28));
+    let mut out: Vec<u8> = Vec::new();
     for k in 0..blocks {
         let c = word(b, 3 + k, h)?;
         let chunk = b
             .get(at..at.checked_add(c).ok_or("block size overflows")?)
             .ok_or("compressed data are truncated")?;
         let expect = if k + 1 == blocks { last } else { block_size };
-        out.extend(compress::unzlib(chunk, expect)?);
+        let block = compress::unzlib(chunk, expect)?;
+        out.try_reserve(block.len())
+            .map_err(|_| crate::io::alloc_failed(out.len() + block.len(), "the inflated data"))?;
+        out.extend(block);
         at += c;
     }
     Ok(out)
@@ -390,7 +393,8 @@ pub fn load(path: &Path) -> Result<Volume, CliError> {
             &block_stream(&base64_segments(text).map_err(err)?, &h, need).map_err(err)?,
             h.ty,
             h.big_endian,
-        ),
+        )
+        .map_err(err)?,
         Format::Appended { offset } => {
             let Appended {
                 bytes: section,
@@ -406,7 +410,7 @@ pub fn load(path: &Path) -> Result<Volume, CliError> {
                 block_stream(&base64_segments(&start[..end]).map_err(err)?, &h, need)
                     .map_err(err)?
             };
-            decode(&bytes, h.ty, h.big_endian)
+            decode(&bytes, h.ty, h.big_endian).map_err(err)?
         }
     };
     Ok(Volume {

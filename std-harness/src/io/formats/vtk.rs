@@ -163,7 +163,7 @@ pub fn load(path: &Path) -> Result<Volume, CliError> {
                 ),
             )
         })?;
-        decode(body, h.ty, true)
+        decode(body, h.ty, true).map_err(|e| at(path, e))?
     } else {
         // ASCII: exactly the point count, then anything that is not a number ends the data.
         let end = data
