@@ -299,3 +299,36 @@ fn fixed_output_is_bit_identical_across_runs_and_threads() {
     });
     assert!(sums.iter().all(|&c| c == first), "{sums:x?} vs {first:x}");
 }
+
+/// A sheet sum with alpha pushed below zero (or above one) by a negative lobe while colour stays
+/// positive becomes a valid premultiplied colour, alpha in [0, 1] and colour in [0, alpha], in
+/// float and fixed alike (the render fuzz target found colour without coverage before this).
+#[test]
+fn resolved_sheet_pixels_are_valid_premultiplied_colours() {
+    use footprint::composite::clamp_unit;
+    let cases: [[f32; 4]; 6] = [
+        [0.3, 0.1, 0.0, -0.2],
+        [0.3, 0.1, 0.05, 0.2],
+        [1.7, 0.4, -0.5, 1.3],
+        [-0.1, -0.2, -0.3, -0.4],
+        [0.25, 0.5, 0.75, 1.0],
+        [f32::NAN, 0.1, 0.2, f32::NAN],
+    ];
+    let want: [[f32; 4]; 6] = [
+        [0.0; 4],
+        [0.2, 0.1, 0.05, 0.2],
+        [1.0, 0.4, 0.0, 1.0],
+        [0.0; 4],
+        [0.25, 0.5, 0.75, 1.0],
+        [0.0, 0.0, 0.0, 0.0],
+    ];
+    for (c, w) in cases.iter().zip(&want) {
+        assert_eq!(clamp_unit(*c), *w, "float {c:?}");
+        if c.iter().all(|v| v.is_finite()) {
+            // The same sums in Q(24 + 8).
+            let acc = c.map(|v| (f64::from(v) * f64::from(ONE) * 256.0).round() as i64);
+            let q = w.map(|v| (f64::from(v) * f64::from(ONE)).round() as u32);
+            assert_eq!(composite::resolve(acc, 8), q, "fixed {c:?}");
+        }
+    }
+}

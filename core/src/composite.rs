@@ -48,14 +48,18 @@ pub fn over(front: [f32; 4], back: [f32; 4]) -> [f32; 4] {
     ]
 }
 
-/// A sheet's accumulated value made a valid premultiplied colour: every channel clamped to [0, 1].
-/// (Kernel ripple and negative lobes can push sums slightly outside.)
+/// A sheet's accumulated value made a valid premultiplied colour: alpha clamped to [0, 1], each
+/// colour channel to [0, alpha]. (Kernel ripple and negative lobes can push sums outside, and
+/// not in step: where voxels of different colours overlap, a negative lobe can take alpha below
+/// zero while colour stays positive — colour without coverage, which `over` would add as light.)
 #[inline]
 pub fn clamp_unit(c: [f32; 4]) -> [f32; 4] {
+    // max/min, not clamp: a NaN sum becomes 0 instead of a panic.
+    let a = c[3].max(0.0).min(1.0);
     [
-        c[0].clamp(0.0, 1.0),
-        c[1].clamp(0.0, 1.0),
-        c[2].clamp(0.0, 1.0),
-        c[3].clamp(0.0, 1.0),
+        c[0].max(0.0).min(a),
+        c[1].max(0.0).min(a),
+        c[2].max(0.0).min(a),
+        a,
     ]
 }

@@ -76,17 +76,36 @@ impl CliError {
     /// Bad input or I/O: exit code 2.
     pub fn input(message: impl Into<String>) -> Self {
         CliError {
-            message: message.into(),
+            message: one_line(message.into()),
             code: 2,
         }
     }
     /// A check that ran and failed: exit code 1.
     pub fn check(message: impl Into<String>) -> Self {
         CliError {
-            message: message.into(),
+            message: one_line(message.into()),
             code: 1,
         }
     }
+}
+
+/// `message` with its control characters (newlines, tabs, escapes — which a file's own bytes
+/// can bring into a message, quoted by a parser) written as escapes: an error is always one line,
+/// and never sends a terminal control sequence.
+fn one_line(message: String) -> String {
+    if !message.chars().any(char::is_control) {
+        return message;
+    }
+    message
+        .chars()
+        .map(|c| {
+            if c.is_control() {
+                c.escape_default().to_string()
+            } else {
+                c.to_string()
+            }
+        })
+        .collect()
 }
 
 impl fmt::Display for CliError {

@@ -5,18 +5,25 @@
 use super::{FRAC, ONE};
 use crate::frame::Order;
 
-/// An accumulated sheet pixel (Q(24 + `frac`) per channel) rounded to Q24 and clamped to
-/// [0, [`ONE`]], the fixed-point twin of [`crate::composite::clamp_unit`].
+/// An accumulated sheet pixel (Q(24 + `frac`) per channel) rounded to Q24, alpha clamped to
+/// [0, [`ONE`]] and each colour channel to [0, alpha]: the fixed-point twin of
+/// [`crate::composite::clamp_unit`].
 #[inline]
 pub fn resolve(acc: [i64; 4], frac: u32) -> [u32; 4] {
-    acc.map(|a| {
-        let r = if frac == 0 {
+    let round = |a: i64| {
+        if frac == 0 {
             a
         } else {
             a.saturating_add(1 << (frac - 1)) >> frac
-        };
-        r.clamp(0, i64::from(ONE)) as u32
-    })
+        }
+    };
+    let alpha = round(acc[3]).clamp(0, i64::from(ONE));
+    [
+        round(acc[0]).clamp(0, alpha) as u32,
+        round(acc[1]).clamp(0, alpha) as u32,
+        round(acc[2]).clamp(0, alpha) as u32,
+        alpha as u32,
+    ]
 }
 
 /// `front` over `back`: front + (1 − α_front) · back, each product rounded to nearest (ties up),
