@@ -54,7 +54,9 @@ pub fn over(front: [f32; 4], back: [f32; 4]) -> [f32; 4] {
 /// zero while colour stays positive — colour without coverage, which `over` would add as light.)
 #[inline]
 pub fn clamp_unit(c: [f32; 4]) -> [f32; 4] {
-    // max/min, not clamp: a NaN sum becomes 0 instead of a panic.
+    // max/min, not clamp: a NaN alpha becomes 0 (clamp would keep it NaN, and a NaN bound
+    // would make the colour clamps panic).
+    #[allow(clippy::manual_clamp)]
     let a = c[3].max(0.0).min(1.0);
     [
         c[0].max(0.0).min(a),

@@ -203,7 +203,7 @@ pub fn parse_size(s: &str) -> Result<(usize, usize), String> {
     let parse = |v: &str| -> Result<usize, String> {
         let n: usize = v
             .parse()
-            .map_err(|_| format!("'{v}' is not a whole number"))?;
+            .map_err(|_| format!("'{v}' is not a whole number in 1..=16384"))?;
         if !(1..=16384).contains(&n) {
             return Err(format!("image side {n} is outside 1..=16384"));
         }
@@ -325,10 +325,10 @@ fn parse_dims(s: &str) -> Result<[usize; 3], String> {
     }
     let mut out = [0usize; 3];
     for (o, p) in out.iter_mut().zip(v) {
-        *o = p
-            .trim()
-            .parse()
-            .map_err(|_| format!("'{p}' is not a whole number"))?;
+        *o =
+            p.trim().parse().ok().filter(|&n| n >= 1).ok_or_else(|| {
+                format!("'{p}' is not a whole number >= 1 (expected X,Y,Z voxels)")
+            })?;
     }
     Ok(out)
 }
