@@ -432,6 +432,17 @@ fn cases(dir: &Path) -> Vec<Case> {
         dir,
     ));
 
+    // A volume without one finite sample.
+    write("nan.raw", &[0xff; 32]);
+    c.push(refused(
+        "raw f32 volume of NaN only",
+        &[
+            "render", "nan.raw", "--dims", "2,2,2", "--type", "f32", "--out", "out.png",
+        ],
+        "no sample is finite",
+        dir,
+    ));
+
     // A temporary a killed run left beside the output is removed by the next run.
     let stale = dir.join(".out2.png.tmp-999999");
     c.push(Case {

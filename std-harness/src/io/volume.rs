@@ -121,7 +121,7 @@ impl Volume {
         self.len() == 0
     }
 
-    /// Smallest and largest finite sample.
+    /// Smallest and largest finite sample; (+∞, −∞) when no sample is finite.
     pub fn range(&self) -> (f32, f32) {
         let mut lo = f32::INFINITY;
         let mut hi = f32::NEG_INFINITY;

@@ -245,6 +245,12 @@ pub fn prepare(args: &RenderArgs) -> Result<Prepared, CliError> {
                     ))
                 }
             };
+            if lo > hi {
+                // `range` of data without one finite sample.
+                return Err(CliError::input(format!(
+                    "{name}: no sample is finite (all NaN or infinite): nothing to render"
+                )));
+            }
             if !(hi > lo) {
                 return Err(CliError::input(format!(
                     "{name}: the data are constant ({lo}); give --window"
