@@ -411,7 +411,7 @@ fn splat_small<S: Sampler + ?Sized, P: Pixel>(
 /// The inclusive pixel range of image row offset `qy` (pixels from the centre) whose centres lie
 /// inside the footprint's support, unclipped; `None` if the row misses it.
 #[inline]
-fn row_pixels(fp: &Footprint, cx: f32, qy: f32) -> Option<(i64, i64)> {
+pub(crate) fn row_pixels(fp: &Footprint, cx: f32, qy: f32) -> Option<(i64, i64)> {
     let (lo, hi) = fp.row_span(qy)?;
     let (x0, x1) = pixel_range(cx + lo, cx + hi);
     (x0 <= x1).then_some((x0, x1))

@@ -1,5 +1,5 @@
-//! Phase stencils: a view's footprint sampled once per sub-pixel phase, so that splatting a small
-//! or middling footprint is a run of multiply-adds with no table walk per pixel.
+//! Phase stencils: a view's footprint sampled once per sub-pixel phase, so that splatting a
+//! footprint is a run of multiply-adds with no table walk per pixel.
 //!
 //! A voxel projected to screen position c = (i + φx, j + φy) (i, j whole pixels, φ ∈ [0, 1)²)
 //! covers pixel centres whose offsets from its pixel (i, j) lie in a fixed box of B × B pixels,
@@ -10,64 +10,161 @@
 //! voxel deposits exactly one unit. A voxel's weights are the bilinear blend of the four stencils
 //! around its phase; since every stencil sums to one, so does the blend.
 //!
-//! **Accuracy.** Blending between phases adds the error of linear interpolation over a phase step
-//! of 1/P px: at most (1/P)²/8 · |∂²w/∂φ²| ≤ (1/P)²/4 · max|∇²w|, for P = 16 well under a tenth of a
-//! percent of the peak for the smallest footprint the geometry allows (semi-axis 1.5 px); the
-//! harness's `verify` measures it with the rest. The support's edge is blended too, so a pixel at
-//! the edge may keep a weight that the exact support test would zero; the footprint is near zero
-//! there.
+//! **Narrow and wide footprints.** A *narrow* footprint (box side B ≤ [`NARROW_SIDE`], 16 px) is
+//! blended at P = P_max phases (the caller's, 32 in the harness) over every pixel where a corner
+//! stencil is non-zero. A *wide* one varies slowly per pixel, so it needs fewer phases for the
+//! same blending error: P = min(P_max, ⌈[`PHASE_REACH`] / r⌉), r the shorter semi-axis
+//! ([`minor_semi_axis`]), so P·r ≥ 128 px; it visits exactly the pixel centres inside its support
+//! (as the table walk does), blends where all four corner stencils are non-zero and reads the
+//! sampler at the few edge pixels where one is not. (The footprint is not smooth at its support's
+//! edge, and a blend across it is off by a share of the edge weight: blended there at P·r = 64,
+//! `verify` lost up to 1.5 dB against the table walk; with the edge read exactly and P·r ≥ 128 it
+//! stays within 0.44 dB of it on every README volume and view.) Stencils that would exceed
+//! [`MAX_STENCIL_FLOATS`] (long thin footprints needing many phases) are not built: the table
+//! walk serves those.
 //!
-//! **Memory.** (P + 1)² · B² floats, built once per view in caller storage: [`Stencils::len_for`].
-//! For P = 16: 29 KiB at e ≤ 1.5 px (B = 5), 140 KiB at e = 4.2 px (B = 11), 296 KiB at the largest
-//! side used, B = [`MAX_STENCIL_SIDE`].
+//! **Accuracy.** Blending between phases adds the error of linear interpolation over a phase step
+//! of 1/P px: at most (1/P)²/8 · |∂²w/∂φ²|. For a Gaussian of standard deviation σ ≈ r/2.5
+//! (the default kernel) |∂²w/∂φ²| ≤ peak/σ², so the error is at most (2.5/(P·r))²/8 of the peak:
+//! 3.4·10⁻⁴ for the smallest footprint (r = 1.5 px at P = 32), 4.8·10⁻⁵ for a wide one. The
+//! harness's `verify` measures it with the rest; `tests/stencils.rs` checks it against the table
+//! walk and checks every pixel against brute force.
+//!
+//! **Only the support is visited.** For each phase cell (a, b) the stencils store, per box row, the
+//! first and last pixel where any of the cell's four corner stencils is non-zero (narrow) or where
+//! all four are (wide); a narrow splat visits only the former (about π/4 of the box for an
+//! ellipse, less for a thin one). Every pixel skipped would have received a weight of exactly
+//! zero, so this changes no pixel.
+//!
+//! **Memory.** (P + 1)² · B² + P² · B floats, built once per view in caller storage:
+//! [`len_for`]. For P_max = 32 and round footprints: 126 KiB at e = 1.5 px (B = 5), 236 KiB at
+//! e = 2 px (B = 7), 571 KiB at e = 4.2 px (B = 11), 427 KiB at e = 8 px (B = 19, P = 16), 397 KiB
+//! at e = 16 px (B = 35, P = 8), 443 KiB at e = 32 px (B = 67, P = 4), 1.0 MiB at the largest,
+//! e = 63 px (B = 129, P = 3).
 
 use crate::geometry::Footprint;
 use crate::math;
-use crate::splat::{floor_i64, BufferError, ImageMut, Pixel, Sampler, SplatStats, Splatter};
+use crate::splat::{
+    floor_i64, row_pixels, BufferError, ImageMut, Pixel, Sampler, SplatStats, Splatter,
+};
 
-/// Phases per pixel the harness uses.
+/// Largest number of phases per pixel the harness uses ([`phases_for`] lowers it for
+/// wide footprints).
 pub const DEFAULT_PHASES: usize = 32;
 
-/// Largest box side (pixels) worth stencils; larger footprints amortise a table walk per row.
-pub const MAX_STENCIL_SIDE: usize = 16;
+/// For a wide footprint, phases × shorter semi-axis (px) kept at least this large:
+/// P = ⌈`PHASE_REACH` / r⌉, capped by the caller's maximum (see the module docs for the error
+/// it bounds).
+pub const PHASE_REACH: f32 = 128.0;
 
-/// One view's phase stencils (see the module docs), in caller storage.
-#[derive(Clone, Copy, Debug)]
-pub struct Stencils<'a> {
+/// Largest stencil storage, floats (2 MiB): beyond it a footprint is splatted by the table walk.
+pub const MAX_STENCIL_FLOATS: usize = 1 << 19;
+
+/// The shorter semi-axis of `footprint`'s support ellipse |A q| ≤ 1, px: 1 / σ_max(A), A =
+/// [`Footprint::to_unit`] (for a separable kernel's parallelogram, the half-width of its
+/// inscribed ellipse, a lower bound). 0 for a degenerate footprint.
+pub fn minor_semi_axis(footprint: &Footprint) -> f32 {
+    let [[a, b], [c, d]] = footprint.to_unit;
+    let t = a * a + b * b + c * c + d * d;
+    let det = a * d - b * c;
+    let s2 = 0.5 * (t + math::sqrt((t * t - 4.0 * det * det).max(0.0)));
+    if s2 > 0.0 && s2.is_finite() {
+        1.0 / math::sqrt(s2)
+    } else {
+        0.0
+    }
+}
+
+/// Footprints whose box side is at most this many pixels are *narrow*: blended at every phase the
+/// caller allows, up to the support's edge. Wider ones are *wide* (see the module docs).
+pub const NARROW_SIDE: usize = 16;
+
+/// Whether `footprint` is splatted as a wide one: box side above [`NARROW_SIDE`] (such footprints
+/// are never renormalised: their half-extents exceed 4 px).
+pub fn is_wide(footprint: &Footprint) -> bool {
+    side_for(footprint).is_none_or(|b| b > NARROW_SIDE)
+}
+
+/// Largest box side (pixels) stencils are built for (half-extent up to 63.5 px); wider
+/// footprints use the table walk, whose per-row cost they amortise.
+pub const MAX_STENCIL_SIDE: usize = 129;
+
+/// Box side B for `footprint`, if stencils apply (B ≤ [`MAX_STENCIL_SIDE`]).
+pub fn side_for(footprint: &Footprint) -> Option<usize> {
+    let e = footprint.half_extent[0].max(footprint.half_extent[1]);
+    if !(e.is_finite() && e >= 0.0) {
+        return None;
+    }
+    let reach = -math::floor(-(e + 0.5)); // ⌈e + ½⌉
+    let side = 2.0 * reach + 1.0;
+    (side <= MAX_STENCIL_SIDE as f32).then_some(side as usize)
+}
+
+/// Phases per pixel P for `footprint` when the caller allows at most `max_phases` (≥ 1):
+/// min(`max_phases`, ⌈[`PHASE_REACH`] / r⌉), r the footprint's shorter semi-axis
+/// ([`minor_semi_axis`]; the weight varies fastest across it), for a wide footprint
+/// ([`is_wide`]); a narrow one always gets `max_phases`.
+pub fn phases_for(footprint: &Footprint, max_phases: usize) -> usize {
+    let max_phases = max_phases.max(1);
+    let r = minor_semi_axis(footprint);
+    if !is_wide(footprint) || !(r > 0.0) {
+        return max_phases;
+    }
+    let p = -math::floor(-(PHASE_REACH / r)); // ⌈128 / r⌉
+    if p >= max_phases as f32 {
+        max_phases
+    } else {
+        (p as usize).max(1)
+    }
+}
+
+/// Floats needed for `footprint`'s stencils with at most `max_phases` phases per pixel, if
+/// stencils apply: (P + 1)² · B² + P² · B.
+/// `None` also when that would exceed [`MAX_STENCIL_FLOATS`] (a long thin footprint that
+/// needs many phases: the table walk serves it).
+pub fn len_for(footprint: &Footprint, max_phases: usize) -> Option<usize> {
+    let side = side_for(footprint)?;
+    let p = phases_for(footprint, max_phases);
+    let len = (p + 1) * (p + 1) * side * side + p * p * side;
+    (len <= MAX_STENCIL_FLOATS).then_some(len)
+}
+
+/// One view's phase stencils (see the module docs), in caller storage, with the sampler they were
+/// built from (a wide footprint reads it at the support's edge).
+#[derive(Debug)]
+pub struct Stencils<'a, S: ?Sized> {
+    sampler: &'a S,
+    /// Whether the footprint is wide ([`is_wide`]).
+    wide: bool,
+    /// (P + 1)² stencils of B² weights, then P² cells of B row ranges (first | last << 16, kept
+    /// as the bits of an f32: a tiny positive number, never NaN).
     data: &'a [f32],
+    /// Offset of the per-cell row ranges in `data`.
+    ranges: usize,
     side: usize,
     reach: i64,
     phases: usize,
 }
 
-impl<'a> Stencils<'a> {
-    /// Box side B for `footprint`, if stencils are worth it (B ≤ [`MAX_STENCIL_SIDE`]).
-    pub fn side_for(footprint: &Footprint) -> Option<usize> {
-        let e = footprint.half_extent[0].max(footprint.half_extent[1]);
-        if !(e.is_finite() && e >= 0.0) {
-            return None;
-        }
-        let reach = -math::floor(-(e + 0.5)); // ⌈e + ½⌉
-        let side = 2.0 * reach + 1.0;
-        (side <= MAX_STENCIL_SIDE as f32).then_some(side as usize)
+impl<S: ?Sized> Clone for Stencils<'_, S> {
+    fn clone(&self) -> Self {
+        *self
     }
+}
 
-    /// Floats needed for `footprint`'s stencils at `phases` phases per pixel, if stencils apply.
-    pub fn len_for(footprint: &Footprint, phases: usize) -> Option<usize> {
-        let side = Self::side_for(footprint)?;
-        Some((phases + 1) * (phases + 1) * side * side)
-    }
+impl<S: ?Sized> Copy for Stencils<'_, S> {}
 
+impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
     /// Samples `sampler`'s footprint at every phase into `buffer` (at least
-    /// [`Stencils::len_for`] floats). `phases` ≥ 1.
-    pub fn build<S: Sampler + ?Sized>(
-        sampler: &S,
-        phases: usize,
+    /// [`len_for`] floats), with at most `max_phases` (≥ 1) phases per pixel.
+    pub fn build(
+        sampler: &'a S,
+        max_phases: usize,
         buffer: &'a mut [f32],
     ) -> Result<Self, BufferError> {
         let fp = sampler.footprint();
-        let phases = phases.max(1);
-        let (Some(side), Some(len)) = (Self::side_for(fp), Self::len_for(fp, phases)) else {
+        let phases = phases_for(fp, max_phases);
+        let (Some(side), Some(len)) = (side_for(fp), len_for(fp, max_phases)) else {
             let e = fp.half_extent[0].max(fp.half_extent[1]);
             let side = (2.0 * e + 2.0).min(1e9) as usize;
             return Err(BufferError::TooLarge {
@@ -83,7 +180,9 @@ impl<'a> Stencils<'a> {
         }
         let reach = (side / 2) as i64;
         let cells = side * side;
-        for (k, stencil) in buffer[..len].chunks_exact_mut(cells).enumerate() {
+        let ranges = (phases + 1) * (phases + 1) * cells;
+        let (weights, spans) = buffer[..len].split_at_mut(ranges);
+        for (k, stencil) in weights.chunks_exact_mut(cells).enumerate() {
             let (pa, pb) = (k % (phases + 1), k / (phases + 1));
             let phase = [pa as f32 / phases as f32, pb as f32 / phases as f32];
             let mut sum = 0.0f32;
@@ -110,8 +209,60 @@ impl<'a> Stencils<'a> {
                 }
             }
         }
+        // Per phase cell and box row: the first and last pixel where one of the cell's four
+        // corner stencils is non-zero (narrow footprints: the pixels a splat visits), or where
+        // all four are (wide ones: the pixels it blends); first > last when there are none.
+        let all = is_wide(fp);
+        let weights = &*weights;
+        let nonzero = |stencil: usize, my: usize| {
+            let row = &weights[stencil * cells + my * side..][..side];
+            let first = row.iter().position(|&w| w != 0.0);
+            let last = row.iter().rposition(|&w| w != 0.0);
+            first.zip(last)
+        };
+        for (c, cell) in spans.chunks_exact_mut(side).enumerate() {
+            let (a, b) = (c % phases, c / phases);
+            let corners = [
+                b * (phases + 1) + a,
+                b * (phases + 1) + a + 1,
+                (b + 1) * (phases + 1) + a,
+                (b + 1) * (phases + 1) + a + 1,
+            ];
+            for (my, packed) in cell.iter_mut().enumerate() {
+                let (mut first, mut last) = (side, 0);
+                if all {
+                    // Non-zero in all four: inside each corner's run, and no zero within (a
+                    // support row is one interval, but a table can hold a zero inside it).
+                    let (mut lo, mut hi) = (0, side - 1);
+                    let mut any = true;
+                    for &c in &corners {
+                        match nonzero(c, my) {
+                            Some((f, l)) => (lo, hi) = (lo.max(f), hi.min(l)),
+                            None => any = false,
+                        }
+                    }
+                    if any && lo <= hi {
+                        let row = |c: usize| &weights[c * cells + my * side..][lo..=hi];
+                        if corners.iter().all(|&c| row(c).iter().all(|&w| w != 0.0)) {
+                            (first, last) = (lo, hi);
+                        }
+                    }
+                } else {
+                    for (f, l) in corners.iter().filter_map(|&s| nonzero(s, my)) {
+                        first = first.min(f);
+                        last = last.max(l);
+                    }
+                }
+                // B ≤ 129: both fit 16 bits, and the pattern (exponent field ≤ 1) is never a NaN, so
+                // it survives being stored and read as an f32 unchanged.
+                *packed = f32::from_bits(first as u32 | (last as u32) << 16);
+            }
+        }
         Ok(Stencils {
+            sampler,
+            wide: all,
             data: &buffer[..len],
+            ranges,
             side,
             reach,
             phases,
@@ -123,9 +274,18 @@ impl<'a> Stencils<'a> {
         self.side
     }
 
+    /// Phases per pixel P.
+    pub fn phases(&self) -> usize {
+        self.phases
+    }
+
     /// Spreads `value` of a voxel projected to `center` (pixels, absolute) into `image`, calling
     /// `touched(y, x0, x1)` for each row it visited: the blend of the four stencils around the
-    /// centre's sub-pixel phase.
+    /// centre's sub-pixel phase. A narrow footprint visits the pixels where one of them is
+    /// non-zero; a wide one visits the pixel centres inside its support, as the table walk
+    /// ([`crate::splat::splat_rows`]) does, blending where all four are non-zero and reading the
+    /// sampler at the few edge pixels where one is not (the footprint is not smooth at its
+    /// support's edge, so a blend across it is off by a share of the edge weight).
     pub fn splat<P: Pixel>(
         &self,
         center: [f32; 2],
@@ -151,7 +311,8 @@ impl<'a> Stencils<'a> {
             (k, (t - k as f32).clamp(0.0, 1.0))
         };
         let ((ka, fx), (kb, fy)) = (phase(center[0], ix), phase(center[1], iy));
-        let cells = self.side * self.side;
+        let side = self.side;
+        let cells = side * side;
         let at = |a: usize, b: usize| (b * (p + 1) + a) * cells;
         let (s00, s10, s01, s11) = (
             at(ka, kb),
@@ -165,38 +326,77 @@ impl<'a> Stencils<'a> {
             (1.0 - fx) * fy,
             fx * fy,
         );
-        let (lo, hi) = (x0.max(0), (x0 + b - 1).min(w - 1));
-        let (m0, n) = ((lo - x0) as usize, (hi - lo + 1) as usize);
+        let spans = &self.data[self.ranges + (kb * p + ka) * side..][..side];
+        // Rows of the box inside the image.
+        let (my0, my1) = ((-y0).max(0) as usize, (h - y0).min(b) as usize);
         let stride = image.stride();
         let data = image.data_mut();
-        for my in 0..self.side {
+        let mut weights = [0.0f32; MAX_STENCIL_SIDE];
+        let wide = self.wide;
+        for (my, span) in spans.iter().enumerate().take(my1).skip(my0) {
             let y = y0 + my as i64;
-            if y < 0 || y >= h {
+            let qy = y as f32 + 0.5 - center[1];
+            let bits = span.to_bits();
+            let (first, last) = (x0 + i64::from(bits & 0xffff), x0 + i64::from(bits >> 16));
+            // Visited: narrow, where a corner stencil is non-zero; wide, the pixel centres
+            // inside the support (as the table walk), blended where all four corners are
+            // non-zero and read from the sampler at the edge.
+            let (span, blend) = if !wide {
+                ((first, last), (first, last))
+            } else {
+                let Some(span) = row_pixels(self.sampler.footprint(), center[0], qy) else {
+                    continue;
+                };
+                (span, (first.max(span.0), last.min(span.1)))
+            };
+            let (lo, hi) = (span.0.max(0), span.1.min(w - 1));
+            if lo > hi {
                 continue;
             }
-            let r = my * self.side + m0;
-            let (r00, r10, r01, r11) = (
-                &self.data[s00 + r..s00 + r + n],
-                &self.data[s10 + r..s10 + r + n],
-                &self.data[s01 + r..s01 + r + n],
-                &self.data[s11 + r..s11 + r + n],
-            );
-            let start = y as usize * stride + lo as usize;
+            let n = (hi - lo + 1) as usize;
+            let ws = &mut weights[..n];
+            let (b0, b1) = (blend.0.max(lo), blend.1.min(hi));
+            if b0 <= b1 {
+                let (m0, nb) = ((b0 - x0) as usize, (b1 - b0 + 1) as usize);
+                let r = my * side + m0;
+                let (r00, r10, r01, r11) = (
+                    &self.data[s00 + r..][..nb],
+                    &self.data[s10 + r..][..nb],
+                    &self.data[s01 + r..][..nb],
+                    &self.data[s11 + r..][..nb],
+                );
+                // The row's weights first (a loop the compiler vectorises), then the deposit.
+                let out = &mut ws[(b0 - lo) as usize..][..nb];
+                for (k, wt) in out.iter_mut().enumerate() {
+                    *wt = w00 * r00[k] + w10 * r10[k] + w01 * r01[k] + w11 * r11[k];
+                }
+            }
+            // The edge pixels outside the blended run (none for a narrow footprint).
+            let (e0, e1) = if b0 <= b1 {
+                (b0 - lo, b1 - lo + 1)
+            } else {
+                (0, 0)
+            };
+            for k in (0..e0).chain(e1..n as i64) {
+                let q = [(lo + k) as f32 + 0.5 - center[0], qy];
+                ws[k as usize] = self.sampler.weight(q);
+            }
+            let y = y as usize;
+            let start = y * stride + lo as usize;
             // Clipped to the image, so the range is inside the buffer ImageMut checked.
             let px = &mut data[start..start + n];
-            for (k, d) in px.iter_mut().enumerate() {
-                let wt = w00 * r00[k] + w10 * r10[k] + w01 * r01[k] + w11 * r11[k];
+            for (d, &wt) in px.iter_mut().zip(ws.iter()) {
                 d.add_weighted(value, wt);
                 stats.pixels_updated += u32::from(wt != 0.0);
             }
             stats.pixels_visited += n as u32;
-            touched(y as usize, lo as usize, hi as usize);
+            touched(y, lo as usize, hi as usize);
         }
         Ok(stats)
     }
 }
 
-impl Splatter for Stencils<'_> {
+impl<S: Sampler + ?Sized> Splatter for Stencils<'_, S> {
     #[inline]
     fn splat_voxel<P: Pixel>(
         &self,

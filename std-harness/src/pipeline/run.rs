@@ -19,7 +19,7 @@ use footprint::render::{
 use footprint::shade::OPACITY_TABLE_LEN;
 use footprint::source::{render_from, SheetSource};
 use footprint::splat::Direct;
-use footprint::stencil::Stencils;
+use footprint::stencil::{self, Stencils};
 use footprint::{composite::RowSpan, Lookup, ViewTable};
 use std::io::IsTerminal;
 use std::time::Instant;
@@ -105,7 +105,7 @@ pub fn render_frame(
             (AccumArg::Float, _) => {
                 let table = Box::new(ViewTable::<N>::build(&p.frame.footprint, &generic, lookup, lookup));
                 let len = (args.phases > 0)
-                    .then(|| Stencils::len_for(&p.frame.footprint, args.phases))
+                    .then(|| stencil::len_for(&p.frame.footprint, args.phases))
                     .flatten();
                 let r = if let Some(len) = len {
                     // Small and middling footprints: the view table sampled once per phase.
