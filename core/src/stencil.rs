@@ -333,22 +333,48 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
         let data = image.data_mut();
         let mut weights = [0.0f32; MAX_STENCIL_SIDE];
         let wide = self.wide;
+        if !wide {
+            // Narrow: the runs are short (a few pixels), so weight and deposit in one pass.
+            for (my, span) in spans.iter().enumerate().take(my1).skip(my0) {
+                let bits = span.to_bits();
+                let (first, last) = (x0 + i64::from(bits & 0xffff), x0 + i64::from(bits >> 16));
+                let (lo, hi) = (first.max(0), last.min(w - 1));
+                if lo > hi {
+                    continue;
+                }
+                let (m0, n) = ((lo - x0) as usize, (hi - lo + 1) as usize);
+                let r = my * side + m0;
+                let (r00, r10, r01, r11) = (
+                    &self.data[s00 + r..][..n],
+                    &self.data[s10 + r..][..n],
+                    &self.data[s01 + r..][..n],
+                    &self.data[s11 + r..][..n],
+                );
+                let y = (y0 + my as i64) as usize;
+                let start = y * stride + lo as usize;
+                // Clipped to the image, so the range is inside the buffer ImageMut checked.
+                let px = &mut data[start..start + n];
+                for (k, d) in px.iter_mut().enumerate() {
+                    let wt = w00 * r00[k] + w10 * r10[k] + w01 * r01[k] + w11 * r11[k];
+                    d.add_weighted(value, wt);
+                    stats.pixels_updated += u32::from(wt != 0.0);
+                }
+                stats.pixels_visited += n as u32;
+                touched(y, lo as usize, hi as usize);
+            }
+            return Ok(stats);
+        }
         for (my, span) in spans.iter().enumerate().take(my1).skip(my0) {
             let y = y0 + my as i64;
             let qy = y as f32 + 0.5 - center[1];
             let bits = span.to_bits();
             let (first, last) = (x0 + i64::from(bits & 0xffff), x0 + i64::from(bits >> 16));
-            // Visited: narrow, where a corner stencil is non-zero; wide, the pixel centres
-            // inside the support (as the table walk), blended where all four corners are
-            // non-zero and read from the sampler at the edge.
-            let (span, blend) = if !wide {
-                ((first, last), (first, last))
-            } else {
-                let Some(span) = row_pixels(self.sampler.footprint(), center[0], qy) else {
-                    continue;
-                };
-                (span, (first.max(span.0), last.min(span.1)))
+            // Wide: the pixel centres inside the support (as the table walk), blended where all
+            // four corners are non-zero and read from the sampler at the edge.
+            let Some(span) = row_pixels(self.sampler.footprint(), center[0], qy) else {
+                continue;
             };
+            let blend = (first.max(span.0), last.min(span.1));
             let (lo, hi) = (span.0.max(0), span.1.min(w - 1));
             if lo > hi {
                 continue;
@@ -371,7 +397,7 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
                     *wt = w00 * r00[k] + w10 * r10[k] + w01 * r01[k] + w11 * r11[k];
                 }
             }
-            // The edge pixels outside the blended run (none for a narrow footprint).
+            // The edge pixels outside the blended run.
             let (e0, e1) = if b0 <= b1 {
                 (b0 - lo, b1 - lo + 1)
             } else {
