@@ -28,11 +28,13 @@ fn image(extra: &[&str], threads: usize) -> Vec<[u32; 4]> {
 
 #[test]
 fn every_thread_count_gives_the_same_bits() {
-    // Stencil splats (small footprints), the per-pixel table walk (--phases 0), the direct
+    // Stencil splats (small and wide footprints), the per-pixel table walk (--phases 0), the direct
     // method, fixed point; phong needs gradients; front to back composites under; a view whose
     // sheets run along i.
-    let cases: [&[&str]; 7] = [
+    let cases: [&[&str]; 8] = [
         &["--view", "30,20,0"],
+        // Zoomed so the footprints are wide (box over 16 px): stencils with exact edges.
+        &["--view", "30,20,0", "--zoom", "12"],
         &["--view", "30,20,0", "--phases", "0"],
         &[
             "--view",
