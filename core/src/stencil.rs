@@ -19,7 +19,7 @@
 //! sampler at the few edge pixels where one is not. (The footprint is not smooth at its support's
 //! edge, and a blend across it is off by a share of the edge weight: blended there at P·r = 64,
 //! `verify` lost up to 1.5 dB against the table walk; with the edge read exactly and P·r ≥ 128 it
-//! stays within 0.44 dB of it on every README volume and view.) Stencils that would exceed
+//! stays within 0.32 dB of it on every README volume and view.) Stencils that would exceed
 //! [`MAX_STENCIL_FLOATS`] (long thin footprints needing many phases) are not built: the table
 //! walk serves those.
 //!
@@ -212,7 +212,7 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
         // Per phase cell and box row: the first and last pixel where one of the cell's four
         // corner stencils is non-zero (narrow footprints: the pixels a splat visits), or where
         // all four are (wide ones: the pixels it blends); first > last when there are none.
-        let all = is_wide(fp);
+        let wide = is_wide(fp);
         let weights = &*weights;
         let nonzero = |stencil: usize, my: usize| {
             let row = &weights[stencil * cells + my * side..][..side];
@@ -230,7 +230,7 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
             ];
             for (my, packed) in cell.iter_mut().enumerate() {
                 let (mut first, mut last) = (side, 0);
-                if all {
+                if wide {
                     // Non-zero in all four: inside each corner's run, and no zero within (a
                     // support row is one interval, but a table can hold a zero inside it).
                     let (mut lo, mut hi) = (0, side - 1);
@@ -260,7 +260,7 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
         }
         Ok(Stencils {
             sampler,
-            wide: all,
+            wide,
             data: &buffer[..len],
             ranges,
             side,
@@ -327,6 +327,11 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
             fx * fy,
         );
         let spans = &self.data[self.ranges + (kb * p + ka) * side..][..side];
+        // A row's stored run, as absolute pixel columns (first > last when empty).
+        let run = |span: &f32| {
+            let bits = span.to_bits();
+            (x0 + i64::from(bits & 0xffff), x0 + i64::from(bits >> 16))
+        };
         // Rows of the box inside the image.
         let (my0, my1) = ((-y0).max(0) as usize, (h - y0).min(b) as usize);
         let stride = image.stride();
@@ -336,14 +341,14 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
         if !wide {
             // Narrow: the runs are short (a few pixels), so weight and deposit in one pass.
             for (my, span) in spans.iter().enumerate().take(my1).skip(my0) {
-                let bits = span.to_bits();
-                let (first, last) = (x0 + i64::from(bits & 0xffff), x0 + i64::from(bits >> 16));
+                let (first, last) = run(span);
                 let (lo, hi) = (first.max(0), last.min(w - 1));
                 if lo > hi {
                     continue;
                 }
                 let (m0, n) = ((lo - x0) as usize, (hi - lo + 1) as usize);
                 let r = my * side + m0;
+                // Four slices of length n, so the loop below indexes them without checks.
                 let (r00, r10, r01, r11) = (
                     &self.data[s00 + r..][..n],
                     &self.data[s10 + r..][..n],
@@ -367,8 +372,7 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
         for (my, span) in spans.iter().enumerate().take(my1).skip(my0) {
             let y = y0 + my as i64;
             let qy = y as f32 + 0.5 - center[1];
-            let bits = span.to_bits();
-            let (first, last) = (x0 + i64::from(bits & 0xffff), x0 + i64::from(bits >> 16));
+            let (first, last) = run(span);
             // Wide: the pixel centres inside the support (as the table walk), blended where all
             // four corners are non-zero and read from the sampler at the edge.
             let Some(span) = row_pixels(self.sampler.footprint(), center[0], qy) else {

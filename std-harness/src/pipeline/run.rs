@@ -108,7 +108,7 @@ pub fn render_frame(
                     .then(|| stencil::len_for(&p.frame.footprint, args.phases))
                     .flatten();
                 let r = if let Some(len) = len {
-                    // Small and middling footprints: the view table sampled once per phase.
+                    // Footprints up to 128 px across: the view table sampled once per phase.
                     let mut buffer = vec![0.0f32; len];
                     let stencils = Stencils::build(&*table, args.phases, &mut buffer)?;
                     let tables = start.elapsed().as_secs_f64();
