@@ -70,12 +70,40 @@ fn nifti(datatype: i16, dims: [i16; 3], vox: f32, data_len: usize) -> Vec<u8> {
     h
 }
 
+/// A NIfTI-2 header (540 bytes, little-endian) with `magic`, then 4 bytes of extension flag and
+/// `data_len` bytes of samples.
+fn nifti2(magic: &[u8; 4], datatype: i16, dims: [i64; 3], vox: i64, data_len: usize) -> Vec<u8> {
+    let mut h = vec![0u8; 544];
+    h[0..4].copy_from_slice(&540i32.to_le_bytes());
+    h[4..8].copy_from_slice(magic);
+    h[8..12].copy_from_slice(b"\r\n\x1a\n");
+    h[12..14].copy_from_slice(&datatype.to_le_bytes());
+    h[14..16].copy_from_slice(&8i16.to_le_bytes());
+    for (i, d) in [3, dims[0], dims[1], dims[2], 1, 1, 1, 1]
+        .iter()
+        .enumerate()
+    {
+        h[16 + 8 * i..24 + 8 * i].copy_from_slice(&d.to_le_bytes());
+    }
+    for i in 0..4 {
+        h[104 + 8 * i..112 + 8 * i].copy_from_slice(&1f64.to_le_bytes());
+    }
+    h[168..176].copy_from_slice(&vox.to_le_bytes());
+    h.extend(vec![7u8; data_len]);
+    h
+}
+
+/// A legacy VTK file of a 4×3×2 grid whose data sections are `data`.
+fn legacy(data: &str) -> Vec<u8> {
+    format!("# vtk DataFile Version 3.0\nbad\nASCII\nDATASET STRUCTURED_POINTS\nDIMENSIONS 4 3 2\n{data}")
+        .into_bytes()
+}
+
 fn cases() -> Vec<Case> {
     let data = vec![5u8; 24];
     vec![
         // NRRD
         ("truncated.nrrd", nrrd(OK_NRRD, &data[..23]), "24 bytes"),
-        ("too-long.nrrd", nrrd(OK_NRRD, &[0u8; 25]), "24 bytes"),
         ("unknown-type.nrrd", nrrd(&OK_NRRD.replace("uint8", "complex"), &data), "type"),
         ("unknown-encoding.nrrd", nrrd(&OK_NRRD.replace("raw", "bzip2"), &data), "encoding"),
         ("corrupt-gzip.nrrd", nrrd(&OK_NRRD.replace("raw", "gzip"), &[0x1f, 0x8b, 8, 0, 1, 2, 3, 4, 5, 6, 7]), "gzip"),
@@ -93,13 +121,20 @@ fn cases() -> Vec<Case> {
         ("wrong-count.vti", vti("", "<DataArray type=\"UInt8\" Name=\"s\" format=\"ascii\">1 2 3</DataArray>"), "expected 24"),
         ("unknown-type.vti", vti("", "<DataArray type=\"Int64\" Name=\"s\" format=\"ascii\">1</DataArray>"), "Int64"),
         ("not-xml.vti", b"<VTKFile type=\"ImageData\"><unclosed".to_vec(), "XML"),
-        ("lz4.vti", vti(" compressor=\"vtkLZ4DataCompressor\"", ""), "compressor"),
+        ("zstd.vti", vti(" compressor=\"vtkZstdDataCompressor\"", ""), "compressor"),
+        ("corrupt-lz4.vti", vti(" header_type=\"UInt32\" compressor=\"vtkLZ4DataCompressor\"", "<DataArray type=\"UInt8\" Name=\"s\" format=\"binary\">AQAAABgAAAAYAAAACgAAAA==Z2FyYmFnZSEhIQ==</DataArray>"), "LZ4"),
+        ("corrupt-lzma.vti", vti(" header_type=\"UInt32\" compressor=\"vtkLZMADataCompressor\"", "<DataArray type=\"UInt8\" Name=\"s\" format=\"binary\">AQAAABgAAAAYAAAABgAAAA==/Td6WFoA</DataArray>"), "LZMA"),
         // Legacy VTK
         ("truncated-binary.vtk", vtk("BINARY", "4 3 2", "24", "unsigned_char", &data[..20]), "truncated"),
         ("point-mismatch.vtk", vtk("ASCII", "4 3 2", "25", "unsigned_char", b"1"), "POINT_DATA"),
         ("unknown-type.vtk", vtk("ASCII", "4 3 2", "24", "quaternion", b"1"), "type"),
         ("negative-dims.vtk", vtk("ASCII", "4 -3 2", "24", "float", b"1"), "DIMENSIONS"),
         ("bad-mode.vtk", vtk("UTF8", "4 3 2", "24", "float", b"1"), "ASCII or BINARY"),
+        ("short-field.vtk", legacy("POINT_DATA 24\nFIELD f 1\na 1 24 float\n1 2 3\n"), "found 3"),
+        ("unknown-keyword.vtk", legacy("POINT_DATA 24\nSCALERS s float\n"), "not a legacy VTK keyword"),
+        ("vectors-only.vtk", legacy(&format!("POINT_DATA 24\nVECTORS v float\n{}", "0 ".repeat(72))), "no single-component"),
+        ("no-lookup-table.vtk", legacy("POINT_DATA 24\nSCALARS s float\n1 2 3\n"), "LOOKUP_TABLE"),
+        ("huge-field.vtk", legacy("POINT_DATA 24\nFIELD f 1\na 99999999 99999999 double\n"), "values"),
         // MetaImage
         ("truncated.mha", mha("DimSize = 4 3 2\nElementType = MET_UCHAR\n", &data[..3]), "24 bytes"),
         ("unknown-type.mha", mha("DimSize = 4 3 2\nElementType = MET_LONG_LONG\n", &data), "ElementType"),
@@ -112,6 +147,13 @@ fn cases() -> Vec<Case> {
         ("bad-vox-offset.nii", nifti(2, [4, 3, 2], 10.0, 24), "vox_offset"),
         ("short-header.nii", vec![0u8; 100], "shorter"),
         ("corrupt.nii.gz", vec![0x1f, 0x8b, 8, 0, 9, 9, 9], "gzip"),
+        ("n2-truncated.nii", nifti2(b"n+2\0", 2, [4, 3, 2], 544, 10), "truncated"),
+        ("n2-bad-datatype.nii", nifti2(b"n+2\0", 1792, [4, 3, 2], 544, 24), "datatype"),
+        ("n2-bad-vox-offset.nii", nifti2(b"n+2\0", 2, [4, 3, 2], 100, 24), "vox_offset"),
+        ("n2-zero-dim.nii", nifti2(b"n+2\0", 2, [4, 3, 0], 544, 24), "dim[3]"),
+        ("n2-short-header.nii", nifti2(b"n+2\0", 2, [4, 3, 2], 544, 0)[..400].to_vec(), "shorter"),
+        ("n2-bad-magic.nii", nifti2(b"n+1\0", 2, [4, 3, 2], 544, 24), "magic"),
+        ("pair-header-as-nii.nii", nifti2(b"ni2\0", 2, [4, 3, 2], 0, 0), ".img"),
         // Any format
         ("empty.nrrd", vec![], "magic"),
         ("empty.vti", vec![], "XML"),

@@ -165,6 +165,46 @@ fn vtk(dir: &Path, v: &[u16]) -> Vec<PathBuf> {
             "binary.vtk",
             &[head("BINARY").into_bytes(), be(v), b"\n".to_vec()].concat(),
         ),
+        // As VTK 1.0 wrote it (a blank line after the title, ASPECT_RATIO, no component count),
+        // with what later versions and hand edits add: keywords in lower case, comment lines,
+        // cell data first, a FIELD and a METADATA block before the scalars, vectors after.
+        write(
+            dir,
+            "version1.vtk",
+            format!(
+                "# vtk DataFile Version 1.0\nold volume\n\nASCII\n\ndataset structured_points\n\
+                 # made by hand\ndimensions 20 16 12\naspect_ratio 1 1.5 2.5\norigin 0 0 0\n\n\
+                 CELL_DATA 3135\nscalars cells float\nlookup_table default\n{}\n\
+                 point_data 3840\nFIELD extra 2\nmask 1 3840 unsigned_char\n{}\n\
+                 METADATA\nINFORMATION 0\n\nrgb 3 3840 float\n{}\n\
+                 scalars density unsigned_short\nLOOKUP_TABLE default\n{}\n\
+                 VECTORS flow float\n{}\n",
+                "1 ".repeat(19 * 15 * 11),
+                "0 ".repeat(3840),
+                "0.5 ".repeat(3 * 3840),
+                ascii(v),
+                "0 ".repeat(3 * 3840),
+            )
+            .as_bytes(),
+        ),
+        // Binary, with a field array of another type before the scalars and one after.
+        write(
+            dir,
+            "binary-field.vtk",
+            &[
+                b"# vtk DataFile Version 5.1\nt\nBINARY\nDATASET STRUCTURED_POINTS\n\
+                  DIMENSIONS 20 16 12\nSPACING 1 1.5 2.5\nORIGIN 0 0 0\nPOINT_DATA 3840\n\
+                  FIELD FieldData 1\ntemperature 1 3840 double\n"
+                    .to_vec(),
+                vec![0x40; 8 * 3840],
+                b"\nSCALARS density unsigned_short 1\nLOOKUP_TABLE default\n".to_vec(),
+                be(v),
+                b"\nNORMALS n float\n".to_vec(),
+                vec![0; 12 * 3840],
+                b"\n".to_vec(),
+            ]
+            .concat(),
+        ),
     ]
 }
 
@@ -287,7 +327,7 @@ fn every_format_renders_the_same_image() {
     files.extend(vtk(&d, &v));
     files.extend(metaimage(&d, &v));
     files.extend(nifti(&d, &v));
-    assert_eq!(files.len(), 20);
+    assert_eq!(files.len(), 22);
     for f in &files {
         let name = f.file_name().unwrap().to_str().unwrap();
         let img = render(&[f.to_str().unwrap(), "--view", "30,20,0"], &out);
@@ -483,4 +523,84 @@ mod nrrd {
     pub fn aligned(d: &std::path::Path) -> std::path::PathBuf {
         super::write(d, "aligned.nhdr", b"NRRD0004\ntype: uint16\ndimension: 3\nsizes: 20 16 12\nspacings: 1 1.5 2.5\nendian: little\nencoding: raw\ndata file: v.raw\n")
     }
+}
+
+/// A data file is read for exactly the bytes its header declares: an endless device (`/dev/zero`)
+/// and a file with trailing bytes load; `byte skip: -1` on a device (whose end is unknowable) is
+/// an error; `--array` names a VTK file's array and lists them when the name is wrong.
+#[test]
+fn data_files_are_read_to_the_declared_size_only() {
+    use footprint_harness::io::formats;
+    let d = tmpdir("declared-size");
+    if Path::new("/dev/zero").exists() {
+        let nhdr = write(
+            &d,
+            "zero.nhdr",
+            b"NRRD0004\ntype: uint16\ndimension: 3\nsizes: 64 64 64\nendian: little\n\
+              encoding: raw\nbyte skip: 100\ndata file: /dev/zero\n",
+        );
+        let v = formats::load(&nhdr, None).unwrap();
+        assert_eq!(
+            (v.dims, v.value(0), v.value(v.len() - 1)),
+            ([64; 3], 0.0, 0.0)
+        );
+        let mhd = write(
+            &d,
+            "zero.mhd",
+            b"NDims = 3\nDimSize = 32 32 32\nElementType = MET_FLOAT\nElementDataFile = /dev/zero\n",
+        );
+        assert_eq!(formats::load(&mhd, None).unwrap().dims, [32; 3]);
+        let tail = write(
+            &d,
+            "tail.nhdr",
+            b"NRRD0004\ntype: uint8\ndimension: 3\nsizes: 4 4 4\nencoding: raw\nbyte skip: -1\n\
+              data file: /dev/zero\n",
+        );
+        let msg = formats::load(&tail, None).unwrap_err().message;
+        assert!(msg.contains("regular file"), "{msg}");
+        // The CLI renders it (a constant volume needs a window).
+        let out = d.join("zero.png");
+        let args = [
+            "footprint",
+            "render",
+            nhdr.to_str().unwrap(),
+            "--window",
+            "0,1",
+        ];
+        let mut args: Vec<&str> = args.to_vec();
+        args.extend(["--size", "32x32", "--out", out.to_str().unwrap()]);
+        assert_eq!(footprint_harness::run(args), 0);
+    }
+    // Trailing bytes after attached and detached samples: read up to the samples, then stopped.
+    let v = samples();
+    let mut attached =
+        b"NRRD0004\ntype: uint16\ndimension: 3\nsizes: 20 16 12\nendian: little\nencoding: raw\n\n"
+            .to_vec();
+    attached.extend(le(&v));
+    attached.extend([9u8; 1000]);
+    let a = write(&d, "trailing.nrrd", &attached);
+    let loaded = formats::load(&a, None).unwrap();
+    assert_eq!(loaded.value(3839), f32::from(v[3839]));
+    // --array picks, and a wrong name lists the arrays.
+    let files = vtk(&d, &v);
+    let old = &files[2];
+    let mask = formats::load_array(old, None, Some("mask")).unwrap();
+    assert_eq!((mask.dims, mask.value(7)), (DIMS, 0.0));
+    let msg = formats::load_array(old, None, Some("nope"))
+        .unwrap_err()
+        .message;
+    for name in ["mask", "rgb", "density"] {
+        assert!(msg.contains(name), "{msg}");
+    }
+    let msg = formats::load_array(old, None, Some("rgb"))
+        .unwrap_err()
+        .message;
+    assert!(msg.contains("3 components"), "{msg}");
+    let t = formats::load_array(&files[3], None, Some("temperature")).unwrap();
+    assert_eq!(t.value(0), f64::from_be_bytes([0x40; 8]) as f32);
+    let msg = formats::load_array(&a, None, Some("density"))
+        .unwrap_err()
+        .message;
+    assert!(msg.contains("--array"), "{msg}");
+    std::fs::remove_dir_all(&d).unwrap();
 }

@@ -256,6 +256,30 @@ fn cases(dir: &Path) -> Vec<Case> {
         dir,
     ));
 
+    // An NRRD whose detached data file is an endless stream (/dev/zero) for a 64³ volume: the
+    // documented success — exactly the declared 256 KiB are read, never to the end.
+    let endless = write(
+        "endless.nhdr",
+        b"NRRD0004\ntype: uint8\ndimension: 3\nsizes: 64 64 64\nencoding: raw\ndata file: /dev/zero\n",
+    );
+    c.push(Case {
+        name: "NRRD with data file /dev/zero (endless): reads 64³ bytes and renders",
+        args: args(&[
+            "render",
+            &endless,
+            "--window",
+            "0,1",
+            "--size",
+            "64x64",
+            "--out",
+            "endless.png",
+        ]),
+        stdin: None,
+        expect: Expect::Renders,
+        gone: vec![],
+        before: vec![],
+    });
+
     // A valid 8³ NIfTI followed by 3 GiB of zeros in the same gzip stream: the documented
     // success — trailing data are ignored and never inflated.
     let bomb = write("trailing.nii.gz", &nifti_gz_with_trailing_zeros(3 << 30));
@@ -311,7 +335,7 @@ fn cases(dir: &Path) -> Vec<Case> {
         c.push(refused(
             "FIFO as a detached data file",
             &["render", &nhdr, "--out", "out.png"],
-            "not a regular file",
+            "FIFO or socket",
             dir,
         ));
         c.push(refused(

@@ -233,9 +233,14 @@ impl From<OrderArg> for Order {
 /// Every flag of `render` (and of `verify`, which takes them all).
 #[derive(Args, Debug, Clone)]
 pub struct RenderArgs {
-    /// Volume: .nrrd/.nhdr, .vti, .vtk, .mhd/.mha, .nii/.nii.gz, or headerless raw with --dims and
-    /// --type. Omitted: the built-in electron-density scene.
+    /// Volume: .nrrd/.nhdr, .vti, .vtk, .mhd/.mha, .nii/.nii.gz, a NIfTI or Analyze pair
+    /// (.hdr + .img, either may be .gz), or headerless raw with --dims and --type. Omitted: the
+    /// built-in electron-density scene.
     pub volume: Option<PathBuf>,
+    /// VTK files (.vtk, .vti) with several point-data arrays: the one to render, by name (default:
+    /// the active scalars). A name the file lacks is an error that lists the file's arrays.
+    #[arg(long, value_name = "NAME")]
+    pub array: Option<String>,
     /// Image size, WxH pixels.
     #[arg(long, default_value = "512x512", value_parser = parse_size)]
     pub size: (usize, usize),

@@ -133,3 +133,80 @@ pub fn read_prefix(path: &Path, limit: usize) -> Result<Vec<u8>, CliError> {
         .map_err(|e| CliError::input(format!("{}: cannot read: {e}", path.display())))?;
     Ok(out)
 }
+
+/// A data file a header names, opened for reading exactly the bytes the header declares.
+pub struct DataFile {
+    /// Buffered reader at the file's start.
+    pub reader: std::io::BufReader<std::fs::File>,
+    /// The length, for a regular file; `None` for a device (e.g. `/dev/zero`), which may be endless.
+    pub len: Option<u64>,
+}
+
+/// Opens the data file of a header (NRRD `data file:`, MetaImage `ElementDataFile`, a NIfTI pair's
+/// `.img`). Unlike [`regular_file_len`], a character or block device is accepted: it is read for
+/// exactly the bytes the header declares and never to its end, so an endless stream such as
+/// `/dev/zero` costs only the volume. A directory, a FIFO or a socket (whose `open` blocks until
+/// a writer appears, perhaps forever) and a terminal are refused up front, before anything is read.
+pub fn open_data(path: &Path) -> Result<DataFile, CliError> {
+    use std::io::IsTerminal;
+    use std::os::unix::fs::FileTypeExt;
+    let meta = std::fs::metadata(path)
+        .map_err(|e| CliError::input(format!("{}: cannot read: {e}", path.display())))?;
+    let ft = meta.file_type();
+    if ft.is_dir() {
+        return Err(CliError::input(format!(
+            "{}: is a directory, expected a data file",
+            path.display()
+        )));
+    }
+    if ft.is_fifo() || ft.is_socket() {
+        return Err(CliError::input(format!(
+            "{}: a FIFO or socket — refused up front, as opening it blocks until a writer appears; \
+             pipe raw data through standard input with --stream - instead",
+            path.display()
+        )));
+    }
+    let file = std::fs::File::open(path)
+        .map_err(|e| CliError::input(format!("{}: cannot read: {e}", path.display())))?;
+    if file.is_terminal() {
+        return Err(CliError::input(format!(
+            "{}: a terminal, not a data file",
+            path.display()
+        )));
+    }
+    Ok(DataFile {
+        reader: std::io::BufReader::new(file),
+        len: ft.is_file().then_some(meta.len()),
+    })
+}
+
+/// Reads exactly `n` bytes from `r` (memory grows as they arrive, see [`read_growing`]); fewer is
+/// an error naming `what` and how many arrived. Nothing past the `n`th byte is read.
+pub fn read_exactly(r: impl std::io::Read, n: u64, what: &str) -> Result<Vec<u8>, String> {
+    let out = read_growing(r, n, what).map_err(|e| {
+        if e.kind() == std::io::ErrorKind::OutOfMemory {
+            e.to_string()
+        } else {
+            format!("cannot read: {e}")
+        }
+    })?;
+    if (out.len() as u64) < n {
+        return Err(format!(
+            "{what} are truncated: expected {n} bytes, found {}",
+            out.len()
+        ));
+    }
+    Ok(out)
+}
+
+/// Says on stderr that `extra` bytes after a volume's samples were ignored (nothing if none): the
+/// volume still renders (readers stop at the declared size, as VTK's and teem's do), but a header
+/// whose sizes are too small shows rather than rendering silently wrong.
+pub fn note_trailing(path: &Path, extra: u64) {
+    if extra > 0 {
+        eprintln!(
+            "footprint: note: {}: {extra} bytes after the samples the header declares are ignored",
+            path.display()
+        );
+    }
+}

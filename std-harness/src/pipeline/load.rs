@@ -83,7 +83,7 @@ pub(crate) fn load_voxels(args: &RenderArgs) -> Result<Loaded, CliError> {
     let Some(stream) = &args.stream else {
         let (volume, name) = match &args.volume {
             Some(path) => (
-                formats::load(path, raw.as_ref())?,
+                formats::load_array(path, raw.as_ref(), args.array.as_deref())?,
                 path.display().to_string(),
             ),
             None => (

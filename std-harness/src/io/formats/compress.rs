@@ -39,8 +39,91 @@ pub fn gunzip(bytes: &[u8], expected: usize) -> Result<Vec<u8>, String> {
     inflate(GzDecoder::new(bytes), expected, "gzip")
 }
 
+/// Inflates a gzip stream (members back to back, as `gzip` concatenates them) read from `r` as it
+/// inflates, to exactly `expected` bytes (more is an error, found one byte past them); the
+/// compressed input is read only as far as that.
+pub fn gunzip_stream(r: impl std::io::BufRead, expected: usize) -> Result<Vec<u8>, String> {
+    inflate(flate2::bufread::MultiGzDecoder::new(r), expected, "gzip")
+}
+
+/// Inflates a zlib stream read from `r` as it inflates, to exactly `expected` bytes (more is an
+/// error, found one byte past them).
+pub fn unzlib_stream(r: impl std::io::BufRead, expected: usize) -> Result<Vec<u8>, String> {
+    inflate(flate2::bufread::ZlibDecoder::new(r), expected, "zlib")
+}
+
 /// Inflates a zlib stream that must decompress to exactly `expected` bytes (more is an error,
 /// found after inflating one byte past them).
 pub fn unzlib(bytes: &[u8], expected: usize) -> Result<Vec<u8>, String> {
     inflate(ZlibDecoder::new(bytes), expected, "zlib")
+}
+
+/// Decodes an LZ4 *block* (no frame: what VTK's `vtkLZ4DataCompressor` writes, one per data
+/// block) into exactly `expected` bytes. The output buffer is the declared size, so a block that
+/// would decode to more is an error, not an allocation.
+pub fn unlz4(bytes: &[u8], expected: usize) -> Result<Vec<u8>, String> {
+    let mut out = crate::io::try_vec::<u8>(expected, "the decoded LZ4 data")?;
+    out.resize(expected, 0);
+    let n = lz4_flex::block::decompress_into(bytes, &mut out)
+        .map_err(|e| format!("corrupt LZ4 data: {e}"))?;
+    if n != expected {
+        return Err(format!(
+            "LZ4 data decompress to {n} bytes, expected {expected}"
+        ));
+    }
+    Ok(out)
+}
+
+/// A sink that keeps at most `limit` bytes and fails on the byte after: bounds what a decoder
+/// writing into it can make memory hold.
+struct Capped {
+    out: Vec<u8>,
+    limit: usize,
+}
+
+impl std::io::Write for Capped {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        if self.out.len() + buf.len() > self.limit {
+            return Err(std::io::Error::other("more data than declared"));
+        }
+        self.out.try_reserve(buf.len()).map_err(|_| {
+            std::io::Error::new(
+                std::io::ErrorKind::OutOfMemory,
+                crate::io::alloc_failed(self.out.len() + buf.len(), "the decoded data"),
+            )
+        })?;
+        self.out.extend_from_slice(buf);
+        Ok(buf.len())
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+/// Decodes an `.xz` stream (what VTK's `vtkLZMADataCompressor` writes: liblzma's "easy" encoder,
+/// CRC-64 check) into exactly `expected` bytes. Output past `expected` stops the decoder at once.
+pub fn unxz(bytes: &[u8], expected: usize) -> Result<Vec<u8>, String> {
+    let mut sink = Capped {
+        out: Vec::new(),
+        limit: expected,
+    };
+    let mut input = bytes;
+    if let Err(e) = lzma_rs::xz_decompress(&mut input, &mut sink) {
+        return Err(match e {
+            lzma_rs::error::Error::IoError(e) if e.kind() == std::io::ErrorKind::OutOfMemory => {
+                e.to_string()
+            }
+            lzma_rs::error::Error::IoError(e) if e.to_string() == "more data than declared" => {
+                format!("LZMA data decompress to more than {expected} bytes")
+            }
+            e => format!("corrupt LZMA data: {e}"),
+        });
+    }
+    if sink.out.len() != expected {
+        return Err(format!(
+            "LZMA data decompress to {} bytes, expected {expected}",
+            sink.out.len()
+        ));
+    }
+    Ok(sink.out)
 }

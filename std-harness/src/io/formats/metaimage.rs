@@ -6,7 +6,6 @@
 use super::{compress, numbers};
 use crate::io::volume::{at, byte_len, check_spacing, decode, SampleType, Volume, AXIS_ALIGNED};
 use crate::CliError;
-use std::borrow::Cow;
 use std::path::{Path, PathBuf};
 
 /// A parsed MetaImage header.
@@ -147,51 +146,69 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
     })
 }
 
-/// Where the data are and their bytes: the detached data file's (read whole), or the part of the
-/// header file after the header (borrowed, not copied).
-fn data_bytes<'a>(
-    path: &Path,
-    h: &Header,
-    file: &'a [u8],
-) -> Result<(PathBuf, Cow<'a, [u8]>), CliError> {
-    Ok(match &h.data_file {
-        Some(name) => {
-            let source = path.parent().unwrap_or(Path::new(".")).join(name);
-            let bytes = crate::io::read_file(&source)?;
-            (source, Cow::Owned(bytes))
-        }
-        None => (path.to_path_buf(), Cow::Borrowed(&file[h.header_len..])),
-    })
-}
-
 /// Loads a MetaImage volume.
+///
+/// The data (after the header, or in `ElementDataFile`) are read as a stream for exactly the
+/// bytes the header declares (`HeaderSize` bytes skipped, then the samples, or a zlib stream
+/// inflated to exactly them); what follows is never read, so a larger or endless data file costs
+/// only the volume. `HeaderSize = -1` (the data are the file's last bytes) needs a regular file.
 pub fn load(path: &Path) -> Result<Volume, CliError> {
+    use std::io::Read;
     let bytes = crate::io::read_file(path)?;
     let h = parse_header(&bytes).map_err(|e| at(path, e))?;
-    let (source, all) = data_bytes(path, &h, &bytes)?;
+    let (source, mut reader, len): (PathBuf, Box<dyn std::io::BufRead>, Option<u64>) =
+        match &h.data_file {
+            Some(name) => {
+                let source = path.parent().unwrap_or(Path::new(".")).join(name);
+                let d = crate::io::open_data(&source)?;
+                (source, Box::new(d.reader), d.len)
+            }
+            None => {
+                let data = &bytes[h.header_len..];
+                (path.to_path_buf(), Box::new(data), Some(data.len() as u64))
+            }
+        };
     let err = |e: String| at(&source, e);
     let need = byte_len(h.dims, h.ty).map_err(err)?;
-    let body: Cow<[u8]> = if h.compressed {
-        let skip = usize::try_from(h.header_size).unwrap_or(0);
-        Cow::Owned(compress::unzlib(all.get(skip..).unwrap_or(&[]), need).map_err(err)?)
+    let short = |found: u64| {
+        err(format!(
+            "expected {need} bytes of {}x{}x{} {:?}, found {found}",
+            h.dims[0], h.dims[1], h.dims[2], h.ty
+        ))
+    };
+    let skip = if h.header_size == -1 && !h.compressed {
+        let len = len.ok_or_else(|| {
+            err(
+                "HeaderSize = -1 (data at the end of the file) needs a regular file, whose \
+                 length is known"
+                    .into(),
+            )
+        })?;
+        len.checked_sub(need as u64).ok_or_else(|| short(len))?
     } else {
-        let body = if h.header_size == -1 {
-            all.len().checked_sub(need).map(|s| &all[s..])
-        } else {
-            all.get(h.header_size as usize..)
+        u64::try_from(h.header_size).unwrap_or(0)
+    };
+    let got = std::io::copy(&mut (&mut reader).take(skip), &mut std::io::sink())
+        .map_err(|e| err(format!("cannot read: {e}")))?;
+    if got < skip {
+        return Err(err(format!(
+            "HeaderSize {skip} is past the end of the data ({got} bytes)"
+        )));
+    }
+    if let Some(extra) = len.and_then(|l| l.checked_sub(skip + need as u64)) {
+        if !h.compressed {
+            crate::io::note_trailing(&source, extra);
         }
-        .unwrap_or(&[]);
-        if body.len() != need {
-            return Err(err(format!(
-                "expected {need} bytes of {}x{}x{} {:?}, found {}",
-                h.dims[0],
-                h.dims[1],
-                h.dims[2],
-                h.ty,
-                body.len()
-            )));
-        }
-        Cow::Borrowed(body)
+    }
+    let body = if h.compressed {
+        compress::unzlib_stream(reader, need).map_err(err)?
+    } else {
+        crate::io::read_exactly(reader, need as u64, "the samples").map_err(|e| {
+            err(format!(
+                "{}x{}x{} {:?} = {need} bytes: {e}",
+                h.dims[0], h.dims[1], h.dims[2], h.ty
+            ))
+        })?
     };
     Ok(Volume {
         dims: h.dims,

@@ -8,7 +8,7 @@
 //! | `.vti` | [`vti`] |
 //! | `.vtk` | [`vtk`] |
 //! | `.mhd`, `.mha` | [`metaimage`] |
-//! | `.nii`, `.nii.gz` | [`nifti`] |
+//! | `.nii`, `.nii.gz`, `.hdr` + `.img` / `.img.gz` | [`nifti`] (NIfTI-1, NIfTI-2, Analyze 7.5) |
 //! | anything, with `--dims --type` | [`raw`] |
 
 pub mod compress;
@@ -117,11 +117,11 @@ pub fn raw_data_at(path: &Path, h: RawHeader<'_>) -> Result<Streamable, CliError
 }
 
 /// The formats by extension, for messages.
-pub const EXTENSIONS: &str =
-    ".nrrd, .nhdr, .vti, .vtk, .mhd, .mha, .nii, .nii.gz, or raw with --dims and --type";
+pub const EXTENSIONS: &str = ".nrrd, .nhdr, .vti, .vtk, .mhd, .mha, .nii, .nii.gz, .hdr/.img \
+     (NIfTI or Analyze pair, either half may be .gz), or raw with --dims and --type";
 
 /// The format `path`'s extension names, if it is one with a header (NRRD, VTK XML image data,
-/// legacy VTK, MetaImage, NIfTI-1); `None` for anything else (raw data, unknown).
+/// legacy VTK, MetaImage, NIfTI); `None` for anything else (raw data, unknown).
 pub fn header_format(path: &Path) -> Option<&'static str> {
     let name = path
         .file_name()
@@ -133,16 +133,44 @@ pub fn header_format(path: &Path) -> Option<&'static str> {
         "vti" => Some("VTK XML image data"),
         "vtk" => Some("legacy VTK"),
         "mhd" | "mha" => Some("MetaImage"),
-        "nii" => Some("NIfTI-1"),
-        "gz" if name.ends_with(".nii.gz") => Some("NIfTI-1"),
+        "nii" | "hdr" => Some("NIfTI"),
+        "gz" if name.ends_with(".nii.gz") || name.ends_with(".hdr.gz") => Some("NIfTI"),
+        // An image file is half of a pair only if its header is beside it; alone it is raw data.
+        "img" | "gz" if has_pair_header(path) => Some("NIfTI"),
         _ => None,
     }
 }
 
+/// Whether `path` is a `.img` / `.img.gz` with its pair's `.hdr` beside it.
+fn has_pair_header(path: &Path) -> bool {
+    let lower = path.to_string_lossy().to_ascii_lowercase();
+    (lower.ends_with(".img") || lower.ends_with(".img.gz"))
+        && nifti::pair_paths(path).is_some_and(|(hdr, _)| hdr.is_file())
+}
+
 /// Loads `path` by its extension; `raw` options (from `--dims`/`--type`) make it headerless raw.
 pub fn load(path: &Path, raw: Option<&raw::RawOptions>) -> Result<Volume, CliError> {
+    load_array(path, raw, None)
+}
+
+/// [`load`], rendering the point-data array named `array` of a VTK file (`.vtk`, `.vti`); other
+/// formats hold one array, and naming one is an error.
+pub fn load_array(
+    path: &Path,
+    raw: Option<&raw::RawOptions>,
+    array: Option<&str>,
+) -> Result<Volume, CliError> {
     // Before the extension decides anything: a directory or a special file is named as such.
     crate::io::regular_file_len(path)?;
+    let vtk = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("vtk") || e.eq_ignore_ascii_case("vti"));
+    if array.is_some() && (raw.is_some() || !vtk) {
+        return Err(at(
+            path,
+            "--array picks one of several arrays in a VTK file (.vtk, .vti); this format holds one",
+        ));
+    }
     if let Some(o) = raw {
         return raw::load(path, o);
     }
@@ -154,11 +182,12 @@ pub fn load(path: &Path, raw: Option<&raw::RawOptions>) -> Result<Volume, CliErr
     let ext = name.rsplit('.').next().unwrap_or("");
     match ext {
         "nrrd" | "nhdr" => nrrd::load(path),
-        "vti" => vti::load(path),
-        "vtk" => vtk::load(path),
+        "vti" => vti::load(path, array),
+        "vtk" => vtk::load(path, array),
         "mhd" | "mha" => metaimage::load(path),
-        "nii" => nifti::load(path),
-        "gz" if name.ends_with(".nii.gz") => nifti::load(path),
+        "nii" | "hdr" => nifti::load(path),
+        "gz" if name.ends_with(".nii.gz") || name.ends_with(".hdr.gz") => nifti::load(path),
+        "img" | "gz" if has_pair_header(path) => nifti::load(path),
         _ => Err(at(
             path,
             format!("unknown volume format (use {EXTENSIONS})"),

@@ -12,6 +12,7 @@ use crate::io::volume::{
     at, byte_len, check_spacing, decode, decode_ascii, SampleType, Volume, AXIS_ALIGNED,
 };
 use crate::CliError;
+use std::io::{BufRead, Read};
 use std::path::{Path, PathBuf};
 
 /// How the data are encoded.
@@ -190,17 +191,44 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
     })
 }
 
-/// Skips `n` lines of `data`.
-fn skip_lines(data: &[u8], n: usize) -> Result<&[u8], String> {
-    let mut rest = data;
+/// Longest run of bytes `line skip` may pass over, in all (16 MiB): a data file without line
+/// breaks (e.g. an endless device) is an error after this much, not a read without end.
+const LINE_SKIP_LIMIT: u64 = 16 << 20;
+
+/// Skips `n` lines of `r`; returns the bytes skipped.
+fn skip_lines(r: &mut impl BufRead, n: usize) -> Result<u64, String> {
+    let mut skipped = 0u64;
     for i in 0..n {
-        let p = rest
-            .iter()
-            .position(|&b| b == b'\n')
-            .ok_or_else(|| format!("line skip: the data have only {i} lines"))?;
-        rest = &rest[p + 1..];
+        let mut line = Vec::new();
+        let got = (&mut *r)
+            .take(LINE_SKIP_LIMIT - skipped)
+            .read_until(b'\n', &mut line)
+            .map_err(|e| format!("cannot read: {e}"))?;
+        skipped += got as u64;
+        if line.last() != Some(&b'\n') {
+            return Err(if skipped >= LINE_SKIP_LIMIT {
+                format!(
+                    "line skip: no end of line {} within {LINE_SKIP_LIMIT} bytes",
+                    i + 1
+                )
+            } else {
+                format!("line skip: the data have only {i} lines")
+            });
+        }
     }
-    Ok(rest)
+    Ok(skipped)
+}
+
+/// Passes over exactly `n` bytes of `r`; fewer is an error.
+fn skip_bytes(r: &mut impl Read, n: u64) -> Result<(), String> {
+    let got = std::io::copy(&mut r.take(n), &mut std::io::sink())
+        .map_err(|e| format!("cannot read: {e}"))?;
+    if got < n {
+        return Err(format!(
+            "byte skip {n} is past the end of the data ({got} bytes)"
+        ));
+    }
+    Ok(())
 }
 
 /// The file holding the data and the header's view of it.
@@ -212,53 +240,75 @@ fn data_source(path: &Path, h: &Header) -> PathBuf {
 }
 
 /// Loads an NRRD volume.
+///
+/// The data (attached after the header, or in the detached `data file`) are read as a stream, for
+/// exactly the bytes the header declares: `line skip` lines, `byte skip` bytes, then the samples;
+/// whatever follows is never read, so a larger or endless data file (e.g. `/dev/zero`) costs only
+/// the volume. `byte skip: -1` (the data are the file's last bytes) needs a length, so a regular
+/// file. Gzip data are inflated as they are read, and must inflate to exactly what the header
+/// declares (more is an error, found one byte past it).
 pub fn load(path: &Path) -> Result<Volume, CliError> {
     let bytes = crate::io::read_file(path)?;
     let h = parse_header(&bytes).map_err(|e| at(path, e))?;
     let source = data_source(path, &h);
-    let file_bytes;
-    let all: &[u8] = if h.data_file.is_some() {
-        file_bytes = crate::io::read_file(&source)?;
-        &file_bytes
+    let (mut reader, len): (Box<dyn BufRead>, Option<u64>) = if h.data_file.is_some() {
+        let d = crate::io::open_data(&source)?;
+        (Box::new(d.reader), d.len)
     } else {
-        &bytes[h.header_len..]
+        let data = &bytes[h.header_len..];
+        (Box::new(data), Some(data.len() as u64))
     };
     let err = |e: String| at(&source, e);
     let need = byte_len(h.dims, h.ty).map_err(err)?;
     let count = need / h.ty.size();
+    let skipped = skip_lines(&mut reader, h.line_skip).map_err(err)?;
     let samples = match h.encoding {
         Encoding::Raw => {
-            let data = skip_lines(all, h.line_skip).map_err(err)?;
-            let body = if h.byte_skip == -1 {
-                data.len().checked_sub(need).map(|s| &data[s..])
-            } else {
-                usize::try_from(h.byte_skip)
-                    .ok()
-                    .and_then(|s| data.get(s..))
+            let skip =
+                if h.byte_skip == -1 {
+                    let len = len.ok_or_else(|| {
+                    err("byte skip -1 (data at the end of the file) needs a regular file, whose \
+                         length is known"
+                        .into())
+                })?;
+                    len.checked_sub(skipped + need as u64).ok_or_else(|| {
+                        err(format!(
+                            "header says {}x{}x{} {:?} = {need} bytes, the data have {}",
+                            h.dims[0],
+                            h.dims[1],
+                            h.dims[2],
+                            h.ty,
+                            len - skipped
+                        ))
+                    })?
+                } else {
+                    u64::try_from(h.byte_skip).unwrap_or(0)
+                };
+            skip_bytes(&mut reader, skip).map_err(err)?;
+            let body =
+                crate::io::read_exactly(&mut reader, need as u64, "the samples").map_err(|e| {
+                    err(format!(
+                        "header says {}x{}x{} {:?} = {need} bytes: {e}",
+                        h.dims[0], h.dims[1], h.dims[2], h.ty
+                    ))
+                })?;
+            if let Some(extra) = len.and_then(|l| l.checked_sub(skipped + skip + need as u64)) {
+                crate::io::note_trailing(&source, extra);
             }
-            .unwrap_or(&[]);
-            if body.len() != need {
-                return Err(err(format!(
-                    "header says {}x{}x{} {:?} = {need} bytes, the data have {}",
-                    h.dims[0],
-                    h.dims[1],
-                    h.dims[2],
-                    h.ty,
-                    body.len()
-                )));
-            }
-            decode(body, h.ty, h.big_endian).map_err(err)?
+            decode(&body, h.ty, h.big_endian).map_err(err)?
         }
         Encoding::Gzip => {
-            let data = skip_lines(all, h.line_skip).map_err(err)?;
             // Byte skip applies to the decompressed stream.
             let skip = usize::try_from(h.byte_skip).unwrap_or(0);
-            let inflated = compress::gunzip(data, need + skip).map_err(err)?;
+            let inflated = compress::gunzip_stream(reader, need + skip).map_err(err)?;
             decode(&inflated[skip..], h.ty, h.big_endian).map_err(err)?
         }
         Encoding::Ascii => {
-            let data = skip_lines(all, h.line_skip).map_err(err)?;
-            decode_ascii(data, h.ty, count).map_err(err)?
+            // A number and its separator take at most 64 bytes of sensible text.
+            let limit = len.unwrap_or((count as u64).saturating_mul(64));
+            let text = crate::io::read_growing(reader, limit, "the text")
+                .map_err(|e| err(compress::read_error(e, "text")))?;
+            decode_ascii(&text, h.ty, count).map_err(err)?
         }
     };
     Ok(Volume {

@@ -1,5 +1,6 @@
 //! VTK XML ImageData (`.vti`): one piece, point data, one component; `format` ascii, binary
-//! (base64 inline) or appended (raw or base64); uncompressed or `vtkZLibDataCompressor`; header
+//! (base64 inline) or appended (raw or base64); uncompressed or compressed by any of VTK 9's three
+//! compressors (`vtkZLibDataCompressor`, `vtkLZ4DataCompressor`, `vtkLZMADataCompressor`); header
 //! type UInt32 or UInt64; either byte order; `Spacing` and `Direction` (row-major) give the grid.
 
 use super::{compress, numbers};
@@ -51,8 +52,21 @@ pub struct Header {
     pub ty: SampleType,
     pub big_endian: bool,
     pub header64: bool,
-    pub zlib: bool,
+    pub compressor: Compressor,
     pub format: Format,
+}
+
+/// How each data block is compressed (the `compressor` attribute of `VTKFile`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Compressor {
+    /// No `compressor` attribute: one header word (the byte count), then the data.
+    None,
+    /// `vtkZLibDataCompressor`: a zlib stream per block.
+    Zlib,
+    /// `vtkLZ4DataCompressor`: an LZ4 block (no frame) per block.
+    Lz4,
+    /// `vtkLZMADataCompressor`: an `.xz` stream per block.
+    Lzma,
 }
 
 /// Where the array's data are.
@@ -165,6 +179,15 @@ pub fn check_depth(xml: &str, limit: usize) -> Result<(), String> {
 
 /// Parses the XML of a `.vti` (the appended section, if any, is returned separately).
 pub fn parse_header(bytes: &[u8]) -> Result<(Header, Option<Appended<'_>>), String> {
+    parse_header_array(bytes, None)
+}
+
+/// [`parse_header`], choosing the point-data array named `array` (default: the `Scalars`
+/// attribute's, else the first); a name the file lacks is an error listing its arrays.
+pub fn parse_header_array<'a>(
+    bytes: &'a [u8],
+    array: Option<&str>,
+) -> Result<(Header, Option<Appended<'a>>), String> {
     let (xml, appended) = split_appended(bytes)?;
     check_depth(&xml, MAX_XML_DEPTH)?;
     let doc = roxmltree::Document::parse(&xml).map_err(|e| format!("not valid XML: {e}"))?;
@@ -186,12 +209,15 @@ pub fn parse_header(bytes: &[u8]) -> Result<(Header, Option<Appended<'_>>), Stri
         Some("UInt32") | None => false,
         Some(o) => return Err(format!("header_type: '{o}' is not UInt32 or UInt64")),
     };
-    let zlib = match root.attribute("compressor") {
-        None | Some("") => false,
-        Some("vtkZLibDataCompressor") => true,
+    let compressor = match root.attribute("compressor") {
+        None | Some("") => Compressor::None,
+        Some("vtkZLibDataCompressor") => Compressor::Zlib,
+        Some("vtkLZ4DataCompressor") => Compressor::Lz4,
+        Some("vtkLZMADataCompressor") => Compressor::Lzma,
         Some(o) => {
             return Err(format!(
-                "compressor: '{o}' is not supported (vtkZLibDataCompressor only)"
+                "compressor: '{o}' is not one of VTK's (vtkZLibDataCompressor, \
+                 vtkLZ4DataCompressor, vtkLZMADataCompressor)"
             ))
         }
     };
@@ -250,11 +276,25 @@ pub fn parse_header(bytes: &[u8]) -> Result<(Header, Option<Appended<'_>>), Stri
         .children()
         .filter(|n| n.has_tag_name("DataArray"))
         .collect();
-    let array = match point_data.attribute("Scalars") {
-        Some(name) => arrays.iter().find(|a| a.attribute("Name") == Some(name)),
-        None => arrays.first(),
-    }
-    .ok_or("PointData has no scalar DataArray")?;
+    let names = || {
+        arrays
+            .iter()
+            .map(|a| a.attribute("Name").unwrap_or("(unnamed)"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let array = match (array, point_data.attribute("Scalars")) {
+        (Some(name), _) => arrays
+            .iter()
+            .find(|a| a.attribute("Name") == Some(name))
+            .ok_or_else(|| format!("no point-data array '{name}' (the file has: {})", names()))?,
+        (None, Some(name)) => arrays
+            .iter()
+            .find(|a| a.attribute("Name") == Some(name))
+            .or(arrays.first())
+            .ok_or("PointData has no scalar DataArray")?,
+        (None, None) => arrays.first().ok_or("PointData has no scalar DataArray")?,
+    };
     let comps = array.attribute("NumberOfComponents").unwrap_or("1");
     if comps != "1" {
         return Err(format!(
@@ -306,7 +346,7 @@ pub fn parse_header(bytes: &[u8]) -> Result<(Header, Option<Appended<'_>>), Stri
             ty,
             big_endian,
             header64,
-            zlib,
+            compressor,
             format,
         },
         appended,
@@ -332,7 +372,7 @@ fn word(b: &[u8], i: usize, h: &Header) -> Result<usize, String> {
 /// bytes.
 fn block_stream(b: &[u8], h: &Header, need: usize) -> Result<Vec<u8>, String> {
     let size = if h.header64 { 8 } else { 4 };
-    if !h.zlib {
+    if h.compressor == Compressor::None {
         let n = word(b, 0, h)?;
         if n != need {
             return Err(format!(
@@ -372,7 +412,11 @@ fn block_stream(b: &[u8], h: &Header, need: usize) -> Result<Vec<u8>, String> {
             .get(at..at.checked_add(c).ok_or("block size overflows")?)
             .ok_or("compressed data are truncated")?;
         let expect = if k + 1 == blocks { last } else { block_size };
-        let block = compress::unzlib(chunk, expect)?;
+        let block = match h.compressor {
+            Compressor::Lz4 => compress::unlz4(chunk, expect)?,
+            Compressor::Lzma => compress::unxz(chunk, expect)?,
+            _ => compress::unzlib(chunk, expect)?,
+        };
         out.try_reserve(block.len())
             .map_err(|_| crate::io::alloc_failed(out.len() + block.len(), "the inflated data"))?;
         out.extend(block);
@@ -381,10 +425,11 @@ fn block_stream(b: &[u8], h: &Header, need: usize) -> Result<Vec<u8>, String> {
     Ok(out)
 }
 
-/// Loads a `.vti` volume.
-pub fn load(path: &Path) -> Result<Volume, CliError> {
+/// Loads a `.vti` volume: the point-data array named `array`, or the default (see
+/// [`parse_header_array`]).
+pub fn load(path: &Path, array: Option<&str>) -> Result<Volume, CliError> {
     let bytes = crate::io::read_file(path)?;
-    let (h, appended) = parse_header(&bytes).map_err(|e| at(path, e))?;
+    let (h, appended) = parse_header_array(&bytes, array).map_err(|e| at(path, e))?;
     let need = byte_len(h.dims, h.ty).map_err(|e| at(path, e))?;
     let err = |e: String| at(path, e);
     let samples = match &h.format {
