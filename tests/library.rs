@@ -103,10 +103,11 @@ fn memory_volume_errors_are_typed() {
     );
 }
 
-/// The helper is the CLI's `--view` convention: at zero angles +i runs right and +j down; the
-/// fitted box fills 90 % of the tighter side; azimuth 90° turns +k to the right.
+/// `View::from_angles` (the core's own turntable convention, kept for library users): at zero
+/// angles +i runs right and +j down; the fitted box fills 90 % of the tighter side; azimuth 90°
+/// turns +k to the right.
 #[test]
-fn view_from_angles_is_the_cli_convention() {
+fn view_from_angles_is_the_turntable_convention() {
     let grid = Grid::from_spacing([1.0, 1.0, 1.0]).unwrap();
     let v = View::from_angles([0.0; 3], 1.0, [10, 20, 5], &grid, [200, 100]).unwrap();
     let m = v.to_screen();
@@ -114,10 +115,147 @@ fn view_from_angles_is_the_cli_convention() {
     assert!((m.x_axis.x - 4.5).abs() < 1e-5 && m.x_axis.y.abs() < 1e-6);
     assert!((m.y_axis.y - 4.5).abs() < 1e-5 && m.y_axis.x.abs() < 1e-6);
     let v = View::from_angles([90.0, 0.0, 0.0], 2.0, [10, 10, 10], &grid, [100, 100]).unwrap();
-    let m = v.to_screen();
-    let k_on_screen = m.z_axis;
-    assert!(k_on_screen.x.abs() > 0.99 * k_on_screen.length(), "{m:?}");
-    // The harness builds its views with it: same matrix for the same flags.
+    let k_on_screen = v.to_screen().z_axis;
+    assert!(k_on_screen.x.abs() > 0.99 * k_on_screen.length());
+    assert!(View::from_angles([0.0; 3], 0.0, [2; 3], &grid, [8, 8]).is_err());
+    assert!(View::from_angles([f32::NAN, 0.0, 0.0], 1.0, [2; 3], &grid, [8, 8]).is_err());
+    assert!(View::from_angles([0.0; 3], 1.0, [0, 2, 2], &grid, [8, 8]).is_err());
+    // glam is the core's own, re-exported.
+    let _: footprint::glam::Mat3 = m;
+}
+
+/// Rotation of `v` by `deg` degrees about `axis` (right-handed; VTK's `RotateWXYZ`), in f64.
+fn rotate(v: [f64; 3], axis: [f64; 3], deg: f64) -> [f64; 3] {
+    let n = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
+    let k = axis.map(|a| a / n);
+    let (s, c) = deg.to_radians().sin_cos();
+    let dot = k[0] * v[0] + k[1] * v[1] + k[2] * v[2];
+    let cross = [
+        k[1] * v[2] - k[2] * v[1],
+        k[2] * v[0] - k[0] * v[2],
+        k[0] * v[1] - k[1] * v[0],
+    ];
+    [0, 1, 2].map(|i| v[i] * c + cross[i] * s + k[i] * dot * (1.0 - c))
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn unit(a: [f64; 3]) -> [f64; 3] {
+    let n = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+    a.map(|x| x / n)
+}
+
+/// vtkCamera, step by step as VTK 9 does it (focal point at the origin): position (0, 0, 1),
+/// view-up +y; `Azimuth` turns the position about view-up; `Elevation` turns it about minus the
+/// first row of the view transform and restores view-up; `Roll` turns view-up about the
+/// direction of projection; `SetupCamera` builds the rows sideways = up × n, orthoUp = n ×
+/// sideways, n (n = position − focal point). Returns the rows of the world-to-screen rotation
+/// (x right, y down, z away: sideways, −orthoUp, −n).
+fn vtk_camera(az: f64, el: f64, roll: f64) -> [[f64; 3]; 3] {
+    let rows = |pos: [f64; 3], up: [f64; 3]| {
+        let n = unit(pos);
+        let side = unit(cross(up, n));
+        (side, cross(n, side), n)
+    };
+    let up = [0.0, 1.0, 0.0];
+    let pos = rotate([0.0, 0.0, 1.0], up, az);
+    let (side, _, _) = rows(pos, up);
+    let pos = rotate(pos, side.map(|x| -x), el);
+    let dop = unit(pos).map(|x| -x);
+    let up = rotate(up, dop, roll);
+    let (side, ortho, n) = rows(pos, up);
+    [side, ortho.map(|x| -x), n.map(|x| -x)]
+}
+
+/// `--view AZ,EL,ROLL` is VTK's camera: the core's `View::from_vtk_camera` equals VTK's
+/// operations done step by step in f64 (above) for angles all round, elevations past ±90°
+/// included; the fit is ResetCamera's (the bounding sphere of the voxel centres fits the shorter
+/// image side); ParaView's six direction buttons look where they say; the CLI builds the same.
+#[test]
+fn view_is_vtks_camera() {
+    let grid = Grid::from_spacing([1.0, 1.0, 1.0]).unwrap();
+    // Defaults: +i right, +j up (screen y down is −j), looking along −k.
+    let m = View::from_vtk_camera([0.0; 3], 1.0, [10, 20, 5], &grid, [200, 100])
+        .unwrap()
+        .to_screen();
+    // Bounds 9 × 19 × 4: radius √458 / 2; the image's shorter side is 100 px.
+    let s = 100.0 / 458f32.sqrt();
+    assert!((m.x_axis.x - s).abs() < 1e-4, "{m:?}");
+    assert!((m.y_axis.y + s).abs() < 1e-4, "{m:?}");
+    assert!((m.z_axis.z + s).abs() < 1e-4, "{m:?}");
+    // Tall images fit the width (VTK divides the parallel scale by the aspect).
+    let tall = View::from_vtk_camera([0.0; 3], 2.0, [10, 20, 5], &grid, [80, 300]).unwrap();
+    assert!((tall.to_screen().x_axis.x - 2.0 * 80.0 / 458f32.sqrt()).abs() < 1e-4);
+    let mut worst = 0.0f64;
+    for az in (-180..=180).step_by(35) {
+        for el in (-175..=175).step_by(25) {
+            for roll in [-120.0, 0.0, 33.0, 90.0] {
+                let (az, el) = (f64::from(az), f64::from(el));
+                let want = vtk_camera(az, el, roll);
+                let m = View::from_vtk_camera(
+                    [az as f32, el as f32, roll as f32],
+                    1.0,
+                    [2, 2, 2],
+                    &grid,
+                    [10, 10],
+                )
+                .unwrap()
+                .to_screen();
+                // Bounds 1 × 1 × 1: radius √3 / 2, 10 px: 10 / √3 px per unit.
+                let m = m * (3f32.sqrt() / 10.0);
+                for (r, row) in want.iter().enumerate() {
+                    for (c, w) in row.iter().enumerate() {
+                        let got = f64::from(m.col(c)[r]);
+                        worst = worst.max((got - w).abs());
+                    }
+                }
+            }
+        }
+    }
+    assert!(worst < 1e-5, "worst entry differs by {worst}");
+    // ParaView's buttons: the direction of projection and the up vector they set.
+    for (name, dop, up) in [
+        ("+x", [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]),
+        ("-x", [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]),
+        ("+y", [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]),
+        ("-y", [0.0, -1.0, 0.0], [0.0, 0.0, 1.0]),
+        ("+z", [0.0, 0.0, 1.0], [0.0, 1.0, 0.0]),
+        ("-z", [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]),
+    ] {
+        let args =
+            footprint_harness::args::parse_args(&["--view", name, "--size", "64x48"]).unwrap();
+        let via_cli = footprint_harness::pipeline::prepare::view_for(&args, [10, 20, 5], &grid)
+            .unwrap()
+            .to_screen();
+        let want = View::looking(
+            footprint::glam::Vec3::from_array(dop),
+            footprint::glam::Vec3::from_array(up),
+            1.0,
+            [10, 20, 5],
+            &grid,
+            [64, 48],
+        )
+        .unwrap()
+        .to_screen();
+        assert!(
+            via_cli.abs_diff_eq(want, 1e-5),
+            "{name}: {via_cli:?} vs {want:?}"
+        );
+        // Screen z is the direction of projection, screen y (down) is minus up.
+        let inv = via_cli.transpose();
+        assert!(inv
+            .z_axis
+            .normalize()
+            .abs_diff_eq(footprint::glam::Vec3::from_array(dop), 1e-5));
+        assert!((-inv.y_axis.normalize()).abs_diff_eq(footprint::glam::Vec3::from_array(up), 1e-5));
+    }
+    // The CLI's angles build the core's view.
     let args = footprint_harness::args::parse_args(&[
         "--view", "30,20,10", "--zoom", "1.5", "--size", "64x48",
     ])
@@ -125,15 +263,14 @@ fn view_from_angles_is_the_cli_convention() {
     let via_cli = footprint_harness::pipeline::prepare::view_for(&args, [10, 20, 5], &grid)
         .unwrap()
         .to_screen();
-    let direct = View::from_angles([30.0, 20.0, 10.0], 1.5, [10, 20, 5], &grid, [64, 48])
+    let direct = View::from_vtk_camera([30.0, 20.0, 10.0], 1.5, [10, 20, 5], &grid, [64, 48])
         .unwrap()
         .to_screen();
     assert_eq!(via_cli, direct);
-    assert!(View::from_angles([0.0; 3], 0.0, [2; 3], &grid, [8, 8]).is_err());
-    assert!(View::from_angles([f32::NAN, 0.0, 0.0], 1.0, [2; 3], &grid, [8, 8]).is_err());
-    assert!(View::from_angles([0.0; 3], 1.0, [0, 2, 2], &grid, [8, 8]).is_err());
-    // glam is the core's own, re-exported.
-    let _: footprint::glam::Mat3 = m;
+    assert!(View::from_vtk_camera([0.0; 3], 0.0, [2; 3], &grid, [8, 8]).is_err());
+    assert!(View::from_vtk_camera([f32::NAN, 0.0, 0.0], 1.0, [2; 3], &grid, [8, 8]).is_err());
+    assert!(View::from_vtk_camera([0.0; 3], 1.0, [0, 2, 2], &grid, [8, 8]).is_err());
+    assert!(footprint_harness::args::parse_args(&["--view", "+w"]).is_err());
 }
 
 #[test]

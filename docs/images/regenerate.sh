@@ -20,9 +20,17 @@ while IFS='|' read -r name cmd; do
   "$fp" "$@" --out "$out/$name" >/dev/null
 done <<LIST
 default-scene.png|render
-headsq-phong.png|render $data/headsq_64x64x93_int16_le.nhdr --tf ct-bone-skin --shading phong --view 0,90,180
-headsq-iso.png|render $data/headsq_64x64x93_int16_le.nhdr --tf ct-bone-skin --shading iso:1900 --view 30,100,180
-heart-texture.png|render $data/heart_32x32x12_float32_le.nhdr --tf density --shading texture --view 30,20,0
+headsq-phong.png|render $data/headsq_64x64x93_int16_le.nhdr --tf ct-bone-skin --shading phong --view 180,-90,0
+headsq-iso.png|render $data/headsq_64x64x93_int16_le.nhdr --tf ct-bone-skin --shading iso:1900 --view -30,-80,180
+heart-texture.png|render $data/heart_32x32x12_float32_le.nhdr --tf density --shading texture --view 150,-20,180
+view-+x.png|render $data/headsq_64x64x93_int16_le.nhdr --tf ct-bone-skin --shading phong --size 160x160 --view +x
+view--x.png|render $data/headsq_64x64x93_int16_le.nhdr --tf ct-bone-skin --shading phong --size 160x160 --view -x
+view-+y.png|render $data/headsq_64x64x93_int16_le.nhdr --tf ct-bone-skin --shading phong --size 160x160 --view +y
+view--y.png|render $data/headsq_64x64x93_int16_le.nhdr --tf ct-bone-skin --shading phong --size 160x160 --view -y
+view-+z.png|render $data/headsq_64x64x93_int16_le.nhdr --tf ct-bone-skin --shading phong --size 160x160 --view +z
+view--z.png|render $data/headsq_64x64x93_int16_le.nhdr --tf ct-bone-skin --shading phong --size 160x160 --view -z
+paraview-preset.png|render $data/headsq_64x64x93_int16_le.nhdr --tf docs/presets/ct-warm.json --shading phong --view 180,-90,0 --size 256x256
+cool-to-warm.png|render $data/headsq_64x64x93_int16_le.nhdr --tf 'Cool to Warm' --view 30,20,0 --size 256x256
 splat-gaussian-60-30-30.png|splat --spacing 60,30,30 --rotate-z 30 --rotate-x 20 --table 65
 splat-bilinear-sheared.png|splat --kernel bilinear --spacing 40,40,40 --rotate-x 40 --rotate-y 35 --table 65
 splat-bilinear-sheared-paper.png|splat --kernel bilinear --spacing 40,40,40 --rotate-x 40 --rotate-y 35 --table 65 --method paper

@@ -145,6 +145,27 @@ pub fn parse_list<const N: usize>(s: &str) -> Result<[f32; N], String> {
     Ok(out)
 }
 
+/// ParaView's view-direction buttons as (azimuth, elevation, roll) of [`parse_view`]'s camera:
+/// "+x" looks along +x with +z up, and so on; ±z keep +y up.
+pub const VIEW_DIRECTIONS: [(&str, [f32; 3]); 6] = [
+    ("+x", [-90.0, 0.0, 90.0]),
+    ("-x", [90.0, 0.0, -90.0]),
+    ("+y", [0.0, -90.0, 0.0]),
+    ("-y", [0.0, 90.0, 180.0]),
+    ("+z", [180.0, 0.0, 0.0]),
+    ("-z", [0.0, 0.0, 0.0]),
+];
+
+/// Parses `--view`: `AZ,EL,ROLL` in degrees, or one of ParaView's directions
+/// ([`VIEW_DIRECTIONS`]).
+pub fn parse_view(s: &str) -> Result<[f32; 3], String> {
+    let t = s.trim().to_ascii_lowercase();
+    if let Some((_, a)) = VIEW_DIRECTIONS.iter().find(|(n, _)| *n == t) {
+        return Ok(*a);
+    }
+    parse_list::<3>(s).map_err(|e| format!("{e} (or one of +x, -x, +y, -y, +z, -z)"))
+}
+
 /// Parses `X,Y,Z` voxel spacing: three positive finite numbers (world units).
 pub fn parse_spacing(s: &str) -> Result<[f32; 3], String> {
     let v = parse_list::<3>(s)?;
@@ -244,10 +265,13 @@ pub struct RenderArgs {
     /// Image size, WxH pixels.
     #[arg(long, default_value = "512x512", value_parser = parse_size)]
     pub size: (usize, usize),
-    /// View angles AZ,EL,ROLL in degrees (see the module docs).
-    #[arg(long, default_value = "0,0,0", value_parser = parse_list::<3>, allow_hyphen_values = true)]
+    /// VTK/ParaView camera AZ,EL,ROLL in degrees: from ParaView's default (on +z looking toward
+    /// −z, +y up), Azimuth(AZ), Elevation(EL), Roll(ROLL); or a view-direction button of
+    /// ParaView's: +x, -x, +y, -y (+z up), +z, -z (+y up). See the README's "Camera".
+    #[arg(long, default_value = "0,0,0", value_parser = parse_view, allow_hyphen_values = true)]
     pub view: [f32; 3],
-    /// Multiplies the zoom that fits the volume into the image.
+    /// Multiplies the zoom that fits the volume's bounding sphere into the image (VTK's
+    /// ResetCamera).
     #[arg(long, default_value_t = 1.0, value_parser = parse_positive)]
     pub zoom: f32,
     /// Explicit world-to-screen matrix, nine numbers row-major, pixels per world unit (overrides

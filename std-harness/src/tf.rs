@@ -2,6 +2,8 @@
 //! reads. Control points are `t r g b a` with t ∈ [0, 1] the position in the value window, colour
 //! straight (not premultiplied), a the opacity of a slab one reference distance thick.
 
+pub mod paraview;
+
 use crate::CliError;
 use std::path::Path;
 
@@ -78,21 +80,34 @@ pub fn parse_points(text: &str, name: &str) -> Result<Vec<[f32; 5]>, CliError> {
     Ok(points)
 }
 
-/// Resolves `--tf`: a preset name or a control-point file.
+/// Resolves `--tf`: a preset name (ours, or ParaView's built-in ones, see [`crate::paraview`]), a
+/// ParaView preset file (`.json`; `FILE.json#NAME` picks a preset by name from a file of several),
+/// or a control-point file.
 pub fn load(spec: &str) -> Result<Vec<[f32; 5]>, CliError> {
     if let Some(p) = preset(spec) {
         return Ok(p);
     }
-    let path = Path::new(spec);
+    if let Some(p) = paraview::builtin_points(spec) {
+        return Ok(p);
+    }
+    let (file, want) = match spec.rsplit_once('#') {
+        Some((f, n)) if f.to_ascii_lowercase().ends_with(".json") => (f, Some(n)),
+        _ => (spec, None),
+    };
+    let path = Path::new(file);
     if !path.exists() {
         return Err(CliError::input(format!(
-            "--tf '{spec}': not a preset ({}) nor a file",
-            PRESETS.join(", ")
+            "--tf '{spec}': not a preset ({}; ParaView's {}) nor a file",
+            PRESETS.join(", "),
+            paraview::BUILTINS.join(", ")
         )));
     }
     let bytes = crate::io::read_file(path)?;
     let text =
-        String::from_utf8(bytes).map_err(|_| CliError::input(format!("{spec}: not text")))?;
+        String::from_utf8(bytes).map_err(|_| CliError::input(format!("{file}: not text")))?;
+    if file.to_ascii_lowercase().ends_with(".json") {
+        return paraview::parse_json(&text, file, want);
+    }
     parse_points(&text, spec)
 }
 

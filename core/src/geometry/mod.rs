@@ -265,6 +265,104 @@ impl View {
         View::new(r * (fit * zoom))
     }
 
+    /// The view of VTK's and ParaView's camera, as the CLI's `--view AZ,EL,ROLL` builds it: the
+    /// camera starts on +z looking toward −z with +y up (ParaView's default view), then
+    /// `vtkCamera::Azimuth(azimuth)` turns its position about the view-up vector,
+    /// `Elevation(elevation)` about its right axis (positive raises it toward view-up) and
+    /// `Roll(roll)` turns view-up about the direction of projection (degrees, right-handed, as
+    /// VTK's `RotateWXYZ`). As in VTK, Elevation keeps the original view-up, which the view then
+    /// orthogonalises: past ±90° of elevation the picture stays upright (the camera flips over),
+    /// and at exactly ±90° (where VTK's view is undefined) the up vector is the limit from below.
+    /// See [`View::looking`] for the fit.
+    pub fn from_vtk_camera(
+        [azimuth, elevation, roll]: [f32; 3],
+        zoom: f32,
+        dims: [usize; 3],
+        grid: &Grid,
+        image: [usize; 2],
+    ) -> Result<Self, GeometryError> {
+        if !(azimuth.is_finite() && elevation.is_finite() && roll.is_finite()) {
+            return Err(GeometryError::NonFinite);
+        }
+        let rad = core::f32::consts::PI / 180.0;
+        let up0 = Vec3::Y;
+        // Azimuth: the position (relative to the focal point) about view-up.
+        let p1 = Mat3::from_axis_angle(up0, azimuth * rad) * Vec3::Z;
+        // Elevation: about −right, right = dop × up with dop = −position.
+        let right1 = (-p1).cross(up0).normalize();
+        let turn = Mat3::from_axis_angle(-right1, elevation * rad);
+        let dop = -(turn * p1);
+        // VTK restores the original view-up; the view uses its part orthogonal to dop.
+        let proj = up0 - dop * up0.dot(dop);
+        let up = if proj.length() > 1e-4 {
+            proj.normalize()
+        } else {
+            turn * up0
+        };
+        // Roll: view-up about the direction of projection.
+        let up = Mat3::from_axis_angle(dop, roll * rad) * up;
+        View::looking(dop, up, zoom, dims, grid, image)
+    }
+
+    /// The view looking along `direction` (world; into the screen) with `up` (world; need not be
+    /// orthogonal to `direction`, only not parallel) pointing up on the image: screen x is
+    /// direction × up (right), screen y is down, screen z is `direction`, as VTK's view transform
+    /// builds them. The scale is VTK's `ResetCamera` for a parallel projection: the sphere
+    /// around the bounds of the voxel centres (the axis-aligned box of the grid's corners, as VTK
+    /// bounds an oriented image; radius 0.5 for a single voxel) fits the image's shorter side,
+    /// i.e. `min(W, H) / (2 · radius)` pixels per world unit, times `zoom`.
+    pub fn looking(
+        direction: Vec3,
+        up: Vec3,
+        zoom: f32,
+        dims: [usize; 3],
+        grid: &Grid,
+        image: [usize; 2],
+    ) -> Result<Self, GeometryError> {
+        if !(zoom.is_finite() && zoom > 0.0) {
+            return Err(GeometryError::BadZoom { value: zoom });
+        }
+        if !(direction.is_finite() && up.is_finite()) {
+            return Err(GeometryError::NonFinite);
+        }
+        if dims.contains(&0) || image.contains(&0) {
+            return Err(GeometryError::EmptyFit);
+        }
+        let dop = direction.normalize_or_zero();
+        let right = dop.cross(up).normalize_or_zero();
+        if dop == Vec3::ZERO || right == Vec3::ZERO {
+            return Err(GeometryError::SingularView);
+        }
+        let up = right.cross(dop);
+        let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+        for corner in 0..8 {
+            let c = Vec3::new(
+                if corner & 1 == 0 {
+                    0.0
+                } else {
+                    (dims[0] - 1) as f32
+                },
+                if corner & 2 == 0 {
+                    0.0
+                } else {
+                    (dims[1] - 1) as f32
+                },
+                if corner & 4 == 0 {
+                    0.0
+                } else {
+                    (dims[2] - 1) as f32
+                },
+            );
+            let w = grid.to_world * c;
+            lo = lo.min(w);
+            hi = hi.max(w);
+        }
+        let diameter = (hi - lo).length();
+        let radius = if diameter > 0.0 { 0.5 * diameter } else { 0.5 };
+        let scale = image[0].min(image[1]) as f32 / (2.0 * radius) * zoom;
+        View::new(Mat3::from_cols(right, -up, dop).transpose() * scale)
+    }
+
     /// From nine entries in row-major order (m00, m01, m02, m10, …), as the CLI's `--view-matrix`.
     pub fn from_rows(m: [f32; 9]) -> Result<Self, GeometryError> {
         View::new(Mat3::from_cols_array(&m).transpose())

@@ -140,12 +140,12 @@ impl Prepared {
     }
 }
 
-/// The view for `--view`/`--zoom` (fitted to a volume of `dims` on `grid`, the core's
-/// [`View::from_angles`]) or `--view-matrix`.
+/// The view for `--view`/`--zoom` (VTK's camera fitted to a volume of `dims` on `grid`, the
+/// core's [`View::from_vtk_camera`]) or `--view-matrix` (exactly as given).
 pub fn view_for(args: &RenderArgs, dims: [usize; 3], grid: &Grid) -> Result<View, CliError> {
     let view = match args.view_matrix {
         Some(m) => View::from_rows(m).map_err(|e| CliError::input(format!("--view-matrix: {e}"))),
-        None => View::from_angles(args.view, args.zoom, dims, grid, [args.size.0, args.size.1])
+        None => View::from_vtk_camera(args.view, args.zoom, dims, grid, [args.size.0, args.size.1])
             .map_err(|e| CliError::input(format!("--view/--zoom: {e}"))),
     }?;
     Ok(view)
