@@ -2,14 +2,8 @@
 //! expected, exit code 2, no panic, and no output file left behind.
 
 use footprint_harness::io::formats;
-use std::path::{Path, PathBuf};
-
-fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("fp-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+use footprint_suite::tmpdir;
+use std::path::Path;
 
 /// (file name, contents, a word the message must contain).
 type Case = (&'static str, Vec<u8>, &'static str);

@@ -10,6 +10,7 @@ use flate2::Compression;
 use footprint::source::SheetSource;
 use footprint_harness::io::stream::{FileSource, Layout, PipeSource};
 use footprint_harness::io::volume::SampleType;
+use footprint_suite::tmpdir;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -276,13 +277,6 @@ fn nifti(dir: &Path, v: &[u16]) -> Vec<PathBuf> {
         write(dir, "plain.nii.gz", &gz(&plain)),
         write(dir, "scaled.nii", &scaled),
     ]
-}
-
-fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("fp-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
 }
 
 fn render(args: &[&str], out: &Path) -> Vec<u8> {

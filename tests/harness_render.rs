@@ -4,14 +4,8 @@
 use footprint_harness::io::formats::nrrd::load as load_nrrd;
 use footprint_harness::io::formats::raw::{load as raw_load, RawOptions};
 use footprint_harness::io::volume::{SampleType, Samples};
+use footprint_suite::tmpdir;
 use std::path::{Path, PathBuf};
-
-fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("fp-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 fn run(args: &[&str]) -> i32 {
     let mut v = vec!["footprint"];

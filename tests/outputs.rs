@@ -6,10 +6,7 @@ use footprint_harness::pipeline::prepare::{outside_data_warnings, parse_shading}
 use std::path::{Path, PathBuf};
 
 fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("fp-out-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    footprint_suite::tmpdir(&format!("out-{name}"))
 }
 
 fn run(args: &[&str]) -> i32 {

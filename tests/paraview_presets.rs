@@ -3,14 +3,7 @@
 //! one line on stderr, exit 2 and no output file.
 
 use footprint_harness::tf;
-use std::path::PathBuf;
-
-fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("fp-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+use footprint_suite::tmpdir;
 
 #[test]
 fn an_exported_preset_samples_to_its_points() {

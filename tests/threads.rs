@@ -5,14 +5,7 @@
 use footprint_harness::args::parse_args;
 use footprint_harness::pipeline::visible::FrameCache;
 use footprint_harness::pipeline::{prepare, render_frame};
-use std::path::PathBuf;
-
-fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("fp-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+use footprint_suite::tmpdir;
 
 /// The core's image of the built-in scene with `extra` flags on `threads` threads, as bits.
 fn image(extra: &[&str], threads: usize) -> Vec<[u32; 4]> {

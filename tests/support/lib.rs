@@ -169,3 +169,12 @@ pub fn render_with<P: footprint::render::Precision>(
     r.finish();
     img
 }
+
+/// An empty folder for one test, `fp-NAME-PID` in the system's temporary folder (emptied first if
+/// a killed run left it behind).
+pub fn tmpdir(name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("fp-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
