@@ -82,17 +82,19 @@ def main(out):
                     w.SetEncodeAppendedData(1 if mode == "appended-base64" else 0)
                 assert w.Write() == 1, name
                 add(name, "vtk.vtkXMLImageDataWriter")
-    for mode in ("binary", "ascii"):
+    def legacy(image, name, binary):
         w = vtk.vtkStructuredPointsWriter()
-        w.SetInputData(img)
-        name = f"vtk-legacy-{mode}.vtk"
+        w.SetInputData(image)
         w.SetFileName(name)
-        if mode == "binary":
+        if binary:
             w.SetFileTypeToBinary()
         else:
             w.SetFileTypeToASCII()
         assert w.Write() == 1, name
-        add(name, "vtk.vtkStructuredPointsWriter")
+
+    for mode in ("binary", "ascii"):
+        legacy(img, f"vtk-legacy-{mode}.vtk", mode == "binary")
+        add(f"vtk-legacy-{mode}.vtk", "vtk.vtkStructuredPointsWriter")
     # Several point-data arrays (scalars first, then field arrays): --array picks ours.
     multi = vtk.vtkImageData()
     multi.DeepCopy(img)
@@ -104,15 +106,8 @@ def main(out):
     multi.GetPointData().AddArray(vec)
     multi.GetPointData().AddArray(arr)
     for mode in ("binary", "ascii"):
-        w = vtk.vtkStructuredPointsWriter()
-        w.SetInputData(multi)
         name = f"vtk-legacy-{mode}-arrays.vtk"
-        w.SetFileName(name)
-        if mode == "binary":
-            w.SetFileTypeToBinary()
-        else:
-            w.SetFileTypeToASCII()
-        assert w.Write() == 1, name
+        legacy(multi, name, mode == "binary")
         add(name, "vtk.vtkStructuredPointsWriter, three arrays", array="density")
     w = vtk.vtkXMLImageDataWriter()
     w.SetInputData(multi)

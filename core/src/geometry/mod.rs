@@ -102,12 +102,14 @@ pub enum GeometryError {
         /// θ in degrees where it failed.
         theta_deg: f32,
     },
-    /// A zoom factor that is not a positive finite number ([`View::from_angles`]).
+    /// A zoom factor that is not a positive finite number ([`View::from_vtk_camera`],
+    /// [`View::looking`], [`View::from_angles`]).
     BadZoom {
         /// The value given.
         value: f32,
     },
-    /// Nothing to fit: a zero volume dimension or image side ([`View::from_angles`]).
+    /// Nothing to fit: a zero volume dimension or image side ([`View::from_vtk_camera`],
+    /// [`View::looking`], [`View::from_angles`]).
     EmptyFit,
 }
 
@@ -224,7 +226,8 @@ impl View {
         })
     }
 
-    /// The view the CLI's `--view AZ,EL,ROLL` and `--zoom` build, fitted to an image: rotation
+    /// A turntable view, fitted to an image (the CLI's `--view` before it took VTK's camera, see
+    /// [`View::from_vtk_camera`]; kept for library callers): rotation
     /// R = Rz(roll)·Rx(elevation)·Ry(azimuth) (degrees; azimuth turns the volume about the screen's
     /// vertical axis, elevation about its horizontal axis, roll about the view direction; all zero
     /// looks along +k with +i to the right and +j down), scaled so the volume's box (voxel centres

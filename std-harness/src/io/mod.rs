@@ -199,6 +199,20 @@ pub fn read_exactly(r: impl std::io::Read, n: u64, what: &str) -> Result<Vec<u8>
     Ok(out)
 }
 
+/// Passes over exactly `n` bytes of `r` (the header's field `what` says to skip them); fewer is
+/// an error.
+pub fn skip_exactly(r: &mut impl std::io::Read, n: u64, what: &str) -> Result<(), String> {
+    use std::io::Read;
+    let got = std::io::copy(&mut (&mut *r).take(n), &mut std::io::sink())
+        .map_err(|e| format!("cannot read: {e}"))?;
+    if got < n {
+        return Err(format!(
+            "{what} {n} is past the end of the data ({got} bytes)"
+        ));
+    }
+    Ok(())
+}
+
 /// Says on stderr that `extra` bytes after a volume's samples were ignored (nothing if none): the
 /// volume still renders (readers stop at the declared size, as VTK's and teem's do), but a header
 /// whose sizes are too small shows rather than rendering silently wrong.

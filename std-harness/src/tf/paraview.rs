@@ -308,19 +308,46 @@ fn mix(a: [f64; 3], b: [f64; 3], t: f64, space: &str) -> Result<[f64; 3], String
     })
 }
 
+/// Splits a flat list of `key` into points of four numbers (`fields` names them, for messages):
+/// at least two, with positions (the first number) that do not decrease.
+fn quads(v: &[f64], key: &str, fields: &str) -> Result<Vec<[f64; 4]>, String> {
+    if v.len() < 8 || !v.len().is_multiple_of(4) {
+        return Err(format!(
+            "{key}: {} numbers; expected {fields} for at least two points",
+            v.len()
+        ));
+    }
+    let p: Vec<[f64; 4]> = v.chunks(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
+    if p.windows(2).any(|w| w[1][0] < w[0][0]) {
+        return Err(format!("{key}: positions must not decrease"));
+    }
+    Ok(p)
+}
+
+/// The interval of `points` that holds `x`: the index j of its right end (the first point at or
+/// past `x`, the last if none is; 0 when `x` is at or before the first point) and the fraction
+/// t ∈ [0, 1] of the way from point j − 1 to j (1 for an interval of zero width; 0 when j = 0).
+fn locate(points: &[[f64; 4]], x: f64) -> (usize, f64) {
+    let j = points
+        .iter()
+        .position(|p| p[0] >= x)
+        .unwrap_or(points.len() - 1);
+    if j == 0 {
+        return (0, 0.0);
+    }
+    let (p, q) = (points[j - 1], points[j]);
+    let t = if q[0] > p[0] {
+        ((x - p[0]) / (q[0] - p[0])).clamp(0.0, 1.0)
+    } else {
+        1.0
+    };
+    (j, t)
+}
+
 /// Samples a preset's colours (`x r g b` quadruples) and opacities (`x a midpoint sharpness`)
 /// into [`LUT_SIZE`] control points over t ∈ [0, 1] (the colour range mapped onto the window).
 fn sample(rgb: &[f64], alpha: Option<&[f64]>, space: &str) -> Result<Vec<[f32; 5]>, String> {
-    if rgb.len() < 8 || !rgb.len().is_multiple_of(4) {
-        return Err(format!(
-            "RGBPoints: {} numbers; expected x r g b for at least two points",
-            rgb.len()
-        ));
-    }
-    let pts: Vec<[f64; 4]> = rgb.chunks(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
-    if pts.windows(2).any(|w| w[1][0] < w[0][0]) {
-        return Err("RGBPoints: positions must not decrease".into());
-    }
+    let pts = quads(rgb, "RGBPoints", "x r g b")?;
     if pts
         .iter()
         .any(|p| p[1..].iter().any(|c| !(0.0..=1.0).contains(c)))
@@ -331,19 +358,10 @@ fn sample(rgb: &[f64], alpha: Option<&[f64]>, space: &str) -> Result<Vec<[f32; 5
     if x1 <= x0 {
         return Err("RGBPoints: the positions span no range".into());
     }
-    let ops: Option<Vec<[f64; 4]>> = match alpha {
+    let ops = match alpha {
         None => None,
         Some(a) => {
-            if a.len() < 8 || !a.len().is_multiple_of(4) {
-                return Err(format!(
-                    "Points: {} numbers; expected x opacity midpoint sharpness for at least two points",
-                    a.len()
-                ));
-            }
-            let p: Vec<[f64; 4]> = a.chunks(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
-            if p.windows(2).any(|w| w[1][0] < w[0][0]) {
-                return Err("Points: positions must not decrease".into());
-            }
+            let p = quads(a, "Points", "x opacity midpoint sharpness")?;
             if p.iter().any(|q| !(0.0..=1.0).contains(&q[1])) {
                 return Err("Points: opacities must be in [0, 1]".into());
             }
@@ -351,32 +369,22 @@ fn sample(rgb: &[f64], alpha: Option<&[f64]>, space: &str) -> Result<Vec<[f32; 5
         }
     };
     let colour = |x: f64| -> Result<[f64; 3], String> {
-        let j = pts.iter().position(|p| p[0] >= x).unwrap_or(pts.len() - 1);
+        let (j, t) = locate(&pts, x);
         if j == 0 {
             return Ok([pts[0][1], pts[0][2], pts[0][3]]);
         }
         let (p, q) = (pts[j - 1], pts[j]);
-        let t = if q[0] > p[0] {
-            ((x - p[0]) / (q[0] - p[0])).clamp(0.0, 1.0)
-        } else {
-            1.0
-        };
         mix([p[1], p[2], p[3]], [q[1], q[2], q[3]], t, space)
     };
     let opacity = |x: f64| -> f64 {
         let Some(o) = &ops else {
             return ((x - x0) / (x1 - x0)).clamp(0.0, 1.0);
         };
-        let j = o.iter().position(|p| p[0] >= x).unwrap_or(o.len() - 1);
+        let (j, t) = locate(o, x);
         if j == 0 || x >= o[o.len() - 1][0] {
             return o[j][1];
         }
         let (p, q) = (o[j - 1], o[j]);
-        let t = if q[0] > p[0] {
-            ((x - p[0]) / (q[0] - p[0])).clamp(0.0, 1.0)
-        } else {
-            1.0
-        };
         // The interval's midpoint and sharpness are its left point's.
         let (m, sharp) = (p[2].clamp(1e-6, 1.0 - 1e-6), p[3]);
         let v = if sharp >= 0.99 {

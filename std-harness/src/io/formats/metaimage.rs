@@ -153,7 +153,6 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
 /// inflated to exactly them); what follows is never read, so a larger or endless data file costs
 /// only the volume. `HeaderSize = -1` (the data are the file's last bytes) needs a regular file.
 pub fn load(path: &Path) -> Result<Volume, CliError> {
-    use std::io::Read;
     let bytes = crate::io::read_file(path)?;
     let h = parse_header(&bytes).map_err(|e| at(path, e))?;
     let (source, mut reader, len): (PathBuf, Box<dyn std::io::BufRead>, Option<u64>) =
@@ -188,13 +187,7 @@ pub fn load(path: &Path) -> Result<Volume, CliError> {
     } else {
         u64::try_from(h.header_size).unwrap_or(0)
     };
-    let got = std::io::copy(&mut (&mut reader).take(skip), &mut std::io::sink())
-        .map_err(|e| err(format!("cannot read: {e}")))?;
-    if got < skip {
-        return Err(err(format!(
-            "HeaderSize {skip} is past the end of the data ({got} bytes)"
-        )));
-    }
+    crate::io::skip_exactly(&mut reader, skip, "HeaderSize").map_err(err)?;
     if let Some(extra) = len.and_then(|l| l.checked_sub(skip + need as u64)) {
         if !h.compressed {
             crate::io::note_trailing(&source, extra);

@@ -219,18 +219,6 @@ fn skip_lines(r: &mut impl BufRead, n: usize) -> Result<u64, String> {
     Ok(skipped)
 }
 
-/// Passes over exactly `n` bytes of `r`; fewer is an error.
-fn skip_bytes(r: &mut impl Read, n: u64) -> Result<(), String> {
-    let got = std::io::copy(&mut r.take(n), &mut std::io::sink())
-        .map_err(|e| format!("cannot read: {e}"))?;
-    if got < n {
-        return Err(format!(
-            "byte skip {n} is past the end of the data ({got} bytes)"
-        ));
-    }
-    Ok(())
-}
-
 /// The file holding the data and the header's view of it.
 fn data_source(path: &Path, h: &Header) -> PathBuf {
     match &h.data_file {
@@ -284,7 +272,7 @@ pub fn load(path: &Path) -> Result<Volume, CliError> {
                 } else {
                     u64::try_from(h.byte_skip).unwrap_or(0)
                 };
-            skip_bytes(&mut reader, skip).map_err(err)?;
+            crate::io::skip_exactly(&mut reader, skip, "byte skip").map_err(err)?;
             let body =
                 crate::io::read_exactly(&mut reader, need as u64, "the samples").map_err(|e| {
                     err(format!(

@@ -149,27 +149,33 @@ impl<'a> Words<'a> {
         }
     }
 
-    /// VTK 8+ writes an optional `METADATA` block after an array: its lines up to a blank one.
+    /// VTK 8+ writes an optional `METADATA` block after an array: passes it if it is next.
     fn skip_metadata(&mut self) {
         let save = self.pos;
         if self
             .word()
             .is_some_and(|w| w.eq_ignore_ascii_case("METADATA"))
         {
-            self.skip_line();
-            while self.pos < self.b.len() {
-                let end = self.b[self.pos..]
-                    .iter()
-                    .position(|&c| c == b'\n')
-                    .map_or(self.b.len(), |p| self.pos + p);
-                let blank = self.b[self.pos..end].iter().all(u8::is_ascii_whitespace);
-                self.pos = (end + 1).min(self.b.len());
-                if blank {
-                    break;
-                }
-            }
+            self.metadata_body();
         } else {
             self.pos = save;
+        }
+    }
+
+    /// Passes a `METADATA` block's body (the keyword read): the rest of its line, then lines up
+    /// to and including a blank one.
+    fn metadata_body(&mut self) {
+        self.skip_line();
+        while self.pos < self.b.len() {
+            let end = self.b[self.pos..]
+                .iter()
+                .position(|&c| c == b'\n')
+                .map_or(self.b.len(), |p| self.pos + p);
+            let blank = self.b[self.pos..end].iter().all(u8::is_ascii_whitespace);
+            self.pos = (end + 1).min(self.b.len());
+            if blank {
+                break;
+            }
         }
     }
 }
@@ -402,10 +408,7 @@ pub fn parse(bytes: &[u8], array: Option<&str>) -> Result<Header, String> {
                     });
                 }
             }
-            "METADATA" => {
-                w.pos -= word.len();
-                w.skip_metadata();
-            }
+            "METADATA" => w.metadata_body(),
             _ => {
                 return Err(format!("unexpected '{word}' (not a legacy VTK keyword)"));
             }
