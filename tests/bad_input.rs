@@ -483,9 +483,14 @@ fn a_huge_png_background_is_refused_before_decoding() {
         2
     );
     assert!(!out.exists());
-    let msg = footprint_harness::io::image::decode_png_rgba_sized(&png, "bg", (16, 16))
-        .unwrap_err()
-        .message;
+    let msg = footprint_harness::io::image::decode_png_rgba_sized(
+        &png,
+        "bg",
+        (16, 16),
+        Default::default(),
+    )
+    .unwrap_err()
+    .message;
     assert!(msg.contains("12000x12000"), "{msg}");
     eprintln!("refused in {:?}", start.elapsed());
     std::fs::remove_dir_all(&d).unwrap();
@@ -550,5 +555,75 @@ fn declared_sizes_do_not_reserve_memory_the_data_cannot_fill() {
     assert!(msg.contains("found 3"), "{msg}");
     let err = footprint_harness::io::try_filled(usize::MAX / 8, 0u64, "a test buffer").unwrap_err();
     assert!(err.message.contains("cannot allocate"), "{}", err.message);
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+/// The output options (issue 14): a style the output type cannot hold, a bad value, and a
+/// background that is not a usable PNG are each one line on stderr, exit 2, and no output file.
+#[test]
+fn output_options_fail_cleanly() {
+    let d = tmpdir("output-options");
+    let png = d.join("out.png");
+    let pfm = d.join("out.pfm");
+    let (p, f) = (png.to_str().unwrap(), pfm.to_str().unwrap());
+    let bg16 = d.join("bg16.png");
+    // A 16-bit RGBA background of the wrong size, and one cut short.
+    let img = vec![[0.5f32, 0.25, 0.0, 1.0]; 12 * 12];
+    let style = footprint_harness::io::image::PngStyle {
+        alpha: true,
+        sixteen: true,
+        ..Default::default()
+    };
+    let bytes = footprint_harness::io::image::encode_png(&img, 12, 12, style).unwrap();
+    std::fs::write(&bg16, &bytes).unwrap();
+    let cut = d.join("cut.png");
+    std::fs::write(&cut, &bytes[..bytes.len() - 20]).unwrap();
+    let (b16, c) = (bg16.to_str().unwrap(), cut.to_str().unwrap());
+    let r = d.join("ref.pfm");
+    for (args, out) in [
+        (vec!["--background", "transparent", "--out", f], f),
+        (vec!["--gamma", "srgb", "--out", f], f),
+        (vec!["--depth", "16", "--out", f], f),
+        (vec!["--depth", "12", "--out", p], p),
+        (vec!["--depth", "", "--out", p], p),
+        (vec!["--gamma", "rec709", "--out", p], p),
+        (vec!["--background", "", "--out", p], p),
+        (vec!["--background", "Transparent.png", "--out", p], p),
+        (vec!["--background", b16, "--size", "16x16", "--out", p], p),
+        (vec!["--background", c, "--size", "12x12", "--out", p], p),
+        (
+            vec![
+                "verify",
+                "--gamma",
+                "srgb",
+                "--size",
+                "12x12",
+                "--reference-out",
+                r.to_str().unwrap(),
+            ],
+            r.to_str().unwrap(),
+        ),
+        (
+            vec!["bench", "--frames", "1", "--depth", "16", "--out", f],
+            f,
+        ),
+    ] {
+        let args: Vec<&str> = if matches!(args[0], "verify" | "bench") {
+            args
+        } else {
+            [&["render"][..], &args].concat()
+        };
+        assert_eq!(
+            footprint_harness::run(std::iter::once("footprint").chain(args.iter().copied())),
+            2,
+            "{args:?}"
+        );
+        assert!(!Path::new(out).exists(), "{args:?} left an output");
+    }
+    // The same 16-bit background at the right size is used.
+    assert_eq!(
+        run(&["--background", b16, "--size", "12x12", "--out", p]),
+        0
+    );
     std::fs::remove_dir_all(&d).unwrap();
 }

@@ -231,3 +231,169 @@ fn leftovers_of_killed_runs_are_removed() {
     assert!(other.exists(), "another output's temporary was touched");
     std::fs::remove_dir_all(&d).unwrap();
 }
+
+/// A colour PFM's premultiplied RGB (rows top first).
+fn read_pfm_rgb(path: &Path) -> Vec<[f32; 3]> {
+    let bytes = std::fs::read(path).unwrap();
+    let mut lines = 0;
+    let mut at = 0;
+    while lines < 3 {
+        if bytes[at] == b'\n' {
+            lines += 1;
+        }
+        at += 1;
+    }
+    let head = std::str::from_utf8(&bytes[..at]).unwrap();
+    let dims: Vec<usize> = head
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split(' ')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    let px: Vec<[f32; 3]> = bytes[at..]
+        .chunks_exact(12)
+        .map(|c| {
+            let f = |k: usize| f32::from_le_bytes([c[k], c[k + 1], c[k + 2], c[k + 3]]);
+            [f(0), f(4), f(8)]
+        })
+        .collect();
+    // PFM stores rows bottom to top.
+    px.chunks(dims[0]).rev().flatten().copied().collect()
+}
+
+fn srgb_to_linear(v: f32) -> f32 {
+    if v <= 0.04045 {
+        v / 12.92
+    } else {
+        ((v + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// `--background transparent`, `--gamma srgb` and `--depth 16` write the same float render, each
+/// within its format's rounding: checked against the `.pfm` of the same render (exact floats).
+#[test]
+fn png_options_encode_the_float_render() {
+    let d = tmpdir("png-options");
+    let path = |n: &str| d.join(n).to_str().unwrap().to_string();
+    let render = |out: &str, extra: &[&str]| {
+        let mut args = vec![
+            "render", "--size", "40x40", "--view", "30,20,0", "--out", out,
+        ];
+        args.extend_from_slice(extra);
+        assert_eq!(run(&args), 0, "{args:?}");
+        let bytes = std::fs::read(out).unwrap();
+        (
+            bytes.clone(),
+            footprint_harness::io::image::decode_png_rgba(&bytes, out)
+                .unwrap()
+                .2,
+        )
+    };
+    assert_eq!(
+        run(&[
+            "render",
+            "--size",
+            "40x40",
+            "--view",
+            "30,20,0",
+            "--out",
+            &path("f.pfm")
+        ]),
+        0
+    );
+    let exact = read_pfm_rgb(&d.join("f.pfm"));
+    let clamp = |v: f32| v.clamp(0.0, 1.0);
+    let worst = |png: &[[f32; 4]], linear: &dyn Fn(f32, f32) -> f32| -> f32 {
+        png.iter()
+            .zip(&exact)
+            .flat_map(|(p, e)| (0..3).map(move |c| (linear(p[c], p[3]) - clamp(e[c])).abs()))
+            .fold(0.0, f32::max)
+    };
+    // Plain 8-bit RGB: half a level.
+    let (plain, px) = render(&path("plain.png"), &[]);
+    assert!(worst(&px, &|v, _| v) <= 0.5 / 255.0 + 1e-6);
+    // 16-bit RGB: half a 16-bit level.
+    let (wide, px) = render(&path("wide.png"), &["--depth", "16"]);
+    assert!(worst(&px, &|v, _| v) <= 0.5 / 65535.0 + 1e-6);
+    assert_eq!(wide[24], 16, "bit depth byte of IHDR");
+    // sRGB, 16-bit: the curve undone gives the linear values back; the file says it is sRGB.
+    let (srgb, px) = render(&path("srgb.png"), &["--gamma", "srgb", "--depth", "16"]);
+    assert!(
+        worst(&px, &|v, _| srgb_to_linear(v)) <= 2e-5,
+        "{}",
+        worst(&px, &|v, _| srgb_to_linear(v))
+    );
+    assert!(srgb.windows(4).any(|w| w == b"sRGB") && !plain.windows(4).any(|w| w == b"sRGB"));
+    // Transparent: RGBA (colour type 6) with straight alpha; premultiplied again (as the decoder
+    // does) it is the black-background render, within the rounding of both channels.
+    let (clear, px) = render(&path("clear.png"), &["--background", "transparent"]);
+    assert_eq!(clear[25], 6, "colour type byte of IHDR");
+    assert!(worst(&px, &|v, _| v) <= 1.0 / 255.0 + 1e-6);
+    let alphas: Vec<f32> = px.iter().map(|p| p[3]).collect();
+    assert_eq!(alphas[0], 0.0, "the corner is uncovered");
+    assert!(
+        alphas.iter().any(|&a| a > 0.0 && a < 1.0),
+        "coverage is partial somewhere"
+    );
+    // Straight alpha: a covered pixel's stored colour is its premultiplied colour over alpha.
+    let dim = px
+        .iter()
+        .zip(&exact)
+        .find(|(p, _)| p[3] > 0.2 && p[3] < 0.8)
+        .expect("a half-covered pixel");
+    let straight = dim.1[0] / dim.0[3];
+    assert!(
+        (dim.0[0] / dim.0[3] - straight).abs() < 3.0 / 255.0,
+        "{dim:?}"
+    );
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+/// Under `--gamma srgb`, a background PNG is read as sRGB: where the volume does not reach, the
+/// output's pixels are the background's, unchanged (8 and 16 bits).
+#[test]
+fn an_srgb_background_comes_back_unchanged() {
+    let d = tmpdir("srgb-background");
+    let bg = d.join("bg.png");
+    let out = d.join("o.png");
+    // A horizontal ramp, opaque.
+    let ramp: Vec<[f32; 4]> = (0..32 * 32)
+        .map(|i| {
+            let v = (i % 32) as f32 / 31.0;
+            [v, 0.5 * v, 1.0 - v, 1.0]
+        })
+        .collect();
+    std::fs::write(
+        &bg,
+        footprint_harness::io::image::encode_png_rgb(&ramp, 32, 32).unwrap(),
+    )
+    .unwrap();
+    let (b, o) = (bg.to_str().unwrap(), out.to_str().unwrap());
+    assert_eq!(
+        run(&[
+            "render",
+            "--size",
+            "32x32",
+            "--zoom",
+            "0.3",
+            "--background",
+            b,
+            "--gamma",
+            "srgb",
+            "--out",
+            o
+        ]),
+        0
+    );
+    let read = |p: &Path| {
+        footprint_harness::io::image::decode_png_rgba(&std::fs::read(p).unwrap(), "x")
+            .unwrap()
+            .2
+    };
+    let (before, after) = (read(&bg), read(&out));
+    // Row 0 is outside a volume zoomed to 0.3 of the fit.
+    assert_eq!(&before[..32], &after[..32]);
+    assert_ne!(before, after, "the volume shows in the middle");
+    std::fs::remove_dir_all(&d).unwrap();
+}

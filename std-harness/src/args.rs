@@ -49,6 +49,43 @@ pub enum AccumArg {
     Fixed,
 }
 
+/// What the volume is composited over (`--background`).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Background {
+    /// Black, opaque: the PNG is RGB, the premultiplied colour as it is (the default).
+    Black,
+    /// Nothing: the PNG is RGBA with straight alpha, the render's coverage.
+    Transparent,
+    /// A PNG of the output size, composited behind the volume (its alpha respected).
+    Image(PathBuf),
+}
+
+fn parse_background(s: &str) -> Result<Background, String> {
+    Ok(match s {
+        "black" => Background::Black,
+        "transparent" => Background::Transparent,
+        "" => return Err("expected black, transparent or a PNG file".into()),
+        path => Background::Image(PathBuf::from(path)),
+    })
+}
+
+/// The transfer curve of PNG colour values (see [`crate::io::image::Gamma`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum GammaArg {
+    /// Values as computed, no curve (VTK and ParaView's default).
+    Linear,
+    /// The sRGB curve, and an `sRGB` chunk.
+    Srgb,
+}
+
+fn parse_depth(s: &str) -> Result<u8, String> {
+    match s {
+        "8" => Ok(8),
+        "16" => Ok(16),
+        _ => Err(format!("'{s}' is not a PNG bit depth (expected 8 or 16)")),
+    }
+}
+
 /// The footprint flags `splat`, `render` and `verify` share.
 #[derive(clap::Args, Debug, Clone)]
 pub struct FootprintArgs {
@@ -313,9 +350,19 @@ pub struct RenderArgs {
     /// Shading: emission, phong, iso:VALUE (Levoy iso-surface at VALUE, data units), texture.
     #[arg(long, default_value = "emission")]
     pub shading: String,
-    /// Starting working image (PNG of the output size), composited behind the volume.
-    #[arg(long)]
-    pub background: Option<PathBuf>,
+    /// What the volume is composited over: `black` (an RGB PNG), `transparent` (an RGBA PNG
+    /// with straight alpha, the render's coverage; PNG output only) or a PNG file of the output
+    /// size (read with --gamma's curve; a file named `black` or `transparent` needs a `./`).
+    #[arg(long, default_value = "black", value_parser = parse_background)]
+    pub background: Background,
+    /// PNG colour values: `linear` writes them as computed, with no curve (VTK and ParaView's
+    /// default, so presets show the colours they show there; PSNR is measured on these values);
+    /// `srgb` treats them as linear light and applies the sRGB curve. PNG output only.
+    #[arg(long, value_enum, default_value_t = GammaArg::Linear)]
+    pub gamma: GammaArg,
+    /// PNG bits per sample: 8 or 16. PNG output only.
+    #[arg(long, default_value = "8", value_parser = parse_depth)]
+    pub depth: u8,
     /// Compositing direction (default back-to-front; a pipe's views impose theirs).
     #[arg(long, value_enum)]
     pub order: Option<OrderArg>,
@@ -339,8 +386,9 @@ pub struct RenderArgs {
     /// Raw volumes: spacing X,Y,Z in world units.
     #[arg(long, default_value = "1,1,1", value_parser = parse_spacing, allow_hyphen_values = true)]
     pub spacing: [f32; 3],
-    /// Output image: `.png` (8-bit RGB, linear premultiplied colour over the background, clamped)
-    /// or `.pfm` (float32 RGB, the same values unclamped); other extensions are refused. `render`
+    /// Output image: `.png` (RGB, the premultiplied colour over the background, clamped; RGBA
+    /// with --background transparent; see --gamma and --depth) or `.pfm` (float32 RGB, linear
+    /// values unclamped, over black or the background image); other extensions are refused. `render`
     /// defaults to footprint.png; `verify` writes one only if asked. Every output is checked
     /// before rendering, and none is written unless all are.
     #[arg(long)]
@@ -363,6 +411,31 @@ fn parse_dims(s: &str) -> Result<[usize; 3], String> {
 }
 
 impl RenderArgs {
+    /// How a PNG output is written: `--background transparent`, `--gamma`, `--depth`.
+    pub fn png_style(&self) -> crate::io::image::PngStyle {
+        crate::io::image::PngStyle {
+            alpha: self.background == Background::Transparent,
+            gamma: self.gamma_curve(),
+            sixteen: self.depth == 16,
+        }
+    }
+
+    /// `--gamma` as the image module's curve.
+    pub fn gamma_curve(&self) -> crate::io::image::Gamma {
+        match self.gamma {
+            GammaArg::Linear => crate::io::image::Gamma::Linear,
+            GammaArg::Srgb => crate::io::image::Gamma::Srgb,
+        }
+    }
+
+    /// The background image file, if `--background` names one.
+    pub fn background_file(&self) -> Option<&std::path::Path> {
+        match &self.background {
+            Background::Image(p) => Some(p),
+            _ => None,
+        }
+    }
+
     /// `--threads`, with 0 resolved to the number of cores.
     pub fn thread_count(&self) -> usize {
         match self.threads {

@@ -21,7 +21,7 @@
 //! - [`pipeline`]: the render pipeline the commands share.
 //! - [`args`]: argument structs and value parsers shared by several commands.
 //! - [`metrics`]: PSNR, RMSE, max error; max relative footprint difference.
-//! - [`reference`]: the f64, table-free footprint (exact line integrals) and renderer.
+//! - [`reference`](mod@reference): the f64, table-free footprint (exact line integrals) and renderer.
 //! - [`io`]: volume formats, streaming sources, images, tables, JSON (written atomically).
 //! - [`dispatch`]: runtime table size → const generic.
 

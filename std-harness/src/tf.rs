@@ -80,7 +80,7 @@ pub fn parse_points(text: &str, name: &str) -> Result<Vec<[f32; 5]>, CliError> {
     Ok(points)
 }
 
-/// Resolves `--tf`: a preset name (ours, or ParaView's built-in ones, see [`crate::paraview`]), a
+/// Resolves `--tf`: a preset name (ours, or ParaView's built-in ones, see [`crate::tf::paraview`]), a
 /// ParaView preset file (`.json`; `FILE.json#NAME` picks a preset by name from a file of several),
 /// or a control-point file.
 pub fn load(spec: &str) -> Result<Vec<[f32; 5]>, CliError> {

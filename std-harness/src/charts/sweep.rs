@@ -52,6 +52,7 @@ pub fn sweep(
         render_core_with(&p, &c.apply(base), c.accum)?;
     }
     let mut out = Vec::new();
+    let bar = crate::io::progress::Progress::new("chart", configs.len(), "configurations");
     for c in configs {
         let args = c.apply(base);
         let mut times = Vec::with_capacity(runs);
@@ -74,15 +75,18 @@ pub fn sweep(
             max_abs: overall.max_abs,
             pareto: false,
         };
-        crate::say!(
-            "{:<36} {:>8.3} s ({:.3}–{:.3})  {:>7.2} dB  max {:.2e}",
-            c.label(),
-            m.median_s,
-            m.min_s,
-            m.max_s,
-            m.psnr_db,
-            m.max_abs
-        );
+        bar.suspend(|| {
+            crate::say!(
+                "{:<36} {:>8.3} s ({:.3}–{:.3})  {:>7.2} dB  max {:.2e}",
+                c.label(),
+                m.median_s,
+                m.min_s,
+                m.max_s,
+                m.psnr_db,
+                m.max_abs
+            )
+        });
+        bar.step();
         out.push(m);
     }
     mark_pareto(&mut out);

@@ -57,6 +57,9 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
         ));
     }
     io::outputs::check_image_and_json(args.render.out.as_deref(), args.render.json.as_deref())?;
+    if let Some(out) = &args.render.out {
+        io::image::check_style(out, args.render.png_style())?;
+    }
     let mut p = prepare(&args.render)?;
     let (base, choice) = apply_quality(&p, &args.render)?;
     let mut cache = FrameCache::default();
@@ -116,7 +119,7 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
         let img = first_image.expect("frame 1 was rendered");
         files.push((
             out.as_path(),
-            io::image::encode_rgb_for(out, &img, base.size.0, base.size.1)?,
+            io::image::encode_rgb_for(out, &img, base.size.0, base.size.1, base.png_style())?,
         ));
     }
     if let Some(j) = &base.json {

@@ -1,8 +1,8 @@
 //! `footprint render`: a volume (or the built-in scene) rendered by the core, sheet by sheet, to a
-//! PNG (see [`crate::pipeline::prepare`] for the view conventions).
+//! PNG (see [`crate::pipeline::prepare`](mod@crate::pipeline::prepare) for the view conventions).
 
 use crate::args::{MethodArg, RenderArgs};
-use crate::io::image::{encode_rgb_for, RGB_EXTENSIONS};
+use crate::io::image::{check_style, encode_rgb_for, RGB_EXTENSIONS};
 use crate::io::outputs::{self, Planned};
 use crate::pipeline::quality::{apply_quality, quality_json};
 use crate::pipeline::{describe, prepare, render_core, render_ref};
@@ -27,6 +27,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         });
     }
     outputs::check(&planned)?;
+    check_style(&out, args.png_style())?;
     let p = prepare(args)?;
     let (args, choice) = apply_quality(&p, args)?;
     let args = &args;
@@ -66,7 +67,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         Some(c) => summary.obj("quality", quality_json(c)),
         None => summary,
     };
-    let image = encode_rgb_for(&out, &rgb, args.size.0, args.size.1)?;
+    let image = encode_rgb_for(&out, &rgb, args.size.0, args.size.1, args.png_style())?;
     let summary = summary.str("out", &out.display().to_string()).finish();
     let mut files = vec![(out.as_path(), image.as_slice())];
     if let Some(j) = &args.json {

@@ -5,7 +5,7 @@
 //! background (transparent black if none); the measures are [`crate::metrics`]'.
 
 use crate::args::{AccumArg, MethodArg, RenderArgs};
-use crate::io::image::{encode_rgb_for, RGB_EXTENSIONS};
+use crate::io::image::{check_style, encode_rgb_for, RGB_EXTENSIONS};
 use crate::io::json::Json;
 use crate::io::outputs::{self, Planned};
 use crate::metrics::compare;
@@ -49,6 +49,9 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         }
     }
     outputs::check(&planned)?;
+    for path in [&r.out, &args.reference_out].into_iter().flatten() {
+        check_style(path, r.png_style())?;
+    }
     let p = prepare(r)?;
     let (chosen, choice) = apply_quality(&p, r)?;
     let r = &chosen;
@@ -95,11 +98,17 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
     };
     let mut files: Vec<(&std::path::Path, Vec<u8>)> = Vec::new();
     if let Some(out) = &r.out {
-        files.push((out, encode_rgb_for(out, &core, r.size.0, r.size.1)?));
+        files.push((
+            out,
+            encode_rgb_for(out, &core, r.size.0, r.size.1, r.png_style())?,
+        ));
     }
     if let Some(out) = &args.reference_out {
         let img: Vec<[f32; 4]> = reference.iter().map(|c| c.map(|x| x as f32)).collect();
-        files.push((out, encode_rgb_for(out, &img, r.size.0, r.size.1)?));
+        files.push((
+            out,
+            encode_rgb_for(out, &img, r.size.0, r.size.1, r.png_style())?,
+        ));
     }
     let pass = args.min_psnr.is_none_or(|m| overall.psnr_db >= m);
     if let Some(j) = &r.json {

@@ -137,23 +137,138 @@ pub fn save_grey(img: &GreyImage, path: &Path) -> Result<(), CliError> {
     super::write_atomic(path, &bytes)
 }
 
-/// Encodes premultiplied RGBA (composited over black, i.e. the colour channels as they are) as an
-/// 8-bit RGB PNG. Values are linear and written without a gamma curve, clamped to [0, 1].
-pub fn encode_png_rgb(rgba: &[[f32; 4]], width: usize, height: usize) -> Result<Vec<u8>, CliError> {
-    let pixels: Vec<u8> = rgba
-        .iter()
-        .flat_map(|p| [p[0], p[1], p[2]])
-        .map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8)
-        .collect();
+/// How colour values become PNG samples: the transfer curve applied to the colour channels (alpha
+/// is always linear, as PNG defines it).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Gamma {
+    /// Values written as computed, no curve. This is what VTK and ParaView do by default
+    /// (`vtkRenderWindow::UseSRGBColorSpace` is off): their transfer-function colours are display
+    /// values, blended and stored unchanged, and viewers read the file as sRGB. A preset renders
+    /// here with the colours it shows in ParaView.
+    #[default]
+    Linear,
+    /// Values treated as linear light and encoded with the sRGB curve (IEC 61966-2-1), and the
+    /// file tagged with an `sRGB` chunk: physically meaningful emission (X-ray, density) looks
+    /// right on a display, at the cost of lighter images than ParaView's for the same colours.
+    Srgb,
+}
+
+impl Gamma {
+    /// A linear value in [0, 1] as stored in the file, in [0, 1].
+    pub fn encode(self, v: f32) -> f32 {
+        match self {
+            Gamma::Linear => v,
+            Gamma::Srgb => {
+                if v <= 0.003_130_8 {
+                    v * 12.92
+                } else {
+                    1.055 * v.powf(1.0 / 2.4) - 0.055
+                }
+            }
+        }
+    }
+    /// A stored value in [0, 1] as linear, the inverse of [`Gamma::encode`].
+    pub fn decode(self, v: f32) -> f32 {
+        match self {
+            Gamma::Linear => v,
+            Gamma::Srgb => {
+                if v <= 0.040_45 {
+                    v / 12.92
+                } else {
+                    ((v + 0.055) / 1.055).powf(2.4)
+                }
+            }
+        }
+    }
+}
+
+/// How a colour PNG is written. The default (opaque 8-bit RGB, [`Gamma::Linear`]) is what
+/// `render` writes without `--background transparent`, `--gamma` or `--depth`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PngStyle {
+    /// RGBA with straight (not premultiplied) alpha, as PNG requires: the render's coverage over
+    /// a transparent background. Otherwise RGB: the premultiplied colour, i.e. composited over
+    /// the working image's background (black unless one was given).
+    pub alpha: bool,
+    /// Transfer curve of the colour channels.
+    pub gamma: Gamma,
+    /// 16 bits per sample instead of 8.
+    pub sixteen: bool,
+}
+
+impl PngStyle {
+    /// Whether this is the plain style a `.pfm` (linear float RGB, no alpha) can also stand for.
+    pub fn is_plain(&self) -> bool {
+        *self == PngStyle::default()
+    }
+}
+
+/// Encodes premultiplied RGBA (linear, row-major, top row first) as a PNG in `style`: values are
+/// clamped to [0, 1] (colour to [0, alpha]), un-premultiplied for an RGBA file, passed through
+/// the transfer curve and rounded to the nearest 8- or 16-bit level.
+pub fn encode_png(
+    rgba: &[[f32; 4]],
+    width: usize,
+    height: usize,
+    style: PngStyle,
+) -> Result<Vec<u8>, CliError> {
+    let channels = if style.alpha { 4 } else { 3 };
+    let top = if style.sixteen { 65535.0 } else { 255.0 };
+    let mut samples: Vec<u16> = Vec::new();
+    samples
+        .try_reserve_exact(rgba.len().saturating_mul(channels))
+        .map_err(|_| CliError::input(format!("{width}x{height} image: out of memory")))?;
+    for p in rgba {
+        let a = if p[3] > 0.0 { p[3].min(1.0) } else { 0.0 };
+        let colour = |c: f32| -> f32 {
+            let c = c.clamp(0.0, 1.0);
+            if !style.alpha {
+                c
+            } else if a > 0.0 {
+                (c / a).min(1.0)
+            } else {
+                0.0
+            }
+        };
+        for &c in &p[..3] {
+            samples.push((style.gamma.encode(colour(c)) * top).round() as u16);
+        }
+        if style.alpha {
+            samples.push((a * top).round() as u16);
+        }
+    }
+    let bytes: Vec<u8> = if style.sixteen {
+        samples.iter().flat_map(|v| v.to_be_bytes()).collect()
+    } else {
+        samples.iter().map(|&v| v as u8).collect()
+    };
     let mut out = Vec::new();
     let mut enc = png::Encoder::new(&mut out, width as u32, height as u32);
-    enc.set_color(png::ColorType::Rgb);
-    enc.set_depth(png::BitDepth::Eight);
+    enc.set_color(if style.alpha {
+        png::ColorType::Rgba
+    } else {
+        png::ColorType::Rgb
+    });
+    enc.set_depth(if style.sixteen {
+        png::BitDepth::Sixteen
+    } else {
+        png::BitDepth::Eight
+    });
+    if style.gamma == Gamma::Srgb {
+        enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+    }
     let err = |e: png::EncodingError| CliError::input(format!("PNG encoder: {e}"));
     let mut writer = enc.write_header().map_err(err)?;
-    writer.write_image_data(&pixels).map_err(err)?;
+    writer.write_image_data(&bytes).map_err(err)?;
     writer.finish().map_err(err)?;
     Ok(out)
+}
+
+/// Encodes premultiplied RGBA (composited over black, i.e. the colour channels as they are) as an
+/// 8-bit RGB PNG. Values are linear and written without a gamma curve, clamped to [0, 1]
+/// ([`encode_png`] in the default [`PngStyle`]).
+pub fn encode_png_rgb(rgba: &[[f32; 4]], width: usize, height: usize) -> Result<Vec<u8>, CliError> {
+    encode_png(rgba, width, height, PngStyle::default())
 }
 
 /// Extensions a colour image output may have: `.png` (8-bit, [`encode_png_rgb`]) or `.pfm` (float,
@@ -179,16 +294,18 @@ pub fn encode_pfm_rgb(rgba: &[[f32; 4]], width: usize, height: usize) -> Vec<u8>
 }
 
 /// `rgba` encoded as the colour image type `path`'s extension names (see [`RGB_EXTENSIONS`];
-/// commands check the extension before rendering).
+/// commands check the extension and [`check_style`] before rendering).
 pub fn encode_rgb_for(
     path: &Path,
     rgba: &[[f32; 4]],
     width: usize,
     height: usize,
+    style: PngStyle,
 ) -> Result<Vec<u8>, CliError> {
+    check_style(path, style)?;
     match super::outputs::extension(path).as_deref() {
         Some("pfm") => Ok(encode_pfm_rgb(rgba, width, height)),
-        Some("png") => encode_png_rgb(rgba, width, height),
+        Some("png") => encode_png(rgba, width, height, style),
         _ => Err(CliError::input(format!(
             "{}: cannot write this image type (use .png or .pfm)",
             path.display()
@@ -196,13 +313,33 @@ pub fn encode_rgb_for(
     }
 }
 
-/// Decodes an 8-bit grey, grey+alpha, RGB or RGBA PNG into premultiplied RGBA f32 (linear, as
-/// stored). Returns (width, height, pixels).
+/// Refuses a PNG style that `path`'s type cannot hold: a `.pfm` is linear float RGB, so
+/// `--background transparent`, `--gamma srgb` and `--depth 16` apply to `.png` only.
+pub fn check_style(path: &Path, style: PngStyle) -> Result<(), CliError> {
+    if super::outputs::extension(path).as_deref() == Some("pfm") && !style.is_plain() {
+        let what = if style.alpha {
+            "--background transparent (PFM has no alpha channel)"
+        } else if style.gamma != Gamma::Linear {
+            "--gamma srgb (PFM holds linear values)"
+        } else {
+            "--depth 16 (PFM is float32)"
+        };
+        return Err(CliError::input(format!(
+            "{}: {what} applies to .png output only",
+            path.display()
+        )));
+    }
+    Ok(())
+}
+
+/// Decodes a grey, grey+alpha, RGB or RGBA PNG (8 or 16 bits; palettes and fewer bits are
+/// expanded) into premultiplied RGBA f32, values as stored (no transfer curve undone). Returns
+/// (width, height, pixels).
 pub fn decode_png_rgba(
     bytes: &[u8],
     name: &str,
 ) -> Result<(usize, usize, Vec<[f32; 4]>), CliError> {
-    decode_png_checked(open_png(bytes, name)?, name)
+    decode_png_checked(open_png(bytes, name)?, name, Gamma::Linear)
 }
 
 /// A PNG reader past the header (size and colour type known, nothing decoded yet).
@@ -211,18 +348,21 @@ fn open_png<'a>(
     name: &str,
 ) -> Result<png::Reader<std::io::Cursor<&'a [u8]>>, CliError> {
     let mut decoder = png::Decoder::new(std::io::Cursor::new(bytes));
-    decoder.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
+    decoder.set_transformations(png::Transformations::EXPAND);
     decoder
         .read_info()
         .map_err(|e| CliError::input(format!("{name}: not a readable PNG: {e}")))
 }
 
-/// [`decode_png_rgba`] of a PNG that must be `width × height`: the size in its header is checked
-/// before anything is decoded, so a small file declaring a huge image costs nothing.
+/// [`decode_png_rgba`] of a PNG that must be `width × height`, its colour channels decoded from
+/// `gamma`'s curve to linear (a background under `--gamma srgb` is read as sRGB, so a pixel the
+/// volume does not cover is written back unchanged). The size in its header is checked before
+/// anything is decoded, so a small file declaring a huge image costs nothing.
 pub fn decode_png_rgba_sized(
     bytes: &[u8],
     name: &str,
     (width, height): (usize, usize),
+    gamma: Gamma,
 ) -> Result<(usize, usize, Vec<[f32; 4]>), CliError> {
     let bad = |e: String| CliError::input(format!("{name}: {e}"));
     let reader = open_png(bytes, name)?;
@@ -233,18 +373,22 @@ pub fn decode_png_rgba_sized(
             info.width, info.height
         )));
     }
-    decode_png_checked(reader, name)
+    decode_png_checked(reader, name, gamma)
 }
 
 fn decode_png_checked(
     mut reader: png::Reader<std::io::Cursor<&[u8]>>,
     name: &str,
+    gamma: Gamma,
 ) -> Result<(usize, usize, Vec<[f32; 4]>), CliError> {
     let bad = |e: String| CliError::input(format!("{name}: {e}"));
     let size = reader
         .output_buffer_size()
         .ok_or_else(|| bad("PNG too large".into()))?;
-    let mut buf = vec![0u8; size];
+    let mut buf = Vec::new();
+    buf.try_reserve_exact(size)
+        .map_err(|_| bad("PNG too large".into()))?;
+    buf.resize(size, 0u8);
     let info = reader
         .next_frame(&mut buf)
         .map_err(|e| bad(format!("corrupt PNG: {e}")))?;
@@ -256,17 +400,31 @@ fn decode_png_checked(
         png::ColorType::Rgba => 4,
         other => return Err(bad(format!("unsupported PNG colour type {other:?}"))),
     };
-    let px = buf[..w * h * channels]
-        .chunks_exact(channels)
+    let wide = info.bit_depth == png::BitDepth::Sixteen;
+    let bytes_per = if wide { 2 } else { 1 };
+    let sample = |b: &[u8]| -> f32 {
+        if wide {
+            f32::from(u16::from_be_bytes([b[0], b[1]])) / 65535.0
+        } else {
+            f32::from(b[0]) / 255.0
+        }
+    };
+    let stride = channels * bytes_per;
+    let px = buf[..w * h * stride]
+        .chunks_exact(stride)
         .map(|c| {
-            let f = |v: u8| f32::from(v) / 255.0;
+            let mut s = [0.0f32; 4];
+            for (v, b) in s.iter_mut().zip(c.chunks_exact(bytes_per)) {
+                *v = sample(b);
+            }
             let (r, g, b, a) = match channels {
-                1 => (f(c[0]), f(c[0]), f(c[0]), 1.0),
-                2 => (f(c[0]), f(c[0]), f(c[0]), f(c[1])),
-                3 => (f(c[0]), f(c[1]), f(c[2]), 1.0),
-                _ => (f(c[0]), f(c[1]), f(c[2]), f(c[3])),
+                1 => (s[0], s[0], s[0], 1.0),
+                2 => (s[0], s[0], s[0], s[1]),
+                3 => (s[0], s[1], s[2], 1.0),
+                _ => (s[0], s[1], s[2], s[3]),
             };
-            [r * a, g * a, b * a, a]
+            let lin = |v: f32| gamma.decode(v) * a;
+            [lin(r), lin(g), lin(b), a]
         })
         .collect();
     Ok((w, h, px))

@@ -1,35 +1,23 @@
-//! A small JSON object writer for the `--json` summaries (flat objects of numbers, strings and
-//! arrays; non-finite numbers are written as null).
+//! The `--json` summaries, built field by field and written by `serde_json` (pretty-printed,
+//! fields in the order they were added). Non-finite numbers are written as `null`; whole numbers
+//! (counts, sizes) as integers.
+
+use serde_json::{Map, Value};
 
 /// A JSON object under construction.
 #[derive(Clone, Debug, Default)]
 pub struct Json {
-    fields: Vec<String>,
+    fields: Map<String, Value>,
 }
 
-fn escape(s: &str) -> String {
-    let mut out = String::with_capacity(s.len() + 2);
-    out.push('"');
-    for c in s.chars() {
-        match c {
-            '"' => out.push_str("\\\""),
-            '\\' => out.push_str("\\\\"),
-            '\n' => out.push_str("\\n"),
-            '\r' => out.push_str("\\r"),
-            '\t' => out.push_str("\\t"),
-            c if (c as u32) < 0x20 => out.push_str(&format!("\\u{:04x}", c as u32)),
-            c => out.push(c),
-        }
-    }
-    out.push('"');
-    out
-}
-
-fn number(v: f64) -> String {
-    if v.is_finite() {
-        format!("{v}")
+/// `v` as a JSON number: an integer when it is a whole number f64 holds exactly, `null` when it
+/// is not finite.
+fn number(v: f64) -> Value {
+    const EXACT: f64 = 9_007_199_254_740_992.0; // 2^53
+    if v.is_finite() && v.fract() == 0.0 && v.abs() <= EXACT {
+        Value::from(v as i64)
     } else {
-        "null".into()
+        Value::from(v) // serde_json maps NaN and ±inf to null
     }
 }
 
@@ -38,13 +26,13 @@ impl Json {
     pub fn object() -> Self {
         Json::default()
     }
-    fn push(mut self, key: &str, value: String) -> Self {
-        self.fields.push(format!("{}: {}", escape(key), value));
+    fn push(mut self, key: &str, value: Value) -> Self {
+        self.fields.insert(key.to_string(), value);
         self
     }
     /// A string field.
     pub fn str(self, key: &str, v: &str) -> Self {
-        self.push(key, escape(v))
+        self.push(key, Value::from(v))
     }
     /// A number field (null if not finite).
     pub fn num(self, key: &str, v: f64) -> Self {
@@ -52,25 +40,55 @@ impl Json {
     }
     /// A boolean field.
     pub fn bool(self, key: &str, v: bool) -> Self {
-        self.push(key, v.to_string())
+        self.push(key, Value::from(v))
     }
     /// An array of numbers.
     pub fn arr_f64(self, key: &str, v: &[f64]) -> Self {
-        let items: Vec<String> = v.iter().map(|&x| number(x)).collect();
-        self.push(key, format!("[{}]", items.join(", ")))
+        self.push(key, Value::Array(v.iter().map(|&x| number(x)).collect()))
     }
     /// An array of whole numbers.
     pub fn arr_usize(self, key: &str, v: &[usize]) -> Self {
-        let items: Vec<String> = v.iter().map(|x| x.to_string()).collect();
-        self.push(key, format!("[{}]", items.join(", ")))
+        self.push(
+            key,
+            Value::Array(v.iter().map(|&x| Value::from(x)).collect()),
+        )
     }
     /// A nested object.
     pub fn obj(self, key: &str, v: Json) -> Self {
-        let inner = v.finish();
-        self.push(key, inner.trim_end().to_string())
+        self.push(key, Value::Object(v.fields))
     }
-    /// The object's text, with a trailing newline.
+    /// The object's text, pretty-printed, with a trailing newline.
     pub fn finish(&self) -> String {
-        format!("{{{}}}\n", self.fields.join(", "))
+        let mut text = serde_json::to_string_pretty(&self.fields)
+            .expect("a map of JSON values with string keys always serialises");
+        text.push('\n');
+        text
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Json;
+
+    #[test]
+    fn fields_keep_their_order_and_types() {
+        let j = Json::object()
+            .str("z", "a \"quoted\"\nline")
+            .num("count", 3.0)
+            .num("ratio", 0.25)
+            .num("nan", f64::NAN)
+            .bool("pass", true)
+            .arr_f64("xs", &[1.0, f64::INFINITY])
+            .obj("inner", Json::object().num("k", -2.0))
+            .finish();
+        let v: serde_json::Value = serde_json::from_str(&j).unwrap();
+        let keys: Vec<&String> = v.as_object().unwrap().keys().collect();
+        assert_eq!(keys, ["z", "count", "ratio", "nan", "pass", "xs", "inner"]);
+        assert_eq!(v["z"], "a \"quoted\"\nline");
+        assert!(v["count"].is_i64() && v["count"] == 3);
+        assert_eq!(v["ratio"], 0.25);
+        assert!(v["nan"].is_null() && v["xs"][1].is_null());
+        assert_eq!(v["inner"]["k"], -2);
+        assert!(j.contains("\"pass\": true") && j.ends_with("}\n"));
     }
 }

@@ -5,6 +5,7 @@ pub mod formats;
 pub mod image;
 pub mod json;
 pub mod outputs;
+pub mod progress;
 pub mod stream;
 pub mod table;
 pub mod volume;
@@ -71,7 +72,7 @@ const GROW_STEP: usize = 4 << 20;
 
 /// Reads `r` until its end or `limit` bytes, whichever comes first, growing the buffer as data
 /// arrives: a source that declares much and delivers little costs only what it delivers (at most
-/// [`GROW_STEP`] more). Capacity doubles, capped at `limit`, so a source that does deliver
+/// `GROW_STEP` more). Capacity doubles, capped at `limit`, so a source that does deliver
 /// `limit` bytes ends with one exact-size buffer and memory for at most twice its data.
 /// Memory refusing is an error of kind `OutOfMemory` whose text is [`alloc_failed`]'s (naming
 /// `what`), never an abort.

@@ -177,8 +177,10 @@ pub(crate) fn load_voxels(args: &RenderArgs) -> Result<Loaded, CliError> {
 pub(crate) fn load_background(
     path: &std::path::Path,
     size: (usize, usize),
+    gamma: crate::io::image::Gamma,
 ) -> Result<Vec<[f32; 4]>, CliError> {
     let bytes = io::read_file(path)?;
-    let img = crate::io::image::decode_png_rgba_sized(&bytes, &path.display().to_string(), size)?;
+    let img =
+        crate::io::image::decode_png_rgba_sized(&bytes, &path.display().to_string(), size, gamma)?;
     Ok(img.2)
 }

@@ -7,7 +7,7 @@
 //! ```
 //!
 //! - [`load`]: where the voxels come from.
-//! - [`prepare`]: [`Prepared`], a render set up and ready to run.
+//! - [`prepare`](mod@prepare): [`Prepared`], a render set up and ready to run.
 //! - [`run`]: the core's render (float or fixed, view table or direct) and the f64 reference.
 //! - [`visible`]: visible-voxel lists, classified once and kept across frames ([`visible::FrameCache`]).
 //! - [`bands`]: a frame split into bands of rows, one per thread, byte-identical for any count.

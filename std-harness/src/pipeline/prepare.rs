@@ -275,9 +275,8 @@ pub fn prepare(args: &RenderArgs) -> Result<Prepared, CliError> {
         }
     }
     let background_out = args
-        .background
-        .as_ref()
-        .map(|p| load_background(p, args.size))
+        .background_file()
+        .map(|p| load_background(p, args.size, args.gamma_curve()))
         .transpose()?;
     let background = background_out
         .as_ref()
@@ -332,4 +331,14 @@ pub fn describe(p: &Prepared, args: &RenderArgs) -> Json {
                 .map(|e| f64::from(e) / p.supersample as f64),
         )
         .num("supersample", p.supersample as f64)
+        .str(
+            "background",
+            &match &args.background {
+                crate::args::Background::Black => "black".to_string(),
+                crate::args::Background::Transparent => "transparent".to_string(),
+                crate::args::Background::Image(path) => path.display().to_string(),
+            },
+        )
+        .str("gamma", &format!("{:?}", args.gamma).to_lowercase())
+        .num("depth", f64::from(args.depth))
 }

@@ -8,6 +8,7 @@ use super::prepare::Prepared;
 use super::supersample::downsample;
 use super::visible::FrameCache;
 use crate::args::{AccumArg, MethodArg, RenderArgs};
+use crate::io::progress::sheets;
 use crate::io::stream::{FileSource, MemorySource, PipeSource};
 use crate::io::try_filled;
 use crate::reference::render::{render_reference, ReferenceScene};
@@ -21,23 +22,7 @@ use footprint::source::{render_from, SheetSource};
 use footprint::splat::Direct;
 use footprint::stencil::{self, Stencils};
 use footprint::{composite::RowSpan, Lookup, ViewTable};
-use std::io::IsTerminal;
 use std::time::Instant;
-
-/// Shows `sheet n/N` on stderr when it is a terminal.
-pub fn progress(label: &'static str) -> impl FnMut(usize, usize) {
-    let tty = std::io::stderr().is_terminal();
-    move |n, total| {
-        if tty {
-            use std::io::Write as _;
-            let end = if n == total { "\n" } else { "" };
-            let _ = write!(
-                std::io::stderr().lock(),
-                "\r{label}: sheet {n}/{total}{end}"
-            );
-        }
-    }
-}
 
 /// One frame rendered by the core.
 #[derive(Clone, Debug)]
@@ -248,7 +233,7 @@ fn run_sheets<P: Precision>(
     )?;
     let mut ring = SheetRing::new(&mut storage, f, p.order)?;
     let mut show = Progress {
-        inner: progress("render"),
+        inner: sheets("render"),
         count: f.sheet_count(),
         done: 0,
     };
@@ -327,7 +312,7 @@ pub fn render_ref(p: &Prepared) -> Result<(Vec<[f64; 4]>, f64), CliError> {
     let img = render_reference(
         &scene,
         |s, out| volume.sheet_into(axis, s, out),
-        progress("reference"),
+        sheets("reference"),
     )?;
     let img = match p.supersample {
         1 => img,

@@ -6,7 +6,7 @@
 //! byte order (detected from `sizeof_hdr`: 348 for NIfTI-1, 540 for NIfTI-2).
 //!
 //! The two versions hold the same fields at different offsets and widths (NIfTI-2: 64-bit
-//! integers and doubles); [`Layout`] names them once for each.
+//! integers and doubles); `Layout` names them once for each.
 
 use super::compress;
 use crate::io::volume::{
