@@ -159,10 +159,11 @@ impl Gamma {
         match self {
             Gamma::Linear => v,
             Gamma::Srgb => {
+                // Clamped: the curve's rounding must not carry 1 past 1.
                 if v <= 0.003_130_8 {
                     v * 12.92
                 } else {
-                    1.055 * v.powf(1.0 / 2.4) - 0.055
+                    (1.055 * v.powf(1.0 / 2.4) - 0.055).min(1.0)
                 }
             }
         }
@@ -175,7 +176,7 @@ impl Gamma {
                 if v <= 0.040_45 {
                     v / 12.92
                 } else {
-                    ((v + 0.055) / 1.055).powf(2.4)
+                    ((v + 0.055) / 1.055).powf(2.4).min(1.0)
                 }
             }
         }
