@@ -148,3 +148,54 @@ fn tables_command_output_loads_in_splat() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `from_file_const` (the compile-time loader a firmware puts in flash) gives what `from_bytes`
+/// gives, and refuses every corruption `from_bytes` refuses (as a panic: a compile error in a
+/// `static`).
+#[test]
+fn the_const_loader_agrees_with_from_bytes() {
+    for k in default_kernels() {
+        let t = GenericTable::<17>::build(k);
+        let bytes = bytes_of(&t);
+        assert_eq!(GenericTable::<17>::from_file_const(k, &bytes), t, "{k}");
+    }
+    // The committed firmware table, decoded at compile time, is the one the core builds.
+    static FLASH: GenericTable<33> = GenericTable::from_file_const(
+        Kernel::PAPER_GAUSSIAN,
+        include_bytes!("../embedded/scene/gaussian-33.fpt"),
+    );
+    let bytes = include_bytes!("../embedded/scene/gaussian-33.fpt");
+    assert_eq!(GenericTable::<33>::from_bytes(bytes).unwrap(), FLASH);
+    assert_eq!(FLASH, GenericTable::<33>::build(Kernel::PAPER_GAUSSIAN));
+    let good = bytes_of(&GenericTable::<9>::build(Kernel::PAPER_GAUSSIAN));
+    let spec_len = Kernel::PAPER_GAUSSIAN.spec().len();
+    let mut cases: Vec<(&str, Vec<u8>)> = vec![
+        ("truncated", good[..good.len() - 1].to_vec()),
+        ("short header", good[..8].to_vec()),
+    ];
+    let mut b = good.clone();
+    b[0] = b'X';
+    cases.push(("magic", b));
+    let mut b = good.clone();
+    b[4] = 9;
+    reseal(&mut b);
+    cases.push(("version", b));
+    let mut b = good.clone();
+    b[8] = 7;
+    reseal(&mut b);
+    cases.push(("N", b));
+    let mut b = good.clone();
+    b[12 + spec_len] ^= 1;
+    cases.push(("crc", b));
+    let mut b = good.clone();
+    b[12 + spec_len..12 + spec_len + 4].copy_from_slice(&f32::NAN.to_le_bytes());
+    reseal(&mut b);
+    cases.push(("NaN sample", b));
+    for (what, bytes) in cases {
+        assert!(GenericTable::<9>::from_bytes(&bytes).is_err(), "{what}");
+        let r = std::panic::catch_unwind(|| {
+            GenericTable::<9>::from_file_const(Kernel::PAPER_GAUSSIAN, &bytes)
+        });
+        assert!(r.is_err(), "{what}: accepted");
+    }
+}

@@ -1,9 +1,23 @@
-//! Puts memory.x where cortex-m-rt's link.x finds it.
+//! Puts the board's memory map where cortex-m-rt's link.x finds it as `memory.x`: the micro:bit's
+//! (`memory-microbit.x`, 16 KiB RAM) for Cortex-M0 (`thumbv6m-none-eabi`), QEMU's MPS2 boards'
+//! (`memory.x`, 4 MiB) otherwise.
 use std::{env, fs, path::PathBuf};
 
 fn main() {
     let out = PathBuf::from(env::var_os("OUT_DIR").expect("cargo sets OUT_DIR"));
-    fs::copy("memory.x", out.join("memory.x")).expect("memory.x is readable");
+    let target = env::var("TARGET").unwrap_or_default();
+    let map = if target.starts_with("thumbv6m") {
+        "memory-microbit.x"
+    } else {
+        "memory.x"
+    };
+    // `cfg(microbit)`: the firmware's image and band sizes for the 16 KiB part.
+    println!("cargo::rustc-check-cfg=cfg(microbit)");
+    if target.starts_with("thumbv6m") {
+        println!("cargo:rustc-cfg=microbit");
+    }
+    fs::copy(map, out.join("memory.x")).expect("the memory map is readable");
     println!("cargo:rustc-link-search={}", out.display());
     println!("cargo:rerun-if-changed=memory.x");
+    println!("cargo:rerun-if-changed=memory-microbit.x");
 }

@@ -20,6 +20,7 @@
 //! [`Splatter`]: a footprint sampler or phase stencils) or [`FixedPath`] (integer table, `i64` accumulator, Q24 image; see
 //! [`crate::fixed`]). One build holds both, so they can be compared on the same frame.
 
+mod band;
 mod precision;
 mod sheets;
 mod visible;
@@ -32,6 +33,7 @@ use crate::composite::RowSpan;
 use crate::frame::{FrameSetup, Order};
 use crate::shade::{Lighting, OpacityTable, Sample, Shader};
 use crate::splat::{BufferError, ImageMut, Splatter};
+use band::BandReach;
 use core::fmt;
 
 /// Why a render step was refused.
@@ -379,16 +381,7 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
         let mut image = ImageMut::new(&mut *self.buffers.accumulator, w, h, w)?;
         let rows = &mut *self.buffers.rows;
         let (na, nb) = (f.sheet_shape().1, f.sheet_shape().2);
-        // A band renders only the voxels whose footprint can reach its rows: screen y of voxel
-        // (u, v) is affine in u and v. The test is conservative by a pixel and more, so it never
-        // drops a voxel that a whole-image render would splat into these rows.
-        let cols = f.grid_to_screen;
-        let (ia, ib) = f.in_sheet;
-        let y_sheet = f.origin.y + cols.col(f.sheet_axis).y * index as f32;
-        let (ya, yb) = (cols.col(ia).y, cols.col(ib).y);
-        let reach = f.footprint.half_extent[1] + 2.0;
-        let (top, bottom) = (self.band.0 as f32, (self.band.0 + self.band.1) as f32);
-        let whole = self.band.0 == 0 && self.band.1 == f.size[1];
+        let reach = BandReach::new(f, self.band, index);
         for (k, vox) in visible.voxels.iter().enumerate() {
             let (u, v) = (usize::from(vox.u), usize::from(vox.v));
             if u >= na || v >= nb {
@@ -397,11 +390,8 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
                     got: v * na + u + 1,
                 });
             }
-            if !whole {
-                let y = y_sheet + ya * u as f32 + yb * v as f32;
-                if y + reach < top || y - reach > bottom {
-                    continue;
-                }
+            if !reach.may_reach(u, v) {
+                continue;
             }
             let g = || {
                 if needs_gradient {
@@ -485,8 +475,33 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
         Ok(())
     }
 
+    /// Splats and composites sheet `index` with each voxel's value computed on the fly by
+    /// `shade(u, v)` (`u` < `dims[a]`, `v` < `dims[b]`, the sheet layout; visited row by row,
+    /// `u` fastest), so no sheet of values is stored: a caller streaming samples from a sensor or
+    /// a file shades each through an integer table as it goes. Transparent values are skipped.
+    /// The image is bit-identical to [`SheetRenderer::render_value_sheet`] of the same values.
+    pub fn render_sheet_with(
+        &mut self,
+        index: usize,
+        shade: impl FnMut(usize, usize) -> P::Value,
+    ) -> Result<(), RenderError> {
+        Self::splat_sheet(
+            self.frame,
+            &self.path,
+            self.band,
+            &mut self.buffers,
+            &mut self.stats,
+            index,
+            [None, None, None],
+            shade,
+        )?;
+        self.composite_sheet();
+        Ok(())
+    }
+
     /// Checks sheet `index` and the given sheet `lengths`, then splats the value that
-    /// `shade(u, v)` gives for every voxel (skipping transparent ones).
+    /// `shade(u, v)` gives for every voxel (skipping transparent ones, and in a band the voxels
+    /// that cannot reach it, without shading them).
     #[allow(clippy::too_many_arguments)]
     fn splat_sheet(
         f: &FrameSetup,
@@ -508,8 +523,9 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
         }
         let mut image = ImageMut::new(&mut *buffers.accumulator, f.size[0], band.1, f.size[0])?;
         let rows = &mut *buffers.rows;
+        let reach = BandReach::new(f, band, index);
         for v in 0..nb {
-            for u in 0..na {
+            for u in reach.row(v, na) {
                 stats.voxels += 1;
                 let value = shade(u, v);
                 if P::is_transparent(&value) {

@@ -229,6 +229,73 @@ impl<const N: usize> GenericTable<N> {
     }
 }
 
+impl<const N: usize> GenericTable<N> {
+    /// A table from a table file's bytes (as [`GenericTable::write_bytes`] and `footprint tables`
+    /// write them), at compile time: `static T: GenericTable<33> =
+    /// GenericTable::from_file_const(Kernel::PAPER_GAUSSIAN, include_bytes!("g.fpt"));` puts the
+    /// table in flash, so a microcontroller spends no RAM on it and no time building it.
+    ///
+    /// Checks the length, magic, version, N, CRC and that every sample is finite; evaluated in a
+    /// `const` or `static`, a bad file is a compile error. The kernel spec stored in the file is
+    /// not parsed here (that is not possible in a `const fn`): `kernel` is the caller's word for
+    /// it, and a test comparing the result with [`GenericTable::from_bytes`] of the same bytes
+    /// checks that word. At run time, prefer [`GenericTable::from_bytes`].
+    ///
+    /// # Panics
+    /// On any failed check (at compile time when used in a `const` or `static`).
+    pub const fn from_file_const(kernel: Kernel, bytes: &[u8]) -> Self {
+        #[allow(clippy::let_unit_value)]
+        let () = Self::VALID;
+        const fn u32_at(b: &[u8], at: usize) -> u32 {
+            u32::from_le_bytes([b[at], b[at + 1], b[at + 2], b[at + 3]])
+        }
+        assert!(bytes.len() >= HEADER, "table file: shorter than its header");
+        assert!(
+            bytes[0] == MAGIC[0]
+                && bytes[1] == MAGIC[1]
+                && bytes[2] == MAGIC[2]
+                && bytes[3] == MAGIC[3],
+            "table file: bad magic"
+        );
+        assert!(
+            u16::from_le_bytes([bytes[4], bytes[5]]) == FORMAT_VERSION,
+            "table file: unsupported version"
+        );
+        assert!(
+            u32_at(bytes, 8) as usize == N,
+            "table file: N differs from the table type's"
+        );
+        let body = HEADER + u16::from_le_bytes([bytes[6], bytes[7]]) as usize;
+        let end = body + 4 * N * N;
+        assert!(
+            bytes.len() == end + 4,
+            "table file: length does not match its header"
+        );
+        // CRC-32 of everything before the stored checksum, bitwise as in `Crc32::update`.
+        let mut crc = !0u32;
+        let mut i = 0;
+        while i < end {
+            crc ^= bytes[i] as u32;
+            let mut bit = 0;
+            while bit < 8 {
+                crc = (crc >> 1) ^ (0xEDB8_8320 & (crc & 1).wrapping_neg());
+                bit += 1;
+            }
+            i += 1;
+        }
+        assert!(!crc == u32_at(bytes, end), "table file: checksum mismatch");
+        let mut data = [[0.0f32; N]; N];
+        let mut k = 0;
+        while k < N * N {
+            let v = f32::from_bits(u32_at(bytes, body + 4 * k));
+            assert!(v.is_finite(), "table file: a sample is not finite");
+            data[k / N][k % N] = v;
+            k += 1;
+        }
+        GenericTable { kernel, data }
+    }
+}
+
 /// Checks everything about `bytes` before a sample is copied; returns the parsed kernel.
 fn validate<const N: usize>(bytes: &[u8]) -> Result<Kernel, TableError> {
     if bytes.len() < HEADER {

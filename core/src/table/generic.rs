@@ -14,7 +14,7 @@ pub struct GenericTable<const N: usize> {
 }
 
 impl<const N: usize> GenericTable<N> {
-    const VALID: () = assert!(N >= 2, "a table needs at least 2×2 nodes");
+    pub(crate) const VALID: () = assert!(N >= 2, "a table needs at least 2×2 nodes");
 
     /// An all-zero table for `kernel`, to be filled by [`GenericTable::build_into`] or
     /// [`GenericTable::load_into`]. Usable in `static` initialisers.

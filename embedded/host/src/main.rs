@@ -1,88 +1,223 @@
 //! The embedded demo scene rendered on the host: prints the same lines the firmware prints for
 //! its checksums, so CI can compare them (`fixed checksum 0x…` must match bit for bit).
 //!
-//! `--threads N` renders it on N threads at once and checks they all agree.
+//! ```text
+//! footprint-scene-host [--threads N]     checksums: 64×64 (MPS2 boards), 48×48 (micro:bit)
+//! footprint-scene-host compare LOG DIR   the firmware's image (from its printed LOG) against
+//!                                        the host's float render: PNGs in DIR and the PSNR
+//! ```
+//!
+//! The host renders the whole image at once (one band) and, to show that bands change nothing,
+//! again in bands of 1, 2 and 5 rows: every band height must give the same checksum. `--threads N`
+//! renders it on N threads at once and checks they all agree.
 
 use footprint::composite::RowSpan;
 use footprint::fixed::FixedTable;
-use footprint::{GenericTable, Kernel, ViewTable};
+use footprint::ViewTable;
 use footprint_scene::{render_fixed, render_float, FixedBuffers, FloatBuffers, Report};
-use footprint_scene::{DIM, PIXELS, SIDE};
+use footprint_scene::{SIDE, SIDE_MICROBIT};
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
-    let threads = match std::env::args().skip(1).collect::<Vec<_>>().as_slice() {
-        [] => 1,
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let result = match args.as_slice() {
+        [] => checksums(1),
         [flag, n] if flag == "--threads" => match n.parse::<usize>() {
-            Ok(n) if n >= 1 => n,
-            _ => {
-                eprintln!("--threads needs a whole number ≥ 1, got '{n}'");
-                return ExitCode::from(2);
-            }
+            Ok(n) if n >= 1 => checksums(n),
+            _ => Err(format!("--threads needs a whole number ≥ 1, got '{n}'")),
         },
-        _ => {
-            eprintln!("usage: footprint-scene-host [--threads N]");
-            return ExitCode::from(2);
-        }
+        [cmd, log, dir] if cmd == "compare" => compare(log, dir),
+        _ => Err("usage: footprint-scene-host [--threads N] | compare LOG DIR".into()),
     };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("footprint-scene-host: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn checksums(threads: usize) -> Result<(), String> {
     let fixed = std::thread::scope(|s| {
         let handles: Vec<_> = (0..threads)
-            .map(|_| s.spawn(|| render_fixed_boxed().map(|r| (r.checksum, r.stats))))
+            .map(|_| s.spawn(|| fixed_image(SIDE, SIDE)))
             .collect();
         handles
             .into_iter()
             .map(|h| h.join().expect("render thread panicked"))
             .collect::<Result<Vec<_>, _>>()
-    });
-    let fixed = match fixed {
-        Ok(v) => v,
-        Err(e) => {
-            eprintln!("fixed render failed: {e}");
-            return ExitCode::FAILURE;
-        }
-    };
-    let (sum, stats) = fixed[0];
-    if fixed.iter().any(|&(c, _)| c != sum) {
-        eprintln!("threads disagree: {fixed:x?}");
-        return ExitCode::FAILURE;
+    })?;
+    let (report, _) = &fixed[0];
+    if fixed.iter().any(|(r, _)| r.checksum != report.checksum) {
+        return Err("threads disagree".into());
     }
-    let float = match render_float_boxed() {
-        Ok(r) => r,
-        Err(e) => {
-            eprintln!("float render failed: {e}");
-            return ExitCode::FAILURE;
+    for side in [SIDE, SIDE_MICROBIT] {
+        let whole = fixed_image(side, side)?.0.checksum;
+        for band in [1, 2, 5] {
+            let banded = fixed_image(side, band)?.0.checksum;
+            if banded != whole {
+                return Err(format!(
+                    "{side}x{side}: bands of {band} rows give 0x{banded:08x}, the whole image 0x{whole:08x}"
+                ));
+            }
         }
-    };
+    }
+    let float = float_image(SIDE, SIDE)?.0;
+    let stats = report.stats;
     println!(
-        "scene: {} sheets, {} voxels splatted, {} pixel updates ({threads} thread(s) agree)",
+        "scene: {} sheets, {} voxels splatted, {} pixel updates ({threads} thread(s) agree; bands of 1, 2, 5 rows agree)",
         stats.sheets, stats.voxels_splatted, stats.pixel_updates
     );
-    println!("fixed checksum 0x{sum:08x}");
+    println!("fixed checksum 0x{:08x}", report.checksum);
+    println!(
+        "microbit fixed checksum 0x{:08x}",
+        fixed_image(SIDE_MICROBIT, SIDE_MICROBIT)?.0.checksum
+    );
     println!("float checksum 0x{:08x} (informational)", float.checksum);
-    ExitCode::SUCCESS
+    Ok(())
 }
 
-/// The fixed render with heap buffers.
-fn render_fixed_boxed() -> Result<Report, footprint::Error> {
-    render_fixed(FixedBuffers {
-        generic: &mut Box::new(GenericTable::zeroed(Kernel::PAPER_GAUSSIAN)),
-        table: &mut Box::new(FixedTable::zeroed()),
-        lut: &mut Box::new([[0; 4]; 256]),
-        sheet: &mut Box::new([[0; 4]; DIM * DIM]),
-        acc: &mut vec![[0; 4]; PIXELS].try_into().expect("PIXELS long"),
-        image: &mut vec![[0; 4]; PIXELS].try_into().expect("PIXELS long"),
-        rows: &mut Box::new([RowSpan::EMPTY; SIDE]),
-    })
+/// The fixed render at `side`² in bands of `band` rows, with heap buffers: its report and image
+/// (Q24 premultiplied RGBA, row-major).
+fn fixed_image(side: usize, band: usize) -> Result<(Report, Vec<[u32; 4]>), String> {
+    let band = band.min(side);
+    let mut image = vec![[0u32; 4]; side * side];
+    let report = render_fixed(
+        side,
+        FixedBuffers {
+            table: &mut Box::new(FixedTable::zeroed()),
+            lut: &mut Box::new([[0; 4]; 256]),
+            acc: &mut vec![[0; 4]; band * side],
+            image: &mut vec![[0; 4]; band * side],
+            rows: &mut vec![RowSpan::EMPTY; band],
+        },
+        |first, px| image[first * side..first * side + px.len()].copy_from_slice(px),
+    )
+    .map_err(|e| format!("fixed render failed: {e}"))?;
+    Ok((report, image))
 }
 
-/// The float render with heap buffers.
-fn render_float_boxed() -> Result<Report, footprint::Error> {
-    render_float(FloatBuffers {
-        generic: &mut Box::new(GenericTable::zeroed(Kernel::PAPER_GAUSSIAN)),
-        table: &mut Box::new(ViewTable::zeroed(footprint::Footprint::EMPTY)),
-        sheet: &mut Box::new([[0.0; 4]; DIM * DIM]),
-        acc: &mut vec![[0.0; 4]; PIXELS].try_into().expect("PIXELS long"),
-        image: &mut vec![[0.0; 4]; PIXELS].try_into().expect("PIXELS long"),
-        rows: &mut Box::new([RowSpan::EMPTY; SIDE]),
-    })
+/// The float render at `side`² in bands of `band` rows: its report and image.
+fn float_image(side: usize, band: usize) -> Result<(Report, Vec<[f32; 4]>), String> {
+    let band = band.min(side);
+    let mut image = vec![[0f32; 4]; side * side];
+    let report = render_float(
+        side,
+        FloatBuffers {
+            table: &mut Box::new(ViewTable::zeroed(footprint::Footprint::EMPTY)),
+            acc: &mut vec![[0.0; 4]; band * side],
+            image: &mut vec![[0.0; 4]; band * side],
+            rows: &mut vec![RowSpan::EMPTY; band],
+        },
+        |first, px| image[first * side..first * side + px.len()].copy_from_slice(px),
+    )
+    .map_err(|e| format!("float render failed: {e}"))?;
+    Ok((report, image))
+}
+
+/// The image a firmware printed: `image W H`, then `row Y` followed by W pixels of four 8-digit
+/// hex Q24 channels (R G B A), one line per row.
+fn parse_dump(text: &str) -> Result<(usize, Vec<[u32; 4]>), String> {
+    let mut lines = text.lines().map(str::trim);
+    let side = lines
+        .by_ref()
+        .find_map(|l| l.strip_prefix("image "))
+        .ok_or("no 'image W H' line")?;
+    let dims: Vec<usize> = side
+        .split(' ')
+        .map(|v| v.parse().map_err(|_| format!("bad image size '{side}'")))
+        .collect::<Result<_, _>>()?;
+    let [w, h] = dims[..] else {
+        return Err(format!("bad image size '{side}'"));
+    };
+    if w != h || w == 0 || w > 1024 {
+        return Err(format!("unexpected image size {w}x{h}"));
+    }
+    let mut image = vec![[0u32; 4]; w * h];
+    let mut seen = vec![false; h];
+    for l in lines {
+        let Some(rest) = l.strip_prefix("row ") else {
+            continue;
+        };
+        let (y, hex) = rest.split_once(' ').ok_or("a row without pixels")?;
+        let y: usize = y.parse().map_err(|_| format!("bad row number '{y}'"))?;
+        if y >= h || hex.len() != 32 * w {
+            return Err(format!(
+                "row {y}: {} hex digits, expected {}",
+                hex.len(),
+                32 * w
+            ));
+        }
+        for (x, px) in image[y * w..(y + 1) * w].iter_mut().enumerate() {
+            for (c, v) in px.iter_mut().enumerate() {
+                let at = 32 * x + 8 * c;
+                *v = u32::from_str_radix(&hex[at..at + 8], 16)
+                    .map_err(|_| format!("row {y}: bad hex"))?;
+            }
+        }
+        seen[y] = true;
+    }
+    if let Some(y) = seen.iter().position(|s| !s) {
+        return Err(format!("row {y} missing"));
+    }
+    Ok((w, image))
+}
+
+/// 8-bit RGB PNG of premultiplied colour over black, linear, clamped (as `footprint render`).
+fn write_png(path: &std::path::Path, side: usize, rgb: &[[f64; 3]]) -> Result<(), String> {
+    let bytes: Vec<u8> = rgb
+        .iter()
+        .flatten()
+        .map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8)
+        .collect();
+    let file = std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut enc = png::Encoder::new(std::io::BufWriter::new(file), side as u32, side as u32);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    let err = |e: png::EncodingError| format!("{}: {e}", path.display());
+    let mut w = enc.write_header().map_err(err)?;
+    w.write_image_data(&bytes).map_err(err)?;
+    w.finish().map_err(err)
+}
+
+/// `compare LOG DIR`: the firmware's printed image against the host's float render of the same
+/// scene. Checks the image's CRC is the host's fixed checksum, writes `DIR/microbit.png` and
+/// `DIR/host-float.png`, and prints `psnr_vs_float N dB` (RGB, values in [0, 1], peak 1).
+fn compare(log: &str, dir: &str) -> Result<(), String> {
+    let text = std::fs::read_to_string(log).map_err(|e| format!("{log}: {e}"))?;
+    let (side, target) = parse_dump(&text)?;
+    let crc = footprint::fixed::checksum(&target);
+    let (host, _) = fixed_image(side, side)?;
+    if crc != host.checksum {
+        return Err(format!(
+            "the printed image's CRC 0x{crc:08x} is not the host's fixed checksum 0x{:08x}",
+            host.checksum
+        ));
+    }
+    let (_, float) = float_image(side, side)?;
+    let to_rgb = |c: [f32; 4]| [f64::from(c[0]), f64::from(c[1]), f64::from(c[2])];
+    let target_rgb: Vec<[f64; 3]> = target
+        .iter()
+        .map(|&c| to_rgb(footprint::fixed::to_f32(c)))
+        .collect();
+    let float_rgb: Vec<[f64; 3]> = float.iter().map(|&c| to_rgb(c)).collect();
+    let mse = target_rgb
+        .iter()
+        .flatten()
+        .zip(float_rgb.iter().flatten())
+        .map(|(a, b)| (a - b) * (a - b))
+        .sum::<f64>()
+        / (3 * side * side) as f64;
+    let psnr = if mse > 0.0 {
+        10.0 * (1.0 / mse).log10()
+    } else {
+        f64::INFINITY
+    };
+    let dir = std::path::Path::new(dir);
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    write_png(&dir.join("microbit.png"), side, &target_rgb)?;
+    write_png(&dir.join("host-float.png"), side, &float_rgb)?;
+    println!("image {side}x{side}, crc 0x{crc:08x} (= host fixed), psnr_vs_float {psnr:.2} dB");
+    Ok(())
 }

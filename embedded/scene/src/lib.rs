@@ -1,12 +1,20 @@
 //! The embedded demo scene, shared by the firmware (`embedded/firmware`) and the host
 //! (`embedded/host`) so both render exactly the same thing: a 32×32×32 volume of `u8` samples,
-//! generated sheet by sheet from integer formulas (the volume is never in memory, as if streamed
-//! from a sensor), seen at azimuth 30°, elevation 20°, into a 64×64 image, with the paper's
-//! Gaussian and a 33×33 table.
+//! generated voxel by voxel from integer formulas (the volume is never in memory, as if streamed
+//! from a sensor), seen at azimuth 30°, elevation 20°, with the paper's Gaussian and a 33×33
+//! table: 64×64 on the MPS2 boards and the host, 48×48 on the micro:bit.
+//!
+//! **Memory follows the target, not the image.** The generic table is `const` data (flash),
+//! read from the table file `footprint tables` wrote ([`GENERIC`]). Each voxel is shaded
+//! straight from its sample through a 256-entry integer table as it is splatted
+//! ([`SheetRenderer::render_sheet_with`]): no sheet of shaded values is stored. The image is
+//! rendered in bands of rows, as many as the caller's buffers hold ([`FixedBuffers::rows`]), the
+//! volume streamed once per band; each finished band is handed to the caller (`emit`) and its
+//! buffers reused. Bands are bit-identical to a whole-image render, so the checksum does not
+//! depend on the band height.
 //!
 //! Every buffer is borrowed through [`FixedBuffers`] / [`FloatBuffers`]; the firmware keeps them
-//! in `static`s: no heap. The fixed path shades through a 256-entry integer lookup table built once
-//! per view, so its per-voxel and per-pixel work is integer only.
+//! in `static`s: no heap. The fixed path's per-voxel and per-pixel work is integer only.
 #![no_std]
 #![forbid(unsafe_code)]
 
@@ -17,17 +25,25 @@ use footprint::geometry::FootprintOptions;
 use footprint::math;
 use footprint::render::{FixedPath, RenderBuffers, RenderStats, SheetRenderer};
 use footprint::shade::{Lighting, Shader, Shading, TransferFunction};
+use footprint::table::Crc32;
 use footprint::{GenericTable, Grid, Kernel, Lookup, View, ViewTable};
 use glam::{Mat3, Vec3};
 
 /// Voxels along each axis.
 pub const DIM: usize = 32;
-/// Image width and height, pixels.
+/// Image width and height on the MPS2 boards and the host, pixels.
 pub const SIDE: usize = 64;
-/// Pixels in the image.
-pub const PIXELS: usize = SIDE * SIDE;
+/// Image width and height on the micro:bit (16 KiB of RAM), pixels.
+pub const SIDE_MICROBIT: usize = 48;
 /// Generic and view table size (N×N nodes).
 pub const N: usize = 33;
+
+/// The paper Gaussian's generic table, from the table file `footprint tables --kernel
+/// gaussian:spread=1.6,sigmas=2.5 --size 33` wrote, checked and decoded at compile time: it
+/// lives in flash. (`tests/table_format.rs` checks it equals the table the core builds for that
+/// kernel, and what the run-time loader reads from the file.)
+pub static GENERIC: GenericTable<N> =
+    GenericTable::from_file_const(Kernel::PAPER_GAUSSIAN, include_bytes!("../gaussian-33.fpt"));
 /// Compositing order.
 pub const ORDER: Order = Order::BackToFront;
 
@@ -71,15 +87,15 @@ pub fn view_matrix() -> Mat3 {
     rx * ry * zoom
 }
 
-/// The frame of the scene.
-pub fn frame() -> Result<FrameSetup, footprint::Error> {
+/// The frame of the scene at `side`×`side` pixels.
+pub fn frame(side: usize) -> Result<FrameSetup, footprint::Error> {
     Ok(FrameSetup::new(
         [DIM; 3],
         &Grid::from_spacing([1.0; 3])?,
         &View::new(view_matrix())?,
         &Kernel::PAPER_GAUSSIAN,
         FootprintOptions::default(),
-        [SIDE; 2],
+        [side; 2],
     )?)
 }
 
@@ -97,117 +113,154 @@ fn shader() -> Shader<'static> {
 /// What a render reports.
 #[derive(Clone, Copy, Debug)]
 pub struct Report {
-    /// CRC-32 of the image ([`fixed::checksum`] for fixed; the f32 bits for float).
+    /// CRC-32 of the whole image, rows top to bottom ([`fixed::checksum`] for fixed; the f32
+    /// bits for float).
     pub checksum: u32,
-    /// Counts.
+    /// Counts, summed over bands (a voxel that reaches two bands is counted in both).
     pub stats: RenderStats,
+    /// Bands rendered (times the volume was streamed).
+    pub bands: usize,
 }
 
 /// Every buffer of a fixed-point render, borrowed (the firmware's are separate `static`s, so the
-/// all-zero ones land in `.bss` and cost no flash). Bytes: see README "Embedding".
+/// all-zero ones land in `.bss` and cost no flash). A band is `rows.len()` image rows (at most
+/// the image's); `acc` and `image` hold at least that many rows of `side` pixels. Bytes: see
+/// README "Embedding".
 pub struct FixedBuffers<'a> {
-    /// The kernel's generic table (f32, built once).
-    pub generic: &'a mut GenericTable<N>,
     /// The view's integer table.
     pub table: &'a mut FixedTable<N>,
     /// Shaded value per sample value, Q24 premultiplied RGBA (built per view).
     pub lut: &'a mut [[u32; 4]; 256],
-    /// One sheet of shaded values.
-    pub sheet: &'a mut [[u32; 4]; DIM * DIM],
-    /// Sheet accumulator.
-    pub acc: &'a mut [[i64; 4]; PIXELS],
-    /// Working image (Q24 premultiplied RGBA): the result.
-    pub image: &'a mut [[u32; 4]; PIXELS],
-    /// Touched span per row.
-    pub rows: &'a mut [RowSpan; SIDE],
+    /// Sheet accumulator for one band; all zero at the start (left all zero).
+    pub acc: &'a mut [[i64; 4]],
+    /// Working image for one band (Q24 premultiplied RGBA).
+    pub image: &'a mut [[u32; 4]],
+    /// Touched span per band row; its length is the band height.
+    pub rows: &'a mut [RowSpan],
 }
 
-/// Renders the scene with fixed-point accumulation into `b.image`.
+/// The bands of a `side`-row image for buffers of `band` rows: each band's first row and height.
+fn bands(side: usize, band: usize) -> impl Iterator<Item = core::ops::Range<usize>> {
+    let band = band.clamp(1, side.max(1));
+    (0..side)
+        .step_by(band)
+        .map(move |start| start..(start + band).min(side))
+}
+
+/// Renders the scene at `side`×`side` with fixed-point accumulation, band by band, handing each
+/// finished band to `emit(first_row, pixels)` (Q24 premultiplied RGBA, rows top to bottom).
 #[inline(never)]
-pub fn render_fixed(b: FixedBuffers<'_>) -> Result<Report, footprint::Error> {
-    let f = frame()?;
-    // Per-view set-up (float): tables and the shading lookup.
-    b.generic.build_into(Kernel::PAPER_GAUSSIAN);
+pub fn render_fixed(
+    side: usize,
+    b: FixedBuffers<'_>,
+    mut emit: impl FnMut(usize, &[[u32; 4]]),
+) -> Result<Report, footprint::Error> {
+    let f = frame(side)?;
+    // Per-view set-up (float): the view table and the shading lookup.
     b.table
-        .build_view(&f, b.generic, Lookup::Bilinear, Lookup::Bilinear)?;
+        .build_view(&f, &GENERIC, Lookup::Bilinear, Lookup::Bilinear)?;
     let (shader, lighting) = (shader(), Lighting::new(&f));
     for (v, entry) in b.lut.iter_mut().enumerate() {
         let rgba = shader.shade(&lighting, v as f32, || Vec3::ZERO, [0; 3], f.dims);
         *entry = fixed::quantise(rgba);
     }
     // Per voxel and per pixel: integers only.
-    let path = FixedPath::new(&f, b.table)?;
-    let buffers = RenderBuffers {
-        accumulator: &mut b.acc[..],
-        image: &mut b.image[..],
-        rows: &mut b.rows[..],
+    let (lut, table) = (&*b.lut, &*b.table);
+    let mut crc = Crc32::new();
+    let mut report = Report {
+        checksum: 0,
+        stats: RenderStats::default(),
+        bands: 0,
     };
-    let mut r = SheetRenderer::with_path(&f, path, shader, ORDER, buffers, None)?;
-    for step in 0..f.sheet_count() {
-        let s = f.sheet_at(ORDER, step);
-        fill_sheet(&f, s, &mut b.sheet[..], |x| b.lut[x as usize]);
-        r.render_value_sheet(s, &b.sheet[..])?;
+    for rows in bands(side, b.rows.len()) {
+        let n = rows.len() * side;
+        let buffers = RenderBuffers {
+            accumulator: &mut b.acc[..],
+            image: &mut b.image[..],
+            rows: &mut b.rows[..rows.len()],
+        };
+        let path = FixedPath::new(&f, table)?;
+        let mut r = SheetRenderer::with_band(&f, path, shader, ORDER, buffers, None, rows.clone())?;
+        for step in 0..f.sheet_count() {
+            let s = f.sheet_at(ORDER, step);
+            r.render_sheet_with(s, |u, v| {
+                let [i, j, k] = f.grid_index(s, u, v);
+                lut[usize::from(sample(i, j, k))]
+            })?;
+        }
+        add(&mut report.stats, r.finish());
+        report.bands += 1;
+        for c in b.image[..n].as_flattened() {
+            crc.update(&c.to_le_bytes());
+        }
+        emit(rows.start, &b.image[..n]);
     }
-    let stats = r.finish();
-    Ok(Report {
-        checksum: fixed::checksum(&b.image[..]),
-        stats,
-    })
+    report.checksum = crc.finish();
+    Ok(report)
 }
 
-/// Every buffer of a float render, borrowed.
+fn add(total: &mut RenderStats, s: RenderStats) {
+    total.sheets += s.sheets;
+    total.voxels += s.voxels;
+    total.voxels_splatted += s.voxels_splatted;
+    total.pixel_updates += s.pixel_updates;
+    total.pixels_composited += s.pixels_composited;
+}
+
+/// Every buffer of a float render, borrowed (bands as in [`FixedBuffers`]).
 pub struct FloatBuffers<'a> {
-    /// The kernel's generic table.
-    pub generic: &'a mut GenericTable<N>,
     /// The view table.
     pub table: &'a mut ViewTable<N>,
-    /// One sheet of shaded values.
-    pub sheet: &'a mut [[f32; 4]; DIM * DIM],
-    /// Sheet accumulator.
-    pub acc: &'a mut [[f32; 4]; PIXELS],
-    /// Working image: the result.
-    pub image: &'a mut [[f32; 4]; PIXELS],
-    /// Touched span per row.
-    pub rows: &'a mut [RowSpan; SIDE],
+    /// Sheet accumulator for one band.
+    pub acc: &'a mut [[f32; 4]],
+    /// Working image for one band.
+    pub image: &'a mut [[f32; 4]],
+    /// Touched span per band row; its length is the band height.
+    pub rows: &'a mut [RowSpan],
 }
 
-/// Renders the scene with float accumulation into `b.image` (the same shading, unquantised).
+/// [`render_fixed`] with float accumulation (the same shading, unquantised, per voxel).
 #[inline(never)]
-pub fn render_float(b: FloatBuffers<'_>) -> Result<Report, footprint::Error> {
-    let f = frame()?;
-    b.generic.build_into(Kernel::PAPER_GAUSSIAN);
+pub fn render_float(
+    side: usize,
+    b: FloatBuffers<'_>,
+    mut emit: impl FnMut(usize, &[[f32; 4]]),
+) -> Result<Report, footprint::Error> {
+    let f = frame(side)?;
     b.table
-        .build_into(&f.footprint, b.generic, Lookup::Bilinear, Lookup::Bilinear);
+        .build_into(&f.footprint, &GENERIC, Lookup::Bilinear, Lookup::Bilinear);
     let (shader, lighting) = (shader(), Lighting::new(&f));
-    let buffers = RenderBuffers {
-        accumulator: &mut b.acc[..],
-        image: &mut b.image[..],
-        rows: &mut b.rows[..],
+    let table = &*b.table;
+    let mut crc = Crc32::new();
+    let mut report = Report {
+        checksum: 0,
+        stats: RenderStats::default(),
+        bands: 0,
     };
-    let mut r = SheetRenderer::new(&f, &*b.table, shader, ORDER, buffers, None)?;
-    for step in 0..f.sheet_count() {
-        let s = f.sheet_at(ORDER, step);
-        fill_sheet(&f, s, &mut b.sheet[..], |x| {
-            shader.shade(&lighting, f32::from(x), || Vec3::ZERO, [0; 3], f.dims)
-        });
-        r.render_shaded_sheet(s, &b.sheet[..])?;
+    for rows in bands(side, b.rows.len()) {
+        let n = rows.len() * side;
+        let buffers = RenderBuffers {
+            accumulator: &mut b.acc[..],
+            image: &mut b.image[..],
+            rows: &mut b.rows[..rows.len()],
+        };
+        let path = footprint::render::FloatPath { sampler: table };
+        let mut r = SheetRenderer::with_band(&f, path, shader, ORDER, buffers, None, rows.clone())?;
+        for step in 0..f.sheet_count() {
+            let s = f.sheet_at(ORDER, step);
+            r.render_sheet_with(s, |u, v| {
+                let [i, j, k] = f.grid_index(s, u, v);
+                let x = f32::from(sample(i, j, k));
+                shader.shade(&lighting, x, || Vec3::ZERO, [0; 3], f.dims)
+            })?;
+        }
+        add(&mut report.stats, r.finish());
+        report.bands += 1;
+        for c in b.image[..n].as_flattened() {
+            crc.update(&c.to_bits().to_le_bytes());
+        }
+        emit(rows.start, &b.image[..n]);
     }
-    let stats = r.finish();
-    let mut crc = footprint::table::Crc32::new();
-    for c in b.image.as_flattened() {
-        crc.update(&c.to_bits().to_le_bytes());
-    }
-    Ok(Report {
-        checksum: crc.finish(),
-        stats,
-    })
-}
-
-/// Generates sheet `s` in the frame's sheet layout, shading each sample with `shade`.
-fn fill_sheet<V>(f: &FrameSetup, s: usize, out: &mut [V], mut shade: impl FnMut(u8) -> V) {
-    let na = f.sheet_shape().1;
-    for (n, o) in out.iter_mut().enumerate() {
-        let [i, j, k] = f.grid_index(s, n % na, n / na);
-        *o = shade(sample(i, j, k));
-    }
+    report.checksum = crc.finish();
+    Ok(report)
 }
