@@ -48,7 +48,8 @@
 //! # What is float and what is not
 //! Per-view set-up ([`FixedTable`] and [`Placement`]) uses `f32`: the ellipse, the table and the
 //! voxel placement are computed once and quantised. The per-voxel and per-pixel work
-//! ([`splat`], [`composite`]) is integer only: those modules deny `clippy::float_arithmetic`
+//! ([`splat`], [`stencil`], [`composite`]) is integer only: those modules deny
+//! `clippy::float_arithmetic`
 //! and the `f32`/`f64` types, and CI disassembles them on `thumbv7m-none-eabi` (no FPU) to check
 //! they call no soft-float routine. Shading through [`crate::shade::Shader`] is float per voxel;
 //! callers who want no float per voxel shade through an integer lookup table and push values with
@@ -61,6 +62,7 @@
 
 pub mod composite;
 pub mod splat;
+pub mod stencil;
 mod table;
 
 pub use table::{FixedError, FixedTable, Placement};

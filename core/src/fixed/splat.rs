@@ -44,7 +44,7 @@ fn mul_pos(a: i64, b: i64) -> i64 {
 
 /// Walks table coordinates t and unit coordinates u along image rows.
 #[derive(Clone, Copy)]
-struct Cursor {
+pub(super) struct Cursor {
     t: [i64; 2],
     u: [i64; 2],
 }
@@ -52,7 +52,7 @@ struct Cursor {
 impl<const M: usize> FixedTable<M> {
     /// The cursor at screen offset q (Q24 px).
     #[inline]
-    fn cursor(&self, q: [i64; 2]) -> Cursor {
+    pub(super) fn cursor(&self, q: [i64; 2]) -> Cursor {
         let m = |a: &[[i64; 2]; 2], r: usize| {
             mul_pos(a[r][0], q[0]).saturating_add(mul_pos(a[r][1], q[1]))
         };
@@ -76,7 +76,7 @@ impl<const M: usize> FixedTable<M> {
 
     /// The entry-scaled weight (Q f) at the cursor: zero outside the support or the table.
     #[inline]
-    fn weight(&self, c: &Cursor) -> i64 {
+    pub(super) fn weight(&self, c: &Cursor) -> i64 {
         let [u0, u1] = c.u;
         if u0.abs() > ONE_POS || u1.abs() > ONE_POS {
             return 0;

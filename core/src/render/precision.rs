@@ -3,6 +3,7 @@
 //! image; see [`crate::fixed`]).
 
 use crate::composite::{clamp_unit, over};
+use crate::fixed::stencil::FixedStencils;
 use crate::fixed::{self, FixedError, FixedTable, Placement};
 use crate::frame::{FrameSetup, Order};
 use crate::splat::{BufferError, ImageMut, SplatStats, Splatter};
@@ -140,17 +141,27 @@ fn float_position(f: &FrameSetup, sheet: usize, u: usize, v: usize) -> [f32; 2] 
 #[derive(Clone, Copy, Debug)]
 pub struct FixedPath<'a, const M: usize> {
     table: &'a FixedTable<M>,
+    stencils: Option<FixedStencils<'a>>,
     place: Placement,
 }
 
 impl<'a, const M: usize> FixedPath<'a, M> {
-    /// The fixed path for `frame` through `table` (built for this frame). Refused when the
-    /// volume lands outside the fixed-point screen range.
+    /// The fixed path for `frame` through `table` (built for this frame), splatting by the table
+    /// walk. Refused when the volume lands outside the fixed-point screen range.
     pub fn new(frame: &FrameSetup, table: &'a FixedTable<M>) -> Result<Self, FixedError> {
         Ok(FixedPath {
             table,
+            stencils: None,
             place: Placement::new(frame)?,
         })
+    }
+
+    /// Splats through `stencils` (built from this path's table: [`FixedStencils::build`])
+    /// instead of the table walk. Still integer only and bit-exact everywhere, but not the same
+    /// bits as the walk (the blend between phases differs from the walk's lookup).
+    pub fn with_stencils(mut self, stencils: FixedStencils<'a>) -> Self {
+        self.stencils = Some(stencils);
+        self
     }
 }
 
@@ -184,7 +195,10 @@ impl<const M: usize> Precision for FixedPath<'_, M> {
     ) -> Result<SplatStats, BufferError> {
         let mut center = self.place.at(sheet, u, v);
         center[1] -= (row0 as i64) << fixed::POS_FRAC;
-        Ok(fixed::splat::splat(self.table, center, value, acc, touched))
+        Ok(match &self.stencils {
+            Some(s) => s.splat(center, value, acc, touched),
+            None => fixed::splat::splat(self.table, center, value, acc, touched),
+        })
     }
 
     fn composite_row(&self, acc: &mut [[i64; 4]], image: &mut [[u32; 4]], order: Order) {

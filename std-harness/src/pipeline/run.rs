@@ -13,6 +13,7 @@ use crate::io::stream::{FileSource, MemorySource, PipeSource};
 use crate::io::try_filled;
 use crate::reference::render::{render_reference, ReferenceScene};
 use crate::{with_table_size, CliError};
+use footprint::fixed::stencil::FixedStencils;
 use footprint::fixed::{self, FixedTable};
 use footprint::render::{
     FixedPath, FloatPath, Precision, RenderBuffers, RenderStats, SheetRenderer, SheetRing,
@@ -115,6 +116,17 @@ pub fn render_frame(
                 }
                 .map_err(fixed_range)?;
                 let path = FixedPath::new(&p.frame, &*table).map_err(fixed_range)?;
+                // Narrow footprints: the integer table sampled once per phase (as the float
+                // path's stencils); wide ones, or --phases 0, walk the table.
+                let len = (args.phases > 0 && method != MethodArg::Direct)
+                    .then(|| fixed::stencil::len_for(&table, args.phases))
+                    .flatten();
+                let mut buffer = vec![0i32; len.unwrap_or(0)];
+                let path = match len.map(|_| FixedStencils::build(&table, args.phases, &mut buffer)) {
+                    Some(Ok(stencils)) => path.with_stencils(stencils),
+                    // Weights too large for 32 bits: the walk serves this view.
+                    _ => path,
+                };
                 let tables = start.elapsed().as_secs_f64();
                 let bg: Option<Vec<[u32; 4]>> =
                     p.background.as_ref().map(|b| b.iter().map(|&c| fixed::quantise(c)).collect());

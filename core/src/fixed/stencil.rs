@@ -1,0 +1,291 @@
+//! Integer phase stencils: the fixed path's counterpart of [`crate::stencil`]. A view's integer
+//! footprint ([`FixedTable`]) is sampled once per sub-pixel phase, so splatting a voxel is a run
+//! of integer multiply-adds with no table walk per pixel and no second pass to renormalise.
+//! No floating point here, at build or splat time (denied below, like [`super::splat`]).
+//!
+//! A voxel at Q24 screen position c = (i + φx, j + φy) (i, j whole pixels) covers pixel centres
+//! in a box of B × B pixels around (i, j), B = 2·reach + 1. For each phase on a (P + 1) × (P + 1)
+//! grid, φ = (a/P, b/P), the stencil holds the table walk's own integer weight
+//! ([`FixedTable`]'s lookup, bit for bit) at each pixel of the box. For a footprint the walk
+//! renormalises, each stencil is scaled once, here, to sum to exactly C = round(cell area · 2^f)
+//! (the walk scales each voxel's value by C / S instead; rounding is spread so the sum is exact).
+//! A voxel's weights are the bilinear blend of the four stencils around its phase, with Q8
+//! fractions: (Σ c_k s_k + 2¹⁵) >> 16, c_k summing to 2¹⁶.
+//!
+//! **Only narrow footprints** (box side ≤ [`crate::stencil::NARROW_SIDE`]) get stencils, the
+//! common case at ordinary zoom; wider ones are splatted by the table walk, which their per-row
+//! cost amortises. So are footprints whose scaled weights would not fit an `i32`.
+//!
+//! **Accuracy.** The blend adds the error of linear interpolation over a phase step of 1/P px,
+//! as for the float stencils (see [`crate::stencil`]), and Q8 fractions add at most 1/512 of a
+//! phase step; the harness's `verify` measures it, and `tests/stencils.rs` compares these
+//! stencils with the walk.
+//!
+//! **Memory.** (P + 1)² · B² + P² · B `i32`s ([`len_for`]), built per view in caller storage:
+//! the same count as the float stencils.
+#![deny(clippy::float_arithmetic, clippy::disallowed_types)]
+
+use super::{FixedTable, POS_FRAC};
+use crate::splat::{BufferError, ImageMut, SplatStats};
+
+const HALF_POS: i64 = 1 << (POS_FRAC - 1);
+
+/// Why integer stencils were not built (the table walk serves the view instead).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum StencilError {
+    /// The footprint is wider than [`crate::stencil::NARROW_SIDE`] pixels (or not finite).
+    Wide,
+    /// `phases` is 0.
+    NoPhases,
+    /// A renormalised weight does not fit an `i32`.
+    Range,
+    /// The caller's buffer is shorter than [`len_for`].
+    Buffer(BufferError),
+}
+
+impl core::fmt::Display for StencilError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::Wide => write!(f, "the footprint is too wide for integer stencils"),
+            Self::NoPhases => write!(f, "integer stencils need at least one phase"),
+            Self::Range => write!(f, "a stencil weight does not fit 32 bits"),
+            Self::Buffer(e) => write!(f, "{e}"),
+        }
+    }
+}
+
+impl core::error::Error for StencilError {}
+
+/// Box side B of `table`'s footprint, if it is narrow: 2·⌈e + ½⌉ + 1 px, e the larger
+/// half-extent (as [`crate::stencil::side_for`], in integers).
+pub fn side_for<const M: usize>(table: &FixedTable<M>) -> Option<usize> {
+    let e = table.half_extent[0].max(table.half_extent[1]);
+    if e < 0 {
+        return None;
+    }
+    let reach = (e + HALF_POS + (1 << POS_FRAC) - 1) >> POS_FRAC; // ⌈e + ½⌉
+    let side = 2 * reach + 1;
+    (side <= crate::stencil::NARROW_SIDE as i64).then_some(side as usize)
+}
+
+/// `i32`s needed for `table`'s stencils at `phases` phases per pixel, if it is narrow:
+/// (P + 1)² · B² + P² · B.
+pub fn len_for<const M: usize>(table: &FixedTable<M>, phases: usize) -> Option<usize> {
+    let side = side_for(table)?;
+    Some((phases + 1) * (phases + 1) * side * side + phases * phases * side)
+}
+
+/// One view's integer phase stencils, in caller storage.
+#[derive(Clone, Copy, Debug)]
+pub struct FixedStencils<'a> {
+    /// (P + 1)² stencils of B² weights (Q f), then P² cells of B row runs (first | last << 16).
+    data: &'a [i32],
+    ranges: usize,
+    side: usize,
+    reach: i64,
+    phases: usize,
+}
+
+impl<'a> FixedStencils<'a> {
+    /// Samples `table`'s footprint at every phase (`phases` ≥ 1 per pixel) into `buffer` (at
+    /// least [`len_for`] long).
+    pub fn build<const M: usize>(
+        table: &FixedTable<M>,
+        phases: usize,
+        buffer: &'a mut [i32],
+    ) -> Result<Self, StencilError> {
+        if phases == 0 {
+            return Err(StencilError::NoPhases);
+        }
+        let side = side_for(table).ok_or(StencilError::Wide)?;
+        let len = (phases + 1) * (phases + 1) * side * side + phases * phases * side;
+        if buffer.len() < len {
+            return Err(StencilError::Buffer(BufferError::TooSmall {
+                needed: len,
+                got: buffer.len(),
+            }));
+        }
+        let reach = (side / 2) as i64;
+        let cells = side * side;
+        let ranges = (phases + 1) * (phases + 1) * cells;
+        let (weights, spans) = buffer[..len].split_at_mut(ranges);
+        let mut raw = [0i64; crate::stencil::NARROW_SIDE * crate::stencil::NARROW_SIDE];
+        let raw = &mut raw[..cells];
+        for (k, stencil) in weights.chunks_exact_mut(cells).enumerate() {
+            let (pa, pb) = ((k % (phases + 1)) as i64, (k / (phases + 1)) as i64);
+            // The phase's offset inside pixel (0, 0), Q24 (a/P of a pixel, rounded down).
+            let phase = [
+                (pa << POS_FRAC) / phases as i64,
+                (pb << POS_FRAC) / phases as i64,
+            ];
+            let mut sum = 0i64;
+            for (n, w) in raw.iter_mut().enumerate() {
+                let (mx, my) = ((n % side) as i64, (n / side) as i64);
+                let q = [
+                    ((mx - reach) << POS_FRAC) + HALF_POS - phase[0],
+                    ((my - reach) << POS_FRAC) + HALF_POS - phase[1],
+                ];
+                *w = table.weight(&table.cursor(q));
+                sum += *w;
+            }
+            if table.renorm != 0 {
+                if sum > 0 {
+                    // Scaled to sum to C exactly: each weight is the step of round(C · prefix / S).
+                    let (c, s) = (i128::from(table.renorm), i128::from(sum));
+                    let (mut prefix, mut before) = (0i128, 0i128);
+                    for w in raw.iter_mut() {
+                        prefix += i128::from(*w);
+                        let upto = (c * prefix * 2 + s).div_euclid(2 * s);
+                        *w = i64::try_from(upto - before).map_err(|_| StencilError::Range)?;
+                        before = upto;
+                    }
+                } else {
+                    // No pixel centre saw the footprint: the whole voxel goes to the pixel holding
+                    // its centre, as the walk does.
+                    raw.fill(0);
+                    let (cx, cy) = (phase[0] >> POS_FRAC, phase[1] >> POS_FRAC);
+                    let at = (reach + cy) as usize * side + (reach + cx) as usize;
+                    raw[at] = table.renorm;
+                }
+            }
+            for (o, &w) in stencil.iter_mut().zip(raw.iter()) {
+                *o = i32::try_from(w).map_err(|_| StencilError::Range)?;
+            }
+        }
+        // Per phase cell and box row: the first and last pixel where one of the cell's four
+        // corner stencils is non-zero; first > last when there is none.
+        let weights = &*weights;
+        let nonzero = |stencil: usize, my: usize| {
+            let row = &weights[stencil * cells + my * side..][..side];
+            let first = row.iter().position(|&w| w != 0);
+            let last = row.iter().rposition(|&w| w != 0);
+            first.zip(last)
+        };
+        for (c, cell) in spans.chunks_exact_mut(side).enumerate() {
+            let (a, b) = (c % phases, c / phases);
+            let corners = [
+                b * (phases + 1) + a,
+                b * (phases + 1) + a + 1,
+                (b + 1) * (phases + 1) + a,
+                (b + 1) * (phases + 1) + a + 1,
+            ];
+            for (my, packed) in cell.iter_mut().enumerate() {
+                let (mut first, mut last) = (side, 0);
+                for (f, l) in corners.iter().filter_map(|&s| nonzero(s, my)) {
+                    first = first.min(f);
+                    last = last.max(l);
+                }
+                // B ≤ 16: both fit 16 bits.
+                *packed = (first | last << 16) as i32;
+            }
+        }
+        Ok(FixedStencils {
+            data: &buffer[..len],
+            ranges,
+            side,
+            reach,
+            phases,
+        })
+    }
+
+    /// Box side B, pixels.
+    pub fn side(&self) -> usize {
+        self.side
+    }
+
+    /// Phases per pixel P.
+    pub fn phases(&self) -> usize {
+        self.phases
+    }
+
+    /// Spreads `value` (premultiplied RGBA, Q24) of a voxel projected to `center` (Q24 px,
+    /// absolute) into `acc` (Q(24 + f), saturating adds), calling `touched(y, x0, x1)` for each
+    /// row it updated: the blend of the four stencils around the centre's sub-pixel phase.
+    pub fn splat(
+        &self,
+        center: [i64; 2],
+        value: &[u32; 4],
+        acc: &mut ImageMut<'_, [i64; 4]>,
+        mut touched: impl FnMut(usize, usize, usize),
+    ) -> SplatStats {
+        let (w, h) = (acc.width() as i64, acc.height() as i64);
+        let (ix, iy) = (center[0] >> POS_FRAC, center[1] >> POS_FRAC);
+        let (x0, y0) = (ix - self.reach, iy - self.reach);
+        let b = self.side as i64;
+        let mut stats = SplatStats::default();
+        if x0 + b <= 0 || y0 + b <= 0 || x0 >= w || y0 >= h {
+            return stats;
+        }
+        let p = self.phases;
+        // Phase cell k and the Q8 fraction within it.
+        let phase = |c: i64, i: i64| {
+            let t = (c - (i << POS_FRAC)) * p as i64; // [0, P) in Q24
+            let k = ((t >> POS_FRAC) as usize).min(p - 1);
+            let f = ((t - ((k as i64) << POS_FRAC)) >> (POS_FRAC - 8)).clamp(0, 256);
+            (k, f)
+        };
+        let ((ka, fx), (kb, fy)) = (phase(center[0], ix), phase(center[1], iy));
+        let side = self.side;
+        let cells = side * side;
+        let at = |a: usize, b: usize| (b * (p + 1) + a) * cells;
+        let (s00, s10, s01, s11) = (
+            at(ka, kb),
+            at(ka + 1, kb),
+            at(ka, kb + 1),
+            at(ka + 1, kb + 1),
+        );
+        let (c00, c10, c01, c11) = (
+            (256 - fx) * (256 - fy),
+            fx * (256 - fy),
+            (256 - fx) * fy,
+            fx * fy,
+        );
+        let v = value.map(i64::from);
+        let spans = &self.data[self.ranges + (kb * p + ka) * side..][..side];
+        let (my0, my1) = ((-y0).max(0) as usize, (h - y0).min(b) as usize);
+        let stride = acc.stride();
+        let data = acc.data_mut();
+        for (my, &span) in spans.iter().enumerate().take(my1).skip(my0) {
+            let bits = span as u32;
+            let (first, last) = (x0 + i64::from(bits & 0xffff), x0 + i64::from(bits >> 16));
+            let (lo, hi) = (first.max(0), last.min(w - 1));
+            if lo > hi {
+                continue;
+            }
+            let (m0, n) = ((lo - x0) as usize, (hi - lo + 1) as usize);
+            let r = my * side + m0;
+            // Four slices of length n, so the loop below indexes them without checks.
+            let (r00, r10, r01, r11) = (
+                &self.data[s00 + r..][..n],
+                &self.data[s10 + r..][..n],
+                &self.data[s01 + r..][..n],
+                &self.data[s11 + r..][..n],
+            );
+            let y = (y0 + my as i64) as usize;
+            let start = y * stride + lo as usize;
+            // Clipped to the image, so the range is inside the buffer ImageMut checked.
+            let px = &mut data[start..start + n];
+            let mut updated = 0u32;
+            for (k, d) in px.iter_mut().enumerate() {
+                let wt = (c00 * i64::from(r00[k])
+                    + c10 * i64::from(r10[k])
+                    + c01 * i64::from(r01[k])
+                    + c11 * i64::from(r11[k])
+                    + (1 << 15))
+                    >> 16;
+                if wt != 0 {
+                    // |v| < 2³² and |wt| < 2³¹: the product fits.
+                    for (a, c) in d.iter_mut().zip(&v) {
+                        *a = a.saturating_add(c * wt);
+                    }
+                    updated += 1;
+                }
+            }
+            stats.pixels_visited += n as u32;
+            stats.pixels_updated += updated;
+            touched(y, lo as usize, hi as usize);
+        }
+        stats
+    }
+}
