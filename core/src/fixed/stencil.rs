@@ -12,9 +12,15 @@
 //! A voxel's weights are the bilinear blend of the four stencils around its phase, with Q8
 //! fractions: (Σ c_k s_k + 2¹⁵) >> 16, c_k summing to 2¹⁶.
 //!
-//! **Only narrow footprints** (box side ≤ [`crate::stencil::NARROW_SIDE`]) get stencils, the
-//! common case at ordinary zoom; wider ones are splatted by the table walk, which their per-row
-//! cost amortises. So are footprints whose scaled weights would not fit an `i32`.
+//! **Narrow and wide.** A *narrow* footprint (box side ≤ [`crate::stencil::NARROW_SIDE`]) is
+//! blended over every pixel where a corner stencil is non-zero, as the float path does. A *wide*
+//! one (up to [`MAX_STENCIL_SIDE`] px, and [`MAX_STENCIL_FLOATS`] entries, with the fewer phases
+//! the caller picks for it, see [`crate::stencil::phases_for`]) is blended only where all four
+//! corner stencils are non-zero; at the support's edge, where one of them is zero (the truncated
+//! kernel drops there from a few per cent of its peak to nothing), the pixel takes the walk's
+//! own weight, so no blend crosses the edge. Rows and runs are widened by a pixel so that an edge
+//! pixel none of the four corners reaches is still visited. Footprints beyond those limits, and
+//! renormalised ones whose scaled weights would not fit an `i32`, are splatted by the walk.
 //!
 //! **Accuracy.** The blend adds the error of linear interpolation over a phase step of 1/P px,
 //! as for the float stencils (see [`crate::stencil`]), and Q8 fractions add at most 1/512 of a
@@ -27,6 +33,7 @@
 
 use super::{FixedTable, POS_FRAC};
 use crate::splat::{BufferError, ImageMut, SplatStats};
+use crate::stencil::{MAX_STENCIL_FLOATS, MAX_STENCIL_SIDE, NARROW_SIDE};
 
 const HALF_POS: i64 = 1 << (POS_FRAC - 1);
 
@@ -34,7 +41,8 @@ const HALF_POS: i64 = 1 << (POS_FRAC - 1);
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[non_exhaustive]
 pub enum StencilError {
-    /// The footprint is wider than [`crate::stencil::NARROW_SIDE`] pixels (or not finite).
+    /// The footprint's box is wider than [`MAX_STENCIL_SIDE`] pixels, or the stencils would
+    /// exceed [`MAX_STENCIL_FLOATS`] entries.
     Wide,
     /// `phases` is 0.
     NoPhases,
@@ -57,8 +65,9 @@ impl core::fmt::Display for StencilError {
 
 impl core::error::Error for StencilError {}
 
-/// Box side B of `table`'s footprint, if it is narrow: 2·⌈e + ½⌉ + 1 px, e the larger
-/// half-extent (as [`crate::stencil::side_for`], in integers).
+/// Box side B of `table`'s footprint, if stencils apply: 2·⌈e + ½⌉ + 1 px ≤
+/// [`MAX_STENCIL_SIDE`], e the larger half-extent (as [`crate::stencil::side_for`], in
+/// integers).
 pub fn side_for<const M: usize>(table: &FixedTable<M>) -> Option<usize> {
     let e = table.half_extent[0].max(table.half_extent[1]);
     if e < 0 {
@@ -66,32 +75,46 @@ pub fn side_for<const M: usize>(table: &FixedTable<M>) -> Option<usize> {
     }
     let reach = (e + HALF_POS + (1 << POS_FRAC) - 1) >> POS_FRAC; // ⌈e + ½⌉
     let side = 2 * reach + 1;
-    (side <= crate::stencil::NARROW_SIDE as i64).then_some(side as usize)
+    (side <= MAX_STENCIL_SIDE as i64).then_some(side as usize)
 }
 
-/// `i32`s needed for `table`'s stencils at `phases` phases per pixel, if it is narrow:
-/// (P + 1)² · B² + P² · B.
+/// `i32`s needed for `table`'s stencils at `phases` phases per pixel, if stencils apply:
+/// (P + 1)² · B² + P² · B ≤ [`MAX_STENCIL_FLOATS`]. A wide footprint should be given the fewer
+/// phases [`crate::stencil::phases_for`] picks for it.
 pub fn len_for<const M: usize>(table: &FixedTable<M>, phases: usize) -> Option<usize> {
     let side = side_for(table)?;
-    Some((phases + 1) * (phases + 1) * side * side + phases * phases * side)
+    let len = (phases + 1) * (phases + 1) * side * side + phases * phases * side;
+    (len <= MAX_STENCIL_FLOATS).then_some(len)
 }
 
-/// One view's integer phase stencils, in caller storage.
-#[derive(Clone, Copy, Debug)]
-pub struct FixedStencils<'a> {
+/// One view's integer phase stencils, in caller storage, with the table they were sampled from.
+#[derive(Debug)]
+pub struct FixedStencils<'a, const M: usize> {
     /// (P + 1)² stencils of B² weights (Q f), then P² cells of B row runs (first | last << 16).
     data: &'a [i32],
     ranges: usize,
     side: usize,
     reach: i64,
     phases: usize,
+    /// Box side above [`NARROW_SIDE`]: blended only inside all four corners' support.
+    wide: bool,
+    /// The table the stencils were sampled from (a wide footprint's edge pixels read it).
+    table: &'a FixedTable<M>,
 }
 
-impl<'a> FixedStencils<'a> {
+impl<const M: usize> Clone for FixedStencils<'_, M> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<const M: usize> Copy for FixedStencils<'_, M> {}
+
+impl<'a, const M: usize> FixedStencils<'a, M> {
     /// Samples `table`'s footprint at every phase (`phases` ≥ 1 per pixel) into `buffer` (at
     /// least [`len_for`] long).
-    pub fn build<const M: usize>(
-        table: &FixedTable<M>,
+    pub fn build(
+        table: &'a FixedTable<M>,
         phases: usize,
         buffer: &'a mut [i32],
     ) -> Result<Self, StencilError> {
@@ -99,7 +122,12 @@ impl<'a> FixedStencils<'a> {
             return Err(StencilError::NoPhases);
         }
         let side = side_for(table).ok_or(StencilError::Wide)?;
-        let len = (phases + 1) * (phases + 1) * side * side + phases * phases * side;
+        let len = len_for(table, phases).ok_or(StencilError::Wide)?;
+        let wide = side > NARROW_SIDE;
+        if wide && table.renorm != 0 {
+            // Renormalised footprints are a few pixels wide; a wide one is not expected.
+            return Err(StencilError::Wide);
+        }
         if buffer.len() < len {
             return Err(StencilError::Buffer(BufferError::TooSmall {
                 needed: len,
@@ -110,8 +138,7 @@ impl<'a> FixedStencils<'a> {
         let cells = side * side;
         let ranges = (phases + 1) * (phases + 1) * cells;
         let (weights, spans) = buffer[..len].split_at_mut(ranges);
-        let mut raw = [0i64; crate::stencil::NARROW_SIDE * crate::stencil::NARROW_SIDE];
-        let raw = &mut raw[..cells];
+        let mut raw = [0i64; NARROW_SIDE * NARROW_SIDE];
         for (k, stencil) in weights.chunks_exact_mut(cells).enumerate() {
             let (pa, pb) = ((k % (phases + 1)) as i64, (k / (phases + 1)) as i64);
             // The phase's offset inside pixel (0, 0), Q24 (a/P of a pixel, rounded down).
@@ -119,42 +146,53 @@ impl<'a> FixedStencils<'a> {
                 (pa << POS_FRAC) / phases as i64,
                 (pb << POS_FRAC) / phases as i64,
             ];
-            let mut sum = 0i64;
-            for (n, w) in raw.iter_mut().enumerate() {
+            let weight_at = |n: usize| {
                 let (mx, my) = ((n % side) as i64, (n / side) as i64);
                 let q = [
                     ((mx - reach) << POS_FRAC) + HALF_POS - phase[0],
                     ((my - reach) << POS_FRAC) + HALF_POS - phase[1],
                 ];
-                *w = table.weight(&table.cursor(q));
+                table.weight(&table.cursor(q))
+            };
+            if table.renorm == 0 {
+                // The walk's entries as they are (an entry is an i32).
+                for (n, o) in stencil.iter_mut().enumerate() {
+                    *o = i32::try_from(weight_at(n)).map_err(|_| StencilError::Range)?;
+                }
+                continue;
+            }
+            let raw = &mut raw[..cells];
+            let mut sum = 0i64;
+            for (n, w) in raw.iter_mut().enumerate() {
+                *w = weight_at(n);
                 sum += *w;
             }
-            if table.renorm != 0 {
-                if sum > 0 {
-                    // Scaled to sum to C exactly: each weight is the step of round(C · prefix / S).
-                    let (c, s) = (i128::from(table.renorm), i128::from(sum));
-                    let (mut prefix, mut before) = (0i128, 0i128);
-                    for w in raw.iter_mut() {
-                        prefix += i128::from(*w);
-                        let upto = (c * prefix * 2 + s).div_euclid(2 * s);
-                        *w = i64::try_from(upto - before).map_err(|_| StencilError::Range)?;
-                        before = upto;
-                    }
-                } else {
-                    // No pixel centre saw the footprint: the whole voxel goes to the pixel holding
-                    // its centre, as the walk does.
-                    raw.fill(0);
-                    let (cx, cy) = (phase[0] >> POS_FRAC, phase[1] >> POS_FRAC);
-                    let at = (reach + cy) as usize * side + (reach + cx) as usize;
-                    raw[at] = table.renorm;
+            if sum > 0 {
+                // Scaled to sum to C exactly: each weight is the step of round(C · prefix / S).
+                let (c, s) = (i128::from(table.renorm), i128::from(sum));
+                let (mut prefix, mut before) = (0i128, 0i128);
+                for w in raw.iter_mut() {
+                    prefix += i128::from(*w);
+                    let upto = (c * prefix * 2 + s).div_euclid(2 * s);
+                    *w = i64::try_from(upto - before).map_err(|_| StencilError::Range)?;
+                    before = upto;
                 }
+            } else {
+                // No pixel centre saw the footprint: the whole voxel goes to the pixel holding
+                // its centre, as the walk does.
+                raw.fill(0);
+                let (cx, cy) = (phase[0] >> POS_FRAC, phase[1] >> POS_FRAC);
+                let at = (reach + cy) as usize * side + (reach + cx) as usize;
+                raw[at] = table.renorm;
             }
             for (o, &w) in stencil.iter_mut().zip(raw.iter()) {
                 *o = i32::try_from(w).map_err(|_| StencilError::Range)?;
             }
         }
         // Per phase cell and box row: the first and last pixel where one of the cell's four
-        // corner stencils is non-zero; first > last when there is none.
+        // corner stencils is non-zero (wide: on this row or the next or previous one, widened by
+        // a pixel each side, so edge pixels no corner reaches are visited too); first > last when
+        // there is none.
         let weights = &*weights;
         let nonzero = |stencil: usize, my: usize| {
             let row = &weights[stencil * cells + my * side..][..side];
@@ -172,11 +210,21 @@ impl<'a> FixedStencils<'a> {
             ];
             for (my, packed) in cell.iter_mut().enumerate() {
                 let (mut first, mut last) = (side, 0);
-                for (f, l) in corners.iter().filter_map(|&s| nonzero(s, my)) {
-                    first = first.min(f);
-                    last = last.max(l);
+                let rows = if wide {
+                    my.saturating_sub(1)..(my + 2).min(side)
+                } else {
+                    my..my + 1
+                };
+                for r in rows {
+                    for (f, l) in corners.iter().filter_map(|&s| nonzero(s, r)) {
+                        first = first.min(f);
+                        last = last.max(l);
+                    }
                 }
-                // B ≤ 16: both fit 16 bits.
+                if wide && first <= last {
+                    (first, last) = (first.saturating_sub(1), (last + 1).min(side - 1));
+                }
+                // B ≤ 129: both fit 16 bits.
                 *packed = (first | last << 16) as i32;
             }
         }
@@ -186,6 +234,8 @@ impl<'a> FixedStencils<'a> {
             side,
             reach,
             phases,
+            wide,
+            table,
         })
     }
 
@@ -267,13 +317,27 @@ impl<'a> FixedStencils<'a> {
             // Clipped to the image, so the range is inside the buffer ImageMut checked.
             let px = &mut data[start..start + n];
             let mut updated = 0u32;
+            let wide = self.wide;
+            // A wide footprint's edge pixel, weighted as the walk weights it.
+            let exact = |k: usize| {
+                let q = [
+                    ((lo + k as i64) << POS_FRAC) + HALF_POS - center[0],
+                    (((y0 + my as i64) << POS_FRAC) + HALF_POS) - center[1],
+                ];
+                self.table.weight(&self.table.cursor(q))
+            };
             for (k, d) in px.iter_mut().enumerate() {
-                let wt = (c00 * i64::from(r00[k])
-                    + c10 * i64::from(r10[k])
-                    + c01 * i64::from(r01[k])
-                    + c11 * i64::from(r11[k])
-                    + (1 << 15))
-                    >> 16;
+                let (a, b, c, e) = (r00[k], r10[k], r01[k], r11[k]);
+                let wt = if wide && (a == 0 || b == 0 || c == 0 || e == 0) {
+                    exact(k)
+                } else {
+                    (c00 * i64::from(a)
+                        + c10 * i64::from(b)
+                        + c01 * i64::from(c)
+                        + c11 * i64::from(e)
+                        + (1 << 15))
+                        >> 16
+                };
                 if wt != 0 {
                     // |v| < 2³² and |wt| < 2³¹: the product fits.
                     for (a, c) in d.iter_mut().zip(&v) {

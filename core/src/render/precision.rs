@@ -141,7 +141,7 @@ fn float_position(f: &FrameSetup, sheet: usize, u: usize, v: usize) -> [f32; 2] 
 #[derive(Clone, Copy, Debug)]
 pub struct FixedPath<'a, const M: usize> {
     table: &'a FixedTable<M>,
-    stencils: Option<FixedStencils<'a>>,
+    stencils: Option<FixedStencils<'a, M>>,
     place: Placement,
 }
 
@@ -159,7 +159,7 @@ impl<'a, const M: usize> FixedPath<'a, M> {
     /// Splats through `stencils` (built from this path's table: [`FixedStencils::build`])
     /// instead of the table walk. Still integer only and bit-exact everywhere, but not the same
     /// bits as the walk (the blend between phases differs from the walk's lookup).
-    pub fn with_stencils(mut self, stencils: FixedStencils<'a>) -> Self {
+    pub fn with_stencils(mut self, stencils: FixedStencils<'a, M>) -> Self {
         self.stencils = Some(stencils);
         self
     }

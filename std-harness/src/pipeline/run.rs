@@ -116,13 +116,15 @@ pub fn render_frame(
                 }
                 .map_err(fixed_range)?;
                 let path = FixedPath::new(&p.frame, &*table).map_err(fixed_range)?;
-                // Narrow footprints: the integer table sampled once per phase (as the float
-                // path's stencils); wide ones, or --phases 0, walk the table.
+                // Footprints up to 128 px across: the integer table sampled once per phase (as
+                // the float path's stencils, with as many phases); wider ones, or --phases 0, walk
+                // the table.
+                let phases = stencil::phases_for(&p.frame.footprint, args.phases);
                 let len = (args.phases > 0 && method != MethodArg::Direct)
-                    .then(|| fixed::stencil::len_for(&table, args.phases))
+                    .then(|| fixed::stencil::len_for(&table, phases))
                     .flatten();
                 let mut buffer = vec![0i32; len.unwrap_or(0)];
-                let path = match len.map(|_| FixedStencils::build(&table, args.phases, &mut buffer)) {
+                let path = match len.map(|_| FixedStencils::build(&table, phases, &mut buffer)) {
                     Some(Ok(stencils)) => path.with_stencils(stencils),
                     // Weights too large for 32 bits: the walk serves this view.
                     _ => path,
