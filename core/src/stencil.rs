@@ -129,6 +129,38 @@ pub fn len_for(footprint: &Footprint, max_phases: usize) -> Option<usize> {
     (len <= MAX_STENCIL_FLOATS).then_some(len)
 }
 
+/// The four stencils at the corners of phase cell `c` = a + b·P (indices into the (P + 1)² grid of
+/// stencils, row b first): (a, b), (a + 1, b), (a, b + 1), (a + 1, b + 1).
+pub(crate) fn cell_corners(c: usize, phases: usize) -> [usize; 4] {
+    let (a, b) = (c % phases, c / phases);
+    [
+        b * (phases + 1) + a,
+        b * (phases + 1) + a + 1,
+        (b + 1) * (phases + 1) + a,
+        (b + 1) * (phases + 1) + a + 1,
+    ]
+}
+
+/// Where the four stencils around phase cell (`ka`, `kb`) start in the stencil data (stencils of
+/// `cells` weights on a (P + 1)² grid): (ka, kb), (ka + 1, kb), (ka, kb + 1), (ka + 1, kb + 1).
+pub(crate) fn corner_offsets(ka: usize, kb: usize, phases: usize, cells: usize) -> [usize; 4] {
+    cell_corners(kb * phases + ka, phases).map(|s| s * cells)
+}
+
+/// The four corner stencils' weights at box pixels `r` … `r + n` (a row's run): four slices of
+/// length n, so a loop over them indexes without checks.
+pub(crate) fn corner_rows<W>(data: &[W], corners: [usize; 4], r: usize, n: usize) -> [&[W]; 4] {
+    corners.map(|s| &data[s + r..][..n])
+}
+
+/// The first and last index of a non-zero weight in `row`, if any.
+pub(crate) fn nonzero_run<W: PartialEq + Default>(row: &[W]) -> Option<(usize, usize)> {
+    let zero = W::default();
+    let first = row.iter().position(|w| *w != zero)?;
+    let last = row.iter().rposition(|w| *w != zero)?;
+    Some((first, last))
+}
+
 /// One view's phase stencils (see the module docs), in caller storage, with the sampler they were
 /// built from (a wide footprint reads it at the support's edge).
 #[derive(Debug)]
@@ -215,19 +247,10 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
         let wide = is_wide(fp);
         let weights = &*weights;
         let nonzero = |stencil: usize, my: usize| {
-            let row = &weights[stencil * cells + my * side..][..side];
-            let first = row.iter().position(|&w| w != 0.0);
-            let last = row.iter().rposition(|&w| w != 0.0);
-            first.zip(last)
+            nonzero_run(&weights[stencil * cells + my * side..][..side])
         };
         for (c, cell) in spans.chunks_exact_mut(side).enumerate() {
-            let (a, b) = (c % phases, c / phases);
-            let corners = [
-                b * (phases + 1) + a,
-                b * (phases + 1) + a + 1,
-                (b + 1) * (phases + 1) + a,
-                (b + 1) * (phases + 1) + a + 1,
-            ];
+            let corners = cell_corners(c, phases);
             for (my, packed) in cell.iter_mut().enumerate() {
                 let (mut first, mut last) = (side, 0);
                 if wide {
@@ -312,14 +335,7 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
         };
         let ((ka, fx), (kb, fy)) = (phase(center[0], ix), phase(center[1], iy));
         let side = self.side;
-        let cells = side * side;
-        let at = |a: usize, b: usize| (b * (p + 1) + a) * cells;
-        let (s00, s10, s01, s11) = (
-            at(ka, kb),
-            at(ka + 1, kb),
-            at(ka, kb + 1),
-            at(ka + 1, kb + 1),
-        );
+        let corners = corner_offsets(ka, kb, p, side * side);
         let (w00, w10, w01, w11) = (
             (1.0 - fx) * (1.0 - fy),
             fx * (1.0 - fy),
@@ -348,13 +364,7 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
                 }
                 let (m0, n) = ((lo - x0) as usize, (hi - lo + 1) as usize);
                 let r = my * side + m0;
-                // Four slices of length n, so the loop below indexes them without checks.
-                let (r00, r10, r01, r11) = (
-                    &self.data[s00 + r..][..n],
-                    &self.data[s10 + r..][..n],
-                    &self.data[s01 + r..][..n],
-                    &self.data[s11 + r..][..n],
-                );
+                let [r00, r10, r01, r11] = corner_rows(self.data, corners, r, n);
                 let y = (y0 + my as i64) as usize;
                 let start = y * stride + lo as usize;
                 // Clipped to the image, so the range is inside the buffer ImageMut checked.
@@ -389,12 +399,7 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
             if b0 <= b1 {
                 let (m0, nb) = ((b0 - x0) as usize, (b1 - b0 + 1) as usize);
                 let r = my * side + m0;
-                let (r00, r10, r01, r11) = (
-                    &self.data[s00 + r..][..nb],
-                    &self.data[s10 + r..][..nb],
-                    &self.data[s01 + r..][..nb],
-                    &self.data[s11 + r..][..nb],
-                );
+                let [r00, r10, r01, r11] = corner_rows(self.data, corners, r, nb);
                 // The row's weights first (a loop the compiler vectorises), then the deposit.
                 let out = &mut ws[(b0 - lo) as usize..][..nb];
                 for (k, wt) in out.iter_mut().enumerate() {

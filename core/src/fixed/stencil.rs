@@ -33,7 +33,10 @@
 
 use super::{FixedTable, POS_FRAC};
 use crate::splat::{BufferError, ImageMut, SplatStats};
-use crate::stencil::{MAX_STENCIL_FLOATS, MAX_STENCIL_SIDE, NARROW_SIDE};
+use crate::stencil::{
+    cell_corners, corner_offsets, corner_rows, nonzero_run, MAX_STENCIL_FLOATS, MAX_STENCIL_SIDE,
+    NARROW_SIDE,
+};
 
 const HALF_POS: i64 = 1 << (POS_FRAC - 1);
 
@@ -195,19 +198,10 @@ impl<'a, const M: usize> FixedStencils<'a, M> {
         // there is none.
         let weights = &*weights;
         let nonzero = |stencil: usize, my: usize| {
-            let row = &weights[stencil * cells + my * side..][..side];
-            let first = row.iter().position(|&w| w != 0);
-            let last = row.iter().rposition(|&w| w != 0);
-            first.zip(last)
+            nonzero_run(&weights[stencil * cells + my * side..][..side])
         };
         for (c, cell) in spans.chunks_exact_mut(side).enumerate() {
-            let (a, b) = (c % phases, c / phases);
-            let corners = [
-                b * (phases + 1) + a,
-                b * (phases + 1) + a + 1,
-                (b + 1) * (phases + 1) + a,
-                (b + 1) * (phases + 1) + a + 1,
-            ];
+            let corners = cell_corners(c, phases);
             for (my, packed) in cell.iter_mut().enumerate() {
                 let (mut first, mut last) = (side, 0);
                 let rows = if wide {
@@ -277,14 +271,7 @@ impl<'a, const M: usize> FixedStencils<'a, M> {
         };
         let ((ka, fx), (kb, fy)) = (phase(center[0], ix), phase(center[1], iy));
         let side = self.side;
-        let cells = side * side;
-        let at = |a: usize, b: usize| (b * (p + 1) + a) * cells;
-        let (s00, s10, s01, s11) = (
-            at(ka, kb),
-            at(ka + 1, kb),
-            at(ka, kb + 1),
-            at(ka + 1, kb + 1),
-        );
+        let corners = corner_offsets(ka, kb, p, side * side);
         let (c00, c10, c01, c11) = (
             (256 - fx) * (256 - fy),
             fx * (256 - fy),
@@ -305,13 +292,7 @@ impl<'a, const M: usize> FixedStencils<'a, M> {
             }
             let (m0, n) = ((lo - x0) as usize, (hi - lo + 1) as usize);
             let r = my * side + m0;
-            // Four slices of length n, so the loop below indexes them without checks.
-            let (r00, r10, r01, r11) = (
-                &self.data[s00 + r..][..n],
-                &self.data[s10 + r..][..n],
-                &self.data[s01 + r..][..n],
-                &self.data[s11 + r..][..n],
-            );
+            let [r00, r10, r01, r11] = corner_rows(self.data, corners, r, n);
             let y = (y0 + my as i64) as usize;
             let start = y * stride + lo as usize;
             // Clipped to the image, so the range is inside the buffer ImageMut checked.

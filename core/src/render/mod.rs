@@ -438,19 +438,9 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
         rgba: &[[f32; 4]],
     ) -> Result<(), RenderError> {
         let na = self.frame.sheet_shape().1;
-        let path = &self.path;
-        Self::splat_sheet(
-            self.frame,
-            path,
-            self.band,
-            &mut self.buffers,
-            &mut self.stats,
-            index,
-            [Some(rgba.len()), None, None],
-            |u, v| path.value(rgba[v * na + u]),
-        )?;
-        self.composite_sheet();
-        Ok(())
+        self.splat_and_composite(index, Some(rgba.len()), |path, u, v| {
+            path.value(rgba[v * na + u])
+        })
     }
 
     /// [`SheetRenderer::render_shaded_sheet`] with values already in the precision's own format
@@ -461,18 +451,7 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
         values: &[P::Value],
     ) -> Result<(), RenderError> {
         let na = self.frame.sheet_shape().1;
-        Self::splat_sheet(
-            self.frame,
-            &self.path,
-            self.band,
-            &mut self.buffers,
-            &mut self.stats,
-            index,
-            [Some(values.len()), None, None],
-            |u, v| values[v * na + u],
-        )?;
-        self.composite_sheet();
-        Ok(())
+        self.splat_and_composite(index, Some(values.len()), |_, u, v| values[v * na + u])
     }
 
     /// Splats and composites sheet `index` with each voxel's value computed on the fly by
@@ -483,17 +462,29 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
     pub fn render_sheet_with(
         &mut self,
         index: usize,
-        shade: impl FnMut(usize, usize) -> P::Value,
+        mut shade: impl FnMut(usize, usize) -> P::Value,
     ) -> Result<(), RenderError> {
+        self.splat_and_composite(index, None, |_, u, v| shade(u, v))
+    }
+
+    /// [`SheetRenderer::splat_sheet`] of a sheet of `len` values (checked, if given), each
+    /// `shade(path, u, v)`, then [`SheetRenderer::composite_sheet`].
+    fn splat_and_composite(
+        &mut self,
+        index: usize,
+        len: Option<usize>,
+        mut shade: impl FnMut(&P, usize, usize) -> P::Value,
+    ) -> Result<(), RenderError> {
+        let path = &self.path;
         Self::splat_sheet(
             self.frame,
-            &self.path,
+            path,
             self.band,
             &mut self.buffers,
             &mut self.stats,
             index,
-            [None, None, None],
-            shade,
+            [len, None, None],
+            |u, v| shade(path, u, v),
         )?;
         self.composite_sheet();
         Ok(())

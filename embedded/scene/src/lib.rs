@@ -23,7 +23,7 @@ use footprint::fixed::{self, FixedTable};
 use footprint::frame::{FrameSetup, Order};
 use footprint::geometry::FootprintOptions;
 use footprint::math;
-use footprint::render::{FixedPath, RenderBuffers, RenderStats, SheetRenderer};
+use footprint::render::{FixedPath, Precision, RenderBuffers, RenderStats, SheetRenderer};
 use footprint::shade::{Lighting, Shader, Shading, TransferFunction};
 use footprint::table::Crc32;
 use footprint::{GenericTable, Grid, Kernel, Lookup, View, ViewTable};
@@ -153,7 +153,7 @@ fn bands(side: usize, band: usize) -> impl Iterator<Item = core::ops::Range<usiz
 pub fn render_fixed(
     side: usize,
     b: FixedBuffers<'_>,
-    mut emit: impl FnMut(usize, &[[u32; 4]]),
+    emit: impl FnMut(usize, &[[u32; 4]]),
 ) -> Result<Report, footprint::Error> {
     let f = frame(side)?;
     // Per-view set-up (float): the view table and the shading lookup.
@@ -165,35 +165,64 @@ pub fn render_fixed(
         *entry = fixed::quantise(rgba);
     }
     // Per voxel and per pixel: integers only.
-    let (lut, table) = (&*b.lut, &*b.table);
+    let (lut, path) = (&*b.lut, FixedPath::new(&f, &*b.table)?);
+    let buffers = (&mut *b.acc, &mut *b.image, &mut *b.rows);
+    render_bands(
+        &f,
+        path,
+        shader,
+        buffers,
+        |x| lut[usize::from(x)],
+        emit,
+        |c, crc| crc.update(&c.to_le_bytes()),
+    )
+}
+
+/// The band loop both precisions share: for each band of `rows.len()` rows, every sheet in
+/// order with each voxel shaded by `shade(sample)`, then the band's pixels into the checksum
+/// (each channel by `bytes`) and out through `emit(first_row, pixels)`.
+fn render_bands<P: Precision + Copy, C: Copy>(
+    f: &FrameSetup,
+    path: P,
+    shader: Shader<'_>,
+    (acc, image, rows): (&mut [P::Acc], &mut [P::Pixel], &mut [RowSpan]),
+    shade: impl Fn(u8) -> P::Value,
+    mut emit: impl FnMut(usize, &[P::Pixel]),
+    mut bytes: impl FnMut(C, &mut Crc32),
+) -> Result<Report, footprint::Error>
+where
+    P::Pixel: AsRef<[C]>,
+{
+    let side = f.size[0];
     let mut crc = Crc32::new();
     let mut report = Report {
         checksum: 0,
         stats: RenderStats::default(),
         bands: 0,
     };
-    for rows in bands(side, b.rows.len()) {
-        let n = rows.len() * side;
+    for band in bands(side, rows.len()) {
+        let n = band.len() * side;
         let buffers = RenderBuffers {
-            accumulator: &mut b.acc[..],
-            image: &mut b.image[..],
-            rows: &mut b.rows[..rows.len()],
+            accumulator: &mut acc[..],
+            image: &mut image[..],
+            rows: &mut rows[..band.len()],
         };
-        let path = FixedPath::new(&f, table)?;
-        let mut r = SheetRenderer::with_band(&f, path, shader, ORDER, buffers, None, rows.clone())?;
+        let mut r = SheetRenderer::with_band(f, path, shader, ORDER, buffers, None, band.clone())?;
         for step in 0..f.sheet_count() {
             let s = f.sheet_at(ORDER, step);
             r.render_sheet_with(s, |u, v| {
                 let [i, j, k] = f.grid_index(s, u, v);
-                lut[usize::from(sample(i, j, k))]
+                shade(sample(i, j, k))
             })?;
         }
         add(&mut report.stats, r.finish());
         report.bands += 1;
-        for c in b.image[..n].as_flattened() {
-            crc.update(&c.to_le_bytes());
+        for px in &image[..n] {
+            for &c in px.as_ref() {
+                bytes(c, &mut crc);
+            }
         }
-        emit(rows.start, &b.image[..n]);
+        emit(band.start, &image[..n]);
     }
     report.checksum = crc.finish();
     Ok(report)
@@ -224,43 +253,16 @@ pub struct FloatBuffers<'a> {
 pub fn render_float(
     side: usize,
     b: FloatBuffers<'_>,
-    mut emit: impl FnMut(usize, &[[f32; 4]]),
+    emit: impl FnMut(usize, &[[f32; 4]]),
 ) -> Result<Report, footprint::Error> {
     let f = frame(side)?;
     b.table
         .build_into(&f.footprint, &GENERIC, Lookup::Bilinear, Lookup::Bilinear);
     let (shader, lighting) = (shader(), Lighting::new(&f));
-    let table = &*b.table;
-    let mut crc = Crc32::new();
-    let mut report = Report {
-        checksum: 0,
-        stats: RenderStats::default(),
-        bands: 0,
-    };
-    for rows in bands(side, b.rows.len()) {
-        let n = rows.len() * side;
-        let buffers = RenderBuffers {
-            accumulator: &mut b.acc[..],
-            image: &mut b.image[..],
-            rows: &mut b.rows[..rows.len()],
-        };
-        let path = footprint::render::FloatPath { sampler: table };
-        let mut r = SheetRenderer::with_band(&f, path, shader, ORDER, buffers, None, rows.clone())?;
-        for step in 0..f.sheet_count() {
-            let s = f.sheet_at(ORDER, step);
-            r.render_sheet_with(s, |u, v| {
-                let [i, j, k] = f.grid_index(s, u, v);
-                let x = f32::from(sample(i, j, k));
-                shader.shade(&lighting, x, || Vec3::ZERO, [0; 3], f.dims)
-            })?;
-        }
-        add(&mut report.stats, r.finish());
-        report.bands += 1;
-        for c in b.image[..n].as_flattened() {
-            crc.update(&c.to_bits().to_le_bytes());
-        }
-        emit(rows.start, &b.image[..n]);
-    }
-    report.checksum = crc.finish();
-    Ok(report)
+    let path = footprint::render::FloatPath { sampler: &*b.table };
+    let buffers = (&mut *b.acc, &mut *b.image, &mut *b.rows);
+    let shade = |x: u8| shader.shade(&lighting, f32::from(x), || Vec3::ZERO, [0; 3], f.dims);
+    render_bands(&f, path, shader, buffers, shade, emit, |c: f32, crc| {
+        crc.update(&c.to_bits().to_le_bytes())
+    })
 }
