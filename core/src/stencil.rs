@@ -147,12 +147,6 @@ pub(crate) fn corner_offsets(ka: usize, kb: usize, phases: usize, cells: usize) 
     cell_corners(kb * phases + ka, phases).map(|s| s * cells)
 }
 
-/// The four corner stencils' weights at box pixels `r` … `r + n` (a row's run): four slices of
-/// length n, so a loop over them indexes without checks.
-pub(crate) fn corner_rows<W>(data: &[W], corners: [usize; 4], r: usize, n: usize) -> [&[W]; 4] {
-    corners.map(|s| &data[s + r..][..n])
-}
-
 /// The first and last index of a non-zero weight in `row`, if any.
 pub(crate) fn nonzero_run<W: PartialEq + Default>(row: &[W]) -> Option<(usize, usize)> {
     let zero = W::default();
@@ -364,7 +358,16 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
                 }
                 let (m0, n) = ((lo - x0) as usize, (hi - lo + 1) as usize);
                 let r = my * side + m0;
-                let [r00, r10, r01, r11] = corner_rows(self.data, corners, r, n);
+                let [s00, s10, s01, s11] = corners;
+                // Four slices of length n, written out so the compiler sees their lengths and
+                // the loop below indexes them without checks (an array of slices measured 22 %
+                // slower on the walnut).
+                let (r00, r10, r01, r11) = (
+                    &self.data[s00 + r..][..n],
+                    &self.data[s10 + r..][..n],
+                    &self.data[s01 + r..][..n],
+                    &self.data[s11 + r..][..n],
+                );
                 let y = (y0 + my as i64) as usize;
                 let start = y * stride + lo as usize;
                 // Clipped to the image, so the range is inside the buffer ImageMut checked.
@@ -399,7 +402,13 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
             if b0 <= b1 {
                 let (m0, nb) = ((b0 - x0) as usize, (b1 - b0 + 1) as usize);
                 let r = my * side + m0;
-                let [r00, r10, r01, r11] = corner_rows(self.data, corners, r, nb);
+                let [s00, s10, s01, s11] = corners;
+                let (r00, r10, r01, r11) = (
+                    &self.data[s00 + r..][..nb],
+                    &self.data[s10 + r..][..nb],
+                    &self.data[s01 + r..][..nb],
+                    &self.data[s11 + r..][..nb],
+                );
                 // The row's weights first (a loop the compiler vectorises), then the deposit.
                 let out = &mut ws[(b0 - lo) as usize..][..nb];
                 for (k, wt) in out.iter_mut().enumerate() {
