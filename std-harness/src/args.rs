@@ -323,9 +323,9 @@ pub struct RenderArgs {
     #[arg(long, value_enum, default_value_t = AccumArg::Float)]
     pub accum: AccumArg,
     /// View-table renders: sub-pixel phases per pixel (at most; wide footprints use fewer) of the
-    /// phase stencils that splat footprints up to 128 px across (float; the view table sampled
-    /// once per phase; see the core's `stencil` module) or up to 16 px across (fixed; the integer
-    /// table sampled once per phase, `fixed::stencil`); 0 walks the table per pixel instead.
+    /// phase stencils that splat footprints up to 128 px across: the view table (float, the
+    /// core's `stencil` module) or the integer table (fixed, `fixed::stencil`) sampled once per
+    /// phase; 0 walks the table per pixel instead.
     #[arg(long, default_value_t = footprint::stencil::DEFAULT_PHASES)]
     pub phases: usize,
     /// Supersampling: `auto` renders at k× the size and averages k×k blocks when voxels project

@@ -52,8 +52,9 @@
 //! `clippy::float_arithmetic`
 //! and the `f32`/`f64` types, and CI disassembles them on `thumbv7m-none-eabi` (no FPU) to check
 //! they call no soft-float routine. Shading through [`crate::shade::Shader`] is float per voxel;
-//! callers who want no float per voxel shade through an integer lookup table and push values with
-//! [`crate::render::SheetRenderer::render_value_sheet`] (the firmware in `embedded/` does).
+//! callers who want no float per voxel shade through an integer lookup table and pass values with
+//! [`crate::render::SheetRenderer::render_value_sheet`], or voxel by voxel with
+//! [`crate::render::SheetRenderer::render_sheet_with`] (the firmware in `embedded/` does).
 //!
 //! # Determinism
 //! Integer arithmetic is exact, and the float set-up uses only IEEE-754 basic operations (no

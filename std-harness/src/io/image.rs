@@ -214,11 +214,24 @@ pub fn encode_png(
     style: PngStyle,
 ) -> Result<Vec<u8>, CliError> {
     let channels = if style.alpha { 4 } else { 3 };
-    let top = if style.sixteen { 65535.0 } else { 255.0 };
-    let mut samples: Vec<u16> = Vec::new();
-    samples
-        .try_reserve_exact(rgba.len().saturating_mul(channels))
+    let (top, bytes_per) = if style.sixteen {
+        (65535.0, 2)
+    } else {
+        (255.0, 1)
+    };
+    let mut bytes: Vec<u8> = Vec::new();
+    bytes
+        .try_reserve_exact(rgba.len().saturating_mul(channels * bytes_per))
         .map_err(|_| CliError::input(format!("{width}x{height} image: out of memory")))?;
+    // A sample in [0, 1] as the nearest level, big-endian at 16 bits as PNG stores it.
+    let mut put = |v: f32| {
+        let level = (v * top).round() as u16;
+        if style.sixteen {
+            bytes.extend_from_slice(&level.to_be_bytes());
+        } else {
+            bytes.push(level as u8);
+        }
+    };
     for p in rgba {
         let a = if p[3] > 0.0 { p[3].min(1.0) } else { 0.0 };
         let colour = |c: f32| -> f32 {
@@ -232,17 +245,12 @@ pub fn encode_png(
             }
         };
         for &c in &p[..3] {
-            samples.push((style.gamma.encode(colour(c)) * top).round() as u16);
+            put(style.gamma.encode(colour(c)));
         }
         if style.alpha {
-            samples.push((a * top).round() as u16);
+            put(a);
         }
     }
-    let bytes: Vec<u8> = if style.sixteen {
-        samples.iter().flat_map(|v| v.to_be_bytes()).collect()
-    } else {
-        samples.iter().map(|&v| v as u8).collect()
-    };
     let mut out = Vec::new();
     let mut enc = png::Encoder::new(&mut out, width as u32, height as u32);
     enc.set_color(if style.alpha {

@@ -1,10 +1,15 @@
-//! Progress on long work (a frame's sheets, the reference, a chart's sweep, a benchmark's
-//! frames): an `indicatif` bar on standard error, drawn only when standard error is a terminal,
+//! Progress on long work (a streamed frame's sheets, the reference, a chart's sweep): an
+//! `indicatif` bar on standard error, drawn only when standard error is a terminal,
 //! so logs, pipes and CI see nothing. The bar is cleared when the work ends or fails (on drop), so
 //! the command's own output and its one-line error stay as they were.
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
+
+/// The bar's layout for steps of `unit`: `LABEL [=====>    ] n/N UNIT (eta)`.
+fn template(unit: &str) -> String {
+    format!("{{prefix}} [{{bar:30}}] {{pos}}/{{len}} {unit} ({{eta}})")
+}
 
 /// One bar: `LABEL [=====>    ] n/N UNIT (eta)`.
 #[derive(Debug)]
@@ -21,10 +26,8 @@ impl Progress {
             ProgressDrawTarget::hidden()
         };
         let bar = ProgressBar::with_draw_target(Some(total as u64), target);
-        // The template is a constant: it parses, or the unit test below fails.
-        if let Ok(style) = ProgressStyle::with_template(&format!(
-            "{{prefix}} [{{bar:30}}] {{pos}}/{{len}} {unit} ({{eta}})"
-        )) {
+        // The template's shape is fixed: it parses, or the unit test below fails.
+        if let Ok(style) = ProgressStyle::with_template(&template(unit)) {
             bar.set_style(style.progress_chars("=> "));
         }
         bar.set_prefix(label.to_string());
@@ -81,11 +84,14 @@ mod tests {
         assert!(!p.is_visible(), "cargo test's stderr is not a terminal");
         p.step();
         p.set(3);
-        // The style was applied: the bar's length reflects the total and its position the steps.
         assert_eq!(p.bar.length(), Some(3));
         assert_eq!(p.bar.position(), 3);
-        assert!(
-            ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} sheets ({eta})").is_ok()
-        );
+        // The template `Progress::new` uses parses, for any unit it is given.
+        for unit in ["sheets", "configurations"] {
+            assert!(
+                ProgressStyle::with_template(&template(unit)).is_ok(),
+                "{unit}"
+            );
+        }
     }
 }

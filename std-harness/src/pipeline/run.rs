@@ -126,7 +126,8 @@ pub fn render_frame(
                 let mut buffer = vec![0i32; len.unwrap_or(0)];
                 let path = match len.map(|_| FixedStencils::build(&table, phases, &mut buffer)) {
                     Some(Ok(stencils)) => path.with_stencils(stencils),
-                    // Weights too large for 32 bits: the walk serves this view.
+                    // --phases 0, the direct method, a footprint past the stencils' limits, or
+                    // renormalised weights too large for 32 bits: the walk serves this view.
                     _ => path,
                 };
                 let tables = start.elapsed().as_secs_f64();
