@@ -24,7 +24,19 @@ fn every_thread_count_gives_the_same_bits() {
     // Stencil splats (small and wide footprints), the per-pixel table walk (--phases 0), the direct
     // method, fixed point; phong needs gradients; front to back composites under; a view whose
     // sheets run along i.
-    let cases: [&[&str]; 8] = [
+    let cases: [&[&str]; 10] = [
+        // Perspective: a footprint per voxel, no band test.
+        &["--view", "30,20,0", "--perspective", "60"],
+        &[
+            "--view",
+            "75,-40,20",
+            "--perspective",
+            "40",
+            "--shading",
+            "phong",
+            "--order",
+            "front-to-back",
+        ],
         &["--view", "30,20,0"],
         // Zoomed so the footprints are wide (box over 16 px): stencils with exact edges.
         &["--view", "30,20,0", "--zoom", "12"],

@@ -12,10 +12,22 @@
 //! row-major over its two in-sheet axes (a, b), a < b: `sheet[v·dims[a] + u]` is the voxel with
 //! index u along a and v along b. For sheet axis k (z) that is exactly a z-slice of an x-fastest file.
 
-use crate::geometry::{in_sheet_axes, Footprint, FootprintOptions, GeometryError, Grid, View};
+use crate::geometry::{
+    in_sheet_axes, Footprint, FootprintOptions, GeometryError, Grid, Perspective, View,
+};
 use crate::kernel::Kernel;
 use crate::math;
 use glam::{Mat3, Vec3};
+
+/// How the frame projects: orthographic (the paper's main case) or a pinhole
+/// ([`FrameSetup::perspective`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Projection {
+    /// Parallel rays along screen z: one footprint for every voxel ([`FrameSetup::footprint`]).
+    Orthographic,
+    /// Rays from an eye: every voxel has its own footprint (see [`crate::geometry::Perspective`]).
+    Perspective(Perspective),
+}
 
 /// The compositing direction.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -59,6 +71,11 @@ pub struct FrameSetup {
     pub to_viewer_world: Vec3,
     /// Each grid axis's world spacing (column lengths of G).
     pub spacing: [f32; 3],
+    /// Orthographic or perspective. For a perspective frame, `grid_to_screen`, `origin`,
+    /// `footprint`, `cell_area` and `sheet_distance` describe the affine approximation at the
+    /// volume's centre (exact there); per-voxel values come from
+    /// [`crate::geometry::Perspective::project`].
+    pub projection: Projection,
 }
 
 /// Why a frame could not be set up.
@@ -77,6 +94,30 @@ pub enum FrameError {
     },
     /// The view or grid is unusable.
     Geometry(GeometryError),
+    /// A perspective eye distance that is not a positive finite number (world units).
+    BadEyeDistance {
+        /// The distance given.
+        value: f32,
+    },
+    /// A perspective view whose matrix is not a rotation times one scale (shear or unequal
+    /// scales have no pinhole meaning).
+    NotARotation,
+    /// The eye lies inside the volume, or so near it that a voxel's kernel reaches behind the eye.
+    EyeInsideVolume {
+        /// The eye's distance from the volume's centre, world units.
+        eye_distance: f32,
+    },
+    /// The eye lies between the first and last sheet (within a kernel radius), so no order of
+    /// the sheets runs from far to near: seen from there, sheets along this axis face the eye
+    /// edge-on. Move the eye farther away or narrow the field of view.
+    EyeAmongSheets {
+        /// The sheet axis (0 = i, 1 = j, 2 = k).
+        axis: usize,
+        /// The eye's grid coordinate along it.
+        eye_index: f32,
+        /// Sheets along it.
+        sheets: usize,
+    },
 }
 
 impl core::fmt::Display for FrameError {
@@ -87,6 +128,28 @@ impl core::fmt::Display for FrameError {
                 write!(f, "image size {}x{} is not usable", size[0], size[1])
             }
             Self::Geometry(e) => e.fmt(f),
+            Self::BadEyeDistance { value } => {
+                write!(f, "eye distance {value} is not a positive finite number")
+            }
+            Self::NotARotation => f.write_str(
+                "a perspective view must be a rotation times one scale (no shear, equal scales)",
+            ),
+            Self::EyeInsideVolume { eye_distance } => write!(
+                f,
+                "the eye, {eye_distance} world units from the volume's centre, is inside the \
+                 volume or within a kernel radius of it: move it farther away"
+            ),
+            Self::EyeAmongSheets {
+                axis,
+                eye_index,
+                sheets,
+            } => write!(
+                f,
+                "the eye lies among the sheets along {} (at index {eye_index:.1} of 0..{sheets}, \
+                 within a kernel radius), so they have no far-to-near order: move the eye \
+                 farther away or narrow the field of view",
+                ["i", "j", "k"][(*axis).min(2)]
+            ),
         }
     }
 }
@@ -156,7 +219,113 @@ impl FrameSetup {
             grid_inverse_transpose: g.inverse().transpose(),
             to_viewer_world,
             spacing,
+            projection: Projection::Orthographic,
         })
+    }
+
+    /// A perspective frame: a pinhole on the view axis, `eye_distance` world units from the
+    /// volume's centre, looking at it through `view` (a rotation times a scale s, pixels per world
+    /// unit at the centre's depth; focal length s·`eye_distance` pixels). The sheets run along the
+    /// axis most parallel to the image plane (as orthographic) and in far-to-near order from the
+    /// eye. Refused when the eye is inside the volume, within a kernel radius of a voxel, or among
+    /// the sheets (see [`FrameError`]).
+    pub fn perspective(
+        dims: [usize; 3],
+        grid: &Grid,
+        view: &View,
+        kernel: &Kernel,
+        options: FootprintOptions,
+        size: [usize; 2],
+        eye_distance: f32,
+    ) -> Result<Self, FrameError> {
+        if !(eye_distance.is_finite() && eye_distance > 0.0) {
+            return Err(FrameError::BadEyeDistance {
+                value: eye_distance,
+            });
+        }
+        let v = view.to_screen();
+        let rows = [v.row(0), v.row(1), v.row(2)];
+        let s = rows[0].length();
+        let tol = 1e-4 * s * s;
+        let orthogonal = (0..3).all(|i| {
+            (0..3).all(|j| {
+                let want = if i == j { s * s } else { 0.0 };
+                math::abs(rows[i].dot(rows[j]) - want) <= tol
+            })
+        });
+        if !orthogonal || !(s > 0.0) {
+            return Err(FrameError::NotARotation);
+        }
+        let mut frame = Self::new(dims, grid, view, kernel, options, size)?;
+        let focal_px = s * eye_distance;
+        let camera = Perspective {
+            eye_distance,
+            focal_px,
+            centre: [size[0] as f32 * 0.5, size[1] as f32 * 0.5],
+        };
+        if !focal_px.is_finite() {
+            return Err(FrameError::BadEyeDistance {
+                value: eye_distance,
+            });
+        }
+        // The kernel's support around the voxel-centre box, in grid steps: its corners must all
+        // lie in front of the eye (the box is convex, so then every kernel does).
+        let r = kernel.spread();
+        let g2s = frame.grid_to_screen;
+        for corner in 0..8 {
+            let c = Vec3::new(
+                if corner & 1 == 0 {
+                    -r
+                } else {
+                    (dims[0] - 1) as f32 + r
+                },
+                if corner & 2 == 0 {
+                    -r
+                } else {
+                    (dims[1] - 1) as f32 + r
+                },
+                if corner & 4 == 0 {
+                    -r
+                } else {
+                    (dims[2] - 1) as f32 + r
+                },
+            );
+            let p = frame.origin + g2s * c;
+            if !(focal_px + p.z > 0.0) {
+                return Err(FrameError::EyeInsideVolume { eye_distance });
+            }
+        }
+        // The eye in grid coordinates: affine screen position (c, −f).
+        let k = frame.sheet_axis;
+        let eye = g2s.inverse()
+            * (Vec3::new(camera.centre[0], camera.centre[1], -focal_px) - frame.origin);
+        let last = (dims[k] - 1) as f32;
+        if !(eye[k] <= -r || eye[k] >= last + r) {
+            return Err(FrameError::EyeAmongSheets {
+                axis: k,
+                eye_index: eye[k],
+                sheets: dims[k],
+            });
+        }
+        // Far to near: away from the eye's side.
+        frame.ascending_recedes = eye[k] < 0.0;
+        frame.projection = Projection::Perspective(camera);
+        Ok(frame)
+    }
+
+    /// The camera of a perspective frame (`None` if orthographic).
+    pub fn camera(&self) -> Option<&Perspective> {
+        match &self.projection {
+            Projection::Perspective(c) => Some(c),
+            Projection::Orthographic => None,
+        }
+    }
+
+    /// Affine screen position of grid point (i, j, k) (see [`crate::geometry::Perspective`]; for an
+    /// orthographic frame, the screen position itself, z along the view).
+    #[inline]
+    pub fn affine_position(&self, index: [f32; 3]) -> Vec3 {
+        self.origin + self.grid_to_screen * Vec3::from_array(index)
     }
 
     /// Number of sheets (voxels along the sheet axis).

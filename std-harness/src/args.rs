@@ -223,6 +223,15 @@ pub fn parse_positive(s: &str) -> Result<f32, String> {
     Ok(v)
 }
 
+/// Parses `--perspective`: a field of view in degrees, strictly between 0 and 180.
+pub fn parse_fov(s: &str) -> Result<f32, String> {
+    let [v] = parse_list::<1>(s)?;
+    if !(v > 0.0 && v < 180.0) {
+        return Err(format!("{v}: a field of view is degrees in (0, 180)"));
+    }
+    Ok(v)
+}
+
 /// Parses `--min-radius`: a finite number of pixels, at least the geometry's smallest.
 pub fn parse_min_radius(s: &str) -> Result<f32, String> {
     let [v] = parse_list::<1>(s)?;
@@ -312,9 +321,21 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = 1.0, value_parser = parse_positive)]
     pub zoom: f32,
     /// Explicit world-to-screen matrix, nine numbers row-major, pixels per world unit (overrides
-    /// --view and --zoom).
+    /// --view and --zoom). With --perspective only its rotation counts: it must be a rotation
+    /// times one scale, and the scale is ignored (the field of view and --zoom set it).
     #[arg(long, value_parser = parse_list::<9>, allow_hyphen_values = true)]
     pub view_matrix: Option<[f32; 9]>,
+    /// Perspective projection with this vertical field of view, degrees (0 < FOVY < 180): a
+    /// pinhole on the view axis, the volume's centre at the image centre, focal length
+    /// (H/2) / tan(FOVY/2) × --zoom pixels. Float accumulation only; every voxel gets its own
+    /// footprint (the generic table is sampled directly, whatever --method says).
+    #[arg(long, value_name = "FOVY", value_parser = parse_fov)]
+    pub perspective: Option<f32>,
+    /// With --perspective: the eye's distance from the volume's centre, world units. Default
+    /// VTK's ResetCamera: R / sin(FOVY/2), R half the diagonal of the voxel-centre box. An eye
+    /// inside the volume (or within a kernel radius of it, or among its sheets) is refused.
+    #[arg(long, value_name = "D", value_parser = parse_positive, requires = "perspective")]
+    pub eye_distance: Option<f32>,
     /// Kernel, tables, lookup, method (`reference` renders with the f64 reference) and minimum
     /// footprint radius.
     #[command(flatten)]

@@ -21,12 +21,19 @@ pub enum FixedError {
         /// What overflowed.
         what: &'static str,
     },
+    /// A perspective frame: the fixed path is orthographic only (one integer affine placement
+    /// and one integer table per view); render perspective in float
+    /// ([`crate::render::PerspectivePath`]).
+    Perspective,
 }
 
 impl fmt::Display for FixedError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Self::Range { what } => write!(f, "{what} is outside the fixed-point range"),
+            Self::Perspective => f.write_str(
+                "the fixed-point path is orthographic only; render perspective in float",
+            ),
         }
     }
 }

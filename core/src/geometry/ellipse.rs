@@ -107,6 +107,19 @@ impl Footprint {
         grid_to_screen: &Mat3,
         options: FootprintOptions,
     ) -> Result<Self, GeometryError> {
+        Self::with_sheet_axis(kernel, grid_to_screen, options, sheet_axis(grid_to_screen))
+    }
+
+    /// [`Footprint::new`] for sheets along `axis` (0, 1 or 2; separable kernels are oriented by
+    /// it) rather than the axis `grid_to_screen` itself would choose: a perspective frame's
+    /// per-voxel maps ([`super::Perspective`]) keep the frame's sheet axis.
+    pub fn with_sheet_axis(
+        kernel: &Kernel,
+        grid_to_screen: &Mat3,
+        options: FootprintOptions,
+        axis: usize,
+    ) -> Result<Self, GeometryError> {
+        let axis = axis.min(2);
         let mr = options.min_radius_px;
         if !mr.is_finite() || mr < MIN_MIN_RADIUS_PX {
             return Err(GeometryError::BadMinRadius { value: mr });
@@ -117,7 +130,6 @@ impl Footprint {
         if !well_conditioned(grid_to_screen) {
             return Err(GeometryError::SingularView);
         }
-        let axis = sheet_axis(grid_to_screen);
         let r = kernel.spread();
         let cols = [
             grid_to_screen.x_axis,

@@ -23,7 +23,9 @@ struct BandTest {
 
 impl BandReach {
     pub(super) fn new(f: &FrameSetup, band: (usize, usize), index: usize) -> Self {
-        if band.0 == 0 && band.1 == f.size[1] {
+        // A perspective frame's voxels do not lie on an affine lattice on screen: no test (each
+        // splat still clips to the band).
+        if (band.0 == 0 && band.1 == f.size[1]) || f.camera().is_some() {
             return BandReach { test: None };
         }
         let cols = f.grid_to_screen;

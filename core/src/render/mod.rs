@@ -21,10 +21,12 @@
 //! [`crate::fixed`]). One build holds both, so they can be compared on the same frame.
 
 mod band;
+mod perspective;
 mod precision;
 mod sheets;
 mod visible;
 
+pub use perspective::PerspectivePath;
 pub use precision::{FixedPath, FloatPath, Precision};
 pub use sheets::{gradient, SheetRing, SheetWindow};
 pub use visible::{classify_sheet, VisibleSheet, VisibleVoxel};
@@ -76,6 +78,11 @@ pub enum RenderError {
     },
     /// A transfer function that cannot classify.
     TransferFunction(crate::shade::TransferFunctionError),
+    /// A perspective frame given to a precision that splats with one footprint per view
+    /// ([`FloatPath`], [`FixedPath`]): use [`PerspectivePath`].
+    Projection,
+    /// A voxel's own footprint (perspective) could not be built.
+    Geometry(crate::geometry::GeometryError),
 }
 
 impl fmt::Display for RenderError {
@@ -101,6 +108,10 @@ impl fmt::Display for RenderError {
                 )
             }
             Self::TransferFunction(e) => e.fmt(f),
+            Self::Projection => f.write_str(
+                "a perspective frame needs per-voxel footprints (PerspectivePath); this path has one footprint per view",
+            ),
+            Self::Geometry(e) => write!(f, "a voxel's footprint: {e}"),
         }
     }
 }
@@ -257,6 +268,9 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
             .into());
         }
         shader.tf.check()?;
+        if frame.camera().is_some() && !P::PERSPECTIVE {
+            return Err(RenderError::Projection);
+        }
         let r = SheetRenderer {
             frame,
             path,

@@ -2,11 +2,12 @@
 //! accumulator and image, any [`Sampler`]) and [`FixedPath`] (integer table, `i64` accumulator, Q24
 //! image; see [`crate::fixed`]).
 
+use super::RenderError;
 use crate::composite::{clamp_unit, over};
 use crate::fixed::stencil::FixedStencils;
 use crate::fixed::{self, FixedError, FixedTable, Placement};
 use crate::frame::{FrameSetup, Order};
-use crate::splat::{BufferError, ImageMut, SplatStats, Splatter};
+use crate::splat::{ImageMut, SplatStats, Splatter};
 
 /// What a [`SheetRenderer`](super::SheetRenderer) splats with and accumulates into.
 pub trait Precision {
@@ -16,6 +17,9 @@ pub trait Precision {
     type Acc: Copy;
     /// A working-image pixel (premultiplied RGBA).
     type Pixel: Copy;
+    /// Whether this precision can render a perspective frame (per-voxel footprints); a renderer
+    /// refuses a perspective frame with [`RenderError::Projection`] otherwise.
+    const PERSPECTIVE: bool = false;
     /// The cleared accumulator pixel (what a caller fills a fresh accumulator with).
     const ACC_ZERO: Self::Acc;
     /// Transparent black.
@@ -36,7 +40,7 @@ pub trait Precision {
         value: &Self::Value,
         acc: &mut ImageMut<'_, Self::Acc>,
         touched: impl FnMut(usize, usize, usize),
-    ) -> Result<SplatStats, BufferError>;
+    ) -> Result<SplatStats, RenderError>;
     /// Composites one row of the accumulated sheet into the image (over back to front, under
     /// front to back) and clears the accumulator row.
     fn composite_row(&self, acc: &mut [Self::Acc], image: &mut [Self::Pixel], order: Order);
@@ -87,13 +91,14 @@ impl<S: Splatter + ?Sized> Precision for FloatPath<'_, S> {
         value: &[f32; 4],
         acc: &mut ImageMut<'_, [f32; 4]>,
         touched: impl FnMut(usize, usize, usize),
-    ) -> Result<SplatStats, BufferError> {
+    ) -> Result<SplatStats, RenderError> {
         let p = float_position(f, sheet, u, v);
         let value = value.map(|c| c * f.cell_area);
         // Subtracting a whole number of rows is exact here (|p.y| < 2²⁴), so every pixel of a
         // band sees the offsets, and so the weights, of a whole-image render.
-        self.sampler
-            .splat_voxel([p[0], p[1] - row0 as f32], &value, acc, touched)
+        Ok(self
+            .sampler
+            .splat_voxel([p[0], p[1] - row0 as f32], &value, acc, touched)?)
     }
 
     fn composite_row(&self, acc: &mut [[f32; 4]], image: &mut [[f32; 4]], order: Order) {
@@ -107,7 +112,7 @@ impl<S: Splatter + ?Sized> Precision for FloatPath<'_, S> {
 
 /// The float paths' compositing: clamp the accumulated sheet to [0, 1], over or under the image,
 /// clear the accumulator.
-fn float_composite_row(acc: &mut [[f32; 4]], image: &mut [[f32; 4]], order: Order) {
+pub(super) fn float_composite_row(acc: &mut [[f32; 4]], image: &mut [[f32; 4]], order: Order) {
     for (a, i) in acc.iter_mut().zip(image.iter_mut()) {
         let s = clamp_unit(*a);
         *a = [0.0; 4];
@@ -118,7 +123,7 @@ fn float_composite_row(acc: &mut [[f32; 4]], image: &mut [[f32; 4]], order: Orde
     }
 }
 
-fn float_over_row(front: &mut [[f32; 4]], back: &[[f32; 4]]) {
+pub(super) fn float_over_row(front: &mut [[f32; 4]], back: &[[f32; 4]]) {
     for (i, b) in front.iter_mut().zip(back) {
         *i = over(*i, *b);
     }
@@ -147,8 +152,13 @@ pub struct FixedPath<'a, const M: usize> {
 
 impl<'a, const M: usize> FixedPath<'a, M> {
     /// The fixed path for `frame` through `table` (built for this frame), splatting by the table
-    /// walk. Refused when the volume lands outside the fixed-point screen range.
+    /// walk. Refused when the volume lands outside the fixed-point screen range, and for a
+    /// perspective frame ([`FixedError::Perspective`]: the fixed path places voxels with one
+    /// integer affine map and one table per view).
     pub fn new(frame: &FrameSetup, table: &'a FixedTable<M>) -> Result<Self, FixedError> {
+        if frame.camera().is_some() {
+            return Err(FixedError::Perspective);
+        }
         Ok(FixedPath {
             table,
             stencils: None,
@@ -192,7 +202,7 @@ impl<const M: usize> Precision for FixedPath<'_, M> {
         value: &[u32; 4],
         acc: &mut ImageMut<'_, [i64; 4]>,
         touched: impl FnMut(usize, usize, usize),
-    ) -> Result<SplatStats, BufferError> {
+    ) -> Result<SplatStats, RenderError> {
         let mut center = self.place.at(sheet, u, v);
         center[1] -= (row0 as i64) << fixed::POS_FRAC;
         Ok(match &self.stencils {

@@ -30,7 +30,7 @@ pub fn run(args: &ChartArgs) -> Result<(), CliError> {
     if args.model_only {
         let p = prepare(&args.render)?;
         crate::say!("config,footprint_error");
-        for c in Config::all() {
+        for c in Config::for_frame(&p.frame) {
             crate::say!("{},{:.4e}", c.label(), quality::footprint_error(&p, &c)?);
         }
         return Ok(());
@@ -48,7 +48,8 @@ pub fn run(args: &ChartArgs) -> Result<(), CliError> {
     let mut base = args.render.clone();
     base.out = None;
     base.json = None;
-    let rows = sweep::sweep(&base, &Config::all(), args.runs)?;
+    let configs = Config::for_frame(&prepare(&base)?.frame);
+    let rows = sweep::sweep(&base, &configs, args.runs)?;
     io::write_atomic(&dir.join("tradeoff.csv"), sweep::csv(&rows).as_bytes())?;
     let name = base
         .volume

@@ -17,6 +17,17 @@ pub struct Config {
 
 impl Config {
     /// Every configuration the chart sweeps.
+    /// The configurations a frame can run: all of them orthographic; with perspective only float
+    /// accumulation through the generic table (`direct`): every voxel has its own footprint, so
+    /// there is no view table, and the fixed path is orthographic only.
+    pub fn for_frame(frame: &footprint::frame::FrameSetup) -> Vec<Config> {
+        let mut v = Self::all();
+        if frame.camera().is_some() {
+            v.retain(|c| c.method == MethodArg::Direct && c.accum == AccumArg::Float);
+        }
+        v
+    }
+
     pub fn all() -> Vec<Config> {
         let mut v = Vec::new();
         for table in SIZES {

@@ -153,6 +153,7 @@ pub fn view_for(args: &RenderArgs, dims: [usize; 3], grid: &Grid) -> Result<View
 
 /// The frame for `args`' view, at the output size or, when [`supersample::factor`] asks for it,
 /// at k× that size (the view scaled by k, so the picture is the same); returns it and k.
+/// With `--perspective` the frame is a pinhole's ([`perspective_frame`]).
 pub fn setup_frame(
     args: &RenderArgs,
     dims: [usize; 3],
@@ -162,6 +163,9 @@ pub fn setup_frame(
 ) -> Result<(FrameSetup, usize), CliError> {
     let view = view_for(args, dims, grid)?;
     let size = [args.size.0, args.size.1];
+    if let Some(fovy) = args.perspective {
+        return perspective_frame(args, fovy, &view, dims, grid, kernel, options);
+    }
     let frame = FrameSetup::new(dims, grid, &view, kernel, options, size)?;
     let k = supersample::factor(args.supersample, &frame, options);
     if k == 1 {
@@ -170,6 +174,108 @@ pub fn setup_frame(
     let view = View::new(view.to_screen() * k as f32)
         .map_err(|e| CliError::input(format!("view: {e}")))?;
     let frame = FrameSetup::new(dims, grid, &view, kernel, options, size.map(|n| n * k))?;
+    Ok((frame, k))
+}
+
+/// Half the diagonal of the voxel-centre box, world units (the axis-aligned world box of the
+/// grid's corner voxels, as VTK bounds an image; 0.5 for a single voxel): the radius of VTK's
+/// `ResetCamera`.
+pub fn bounding_radius(dims: [usize; 3], grid: &Grid) -> f32 {
+    let g = grid.to_world();
+    let (mut lo, mut hi) = (
+        glam::Vec3::splat(f32::INFINITY),
+        glam::Vec3::splat(f32::NEG_INFINITY),
+    );
+    for corner in 0..8 {
+        let c = glam::Vec3::new(
+            if corner & 1 == 0 {
+                0.0
+            } else {
+                (dims[0] - 1) as f32
+            },
+            if corner & 2 == 0 {
+                0.0
+            } else {
+                (dims[1] - 1) as f32
+            },
+            if corner & 4 == 0 {
+                0.0
+            } else {
+                (dims[2] - 1) as f32
+            },
+        );
+        lo = lo.min(g * c);
+        hi = hi.max(g * c);
+    }
+    let d = (hi - lo).length();
+    if d > 0.0 {
+        0.5 * d
+    } else {
+        0.5
+    }
+}
+
+/// The perspective frame of `--perspective FOVY`: `view`'s rotation (its scale dropped), the eye
+/// at `--eye-distance` or R / sin(FOVY/2) from the centre, focal length (H/2)/tan(FOVY/2) ×
+/// `--zoom` pixels. Supersampling (`auto`) is decided by the farthest voxels, whose footprints
+/// are the smallest.
+fn perspective_frame(
+    args: &RenderArgs,
+    fovy: f32,
+    view: &View,
+    dims: [usize; 3],
+    grid: &Grid,
+    kernel: &Kernel,
+    options: FootprintOptions,
+) -> Result<(FrameSetup, usize), CliError> {
+    let size = [args.size.0, args.size.1];
+    let m = view.to_screen();
+    let rotation = m * (1.0 / m.row(0).length());
+    let half = (fovy as f64).to_radians() * 0.5;
+    let focal = (size[1] as f64 * 0.5) / half.tan() * f64::from(args.zoom);
+    let distance = match args.eye_distance {
+        Some(d) => f64::from(d),
+        None => f64::from(bounding_radius(dims, grid)) / half.sin(),
+    };
+    let eye = distance as f32;
+    let scaled = |k: f32| {
+        View::new(rotation * (focal / distance) as f32 * k)
+            .map_err(|e| CliError::input(format!("--perspective: {e}")))
+    };
+    let bad =
+        |e: footprint::frame::FrameError| CliError::input(format!("--perspective {fovy}: {e}"));
+    let frame = FrameSetup::perspective(dims, grid, &scaled(1.0)?, kernel, options, size, eye)
+        .map_err(bad)?;
+    // The farthest voxel-centre corner's magnification f/Z, relative to the centre's.
+    let cam = frame.camera().copied().expect("a perspective frame");
+    let far = (0..8)
+        .map(|c| {
+            let i = [0, 1, 2].map(|a| {
+                if c >> a & 1 == 0 {
+                    0.0
+                } else {
+                    (dims[a] - 1) as f32
+                }
+            });
+            cam.focal_px + frame.affine_position(i).z
+        })
+        .fold(0.0f32, f32::max);
+    let shrink = cam.focal_px / far;
+    let far_frame = FrameSetup::new(dims, grid, &scaled(shrink)?, kernel, options, size)?;
+    let k = supersample::factor(args.supersample, &far_frame, options);
+    if k == 1 {
+        return Ok((frame, 1));
+    }
+    let frame = FrameSetup::perspective(
+        dims,
+        grid,
+        &scaled(k as f32)?,
+        kernel,
+        options,
+        size.map(|n| n * k),
+        eye,
+    )
+    .map_err(bad)?;
     Ok((frame, k))
 }
 
@@ -324,6 +430,19 @@ pub fn describe(p: &Prepared, args: &RenderArgs) -> Json {
         .str("tf", &p.tf_name)
         .arr_f64("window", &p.window.map(f64::from))
         .str("sheet_axis", ["i", "j", "k"][f.sheet_axis])
+        .str(
+            "projection",
+            if f.camera().is_some() {
+                "perspective"
+            } else {
+                "orthographic"
+            },
+        )
+        .num("fovy_deg", args.perspective.map_or(f64::NAN, f64::from))
+        .num(
+            "eye_distance",
+            f.camera().map_or(f64::NAN, |c| f64::from(c.eye_distance)),
+        )
         .arr_f64(
             "footprint_half_extent_px",
             &f.footprint

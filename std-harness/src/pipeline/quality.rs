@@ -30,7 +30,7 @@ use crate::io::json::Json;
 use crate::reference::ReferenceFootprint;
 use crate::{with_table_size, CliError};
 use footprint::splat::{splat, Direct, ImageMut, Sampler};
-use footprint::{Lookup, ViewTable};
+use footprint::{Footprint, Lookup, ViewTable};
 
 /// K, dB: the calibration constant of `PSNR ≈ K − 20·log₁₀(e)` (see the module docs).
 pub const K_DB: f64 = CALIBRATED_K_DB - MARGIN_DB;
@@ -131,9 +131,9 @@ fn cost(c: &Config) -> f64 {
     base * (1.0 + c.table as f64 * 1e-6)
 }
 
-/// The candidates, cheapest first.
-pub fn candidates() -> Vec<Config> {
-    let mut v = Config::all();
+/// The candidates for `frame`, cheapest first.
+pub fn candidates(frame: &footprint::frame::FrameSetup) -> Vec<Config> {
+    let mut v = Config::for_frame(frame);
     v.sort_by(|a, b| cost(a).total_cmp(&cost(b)));
     v
 }
@@ -141,19 +141,57 @@ pub fn candidates() -> Vec<Config> {
 /// Sub-pixel positions (fractions of a pixel) at which the footprint error is measured.
 const PHASES: [[f32; 2]; 4] = [[0.31, 0.17], [0.77, 0.59], [0.05, 0.88], [0.52, 0.41]];
 
+/// The footprints the model measures, as (the core's footprint, its map V·G or Jacobian, f64):
+/// an orthographic frame's one footprint; for a perspective frame, the footprints of the
+/// voxel-centre box's nearest and farthest corners and of its centre (footprint sizes vary over
+/// the image; the worst of them is taken).
+fn footprints(p: &Prepared) -> Result<Vec<(Footprint, glam::DMat3)>, CliError> {
+    let f = &p.frame;
+    let Some(cam) = f.camera() else {
+        return Ok(vec![(f.footprint, f.grid_to_screen.as_dmat3())]);
+    };
+    let d = f.dims.map(|n| (n - 1) as f32);
+    let mut points: Vec<[f32; 3]> = (0..8)
+        .map(|c| [0, 1, 2].map(|a| if c >> a & 1 == 0 { 0.0 } else { d[a] }))
+        .collect();
+    let depth = |i: &[f32; 3]| f.affine_position(*i).z;
+    points.sort_by(|a, b| depth(a).total_cmp(&depth(b)));
+    let picks = [points[0], d.map(|x| x * 0.5), points[7]];
+    picks
+        .iter()
+        .map(|&i| {
+            let pr = cam
+                .project(f.affine_position(i), &f.grid_to_screen)
+                .ok_or_else(|| CliError::input(format!("{}: a voxel is behind the eye", p.name)))?;
+            let fp = Footprint::with_sheet_axis(&p.kernel, &pr.jacobian, p.options, f.sheet_axis)
+                .map_err(|e| CliError::input(format!("{}: {e}", p.name)))?;
+            Ok((fp, pr.jacobian.as_dmat3()))
+        })
+        .collect()
+}
+
 /// Max |core − reference| / reference peak for one voxel of `p`'s footprint through a table of
 /// `c`'s size, lookup and method, over four sub-pixel positions (nearest lookup's error depends
-/// strongly on where the centre falls).
+/// strongly on where the centre falls); for a perspective frame, the worst over its
+/// [`footprints`].
 pub fn footprint_error(p: &Prepared, c: &Config) -> Result<f64, CliError> {
-    let fp = p.frame.footprint;
+    let mut worst = 0.0f64;
+    for (fp, map) in footprints(p)? {
+        worst = worst.max(one_footprint_error(p, c, fp, &map)?);
+    }
+    Ok(worst)
+}
+
+fn one_footprint_error(
+    p: &Prepared,
+    c: &Config,
+    fp: Footprint,
+    map: &glam::DMat3,
+) -> Result<f64, CliError> {
     let e = fp.half_extent[0].max(fp.half_extent[1]);
     let side = ((2.0 * e).ceil() as usize + 6).clamp(16, 256);
-    let reference = ReferenceFootprint::new(
-        &p.kernel,
-        &p.frame.grid_to_screen.as_dmat3(),
-        f64::from(p.options.min_radius_px),
-    )
-    .map_err(|e| CliError::input(format!("{}: {e}", p.name)))?;
+    let reference = ReferenceFootprint::new(&p.kernel, map, f64::from(p.options.min_radius_px))
+        .map_err(|e| CliError::input(format!("{}: {e}", p.name)))?;
     let lookup = Lookup::from(c.lookup);
     let mut worst = 0.0f64;
     with_table_size!(c.table, N => {
@@ -194,7 +232,7 @@ pub fn choose(p: &Prepared, target_db: f64) -> Result<Choice, CliError> {
     let mut rejected = Vec::new();
     let mut best: Option<(Config, f64, f64)> = None;
     let mut errors = std::collections::HashMap::new();
-    for c in candidates() {
+    for c in candidates(&p.frame) {
         // Fixed and float share a table error: measure it once.
         let key = (c.table, c.lookup, c.method);
         let e = match errors.get(&key) {

@@ -16,7 +16,8 @@ use crate::{with_table_size, CliError};
 use footprint::fixed::stencil::FixedStencils;
 use footprint::fixed::{self, FixedTable};
 use footprint::render::{
-    FixedPath, FloatPath, Precision, RenderBuffers, RenderStats, SheetRenderer, SheetRing,
+    FixedPath, FloatPath, PerspectivePath, Precision, RenderBuffers, RenderStats, SheetRenderer,
+    SheetRing,
 };
 use footprint::shade::OPACITY_TABLE_LEN;
 use footprint::source::{render_from, SheetSource};
@@ -81,7 +82,18 @@ pub fn render_frame(
     with_table_size!(fa.table, N => {
         let generic = fa.generic_table::<N>(&p.kernel)?;
         // Each path gets its own monomorphised sheet loop: no virtual call per pixel.
+        let perspective = p.frame.camera().is_some();
         let (image, stats, mut phases, visible) = match (accum, fa.method) {
+            (AccumArg::Fixed, _) if perspective => {
+                return Err(fixed_range(fixed::FixedError::Perspective));
+            }
+            (AccumArg::Float, _) if perspective => {
+                // Every voxel its own footprint, sampled from the generic table (no view table).
+                let path = PerspectivePath::new(&p.frame, &p.kernel, p.options, &*generic, lookup)?;
+                let tables = start.elapsed().as_secs_f64();
+                let r = run_path(p, path, p.background.as_deref(), cache, threads)?;
+                (r.0, r.1, Phases { tables, ..r.2 }, r.3)
+            }
             (AccumArg::Float, MethodArg::Direct) => {
                 let sampler = Direct { footprint: p.frame.footprint, table: &*generic, lookup };
                 let tables = start.elapsed().as_secs_f64();

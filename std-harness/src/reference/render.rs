@@ -3,6 +3,7 @@
 //! accumulation and composite is in f64. Shading uses the core's shader (f32), so the difference
 //! between the two renders isolates the tables and the f32 accumulation.
 
+use super::perspective::PerspectiveVoxel;
 use super::ReferenceFootprint;
 use crate::CliError;
 use footprint::frame::{FrameSetup, Order};
@@ -58,6 +59,9 @@ pub fn render_reference(
     let origin = frame.origin.as_dvec3();
     let (ck, ca, cb) = (g2s.col(k), g2s.col(a), g2s.col(b));
     let area = f64::from(frame.cell_area);
+    let camera = frame.camera();
+    let min_r = f64::from(min_radius_px);
+    let failed = std::sync::Mutex::new(false);
     let mut bufs = [vec![0.0f32; len], vec![0.0f32; len], vec![0.0f32; len]];
     let load =
         |s: usize, buf: &mut Vec<f32>, sheet: &mut dyn FnMut(usize, &mut [f32])| sheet(s, buf);
@@ -85,6 +89,7 @@ pub fn render_reference(
             .map_or(1, |n| n.get())
             .clamp(1, 8);
         let band = h.div_ceil(threads);
+        let failed = &failed;
         std::thread::scope(|scope| {
             for (t, chunk) in accum.chunks_mut(band * w).enumerate() {
                 let window = &window;
@@ -106,19 +111,42 @@ pub fn render_reference(
                             if !(rgba[3] > 0.0) {
                                 continue;
                             }
-                            let p = origin + ck * s as f64 + ca * u as f64 + cb * v as f64;
-                            let c = rgba.map(|x| f64::from(x) * area);
-                            fp.for_each_weight([p.x, p.y], w, rows.clone(), |i, wt| {
+                            let mut add = |i: usize, c: &[f64; 4], wt: f64| {
                                 let px = &mut chunk[i - first];
                                 for ch in 0..4 {
                                     px[ch] += c[ch] * wt;
                                 }
-                            });
+                            };
+                            if let Some(cam) = camera {
+                                let idx = frame.grid_index(s, u, v).map(|i| i as f64);
+                                let Ok(pv) = PerspectiveVoxel::new(frame, cam, kernel, min_r, idx)
+                                else {
+                                    *failed.lock().expect("no panics hold it") = true;
+                                    continue;
+                                };
+                                let a = f64::from(rgba[3]);
+                                let scale = if a < 1.0 && pv.exponent != 1.0 {
+                                    (1.0 - (1.0 - a).powf(pv.exponent)) / a
+                                } else {
+                                    1.0
+                                };
+                                let c = rgba.map(|x| f64::from(x) * scale);
+                                pv.for_each_weight(w, rows.clone(), |i, wt| add(i, &c, wt));
+                                continue;
+                            }
+                            let p = origin + ck * s as f64 + ca * u as f64 + cb * v as f64;
+                            let c = rgba.map(|x| f64::from(x) * area);
+                            fp.for_each_weight([p.x, p.y], w, rows.clone(), |i, wt| add(i, &c, wt));
                         }
                     }
                 });
             }
         });
+        if *failed.lock().expect("no panics hold it") {
+            return Err(CliError::input(
+                "the reference could not project a voxel (behind the eye or not finite)",
+            ));
+        }
         for (acc, img) in accum.iter_mut().zip(image.iter_mut()) {
             if *acc == [0.0; 4] {
                 continue;
