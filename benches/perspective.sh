@@ -138,7 +138,4 @@ for c in "${configs[@]}"; do
   r=$(python3 -c "print('%.2f' % ($m / $base))")
   echo "| $c | $f | $m | ${r}x |" >> "$out"
 done
-# Pictures: the same view orthographic and at 60 degrees.
-"$fp" render "$walnut" --size 384x384 --view 30,20,0 --out docs/images/perspective-walnut-ortho.png > /dev/null 2>&1
-"$fp" render "$walnut" --size 384x384 --view 30,20,0 --perspective 60 --out docs/images/perspective-walnut-60.png > /dev/null 2>&1
 cat "$out"

@@ -153,7 +153,7 @@ pub fn view_for(args: &RenderArgs, dims: [usize; 3], grid: &Grid) -> Result<View
 
 /// The frame for `args`' view, at the output size or, when [`supersample::factor`] asks for it,
 /// at k× that size (the view scaled by k, so the picture is the same); returns it and k.
-/// With `--perspective` the frame is a pinhole's ([`perspective_frame`]).
+/// With `--perspective` the frame is a pinhole's (`perspective_frame`).
 pub fn setup_frame(
     args: &RenderArgs,
     dims: [usize; 3],

@@ -173,7 +173,7 @@ fn footprints(p: &Prepared) -> Result<Vec<(Footprint, glam::DMat3)>, CliError> {
 /// Max |core − reference| / reference peak for one voxel of `p`'s footprint through a table of
 /// `c`'s size, lookup and method, over four sub-pixel positions (nearest lookup's error depends
 /// strongly on where the centre falls); for a perspective frame, the worst over its
-/// [`footprints`].
+/// `footprints`.
 pub fn footprint_error(p: &Prepared, c: &Config) -> Result<f64, CliError> {
     let mut worst = 0.0f64;
     for (fp, map) in footprints(p)? {
