@@ -502,3 +502,64 @@ fn verify_reaches_40_db_and_refusals_are_clear() {
     }
     std::fs::remove_dir_all(&d).unwrap();
 }
+
+/// Would a view table per depth band do ("reuse view tables where footprints barely change")?
+/// For every voxel-centre box corner and edge midpoint of a 60° frame, the exact footprint of its
+/// own Jacobian against that of the point at the same depth on the view axis (what one table per
+/// depth band, however thin, would splat): the relative difference, max |a − b| / peak, against
+/// the generic table's own error through the direct method (table 129, bilinear). Printed for
+/// the README; the test holds the claim that a band's table is far less accurate than the
+/// per-voxel footprint it would replace.
+#[test]
+fn one_footprint_per_depth_band_is_far_less_accurate_than_per_voxel_footprints() {
+    use footprint::geometry::Footprint;
+    use footprint::splat::{splat, Direct, ImageMut};
+    use footprint_harness::reference::ReferenceFootprint;
+    let f = frame(60.0, [30.0, 20.0, 0.0]);
+    let cam = *f.camera().unwrap();
+    let kernel = Kernel::PAPER_GAUSSIAN;
+    let generic = footprint::GenericTable::<129>::build(kernel);
+    let side = 96usize;
+    let splat_ref = |j: &glam::Mat3| {
+        let r = ReferenceFootprint::new(&kernel, &j.as_dmat3(), 1.5).unwrap();
+        let mut out = vec![0.0f64; side * side];
+        r.splat([48.3, 47.6], side, side, &mut out);
+        out
+    };
+    let rel = |a: &[f64], b: &[f64]| {
+        let peak = a.iter().fold(0.0f64, |m, &v| m.max(v));
+        a.iter()
+            .zip(b)
+            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+            / peak
+    };
+    let (mut band_worst, mut table_worst) = (0.0f64, 0.0f64);
+    let d = f.dims.map(|n| (n - 1) as f32);
+    for c in 0..27 {
+        let i = [0, 1, 2].map(|a| d[a] * 0.5 * ((c / 3usize.pow(a as u32)) % 3) as f32);
+        let p = f.affine_position(i);
+        let own = cam.project(p, &f.grid_to_screen).unwrap().jacobian;
+        let axis = glam::Vec3::new(cam.centre[0], cam.centre[1], p.z);
+        let band = cam.project(axis, &f.grid_to_screen).unwrap().jacobian;
+        let exact = splat_ref(&own);
+        band_worst = band_worst.max(rel(&exact, &splat_ref(&band)));
+        let fp =
+            Footprint::with_sheet_axis(&kernel, &own, FootprintOptions::default(), f.sheet_axis)
+                .unwrap();
+        let sampler = Direct {
+            footprint: fp,
+            table: &generic,
+            lookup: footprint::Lookup::Bilinear,
+        };
+        let mut got = vec![0.0f32; side * side];
+        let mut img = ImageMut::new(&mut got, side, side, side).unwrap();
+        splat(&sampler, [48.3, 47.6], &1.0f32, &mut img).unwrap();
+        let got: Vec<f64> = got.iter().map(|&v| f64::from(v)).collect();
+        table_worst = table_worst.max(rel(&exact, &got));
+    }
+    eprintln!("depth band footprint: worst {band_worst:.3e}; per-voxel through the table: {table_worst:.3e}");
+    assert!(
+        band_worst > 10.0 * table_worst,
+        "a depth band's footprint {band_worst:.3e} vs per-voxel {table_worst:.3e}"
+    );
+}
