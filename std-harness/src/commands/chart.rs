@@ -76,6 +76,17 @@ pub fn run(args: &ChartArgs) -> Result<(), CliError> {
             r.psnr_db
         );
     }
+    crate::say!("Pareto frontier against the continuous integral:");
+    let mut front: Vec<&sweep::Measured> = rows.iter().filter(|r| r.pareto_continuous).collect();
+    front.sort_by(|a, b| a.median_s.total_cmp(&b.median_s));
+    for r in front {
+        crate::say!(
+            "  {:<36} {:.3} s  {:.2} dB",
+            r.config.label(),
+            r.median_s,
+            r.continuous_db
+        );
+    }
     if !args.no_stability {
         let curves = stability::stability();
         io::write_atomic(

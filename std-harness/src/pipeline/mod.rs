@@ -29,4 +29,6 @@ pub mod supersample;
 pub mod visible;
 
 pub use prepare::{describe, prepare, Prepared};
-pub use run::{render_core, render_core_with, render_frame, render_ref, CoreFrame};
+pub use run::{
+    render_continuous_ref, render_core, render_core_with, render_frame, render_ref, CoreFrame,
+};

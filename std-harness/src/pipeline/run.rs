@@ -11,6 +11,9 @@ use crate::args::{AccumArg, MethodArg, RenderArgs};
 use crate::io::progress::sheets;
 use crate::io::stream::{FileSource, MemorySource, PipeSource};
 use crate::io::try_filled;
+use crate::reference::continuous::{
+    render_continuous, Continuous, ContinuousScene, Reconstruction, MAX_HALVINGS,
+};
 use crate::reference::render::{render_reference, ReferenceScene};
 use crate::{with_table_size, CliError};
 use footprint::fixed::stencil::FixedStencils;
@@ -346,4 +349,35 @@ pub fn render_ref(p: &Prepared) -> Result<(Vec<[f64; 4]>, f64), CliError> {
         k => downsample(&img, p.out_size(), k, |v| v),
     };
     Ok((img, start.elapsed().as_secs_f64()))
+}
+
+/// The continuous reference of `p` (see [`crate::reference::continuous`]): the converged image
+/// (at the output size), how it converged, and its seconds. The volume must be in memory.
+pub fn render_continuous_ref(
+    p: &Prepared,
+    reconstruction: Reconstruction,
+) -> Result<(Vec<[f64; 4]>, Continuous, f64), CliError> {
+    let volume = p.volume().ok_or_else(|| {
+        CliError::input("the continuous reference needs the volume in memory: drop --stream")
+    })?;
+    let start = Instant::now();
+    let scene = ContinuousScene {
+        frame: &p.frame,
+        kernel: &p.kernel,
+        shader: p.shader(),
+        background: p.background.as_deref(),
+        reconstruction,
+    };
+    let mut bar = sheets("continuous");
+    let axis = p.frame.sheet_axis;
+    let c = render_continuous(
+        &scene,
+        |s, out| volume.sheet_into(axis, s, out),
+        |pass, _| bar(pass, MAX_HALVINGS + 1),
+    )?;
+    let img = match p.supersample {
+        1 => c.image.clone(),
+        k => downsample(&c.image, p.out_size(), k, |v| v),
+    };
+    Ok((img, c, start.elapsed().as_secs_f64()))
 }

@@ -13,6 +13,7 @@
 //! exactly (f64) at the mapped point. Small footprints are renormalised to sum to one, as in the
 //! core: that is part of the model, not an approximation.
 
+pub mod continuous;
 pub mod perspective;
 pub mod render;
 
