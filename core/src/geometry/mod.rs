@@ -337,31 +337,7 @@ impl View {
             return Err(GeometryError::SingularView);
         }
         let up = right.cross(dop);
-        let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-        for corner in 0..8 {
-            let c = Vec3::new(
-                if corner & 1 == 0 {
-                    0.0
-                } else {
-                    (dims[0] - 1) as f32
-                },
-                if corner & 2 == 0 {
-                    0.0
-                } else {
-                    (dims[1] - 1) as f32
-                },
-                if corner & 4 == 0 {
-                    0.0
-                } else {
-                    (dims[2] - 1) as f32
-                },
-            );
-            let w = grid.to_world * c;
-            lo = lo.min(w);
-            hi = hi.max(w);
-        }
-        let diameter = (hi - lo).length();
-        let radius = if diameter > 0.0 { 0.5 * diameter } else { 0.5 };
+        let radius = bounding_radius(dims, grid);
         let scale = image[0].min(image[1]) as f32 / (2.0 * radius) * zoom;
         View::new(Mat3::from_cols(right, -up, dop).transpose() * scale)
     }
@@ -379,6 +355,42 @@ impl View {
     /// V · G: maps a grid-index offset to a screen offset in pixels.
     pub fn grid_to_screen(&self, grid: &Grid) -> Mat3 {
         self.to_screen * grid.to_world
+    }
+}
+
+/// Half the diagonal of the voxel-centre box, world units: the axis-aligned world box of the grid's
+/// corner voxels (as VTK bounds an oriented image), 0.5 for a single voxel. VTK's `ResetCamera`
+/// fits the sphere of this radius: [`View::looking`] in parallel projection, the harness's
+/// `--perspective` for the eye's distance. `dims` must be non-zero.
+pub fn bounding_radius(dims: [usize; 3], grid: &Grid) -> f32 {
+    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    for corner in 0..8 {
+        let c = Vec3::new(
+            if corner & 1 == 0 {
+                0.0
+            } else {
+                dims[0].saturating_sub(1) as f32
+            },
+            if corner & 2 == 0 {
+                0.0
+            } else {
+                dims[1].saturating_sub(1) as f32
+            },
+            if corner & 4 == 0 {
+                0.0
+            } else {
+                dims[2].saturating_sub(1) as f32
+            },
+        );
+        let w = grid.to_world * c;
+        lo = lo.min(w);
+        hi = hi.max(w);
+    }
+    let diameter = (hi - lo).length();
+    if diameter > 0.0 {
+        0.5 * diameter
+    } else {
+        0.5
     }
 }
 

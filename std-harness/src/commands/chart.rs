@@ -65,28 +65,13 @@ pub fn run(args: &ChartArgs) -> Result<(), CliError> {
         footprint::math::BACKEND
     );
     plot::write_tradeoff(&dir, &rows, &title)?;
-    crate::say!("Pareto frontier:");
-    let mut front: Vec<&sweep::Measured> = rows.iter().filter(|r| r.pareto).collect();
-    front.sort_by(|a, b| a.median_s.total_cmp(&b.median_s));
-    for r in front {
-        crate::say!(
-            "  {:<36} {:.3} s  {:.2} dB",
-            r.config.label(),
-            r.median_s,
-            r.psnr_db
-        );
-    }
-    crate::say!("Pareto frontier against the continuous integral:");
-    let mut front: Vec<&sweep::Measured> = rows.iter().filter(|r| r.pareto_continuous).collect();
-    front.sort_by(|a, b| a.median_s.total_cmp(&b.median_s));
-    for r in front {
-        crate::say!(
-            "  {:<36} {:.3} s  {:.2} dB",
-            r.config.label(),
-            r.median_s,
-            r.continuous_db
-        );
-    }
+    print_frontier("Pareto frontier:", &rows, |r| r.pareto, |r| r.psnr_db);
+    print_frontier(
+        "Pareto frontier against the continuous integral:",
+        &rows,
+        |r| r.pareto_continuous,
+        |r| r.continuous_db,
+    );
     if !args.no_stability {
         let curves = stability::stability();
         io::write_atomic(
@@ -112,4 +97,24 @@ pub fn run(args: &ChartArgs) -> Result<(), CliError> {
     }
     crate::say!("wrote {}", dir.display());
     Ok(())
+}
+
+/// Prints one frontier, fastest first: the rows `on` marks, with the PSNR `db` gives.
+fn print_frontier(
+    title: &str,
+    rows: &[sweep::Measured],
+    on: impl Fn(&sweep::Measured) -> bool,
+    db: impl Fn(&sweep::Measured) -> f64,
+) {
+    crate::say!("{title}");
+    let mut front: Vec<&sweep::Measured> = rows.iter().filter(|r| on(r)).collect();
+    front.sort_by(|a, b| a.median_s.total_cmp(&b.median_s));
+    for r in front {
+        crate::say!(
+            "  {:<36} {:.3} s  {:.2} dB",
+            r.config.label(),
+            r.median_s,
+            db(r)
+        );
+    }
 }

@@ -177,44 +177,6 @@ pub fn setup_frame(
     Ok((frame, k))
 }
 
-/// Half the diagonal of the voxel-centre box, world units (the axis-aligned world box of the
-/// grid's corner voxels, as VTK bounds an image; 0.5 for a single voxel): the radius of VTK's
-/// `ResetCamera`.
-pub fn bounding_radius(dims: [usize; 3], grid: &Grid) -> f32 {
-    let g = grid.to_world();
-    let (mut lo, mut hi) = (
-        glam::Vec3::splat(f32::INFINITY),
-        glam::Vec3::splat(f32::NEG_INFINITY),
-    );
-    for corner in 0..8 {
-        let c = glam::Vec3::new(
-            if corner & 1 == 0 {
-                0.0
-            } else {
-                (dims[0] - 1) as f32
-            },
-            if corner & 2 == 0 {
-                0.0
-            } else {
-                (dims[1] - 1) as f32
-            },
-            if corner & 4 == 0 {
-                0.0
-            } else {
-                (dims[2] - 1) as f32
-            },
-        );
-        lo = lo.min(g * c);
-        hi = hi.max(g * c);
-    }
-    let d = (hi - lo).length();
-    if d > 0.0 {
-        0.5 * d
-    } else {
-        0.5
-    }
-}
-
 /// The perspective frame of `--perspective FOVY`: `view`'s rotation (its scale dropped), the eye
 /// at `--eye-distance` or R / sin(FOVY/2) from the centre, focal length (H/2)/tan(FOVY/2) ×
 /// `--zoom` pixels. Supersampling (`auto`) is decided by the farthest voxels, whose footprints
@@ -235,7 +197,7 @@ fn perspective_frame(
     let focal = (size[1] as f64 * 0.5) / half.tan() * f64::from(args.zoom);
     let distance = match args.eye_distance {
         Some(d) => f64::from(d),
-        None => f64::from(bounding_radius(dims, grid)) / half.sin(),
+        None => f64::from(footprint::geometry::bounding_radius(dims, grid)) / half.sin(),
     };
     let eye = distance as f32;
     let scaled = |k: f32| {
