@@ -470,6 +470,14 @@ fn verify_reaches_40_db_and_refusals_are_clear() {
             "inside the volume",
         ),
         (vec!["--perspective", "180"], "field of view"),
+        (
+            vec!["--perspective", "60", "--eye-distance", "1e-30"],
+            "inside the volume",
+        ),
+        (
+            vec!["--perspective", "60", "--eye-distance", "1e30"],
+            "projects to nothing",
+        ),
         (vec!["--eye-distance", "200"], "--perspective"),
         (
             vec!["--perspective", "60", "--view-matrix", "1,0,0,0,2,0,0,0,1"],

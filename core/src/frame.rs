@@ -102,7 +102,8 @@ pub enum FrameError {
     /// A perspective view whose matrix is not a rotation times one scale (shear or unequal
     /// scales have no pinhole meaning).
     NotARotation,
-    /// The eye lies inside the volume, or so near it that a voxel's kernel reaches behind the eye.
+    /// The eye lies inside the volume, or so near it that a voxel's kernel reaches behind the eye
+    /// or to within 1/1000 of the eye's distance from the volume's centre.
     EyeInsideVolume {
         /// The eye's distance from the volume's centre, world units.
         eye_distance: f32,
@@ -291,7 +292,9 @@ impl FrameSetup {
                 },
             );
             let p = frame.origin + g2s * c;
-            if !(focal_px + p.z > 0.0) {
+            // In front of the eye by at least 1/1000 of its distance to the centre, so no
+            // footprint is magnified past a thousand times its size there.
+            if !(focal_px + p.z >= 1e-3 * focal_px) {
                 return Err(FrameError::EyeInsideVolume { eye_distance });
             }
         }

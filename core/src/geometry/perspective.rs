@@ -45,7 +45,8 @@ pub struct Perspective {
 pub struct Projected {
     /// Screen position, pixels.
     pub center: [f32; 2],
-    /// d screen / d grid index (rows x, y; row z the depth row), pixels per grid step.
+    /// d screen / d grid index (rows x, y; row z their normal, see the module docs), pixels per
+    /// grid step.
     pub jacobian: Mat3,
     /// The ray from the eye to the point, in affine screen units: (q, Z).
     pub ray: Vec3,
@@ -65,12 +66,14 @@ impl Perspective {
         let k = f / z;
         let q = [p.x - self.centre[0], p.y - self.centre[1]];
         let (qx, qy) = (q[0] / z, q[1] / z);
-        let col = |c: Vec3| Vec3::new(k * (c.x - qx * c.z), k * (c.y - qy * c.z), k * c.z);
-        let jacobian = Mat3::from_cols(
-            col(grid_to_screen.x_axis),
-            col(grid_to_screen.y_axis),
-            col(grid_to_screen.z_axis),
-        );
+        let g = grid_to_screen;
+        let row = |r: usize, q: f32| (g.row(r) - g.row(2) * q) * k;
+        let (rx, ry) = (row(0, qx), row(1, qy));
+        // The third row only keeps the matrix regular: the normal of the first two, at their
+        // scale (a row along VG_z would be nearly parallel to them for grazing rays).
+        let n = rx.cross(ry);
+        let rz = n * (0.5 * (rx.length() + ry.length()) / n.length());
+        let jacobian = Mat3::from_cols(rx, ry, rz).transpose();
         let center = [self.centre[0] + k * q[0], self.centre[1] + k * q[1]];
         (center[0].is_finite() && center[1].is_finite()).then_some(Projected {
             center,

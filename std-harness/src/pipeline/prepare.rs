@@ -200,6 +200,22 @@ fn perspective_frame(
         None => f64::from(footprint::geometry::bounding_radius(dims, grid)) / half.sin(),
     };
     let eye = distance as f32;
+    // Focal length over eye distance is the view's scale at the centre, pixels per world unit:
+    // out of f32's comfortable range the eye is inside the volume (or the volume vanishes).
+    let scale = focal / distance;
+    if !(scale.is_finite() && scale <= 1e12) {
+        return Err(CliError::input(format!(
+            "--perspective {fovy}: {scale:e} pixels per world unit at the volume's centre (focal \
+             length {focal:e} px over the eye's distance {distance:e}): the eye is inside the volume \
+             or --zoom is far too large"
+        )));
+    }
+    if !(scale >= 1e-12 && eye.is_finite()) {
+        return Err(CliError::input(format!(
+            "--perspective {fovy}: the eye, {distance:e} world units from the volume's centre, is \
+             so far away (or the focal length so short) that the volume projects to nothing"
+        )));
+    }
     let scaled = |k: f32| {
         View::new(rotation * (focal / distance) as f32 * k)
             .map_err(|e| CliError::input(format!("--perspective: {e}")))

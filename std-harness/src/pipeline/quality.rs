@@ -190,7 +190,8 @@ fn one_footprint_error(
 ) -> Result<f64, CliError> {
     let e = fp.half_extent[0].max(fp.half_extent[1]);
     let side = ((2.0 * e).ceil() as usize + 6).clamp(16, 256);
-    let reference = ReferenceFootprint::new(&p.kernel, map, f64::from(p.options.min_radius_px))
+    let min_r = f64::from(p.options.min_radius_px);
+    let reference = ReferenceFootprint::with_sheet_axis(&p.kernel, map, min_r, p.frame.sheet_axis)
         .map_err(|e| CliError::input(format!("{}: {e}", p.name)))?;
     let lookup = Lookup::from(c.lookup);
     let mut worst = 0.0f64;

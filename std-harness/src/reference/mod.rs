@@ -108,6 +108,18 @@ impl ReferenceFootprint {
         grid_to_screen: &DMat3,
         min_radius_px: f64,
     ) -> Result<Self, GeometryError> {
+        let axis = sheet_axis(&grid_to_screen.as_mat3());
+        Self::with_sheet_axis(kernel, grid_to_screen, min_radius_px, axis)
+    }
+
+    /// [`ReferenceFootprint::new`] for sheets along `axis` (which orients separable kernels),
+    /// as a perspective frame's per-voxel maps need (the frame's axis, not the map's own).
+    pub fn with_sheet_axis(
+        kernel: &Kernel,
+        grid_to_screen: &DMat3,
+        min_radius_px: f64,
+        axis: usize,
+    ) -> Result<Self, GeometryError> {
         let r = f64::from(kernel.spread());
         let m = *grid_to_screen * r;
         if !m.to_cols_array().iter().all(|v| v.is_finite()) {
@@ -121,7 +133,7 @@ impl ReferenceFootprint {
         // N (2×3): screen x and y rows of M (or of the two in-sheet columns, for bilinear).
         let mut n = [[0.0f64; 3]; 2];
         if separable {
-            let (a, b) = in_sheet_axes(sheet_axis(&grid_to_screen.as_mat3()));
+            let (a, b) = in_sheet_axes(axis);
             n = [[cols[a].x, cols[b].x, 0.0], [cols[a].y, cols[b].y, 0.0]];
         } else {
             for (c, col) in cols.iter().enumerate() {

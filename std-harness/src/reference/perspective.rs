@@ -80,7 +80,8 @@ impl PerspectiveVoxel {
             )
         };
         let jac = DMat3::from_cols(col(g2s.x_axis), col(g2s.y_axis), col(g2s.z_axis));
-        let affine = ReferenceFootprint::new(kernel, &jac, min_radius_px)?;
+        let affine =
+            ReferenceFootprint::with_sheet_axis(kernel, &jac, min_radius_px, frame.sheet_axis)?;
         let (a, b) = frame.in_sheet;
         let (ja, jb) = (jac.col(a), jac.col(b));
         let area = (ja.x * jb.y - ja.y * jb.x).abs();

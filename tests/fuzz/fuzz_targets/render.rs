@@ -21,7 +21,7 @@
 //! Input bytes are read as parameters in a fixed order (missing bytes read as 0).
 use footprint::fixed::{FixedTable, ONE};
 use footprint::frame::{FrameSetup, Order};
-use footprint::render::{FixedPath, FloatPath};
+use footprint::render::{FixedPath, FloatPath, PerspectivePath};
 use footprint::{FootprintOptions, GenericTable, Grid, Kernel, Lookup, View, ViewTable};
 use footprint_harness::reference::ReferenceFootprint;
 use libfuzzer_sys::fuzz_target;
@@ -120,6 +120,20 @@ fuzz_target!(|data: &[u8]| {
                             .collect();
                         check_image(&img, "fixed render");
                     }
+                }
+            }
+        }
+    }
+
+    // Perspective: an eye at a random distance (a few voxels to far away); refusals are fine,
+    // a frame that is accepted renders finite RGBA in [0, 1] both ways.
+    let eye = 8.0 * b.log2(6.0);
+    if let Ok(view) = View::from_angles(angles, zoom, dims, &grid, size) {
+        if let Ok(frame) = FrameSetup::perspective(dims, &grid, &view, &kernel, options, size, eye) {
+            if let Ok(path) = PerspectivePath::new(&frame, &kernel, options, &generic, lookup) {
+                for order in [Order::BackToFront, Order::FrontToBack] {
+                    let img = footprint_fuzz::render_volume(&frame, path, order, &samples, &lut);
+                    check_image(&img, "perspective render");
                 }
             }
         }
