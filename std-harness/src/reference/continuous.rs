@@ -76,6 +76,13 @@ pub struct Continuous {
     pub converged: bool,
 }
 
+/// Per-axis Gaussian factors and squared offsets of one sample, axis a at `[a·n ..][..n]`.
+struct Taps {
+    n: usize,
+    e: Vec<f64>,
+    d2: Vec<f64>,
+}
+
 /// Pre-classified voxels: σ and σ·c (rgb) per voxel, x fastest, and the block map.
 struct Field {
     dims: [usize; 3],
@@ -196,9 +203,21 @@ impl Field {
         })
     }
 
+    /// Scratch for [`Field::at`]'s per-axis kernel factors, sized for this field's kernel (one
+    /// per thread, reused for every sample).
+    fn taps(&self) -> Taps {
+        // Lattice offsets within R of a point: at most ⌊2R⌋ + 1 per axis; one spare.
+        let n = (2.0 * self.reach).floor() as usize + 2;
+        Taps {
+            n,
+            e: vec![0.0; 3 * n],
+            d2: vec![0.0; 3 * n],
+        }
+    }
+
     /// [σ, σr, σg, σb] at grid point `g` (continuous index coordinates).
     #[inline]
-    fn at(&self, g: DVec3) -> [f64; 4] {
+    fn at(&self, g: DVec3, taps: &mut Taps) -> [f64; 4] {
         let d = self.dims;
         let b = [g.x, g.y, g.z].map(|c| (c.max(0.0) as usize) / BLOCK);
         let bi = (b[2].min(self.blocks[2] - 1) * self.blocks[1] + b[1].min(self.blocks[1] - 1))
@@ -237,35 +256,36 @@ impl Field {
                 }
             }
             Some((r, sigmas, norm)) => {
-                // The Gaussian factors per axis (separable inside the ball).
+                // The Gaussian factors per axis (separable inside the ball), one per lattice
+                // offset within R of the sample: at most `taps.n` per axis.
                 let k = sigmas * sigmas / (2.0 * r * r);
-                let lo = [g.x, g.y, g.z].map(|c| (c - r).ceil() as i64);
-                let hi = [g.x, g.y, g.z].map(|c| (c + r).floor() as i64);
                 let gc = [g.x, g.y, g.z];
-                let mut e = [[0.0f64; 8]; 3];
-                let mut d2 = [[0.0f64; 8]; 3];
+                let lo = gc.map(|c| (c - r).ceil() as i64);
+                let hi = gc.map(|c| (c + r).floor() as i64);
+                let n = taps.n;
                 for a in 0..3 {
-                    for (j, v) in (lo[a]..=hi[a]).take(8).enumerate() {
+                    for (j, v) in (lo[a]..=hi[a]).enumerate() {
                         let dd = (gc[a] - v as f64).powi(2);
-                        d2[a][j] = dd;
-                        e[a][j] = (-k * dd).exp();
+                        taps.d2[a * n + j] = dd;
+                        taps.e[a * n + j] = (-k * dd).exp();
                     }
                 }
+                let (e, d2) = (&taps.e, &taps.d2);
                 let r2 = r * r;
-                for (jz, z) in (lo[2]..=hi[2]).take(8).enumerate() {
-                    for (jy, y) in (lo[1]..=hi[1]).take(8).enumerate() {
-                        let dyz = d2[2][jz] + d2[1][jy];
+                for (jz, z) in (lo[2]..=hi[2]).enumerate() {
+                    for (jy, y) in (lo[1]..=hi[1]).enumerate() {
+                        let dyz = d2[2 * n + jz] + d2[n + jy];
                         if dyz >= r2 {
                             continue;
                         }
-                        let eyz = e[2][jz] * e[1][jy];
-                        for (jx, x) in (lo[0]..=hi[0]).take(8).enumerate() {
-                            if dyz + d2[0][jx] >= r2 {
+                        let eyz = e[2 * n + jz] * e[n + jy];
+                        for (jx, x) in (lo[0]..=hi[0]).enumerate() {
+                            if dyz + d2[jx] >= r2 {
                                 continue;
                             }
                             if let Some(v) = voxel(x, y, z) {
                                 if v[0] > 0.0 {
-                                    let w = eyz * e[0][jx] * norm;
+                                    let w = eyz * e[jx] * norm;
                                     for ch in 0..4 {
                                         out[ch] += w * f64::from(v[ch]);
                                     }
@@ -304,6 +324,7 @@ fn march(scene: &ContinuousScene<'_>, field: &Field, h: f64) -> Vec<[f64; 4]> {
     std::thread::scope(|sc| {
         for (t, chunk) in image.chunks_mut(band * w).enumerate() {
             sc.spawn(move || {
+                let mut taps = field.taps();
                 for (i, px) in chunk.iter_mut().enumerate() {
                     let (x, y) = (i % w, t * band + i / w);
                     let (xc, yc) = (x as f64 + 0.5, y as f64 + 0.5);
@@ -352,7 +373,7 @@ fn march(scene: &ContinuousScene<'_>, field: &Field, h: f64) -> Vec<[f64; 4]> {
                         let hw = world / steps as f64;
                         for k in 0..steps {
                             let tm = t0 + (k as f64 + 0.5) * step;
-                            let v = field.at(g0 + dg * tm);
+                            let v = field.at(g0 + dg * tm, &mut taps);
                             if v[0] <= 0.0 {
                                 continue;
                             }
