@@ -51,7 +51,8 @@ fn blob_matches_closed_form(r: f64, sigmas: f64, least_peak: f64) {
     ])
     .unwrap();
     let p = prepare(&args).unwrap();
-    let (img, c, _) = render_continuous_ref(&p, Reconstruction::Kernel).unwrap();
+    let (c, _) = render_continuous_ref(&p, Reconstruction::Kernel).unwrap();
+    let img = &c.image;
     assert!(
         c.converged && c.change_db >= CONVERGED_DB,
         "{} dB",

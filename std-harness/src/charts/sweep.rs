@@ -57,11 +57,12 @@ pub fn sweep(
         footprint::Kernel::Gaussian { .. } => Reconstruction::Kernel,
         _ => Reconstruction::Trilinear,
     };
-    let (truth, c, truth_s) = render_continuous_ref(&p, rec)?;
+    let (truth, truth_s) = render_continuous_ref(&p, rec)?;
     crate::say!(
-        "continuous reference ({rec:?}): {truth_s:.2} s, step {:.4} world units, last change {:.1} dB",
-        c.step,
-        c.change_db
+        "continuous reference ({} reconstruction): {truth_s:.2} s, step {:.4} world units, last change {:.1} dB",
+        rec.name(),
+        truth.step,
+        truth.change_db
     );
     // One untimed render first, so the first configuration is not timed with cold caches.
     if let Some(c) = configs.first() {
@@ -81,7 +82,7 @@ pub fn sweep(
         times.sort_by(f64::total_cmp);
         let (_, overall) = compare(&image, &reference);
         let footprint_error = quality::footprint_error(&p, c)?;
-        let (_, against_truth) = compare(&image, &truth);
+        let (_, against_truth) = compare(&image, &truth.image);
         let m = Measured {
             continuous_db: against_truth.psnr_db,
             pareto_continuous: false,

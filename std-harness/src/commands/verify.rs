@@ -57,6 +57,15 @@ pub enum ReconstructionArg {
     Trilinear,
 }
 
+impl From<ReconstructionArg> for Reconstruction {
+    fn from(a: ReconstructionArg) -> Self {
+        match a {
+            ReconstructionArg::Kernel => Reconstruction::Kernel,
+            ReconstructionArg::Trilinear => Reconstruction::Trilinear,
+        }
+    }
+}
+
 pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
     let r = &args.render;
     if r.footprint.method == MethodArg::Reference {
@@ -91,13 +100,9 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
     let continuous = match args.reference {
         ReferenceArg::Sheets => None,
         ReferenceArg::Continuous => {
-            let rec = match args.reconstruction {
-                ReconstructionArg::Kernel => Reconstruction::Kernel,
-                ReconstructionArg::Trilinear => Reconstruction::Trilinear,
-            };
-            let (img, c, secs) = render_continuous_ref(&p, rec)?;
-            let (_, e) = compare(&core, &img);
-            Some((img, c, secs, e))
+            let (c, secs) = render_continuous_ref(&p, args.reconstruction.into())?;
+            let (_, e) = compare(&core, &c.image);
+            Some((c, secs, e))
         }
     };
     crate::say!(
@@ -123,14 +128,14 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         overall.rmse,
         overall.max_abs
     );
-    if let Some((_, c, secs, e)) = &continuous {
+    if let Some((c, secs, e)) = &continuous {
         crate::say!(
-            "continuous {:>9.2} {:>9.2e} {:>9.2e}   (RGB, against the continuous integral, {:?} \
+            "continuous {:>9.2} {:>9.2e} {:>9.2e}   (RGB, against the continuous integral, {} \
              reconstruction; step {:.4} world units after {} passes, last change {:.1} dB{}; {:.1} s)",
             e.psnr_db,
             e.rmse,
             e.max_abs,
-            args.reconstruction,
+            Reconstruction::from(args.reconstruction).name(),
             c.step,
             c.passes,
             c.change_db,
@@ -161,14 +166,14 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         ));
     }
     if let Some(out) = &args.reference_out {
-        let chosen = continuous.as_ref().map_or(&reference, |c| &c.0);
+        let chosen = continuous.as_ref().map_or(&reference, |c| &c.0.image);
         let img: Vec<[f32; 4]> = chosen.iter().map(|c| c.map(|x| x as f32)).collect();
         files.push((
             out,
             encode_rgb_for(out, &img, r.size.0, r.size.1, r.png_style())?,
         ));
     }
-    let judged = continuous.as_ref().map_or(overall.psnr_db, |c| c.3.psnr_db);
+    let judged = continuous.as_ref().map_or(overall.psnr_db, |c| c.2.psnr_db);
     let pass = args.min_psnr.is_none_or(|m| judged >= m);
     if let Some(j) = &r.json {
         let channels = Json::object()
@@ -190,15 +195,14 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
                 ReferenceArg::Continuous => "continuous",
             },
         );
-        if let Some((_, c, secs, e)) = &continuous {
-            let rec = match args.reconstruction {
-                ReconstructionArg::Kernel => "kernel",
-                ReconstructionArg::Trilinear => "trilinear",
-            };
+        if let Some((c, secs, e)) = &continuous {
             summary = summary.obj(
                 "continuous",
                 e.json()
-                    .str("reconstruction", rec)
+                    .str(
+                        "reconstruction",
+                        Reconstruction::from(args.reconstruction).name(),
+                    )
                     .num("step_world", c.step)
                     .num("passes", c.passes as f64)
                     .num("change_db", c.change_db)

@@ -16,7 +16,6 @@ pub struct Config {
 }
 
 impl Config {
-    /// Every configuration the chart sweeps.
     /// The configurations a frame can run: all of them orthographic; with perspective only float
     /// accumulation through the generic table (`direct`): every voxel has its own footprint, so
     /// there is no view table, and the fixed path is orthographic only.
@@ -28,6 +27,7 @@ impl Config {
         v
     }
 
+    /// Every configuration the chart sweeps.
     pub fn all() -> Vec<Config> {
         let mut v = Vec::new();
         for table in SIZES {

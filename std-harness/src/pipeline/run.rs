@@ -352,11 +352,11 @@ pub fn render_ref(p: &Prepared) -> Result<(Vec<[f64; 4]>, f64), CliError> {
 }
 
 /// The continuous reference of `p` (see [`crate::reference::continuous`]): the converged image
-/// (at the output size), how it converged, and its seconds. The volume must be in memory.
+/// (at the output size) and how it converged, and its seconds. The volume must be in memory.
 pub fn render_continuous_ref(
     p: &Prepared,
     reconstruction: Reconstruction,
-) -> Result<(Vec<[f64; 4]>, Continuous, f64), CliError> {
+) -> Result<(Continuous, f64), CliError> {
     let volume = p.volume().ok_or_else(|| {
         CliError::input("the continuous reference needs the volume in memory: drop --stream")
     })?;
@@ -370,14 +370,13 @@ pub fn render_continuous_ref(
     };
     let mut bar = sheets("continuous");
     let axis = p.frame.sheet_axis;
-    let c = render_continuous(
+    let mut c = render_continuous(
         &scene,
         |s, out| volume.sheet_into(axis, s, out),
         |pass, _| bar(pass, MAX_HALVINGS + 1),
     )?;
-    let img = match p.supersample {
-        1 => c.image.clone(),
-        k => downsample(&c.image, p.out_size(), k, |v| v),
-    };
-    Ok((img, c, start.elapsed().as_secs_f64()))
+    if p.supersample > 1 {
+        c.image = downsample(&c.image, p.out_size(), p.supersample, |v| v);
+    }
+    Ok((c, start.elapsed().as_secs_f64()))
 }

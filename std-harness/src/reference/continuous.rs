@@ -53,6 +53,16 @@ pub enum Reconstruction {
     Trilinear,
 }
 
+impl Reconstruction {
+    /// The name `--reconstruction` and the JSON use.
+    pub fn name(self) -> &'static str {
+        match self {
+            Reconstruction::Kernel => "kernel",
+            Reconstruction::Trilinear => "trilinear",
+        }
+    }
+}
+
 /// What the continuous reference renders.
 pub struct ContinuousScene<'a> {
     pub frame: &'a FrameSetup,
