@@ -13,7 +13,7 @@
 //! index u along a and v along b. For sheet axis k (z) that is exactly a z-slice of an x-fastest file.
 
 use crate::geometry::{
-    in_sheet_axes, Footprint, FootprintOptions, GeometryError, Grid, Perspective, View,
+    box_corners, in_sheet_axes, Footprint, FootprintOptions, GeometryError, Grid, Perspective, View,
 };
 use crate::kernel::Kernel;
 use crate::math;
@@ -273,24 +273,7 @@ impl FrameSetup {
         // lie in front of the eye (the box is convex, so then every kernel does).
         let r = kernel.spread();
         let g2s = frame.grid_to_screen;
-        for corner in 0..8 {
-            let c = Vec3::new(
-                if corner & 1 == 0 {
-                    -r
-                } else {
-                    (dims[0] - 1) as f32 + r
-                },
-                if corner & 2 == 0 {
-                    -r
-                } else {
-                    (dims[1] - 1) as f32 + r
-                },
-                if corner & 4 == 0 {
-                    -r
-                } else {
-                    (dims[2] - 1) as f32 + r
-                },
-            );
+        for c in box_corners(dims, r) {
             let p = frame.origin + g2s * c;
             // In front of the eye by at least 1/1000 of its distance to the centre, so no
             // footprint is magnified past a thousand times its size there.

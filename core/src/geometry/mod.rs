@@ -358,30 +358,27 @@ impl View {
     }
 }
 
+/// The eight corners of the voxel-centre box of a `dims` grid, in grid coordinates, widened by
+/// `pad` grid steps on every side: corner c lies at the high end of axis a when bit a of c is set.
+pub fn box_corners(dims: [usize; 3], pad: f32) -> [Vec3; 8] {
+    core::array::from_fn(|c| {
+        Vec3::from_array(core::array::from_fn(|a| {
+            if c >> a & 1 == 0 {
+                -pad
+            } else {
+                dims[a].saturating_sub(1) as f32 + pad
+            }
+        }))
+    })
+}
+
 /// Half the diagonal of the voxel-centre box, world units: the axis-aligned world box of the grid's
 /// corner voxels (as VTK bounds an oriented image), 0.5 for a single voxel. VTK's `ResetCamera`
 /// fits the sphere of this radius: [`View::looking`] in parallel projection, the harness's
 /// `--perspective` for the eye's distance. `dims` must be non-zero.
 pub fn bounding_radius(dims: [usize; 3], grid: &Grid) -> f32 {
     let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-    for corner in 0..8 {
-        let c = Vec3::new(
-            if corner & 1 == 0 {
-                0.0
-            } else {
-                dims[0].saturating_sub(1) as f32
-            },
-            if corner & 2 == 0 {
-                0.0
-            } else {
-                dims[1].saturating_sub(1) as f32
-            },
-            if corner & 4 == 0 {
-                0.0
-            } else {
-                dims[2].saturating_sub(1) as f32
-            },
-        );
+    for c in box_corners(dims, 0.0) {
         let w = grid.to_world * c;
         lo = lo.min(w);
         hi = hi.max(w);

@@ -226,17 +226,9 @@ fn perspective_frame(
         .map_err(bad)?;
     // The farthest voxel-centre corner's magnification f/Z, relative to the centre's.
     let cam = frame.camera().copied().expect("a perspective frame");
-    let far = (0..8)
-        .map(|c| {
-            let i = [0, 1, 2].map(|a| {
-                if c >> a & 1 == 0 {
-                    0.0
-                } else {
-                    (dims[a] - 1) as f32
-                }
-            });
-            cam.focal_px + frame.affine_position(i).z
-        })
+    let far = footprint::geometry::box_corners(dims, 0.0)
+        .into_iter()
+        .map(|c| cam.focal_px + frame.affine_position(c.to_array()).z)
         .fold(0.0f32, f32::max);
     let shrink = cam.focal_px / far;
     let far_frame = FrameSetup::new(dims, grid, &scaled(shrink)?, kernel, options, size)?;

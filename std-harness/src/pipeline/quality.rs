@@ -151,9 +151,7 @@ fn footprints(p: &Prepared) -> Result<Vec<(Footprint, glam::DMat3)>, CliError> {
         return Ok(vec![(f.footprint, f.grid_to_screen.as_dmat3())]);
     };
     let d = f.dims.map(|n| (n - 1) as f32);
-    let mut points: Vec<[f32; 3]> = (0..8)
-        .map(|c| [0, 1, 2].map(|a| if c >> a & 1 == 0 { 0.0 } else { d[a] }))
-        .collect();
+    let mut points = footprint::geometry::box_corners(f.dims, 0.0).map(|c| c.to_array());
     let depth = |i: &[f32; 3]| f.affine_position(*i).z;
     points.sort_by(|a, b| depth(a).total_cmp(&depth(b)));
     let picks = [points[0], d.map(|x| x * 0.5), points[7]];
