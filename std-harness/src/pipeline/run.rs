@@ -87,9 +87,6 @@ pub fn render_frame(
         // Each path gets its own monomorphised sheet loop: no virtual call per pixel.
         let perspective = p.frame.camera().is_some();
         let (image, stats, mut phases, visible) = match (accum, fa.method) {
-            (AccumArg::Fixed, _) if perspective => {
-                return Err(fixed_range(fixed::FixedError::Perspective));
-            }
             (AccumArg::Float, _) if perspective => {
                 // Every voxel its own footprint, sampled from the generic table (no view table).
                 let path = PerspectivePath::new(&p.frame, &p.kernel, p.options, &*generic, lookup)?;
