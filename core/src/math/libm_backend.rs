@@ -42,6 +42,10 @@ pub fn atan(x: f32) -> f32 {
     libm::atanf(x)
 }
 #[inline]
+pub fn ln(x: f32) -> f32 {
+    libm::logf(x)
+}
+#[inline]
 pub fn floor(x: f32) -> f32 {
     libm::floorf(x)
 }

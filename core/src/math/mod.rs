@@ -98,6 +98,18 @@ pub fn powf(x: f32, y: f32) -> f32 {
     backend::powf(x, y)
 }
 
+/// Natural logarithm for x > 0 (NaN for x < 0, −∞ at 0).
+#[inline]
+pub fn ln(x: f32) -> f32 {
+    backend::ln(x)
+}
+
+/// Smallest integer value not less than `x` (−floor(−x)).
+#[inline]
+pub fn ceil(x: f32) -> f32 {
+    -floor(-x)
+}
+
 /// Largest integer value not greater than `x`.
 #[inline]
 pub fn floor(x: f32) -> f32 {

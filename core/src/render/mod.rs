@@ -24,11 +24,13 @@ mod band;
 mod perspective;
 mod precision;
 mod sheets;
+pub mod slabs;
 mod visible;
 
 pub use perspective::PerspectivePath;
 pub use precision::{FixedPath, FloatPath, Precision};
 pub use sheets::{gradient, SheetRing, SheetWindow};
+pub use slabs::{SlabError, SlabRenderer, SlabSetup, SlabVoxel};
 pub use visible::{classify_sheet, VisibleSheet, VisibleVoxel};
 
 use crate::composite::RowSpan;

@@ -17,10 +17,12 @@
 
 mod format;
 mod generic;
+mod section;
 mod view;
 
 pub use format::{crc32, Crc32, TableError, FORMAT_VERSION, MAGIC};
 pub use generic::GenericTable;
+pub use section::{SectionError, SectionTable};
 pub(crate) use view::for_each_view_node;
 pub use view::{box_fill, ViewLayout, ViewTable, MIN_BOX_FILL};
 
