@@ -128,6 +128,13 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         overall.rmse,
         overall.max_abs
     );
+    if r.slicing == crate::args::SlicingArg::Image {
+        crate::say!(
+            "(--slicing image: the sheet reference renders the paper's object-aligned sheets, so \
+             `overall` above is the difference between the two slicings; --reference continuous \
+             measures image slicing against the truth)"
+        );
+    }
     if let Some((c, secs, e)) = &continuous {
         crate::say!(
             "continuous {:>9.2} {:>9.2e} {:>9.2e}   (RGB, against the continuous integral, {} \

@@ -13,6 +13,7 @@
 //! - [`bands`]: a frame split into bands of rows, one per thread, byte-identical for any count.
 //! - [`config`]: one table configuration (size, lookup, method, accumulation).
 //! - [`quality`]: `--quality`, the cheapest configuration predicted to reach a PSNR.
+//! - [`slabs`]: `--slicing image`, the core's image-aligned slabs over the visible voxels.
 //! - [`single`]: one voxel rendered on its own (`footprint splat`, the stability charts).
 //!
 //! It reads the shared argument structs of [`crate::args`] and calls down into [`crate::io`],
@@ -25,6 +26,7 @@ pub mod prepare;
 pub mod quality;
 pub mod run;
 pub mod single;
+pub mod slabs;
 pub mod supersample;
 pub mod visible;
 

@@ -400,6 +400,14 @@ pub fn describe(p: &Prepared, args: &RenderArgs) -> Json {
         .str("tf", &p.tf_name)
         .arr_f64("window", &p.window.map(f64::from))
         .str("sheet_axis", ["i", "j", "k"][f.sheet_axis])
+        .str("slicing", args.slicing.name())
+        .num(
+            "slab",
+            match args.slicing {
+                crate::args::SlicingArg::Image => f64::from(args.slab),
+                crate::args::SlicingArg::Object => f64::NAN,
+            },
+        )
         .str(
             "projection",
             if f.camera().is_some() {

@@ -7,7 +7,7 @@ use super::load::Voxels;
 use super::prepare::Prepared;
 use super::supersample::downsample;
 use super::visible::FrameCache;
-use crate::args::{AccumArg, MethodArg, RenderArgs};
+use crate::args::{AccumArg, MethodArg, RenderArgs, SlicingArg};
 use crate::io::progress::sheets;
 use crate::io::stream::{FileSource, MemorySource, PipeSource};
 use crate::io::try_filled;
@@ -76,6 +76,9 @@ pub fn render_frame(
     accum: AccumArg,
     cache: &mut FrameCache,
 ) -> Result<CoreFrame, CliError> {
+    if args.slicing == SlicingArg::Image {
+        return super::slabs::render_slabs(p, args, accum, cache);
+    }
     let fa = &args.footprint;
     let lookup = Lookup::from(fa.lookup);
     let threads = args.thread_count();

@@ -1,0 +1,281 @@
+//! `--slicing image`: the core's image-aligned slabs (`footprint::render::slabs`) over the
+//! visible voxels of a volume in memory, on several cores.
+//!
+//! 1. The visible lists (classified once per volume, as for sheets: [`super::visible`]) are
+//!    shaded for one world unit of thickness and turned into extinction and emission
+//!    ([`SlabVoxel::from_unit_rgba`]), placed on screen, and sorted by the first slab each
+//!    overlaps (a counting sort: voxel order within a slab is sheet order, the same for any
+//!    thread count).
+//! 2. Each thread owns a band of image rows and walks the slabs in compositing order, keeping the
+//!    voxels whose kernels overlap the current slab (those that reach its band) in an active list:
+//!    a voxel enters at its first slab and leaves after its last.
+//!
+//! **Memory.** 40 bytes per visible voxel (its [`SlabVoxel`] and slab range) on top of the
+//! visible lists, one slab accumulator per band, and the 65 KiB section table. A slab of an oblique
+//! view crosses every sheet, so a streamed volume (`--stream`) is refused: feeding it from a
+//! bounded window of sheets is not possible (see the core module's docs).
+
+use super::bands::{band_rows, Phases};
+use super::prepare::Prepared;
+use super::run::CoreFrame;
+use super::supersample::downsample;
+use super::visible::FrameCache;
+use crate::args::{AccumArg, RenderArgs};
+use crate::CliError;
+use footprint::composite::RowSpan;
+use footprint::frame::Order;
+use footprint::render::{RenderBuffers, RenderStats, SlabRenderer, SlabSetup, SlabVoxel};
+use footprint::shade::Lighting;
+use footprint::table::SectionTable;
+use std::time::Instant;
+
+/// The section table's nodes: ρ² and half-chord rows, positions along the chord (see
+/// `footprint::table::SectionTable`: 3.4·10⁻⁵ of the peak at worst).
+const ROWS: usize = 129;
+const COLUMNS: usize = 129;
+
+/// Renders one frame of `p` with image-aligned slabs `args.slab` voxel spacings thick.
+pub fn render_slabs(
+    p: &Prepared,
+    args: &RenderArgs,
+    accum: AccumArg,
+    cache: &mut FrameCache,
+) -> Result<CoreFrame, CliError> {
+    let refuse = |why: &str| CliError::input(format!("{}: --slicing image: {why}", p.name));
+    if accum == AccumArg::Fixed {
+        return Err(refuse(
+            "there is no fixed-point slab path (each slab is composited with an exponential per \
+             pixel): use --accum float or --slicing object",
+        ));
+    }
+    let volume = p.volume().ok_or_else(|| {
+        refuse(
+            "a slab of an oblique view crosses every sheet, so it cannot be fed from a few \
+             streamed sheets: drop --stream (the volume is loaded) or use --slicing object",
+        )
+    })?;
+    let setup =
+        SlabSetup::new(&p.frame, &p.kernel, args.slab).map_err(|e| refuse(&e.to_string()))?;
+    let threads = args.thread_count();
+    let start = Instant::now();
+    let mut table = Box::new(SectionTable::<ROWS, COLUMNS>::zeroed(p.kernel));
+    table
+        .build_into(p.kernel)
+        .map_err(|e| refuse(&e.to_string()))?;
+    let tables = start.elapsed().as_secs_f64();
+
+    let t0 = Instant::now();
+    let (lists, fresh) = cache.lists(p, volume, threads)?;
+    let classify_lists = if fresh {
+        t0.elapsed().as_secs_f64()
+    } else {
+        0.0
+    };
+    let t1 = Instant::now();
+    let voxels = slab_voxels(p, &setup, lists)?;
+    let classify = classify_lists + t1.elapsed().as_secs_f64();
+
+    let [w, h] = p.frame.size;
+    let bands = threads.clamp(1, h);
+    let mut image = crate::io::try_filled(w * h, [0.0f32; 4], "the image")?;
+    let mut chunks: Vec<&mut [[f32; 4]]> = Vec::with_capacity(bands);
+    let mut rest: &mut [[f32; 4]] = &mut image;
+    for t in 0..bands {
+        let (band, tail) = rest.split_at_mut(band_rows(h, bands, t).len() * w);
+        chunks.push(band);
+        rest = tail;
+    }
+    let background = p.background.as_deref();
+    let (setup, table, voxels) = (&setup, &*table, &voxels);
+    let results: Vec<Result<(RenderStats, Phases), CliError>> = std::thread::scope(|scope| {
+        let handles: Vec<_> = chunks
+            .into_iter()
+            .enumerate()
+            .map(|(t, band)| {
+                let rows = band_rows(h, bands, t);
+                let bg = background.map(|b| &b[rows.start * w..rows.end * w]);
+                scope.spawn(move || render_band(p, setup, table, voxels, bg, band, rows))
+            })
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().expect("a slab thread panicked"))
+            .collect()
+    });
+    let mut stats = RenderStats::default();
+    let mut phases = Phases {
+        classify,
+        tables,
+        ..Phases::default()
+    };
+    for r in results {
+        let (s, ph) = r?;
+        stats.sheets = s.sheets;
+        stats.voxels += s.voxels;
+        stats.voxels_splatted += s.voxels_splatted;
+        stats.pixel_updates += s.pixel_updates;
+        stats.pixels_composited += s.pixels_composited;
+        phases.splat = phases.splat.max(ph.splat);
+        phases.composite = phases.composite.max(ph.composite);
+    }
+    let image = match p.supersample {
+        1 => image,
+        k => downsample(&image, p.out_size(), k, |v| v as f32),
+    };
+    Ok(CoreFrame {
+        image,
+        stats,
+        seconds: start.elapsed().as_secs_f64(),
+        phases,
+        threads: bands,
+        visible: Some(voxels.voxels.len()),
+    })
+}
+
+/// Every visible voxel as a [`SlabVoxel`] with its slab range, sorted by first slab (stable:
+/// sheet order within a slab).
+struct SlabVoxels {
+    voxels: Vec<SlabVoxel>,
+    /// (first, last) slab of each voxel.
+    range: Vec<(u32, u32)>,
+    /// `voxels[starts[j]..starts[j + 1]]` are those whose first slab is j.
+    starts: Vec<usize>,
+    /// Voxel indices by last slab (for back-to-front), `by_last[ends[j]..ends[j + 1]]` last in j.
+    by_last: Vec<u32>,
+    ends: Vec<usize>,
+}
+
+fn slab_voxels(
+    p: &Prepared,
+    setup: &SlabSetup,
+    lists: &super::visible::VisibleLists,
+) -> Result<SlabVoxels, CliError> {
+    let f = &p.frame;
+    let shader = p.shader();
+    // Opacity per world unit: the shader at an exponent of one (the slab integrates σ along the
+    // ray itself).
+    let mut unit = *f;
+    unit.sheet_distance = unit.reference_distance;
+    let lighting = Lighting::new(&unit);
+    let needs_gradient = shader.shading.needs_gradient();
+    let mut placed: Vec<(SlabVoxel, (u32, u32))> = Vec::new();
+    placed
+        .try_reserve_exact(lists.len())
+        .map_err(|_| CliError::input("cannot allocate the slab voxel list"))?;
+    for s in 0..f.sheet_count() {
+        let sheet = lists.sheet(s);
+        for (k, vox) in sheet.voxels.iter().enumerate() {
+            let idx = f.grid_index(s, usize::from(vox.u), usize::from(vox.v));
+            let g = || {
+                if needs_gradient {
+                    glam::Vec3::from_array(sheet.gradients[k])
+                } else {
+                    glam::Vec3::ZERO
+                }
+            };
+            let rgba = shader.shade_with(&lighting, None, vox.value, g, idx, f.dims);
+            let position = setup.position(idx);
+            if let Some(v) = SlabVoxel::from_unit_rgba(position, rgba) {
+                let (a, b) = setup.slabs_of(position[2]);
+                placed.push((v, (a as u32, b as u32)));
+            }
+        }
+    }
+    let count = setup.slab_count();
+    let mut starts = vec![0usize; count + 1];
+    let mut ends = vec![0usize; count + 1];
+    for (_, (a, b)) in &placed {
+        starts[*a as usize + 1] += 1;
+        ends[*b as usize + 1] += 1;
+    }
+    for j in 0..count {
+        starts[j + 1] += starts[j];
+        ends[j + 1] += ends[j];
+    }
+    let mut next = starts.clone();
+    let mut order = vec![0usize; placed.len()];
+    for (i, (_, (a, _))) in placed.iter().enumerate() {
+        order[next[*a as usize]] = i;
+        next[*a as usize] += 1;
+    }
+    let voxels: Vec<SlabVoxel> = order.iter().map(|&i| placed[i].0).collect();
+    let range: Vec<(u32, u32)> = order.iter().map(|&i| placed[i].1).collect();
+    let mut next = ends.clone();
+    let mut by_last = vec![0u32; placed.len()];
+    for (i, (_, b)) in range.iter().enumerate() {
+        by_last[next[*b as usize]] = i as u32;
+        next[*b as usize] += 1;
+    }
+    Ok(SlabVoxels {
+        voxels,
+        range,
+        starts,
+        by_last,
+        ends,
+    })
+}
+
+/// One band: every slab in compositing order, its active voxels splatted, then composited.
+fn render_band(
+    p: &Prepared,
+    setup: &SlabSetup,
+    table: &SectionTable<ROWS, COLUMNS>,
+    sv: &SlabVoxels,
+    background: Option<&[[f32; 4]]>,
+    image: &mut [[f32; 4]],
+    rows: std::ops::Range<usize>,
+) -> Result<(RenderStats, Phases), CliError> {
+    let w = p.frame.size[0];
+    let n = w * rows.len();
+    let mut acc = crate::io::try_filled(n, [0.0f32; 4], "a band's slab accumulator")?;
+    let mut spans = vec![RowSpan::EMPTY; rows.len()];
+    let buffers = RenderBuffers {
+        accumulator: &mut acc,
+        image,
+        rows: &mut spans,
+    };
+    let reaches = |i: usize| {
+        let r = setup.rows_of(sv.voxels[i].position[1]);
+        r.start < rows.end && r.end > rows.start
+    };
+    let mut renderer =
+        SlabRenderer::with_band(setup, table, p.order, buffers, background, rows.clone())?;
+    let mut phases = Phases::default();
+    let count = setup.slab_count();
+    let mut active: Vec<u32> = Vec::new();
+    for k in 0..count {
+        let t0 = Instant::now();
+        match p.order {
+            Order::FrontToBack => {
+                let j = k;
+                active.retain(|&i| sv.range[i as usize].1 as usize >= j);
+                active.extend(
+                    (sv.starts[j]..sv.starts[j + 1])
+                        .filter(|&i| reaches(i))
+                        .map(|i| i as u32),
+                );
+                for &i in &active {
+                    renderer.splat_section(j, &sv.voxels[i as usize]);
+                }
+            }
+            Order::BackToFront => {
+                let j = count - 1 - k;
+                active.retain(|&i| sv.range[i as usize].0 as usize <= j);
+                active.extend(
+                    sv.by_last[sv.ends[j]..sv.ends[j + 1]]
+                        .iter()
+                        .copied()
+                        .filter(|&i| reaches(i as usize)),
+                );
+                for &i in &active {
+                    renderer.splat_section(j, &sv.voxels[i as usize]);
+                }
+            }
+        }
+        let t1 = Instant::now();
+        renderer.composite_slab();
+        phases.splat += (t1 - t0).as_secs_f64();
+        phases.composite += t1.elapsed().as_secs_f64();
+    }
+    Ok((renderer.finish(), phases))
+}
