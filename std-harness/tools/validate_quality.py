@@ -50,6 +50,8 @@ def main():
         for d in sweeps:
             meta = json.load(open(os.path.join(d, "sweep.json")))
             rows = list(csv.DictReader(open(os.path.join(d, "tradeoff.csv"))))
+            # --quality chooses among table configurations (object slicing) only.
+            rows = [r for r in rows if r.get("slicing", "object") == "object"]
             by_label = {r["config"]: r for r in rows}
             for q in (30, 40, 50):
                 meeting = [r for r in rows if float(r["psnr_db"]) >= q]

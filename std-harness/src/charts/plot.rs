@@ -2,6 +2,7 @@
 //! stability panels, each written as SVG and PNG. Text uses a bundled DejaVu Sans, so the PNGs need
 //! no system fonts.
 
+use super::popping::Popping;
 use super::stability::Curve;
 use super::sweep::Measured;
 use crate::args::{AccumArg, LookupArg, MethodArg};
@@ -33,14 +34,18 @@ fn plot_err<E: std::fmt::Display>(e: E) -> CliError {
     CliError::input(format!("chart: {e}"))
 }
 
-const COLOURS: [RGBColor; 4] = [
+const COLOURS: [RGBColor; 5] = [
     RGBColor(31, 119, 180),
     RGBColor(255, 127, 14),
     RGBColor(44, 160, 44),
     RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
 ];
 
 fn series_colour(c: &Config) -> RGBColor {
+    if c.slab().is_some() {
+        return COLOURS[4];
+    }
     let i = match (c.method, c.accum) {
         (MethodArg::Direct, AccumArg::Float) => 1,
         (MethodArg::Direct, AccumArg::Fixed) => 3,
@@ -55,13 +60,27 @@ fn draw_tradeoff<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     rows: &[Measured],
     title: &str,
+    truth: bool,
 ) -> Result<(), CliError>
 where
     DB::ErrorType: 'static,
 {
     root.fill(&WHITE).map_err(plot_err)?;
     let (plot, side) = root.split_horizontally(root.dim_in_pixel().0 * 72 / 100);
-    let finite: Vec<&Measured> = rows.iter().filter(|r| r.psnr_db.is_finite()).collect();
+    // Against the sheet reference: the paper's sheets only (image slabs are another method, not
+    // an approximation of that reference). Against the continuous integral: every row.
+    let db = |r: &Measured| if truth { r.continuous_db } else { r.psnr_db };
+    let on_front = |r: &Measured| if truth { r.pareto_continuous } else { r.pareto };
+    let finite: Vec<Measured> = rows
+        .iter()
+        .filter(|r| db(r).is_finite() && (truth || r.config.slab().is_none()))
+        .map(|r| Measured {
+            psnr_db: db(r),
+            pareto: on_front(r),
+            ..r.clone()
+        })
+        .collect();
+    let finite: Vec<&Measured> = finite.iter().collect();
     let (t0, t1) = finite.iter().fold((f64::MAX, 0.0f64), |(a, b), r| {
         (a.min(r.min_s), b.max(r.max_s))
     });
@@ -82,7 +101,11 @@ where
     chart
         .configure_mesh()
         .x_desc("frame time, ms (median; bar: min-max)")
-        .y_desc("PSNR vs f64 reference, dB")
+        .y_desc(if truth {
+            "PSNR vs the continuous integral, dB"
+        } else {
+            "PSNR vs f64 sheet reference, dB"
+        })
         .label_style(("sans-serif", 13))
         .draw()
         .map_err(plot_err)?;
@@ -106,7 +129,10 @@ where
                 col.mix(0.6),
             )))
             .map_err(plot_err)?;
-        let label = format!("{}", r.config.table);
+        let label = match r.config.slab() {
+            Some(t) => format!("slab {t}"),
+            None => format!("{}", r.config.table),
+        };
         let style = if r.config.lookup == LookupArg::Bilinear {
             col.filled()
         } else {
@@ -125,6 +151,7 @@ where
         "direct, float",
         "view, fixed",
         "direct, fixed",
+        "image slabs, float",
     ]
     .iter()
     .enumerate()
@@ -153,13 +180,16 @@ where
         "Pareto frontier (fastest first):".to_string(),
     ];
     for r in &front {
-        lines.push(format!(
-            "{} {} {} n={}",
-            method_name(r.config.method),
-            lookup_name(r.config.lookup),
-            accum_name(r.config.accum),
-            r.config.table
-        ));
+        lines.push(match r.config.slab() {
+            Some(t) => format!("image slabs {t}"),
+            None => format!(
+                "{} {} {} n={}",
+                method_name(r.config.method),
+                lookup_name(r.config.lookup),
+                accum_name(r.config.accum),
+                r.config.table
+            ),
+        });
         lines.push(format!("   {:.0} ms, {:.1} dB", ms(r.median_s), r.psnr_db));
     }
     for (i, l) in lines.iter().enumerate() {
@@ -177,12 +207,16 @@ where
 fn draw_stability<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     curves: &[Vec<Curve>; 3],
+    popping: Option<&Popping>,
 ) -> Result<(), CliError>
 where
     DB::ErrorType: 'static,
 {
     root.fill(&WHITE).map_err(plot_err)?;
-    let panels = root.split_evenly((1, 3));
+    let panels = root.split_evenly((1, 3 + usize::from(popping.is_some())));
+    if let Some(pop) = popping {
+        draw_popping(&panels[3], pop)?;
+    }
     let specs = [
         ("(a) rotation about the view axis", "degrees", false),
         ("(b) anisotropy (grid r:1:1)", "ratio r", true),
@@ -309,24 +343,99 @@ fn write_svg_png(
     Ok(())
 }
 
-/// `DIR/tradeoff.svg` and `.png`.
+/// `DIR/tradeoff.svg` and `.png` (against the sheet reference, object slicing) and
+/// `DIR/tradeoff-continuous.svg` and `.png` (every configuration against the continuous
+/// integral, with that frontier).
 pub fn write_tradeoff(dir: &Path, rows: &[Measured], title: &str) -> Result<(), CliError> {
-    write_svg_png(
-        dir,
-        "tradeoff",
-        (1100, 650),
-        |r| draw_tradeoff(r, rows, title),
-        |r| draw_tradeoff(r, rows, title),
-    )
+    for (stem, truth) in [("tradeoff", false), ("tradeoff-continuous", true)] {
+        write_svg_png(
+            dir,
+            stem,
+            (1100, 650),
+            |r| draw_tradeoff(r, rows, title, truth),
+            |r| draw_tradeoff(r, rows, title, truth),
+        )?;
+    }
+    Ok(())
 }
 
-/// `DIR/stability.svg` and `.png`.
-pub fn write_stability(dir: &Path, curves: &[Vec<Curve>; 3]) -> Result<(), CliError> {
+/// `DIR/stability.svg` and `.png`, with the popping panel when it was swept.
+pub fn write_stability(
+    dir: &Path,
+    curves: &[Vec<Curve>; 3],
+    popping: Option<&Popping>,
+) -> Result<(), CliError> {
+    let width = if popping.is_some() { 2000 } else { 1500 };
     write_svg_png(
         dir,
         "stability",
-        (1500, 520),
-        |r| draw_stability(r, curves),
-        |r| draw_stability(r, curves),
+        (width, 520),
+        |r| draw_stability(r, curves, popping),
+        |r| draw_stability(r, curves, popping),
     )
+}
+
+/// Panel (d): consecutive-frame change through 40°–50° azimuth, PSNR dB (lower = a larger jump).
+fn draw_popping<DB: DrawingBackend>(
+    panel: &DrawingArea<DB, Shift>,
+    pop: &Popping,
+) -> Result<(), CliError>
+where
+    DB::ErrorType: 'static,
+{
+    let all = pop
+        .change_db
+        .iter()
+        .flatten()
+        .copied()
+        .filter(|v| v.is_finite());
+    let (lo, hi) = all.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+        (a.min(v), b.max(v))
+    });
+    let (lo, hi) = if lo <= hi {
+        (lo - 3.0, hi + 8.0)
+    } else {
+        (0.0, 100.0)
+    };
+    let (x0, x1) = (pop.azimuths[0], pop.azimuths[pop.azimuths.len() - 1]);
+    let mut chart = ChartBuilder::on(panel)
+        .caption(
+            format!("(d) popping: change per 0.1° (slab {})", pop.slab),
+            ("sans-serif", 16),
+        )
+        .margin(10)
+        .x_label_area_size(38)
+        .y_label_area_size(60)
+        .build_cartesian_2d(x0..x1, lo..hi)
+        .map_err(plot_err)?;
+    chart
+        .configure_mesh()
+        .x_desc("azimuth, degrees")
+        .y_desc("PSNR of frame vs previous frame, dB")
+        .label_style(("sans-serif", 12))
+        .draw()
+        .map_err(plot_err)?;
+    for (k, name) in super::popping::NAMES.iter().enumerate() {
+        let col = COLOURS[k];
+        let pts: Vec<(f64, f64)> = pop.change_db[k]
+            .iter()
+            .enumerate()
+            .filter(|(_, v)| v.is_finite())
+            .map(|(i, &v)| (0.5 * (pop.azimuths[i] + pop.azimuths[i + 1]), v))
+            .collect();
+        chart
+            .draw_series(LineSeries::new(pts, col.stroke_width(2)))
+            .map_err(plot_err)?
+            .label(*name)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], col.stroke_width(2)));
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::LowerLeft)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 12))
+        .draw()
+        .map_err(plot_err)?;
+    Ok(())
 }

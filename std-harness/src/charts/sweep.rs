@@ -81,7 +81,10 @@ pub fn sweep(
         }
         times.sort_by(f64::total_cmp);
         let (_, overall) = compare(&image, &reference);
-        let footprint_error = quality::footprint_error(&p, c)?;
+        let footprint_error = match c.slab() {
+            Some(_) => f64::NAN,
+            None => quality::footprint_error(&p, c)?,
+        };
         let (_, against_truth) = compare(&image, &truth.image);
         let m = Measured {
             continuous_db: against_truth.psnr_db,
@@ -123,10 +126,17 @@ pub fn mark_pareto(rows: &mut [Measured]) {
             .enumerate()
             .any(|(j, &(tj, pj))| j != i && tj <= t && pj >= p && (tj < t || pj > p))
     };
-    let sheets: Vec<(f64, f64)> = rows.iter().map(|r| (r.median_s, r.psnr_db)).collect();
+    // The sheet reference measures object slicing only: image slabs never sit on its frontier.
+    let sheets: Vec<(f64, f64)> = rows
+        .iter()
+        .map(|r| match r.config.slab() {
+            Some(_) => (f64::INFINITY, f64::NEG_INFINITY),
+            None => (r.median_s, r.psnr_db),
+        })
+        .collect();
     let truth: Vec<(f64, f64)> = rows.iter().map(|r| (r.median_s, r.continuous_db)).collect();
     for (i, r) in rows.iter_mut().enumerate() {
-        r.pareto = front(&sheets, i);
+        r.pareto = r.config.slab().is_none() && front(&sheets, i);
         r.pareto_continuous = front(&truth, i);
     }
 }
@@ -134,12 +144,12 @@ pub fn mark_pareto(rows: &mut [Measured]) {
 /// The trade-off CSV: one row per configuration.
 pub fn csv(rows: &[Measured]) -> String {
     let mut s = String::from(
-        "config,table,lookup,method,accum,backend,median_s,min_s,max_s,psnr_db,max_abs,footprint_error,k_db,pareto,continuous_psnr_db,continuous_pareto\n",
+        "config,table,lookup,method,accum,backend,median_s,min_s,max_s,psnr_db,max_abs,footprint_error,k_db,pareto,continuous_psnr_db,continuous_pareto,slicing,slab\n",
     );
     for r in rows {
         let c = &r.config;
         s.push_str(&format!(
-            "{},{},{},{},{},{},{:.6},{:.6},{:.6},{:.3},{:.4e},{:.4e},{:.3},{},{:.3},{}\n",
+            "{},{},{},{},{},{},{:.6},{:.6},{:.6},{:.3},{:.4e},{:.4e},{:.3},{},{:.3},{},{},{}\n",
             c.label(),
             c.table,
             lookup_name(c.lookup),
@@ -155,7 +165,13 @@ pub fn csv(rows: &[Measured]) -> String {
             r.k_db(),
             r.pareto,
             r.continuous_db,
-            r.pareto_continuous
+            r.pareto_continuous,
+            if c.slab().is_some() {
+                "image"
+            } else {
+                "object"
+            },
+            c.slab().map_or(String::new(), |t| t.to_string())
         ));
     }
     s

@@ -2,7 +2,7 @@
 //! [`crate::charts`] for what is swept and how it is measured).
 
 use crate::args::RenderArgs;
-use crate::charts::{plot, stability, sweep};
+use crate::charts::{plot, popping, stability, sweep};
 use crate::io;
 use crate::pipeline::config::Config;
 use crate::pipeline::{prepare, quality};
@@ -20,6 +20,13 @@ pub struct ChartArgs {
     /// Skip the stability sweeps (trade-off only).
     #[arg(long)]
     pub no_stability: bool,
+    /// Skip the popping sweep (the stability chart's panel d: 101 frames through azimuth
+    /// 40°–50°, each with object slicing, image slicing and the continuous reference).
+    #[arg(long)]
+    pub no_popping: bool,
+    /// Image size of the popping sweep, WxH pixels.
+    #[arg(long, default_value = "128x128", value_parser = crate::args::parse_size)]
+    pub popping_size: (usize, usize),
     /// Only print the `--quality` model's footprint error of every configuration at this view
     /// (CSV on standard output; no rendering).
     #[arg(long)]
@@ -48,7 +55,10 @@ pub fn run(args: &ChartArgs) -> Result<(), CliError> {
     let mut base = args.render.clone();
     base.out = None;
     base.json = None;
-    let configs = Config::for_frame(&prepare(&base)?.frame);
+    let prepared = prepare(&base)?;
+    let mut configs = Config::for_frame(&prepared.frame);
+    configs.extend(Config::slabs(&prepared.frame, &prepared.kernel));
+    drop(prepared);
     let rows = sweep::sweep(&base, &configs, args.runs)?;
     io::write_atomic(&dir.join("tradeoff.csv"), sweep::csv(&rows).as_bytes())?;
     let name = base
@@ -78,7 +88,20 @@ pub fn run(args: &ChartArgs) -> Result<(), CliError> {
             &dir.join("stability.csv"),
             stability::stability_csv(&curves).as_bytes(),
         )?;
-        plot::write_stability(&dir, &curves)?;
+        let pop = if args.no_popping {
+            None
+        } else {
+            let mut a = base.clone();
+            a.size = args.popping_size;
+            let pop = popping::popping(&a, crate::io::progress::sheets("popping"))?;
+            io::write_atomic(&dir.join("popping.csv"), pop.csv().as_bytes())?;
+            for (k, name) in popping::NAMES.iter().enumerate() {
+                let (db, az) = pop.worst(k);
+                crate::say!("popping: {name:<21} largest change {db:.2} dB (PSNR) at {az:.1}°");
+            }
+            Some(pop)
+        };
+        plot::write_stability(&dir, &curves, pop.as_ref())?;
         for (panel, set) in ["rotation", "anisotropy", "footprint size"]
             .iter()
             .zip(&curves)

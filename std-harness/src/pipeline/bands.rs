@@ -25,6 +25,25 @@ pub struct Phases {
     pub composite: f64,
 }
 
+/// One frame rendered by the core.
+#[derive(Clone, Debug)]
+pub struct CoreFrame {
+    /// Premultiplied RGBA, linear, row-major, top row first (fixed-point output converted
+    /// exactly to f32).
+    pub image: Vec<[f32; 4]>,
+    /// Counts (summed over bands).
+    pub stats: RenderStats,
+    /// Wall-clock seconds for the whole frame: tables, classification (unless cached), splat,
+    /// composite.
+    pub seconds: f64,
+    /// Where the time went.
+    pub phases: Phases,
+    /// Threads (bands) used.
+    pub threads: usize,
+    /// Visible voxels in the lists the frame rendered (`None` when streamed).
+    pub visible: Option<usize>,
+}
+
 /// The rows of band `t` of `bands` over an image `height` rows high: as equal as can be, the
 /// first bands one row taller.
 pub fn band_rows(height: usize, bands: usize, t: usize) -> std::ops::Range<usize> {

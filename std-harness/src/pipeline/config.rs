@@ -1,7 +1,11 @@
-//! One table configuration (size, lookup, method, accumulation): what `footprint chart` sweeps and
-//! `--quality` chooses among, with the names the benches use.
+//! One table configuration (size, lookup, method, accumulation), or image-aligned slabs of one
+//! thickness: what `footprint chart` sweeps and `--quality` chooses among (table configurations
+//! only), with the names the benches use.
 
-use crate::args::{AccumArg, LookupArg, MethodArg, RenderArgs};
+use crate::args::{AccumArg, LookupArg, MethodArg, RenderArgs, SlicingArg};
+
+/// Slab thicknesses the chart sweeps with `--slicing image`, voxel spacings.
+pub const SLABS: [f32; 4] = [0.25, 0.5, 1.0, 2.0];
 
 /// Table sizes swept.
 pub const SIZES: [usize; 7] = [5, 11, 21, 33, 65, 101, 129];
@@ -13,6 +17,9 @@ pub struct Config {
     pub lookup: LookupArg,
     pub method: MethodArg,
     pub accum: AccumArg,
+    /// `Some(q)`: image-aligned slicing with slabs q/4 voxel spacings thick (the table fields
+    /// then do not apply); `None`: the paper's object-aligned sheets.
+    pub slab_quarters: Option<u16>,
 }
 
 impl Config {
@@ -39,6 +46,7 @@ impl Config {
                             lookup,
                             method,
                             accum,
+                            slab_quarters: None,
                         });
                     }
                 }
@@ -47,8 +55,34 @@ impl Config {
         v
     }
 
-    /// `n=65/bilinear/view/float/libm`, the bench naming.
+    /// Image-aligned slicing at each of [`SLABS`] (for an orthographic frame and a Gaussian
+    /// kernel; none otherwise).
+    pub fn slabs(frame: &footprint::frame::FrameSetup, kernel: &footprint::Kernel) -> Vec<Config> {
+        if frame.camera().is_some() || !matches!(kernel, footprint::Kernel::Gaussian { .. }) {
+            return Vec::new();
+        }
+        SLABS
+            .iter()
+            .map(|&t| Config {
+                table: 0,
+                lookup: LookupArg::Bilinear,
+                method: MethodArg::Direct,
+                accum: AccumArg::Float,
+                slab_quarters: Some((t * 4.0) as u16),
+            })
+            .collect()
+    }
+
+    /// The slab thickness (voxel spacings) of an image-slicing configuration.
+    pub fn slab(&self) -> Option<f32> {
+        self.slab_quarters.map(|q| f32::from(q) / 4.0)
+    }
+
+    /// `n=65/bilinear/view/float/libm`, the bench naming; `image/slab=0.5/float/libm` for slabs.
     pub fn label(&self) -> String {
+        if let Some(t) = self.slab() {
+            return format!("image/slab={t}/float/{}", footprint::math::BACKEND);
+        }
         format!(
             "n={}/{}/{}/{}/{}",
             self.table,
@@ -67,6 +101,13 @@ impl Config {
         a.footprint.lookup = self.lookup;
         a.footprint.method = self.method;
         a.accum = self.accum;
+        match self.slab() {
+            Some(t) => {
+                a.slicing = SlicingArg::Image;
+                a.slab = t;
+            }
+            None => a.slicing = SlicingArg::Object,
+        }
         a
     }
 }

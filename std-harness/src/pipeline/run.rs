@@ -2,6 +2,7 @@
 //! visible voxels of a volume in memory, on several cores ([`super::bands`]), or driven through a
 //! [`SheetRing`] as a streaming source would drive it; and the f64 reference.
 
+pub use super::bands::CoreFrame;
 use super::bands::{run_bands, Phases};
 use super::load::Voxels;
 use super::prepare::Prepared;
@@ -28,25 +29,6 @@ use footprint::splat::Direct;
 use footprint::stencil::{self, Stencils};
 use footprint::{composite::RowSpan, Lookup, ViewTable};
 use std::time::Instant;
-
-/// One frame rendered by the core.
-#[derive(Clone, Debug)]
-pub struct CoreFrame {
-    /// Premultiplied RGBA, linear, row-major, top row first (fixed-point output converted
-    /// exactly to f32).
-    pub image: Vec<[f32; 4]>,
-    /// Counts (summed over bands).
-    pub stats: RenderStats,
-    /// Wall-clock seconds for the whole frame: tables, classification (unless cached), splat,
-    /// composite.
-    pub seconds: f64,
-    /// Where the time went.
-    pub phases: Phases,
-    /// Threads (bands) used.
-    pub threads: usize,
-    /// Visible voxels in the lists the frame rendered (`None` when streamed).
-    pub visible: Option<usize>,
-}
 
 /// The core's render of `p` with `args`' table, method and accumulation: premultiplied RGBA
 /// (fixed-point output converted exactly to f32), counts, seconds.

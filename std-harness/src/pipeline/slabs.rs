@@ -15,9 +15,8 @@
 //! view crosses every sheet, so a streamed volume (`--stream`) is refused: feeding it from a
 //! bounded window of sheets is not possible (see the core module's docs).
 
-use super::bands::{band_rows, Phases};
+use super::bands::{band_rows, CoreFrame, Phases};
 use super::prepare::Prepared;
-use super::run::CoreFrame;
 use super::supersample::downsample;
 use super::visible::FrameCache;
 use crate::args::{AccumArg, RenderArgs};

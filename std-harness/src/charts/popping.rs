@@ -1,0 +1,119 @@
+//! The popping sweep (issue 12): the chart's scene turned through azimuth 40°–50° in 0.1° steps
+//! (elevation and roll from `--view`), where a volume's most image-parallel grid axis switches
+//! at 45° for equal in-plane spacings. Each frame is rendered with object slicing (the paper's
+//! sheets), image slicing (`--slab` as given) and the continuous reference; what is charted is
+//! the change between consecutive frames, as PSNR (RGB) of frame i+1 against frame i: a pop is a
+//! dip in that curve that the continuous reference does not have. Each frame's PSNR against the
+//! continuous reference is recorded too.
+
+use crate::args::{AccumArg, RenderArgs, SlicingArg};
+use crate::metrics::compare;
+use crate::pipeline::visible::FrameCache;
+use crate::pipeline::{prepare, render_continuous_ref, render_frame};
+use crate::reference::continuous::Reconstruction;
+use crate::CliError;
+
+/// First and last azimuth, tenths of a degree.
+const SWEEP: (i32, i32) = (400, 500);
+
+/// The sweep's results: per frame, and per pair of consecutive frames.
+pub struct Popping {
+    /// Azimuth of each frame, degrees.
+    pub azimuths: Vec<f64>,
+    /// Consecutive-frame change, PSNR dB, for object slicing, image slicing and the continuous
+    /// reference (`azimuths.len() − 1` each: entry i compares frames i and i+1).
+    pub change_db: [Vec<f64>; 3],
+    /// Each frame's PSNR against the continuous reference: object, image slicing.
+    pub truth_db: [Vec<f64>; 2],
+    /// The slab thickness image slicing used, voxel spacings.
+    pub slab: f32,
+}
+
+/// The curves' names, in `change_db` order.
+pub const NAMES: [&str; 3] = ["object slicing", "image slicing", "continuous reference"];
+
+/// Runs the sweep on `base`'s scene (its `--view` elevation and roll, its size).
+pub fn popping(
+    base: &RenderArgs,
+    mut progress: impl FnMut(usize, usize),
+) -> Result<Popping, CliError> {
+    let mut args = base.clone();
+    let mut p = prepare(&args)?;
+    let mut caches = [FrameCache::default(), FrameCache::default()];
+    let mut frames: [Vec<Vec<[f64; 4]>>; 3] = Default::default();
+    let mut out = Popping {
+        azimuths: Vec::new(),
+        change_db: Default::default(),
+        truth_db: Default::default(),
+        slab: base.slab,
+    };
+    let total = (SWEEP.1 - SWEEP.0 + 1) as usize;
+    for (i, tenth) in (SWEEP.0..=SWEEP.1).enumerate() {
+        let az = f64::from(tenth) / 10.0;
+        args.view = [az as f32, base.view[1], base.view[2]];
+        args.view_matrix = None;
+        p.reframe(&args)?;
+        let (truth, _) = render_continuous_ref(&p, Reconstruction::Kernel)?;
+        for (k, slicing) in [SlicingArg::Object, SlicingArg::Image]
+            .into_iter()
+            .enumerate()
+        {
+            args.slicing = slicing;
+            let f = render_frame(&p, &args, AccumArg::Float, &mut caches[k])?;
+            let img: Vec<[f64; 4]> = f.image.iter().map(|c| c.map(f64::from)).collect();
+            out.truth_db[k].push(compare(&f.image, &truth.image).1.psnr_db);
+            frames[k].push(img);
+        }
+        frames[2].push(truth.image);
+        out.azimuths.push(az);
+        for (k, set) in frames.iter_mut().enumerate() {
+            if set.len() == 2 {
+                let now: Vec<[f32; 4]> = set[1].iter().map(|c| c.map(|v| v as f32)).collect();
+                out.change_db[k].push(compare(&now, &set[0]).1.psnr_db);
+                set.remove(0);
+            }
+        }
+        progress(i + 1, total);
+    }
+    Ok(out)
+}
+
+impl Popping {
+    /// The lowest consecutive-frame PSNR of curve `k` (its largest change) and where (the later
+    /// frame's azimuth).
+    pub fn worst(&self, k: usize) -> (f64, f64) {
+        self.change_db[k]
+            .iter()
+            .enumerate()
+            .map(|(i, &db)| (db, self.azimuths[i + 1]))
+            .fold(
+                (f64::INFINITY, f64::NAN),
+                |a, b| if b.0 < a.0 { b } else { a },
+            )
+    }
+
+    /// CSV: one row per frame; the change columns compare it with the previous frame (empty on
+    /// the first).
+    pub fn csv(&self) -> String {
+        let mut s = String::from(
+            "azimuth_deg,object_change_db,image_change_db,continuous_change_db,\
+             object_vs_continuous_db,image_vs_continuous_db,slab\n",
+        );
+        for (i, az) in self.azimuths.iter().enumerate() {
+            let change = |k: usize| {
+                i.checked_sub(1)
+                    .map_or(String::new(), |j| format!("{:.3}", self.change_db[k][j]))
+            };
+            s.push_str(&format!(
+                "{az:.1},{},{},{},{:.3},{:.3},{}\n",
+                change(0),
+                change(1),
+                change(2),
+                self.truth_db[0][i],
+                self.truth_db[1][i],
+                self.slab
+            ));
+        }
+        s
+    }
+}
