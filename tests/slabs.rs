@@ -5,7 +5,7 @@ use footprint::composite::RowSpan;
 use footprint::frame::{FrameSetup, Order};
 use footprint::geometry::{FootprintOptions, Grid, View};
 use footprint::render::slabs::slab_layer;
-use footprint::render::{RenderBuffers, SlabError, SlabRenderer, SlabSetup, SlabVoxel};
+use footprint::render::{SlabBuffers, SlabError, SlabRenderer, SlabSetup, SlabVoxel};
 use footprint::table::{SectionError, SectionTable};
 use footprint::Kernel;
 use footprint_suite::{ball_integral, gaussian_3d, simpson, view};
@@ -23,7 +23,7 @@ fn frame(dims: [usize; 3], spacing: [f32; 3], m: Mat3, kernel: &Kernel) -> Frame
     .unwrap()
 }
 
-fn table(kernel: Kernel) -> Box<SectionTable<129, 129>> {
+fn table(kernel: Kernel) -> Box<SectionTable<257, 1025>> {
     let mut t = Box::new(SectionTable::zeroed(kernel));
     t.build_into(kernel).unwrap();
     t
@@ -59,24 +59,24 @@ fn sections_are_line_integrals_of_the_kernel_through_the_slab() {
         let (first, last) = setup.slabs_of(voxel.position[2]);
         assert!(last > first, "a kernel spans several slabs");
         let (mut worst, mut peak, mut total) = (0.0f64, 0.0f64, 0.0f64);
+        let (n, ring) = (48 * 48, setup.ring());
+        let (mut acc, mut img, mut rows) = (
+            vec![[0.0f32; 4]; n * ring],
+            vec![[0.0f32; 4]; n],
+            vec![RowSpan::EMPTY; 48 * ring],
+        );
+        {
+            let buffers = SlabBuffers {
+                accumulators: &mut acc,
+                image: &mut img,
+                rows: &mut rows,
+            };
+            let mut rdr =
+                SlabRenderer::with_band(&setup, &sec, Order::FrontToBack, buffers, None, 0..48)
+                    .unwrap();
+            rdr.splat_voxel(&voxel).unwrap();
+        }
         for slab in first..=last {
-            let n = 48 * 48;
-            let (mut acc, mut img, mut rows) = (
-                vec![[0.0f32; 4]; n],
-                vec![[0.0f32; 4]; n],
-                vec![RowSpan::EMPTY; 48],
-            );
-            {
-                let buffers = RenderBuffers {
-                    accumulator: &mut acc,
-                    image: &mut img,
-                    rows: &mut rows,
-                };
-                let mut rdr =
-                    SlabRenderer::with_band(&setup, &sec, Order::FrontToBack, buffers, None, 0..48)
-                        .unwrap();
-                rdr.splat_section(slab, &voxel);
-            }
             // The slab's depth range, pixels: from its front, one thickness deep.
             let z0 = setup.front(slab) as f64;
             let z1 = z0 + f64::from(setup.thickness_px());
@@ -85,7 +85,7 @@ fn sections_are_line_integrals_of_the_kernel_through_the_slab() {
                     let (dx, dy) = (x as f64 + 0.5 - c.x, y as f64 + 0.5 - c.y);
                     let want = simpson(|z| w(inv * DVec3::new(dx, dy, z - c.z)), z0, z1, 2000)
                         * world_per_z;
-                    let got = f64::from(acc[y * 48 + x][3]);
+                    let got = f64::from(acc[(y * 48 + x) * ring + slab % ring][3]);
                     worst = worst.max((got - want).abs());
                     peak = peak.max(want);
                     total += got;
@@ -123,16 +123,16 @@ fn a_flat_field_accumulates_its_extinction_times_the_slab_length() {
         )
         .unwrap();
         let setup = SlabSetup::new(&f, &kernel, thickness).unwrap();
-        let n = 64 * 64;
+        let (n, ring) = (64 * 64, setup.ring());
         let (mut acc, mut img, mut rows) = (
+            vec![[0.0f32; 4]; n * ring],
             vec![[0.0f32; 4]; n],
-            vec![[0.0f32; 4]; n],
-            vec![RowSpan::EMPTY; 64],
+            vec![RowSpan::EMPTY; 64 * ring],
         );
         let mid = setup.slab_count() / 2;
         {
-            let buffers = RenderBuffers {
-                accumulator: &mut acc,
+            let buffers = SlabBuffers {
+                accumulators: &mut acc,
                 image: &mut img,
                 rows: &mut rows,
             };
@@ -146,14 +146,17 @@ fn a_flat_field_accumulates_its_extinction_times_the_slab_length() {
                             position: setup.position([i, j, k]),
                             value: [0.5, 0.5, 0.5, 1.0],
                         };
-                        rdr.splat_section(mid, &v);
+                        let (a, b) = setup.slabs_of(v.position[2]);
+                        if (a..=b).contains(&mid) {
+                            rdr.splat_voxel(&v).unwrap();
+                        }
                     }
                 }
             }
         }
         let min_spacing = spacing.iter().copied().fold(f32::INFINITY, f32::min);
         let length = f64::from(thickness * min_spacing);
-        let got = f64::from(acc[32 * 64 + 32][3]);
+        let got = f64::from(acc[(32 * 64 + 32) * ring + mid % ring][3]);
         // Brute force: Simpson along the centre pixel's ray through the slab, of the sum over
         // every voxel of w(q), q the grid offset from that voxel.
         let inv = f.grid_to_screen.as_dmat3().inverse();
@@ -230,6 +233,48 @@ fn what_slabs_cannot_do_is_refused() {
         SlabSetup::new(&f, &gauss, 1e-7),
         Err(SlabError::TooManySlabs { .. })
     ));
+    // A voxel reaching a slab already composited.
+    let setup = SlabSetup::new(&f, &gauss, 1.0).unwrap();
+    let sec = table(gauss);
+    let (n, ring) = (48 * 48, setup.ring());
+    let (mut acc, mut img, mut rows) = (
+        vec![[0.0f32; 4]; n * ring],
+        vec![[0.0f32; 4]; n],
+        vec![RowSpan::EMPTY; 48 * ring],
+    );
+    let buffers = SlabBuffers {
+        accumulators: &mut acc,
+        image: &mut img,
+        rows: &mut rows,
+    };
+    let mut rdr =
+        SlabRenderer::with_band(&setup, &sec, Order::FrontToBack, buffers, None, 0..48).unwrap();
+    let front = SlabVoxel {
+        position: setup.position([0, 0, 0]),
+        value: [1.0; 4],
+    };
+    let first = setup.slabs_of(front.position[2]).0;
+    for _ in 0..=first {
+        rdr.composite_next();
+    }
+    assert!(matches!(
+        rdr.splat_voxel(&front),
+        Err(footprint::render::RenderError::SlabOrder { .. })
+    ));
+    // Too small a ring buffer.
+    let (mut acc, mut img, mut rows) = (
+        vec![[0.0f32; 4]; n],
+        vec![[0.0f32; 4]; n],
+        vec![RowSpan::EMPTY; 48 * ring],
+    );
+    let buffers = SlabBuffers {
+        accumulators: &mut acc,
+        image: &mut img,
+        rows: &mut rows,
+    };
+    assert!(
+        SlabRenderer::with_band(&setup, &sec, Order::FrontToBack, buffers, None, 0..48).is_err()
+    );
     let cone = Kernel::cone(1.5).unwrap();
     assert_eq!(
         SlabSetup::new(&f, &cone, 1.0),

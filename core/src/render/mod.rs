@@ -30,7 +30,7 @@ mod visible;
 pub use perspective::PerspectivePath;
 pub use precision::{FixedPath, FloatPath, Precision};
 pub use sheets::{gradient, SheetRing, SheetWindow};
-pub use slabs::{SlabError, SlabRenderer, SlabSetup, SlabVoxel};
+pub use slabs::{SlabBuffers, SlabError, SlabRenderer, SlabSetup, SlabVoxel};
 pub use visible::{classify_sheet, VisibleSheet, VisibleVoxel};
 
 use crate::composite::RowSpan;
@@ -85,6 +85,16 @@ pub enum RenderError {
     Projection,
     /// A voxel's own footprint (perspective) could not be built.
     Geometry(crate::geometry::GeometryError),
+    /// A voxel given to a [`SlabRenderer`] overlaps a slab already composited (voxels must come
+    /// in the order of the slab they reach first).
+    SlabOrder {
+        /// The voxel's first slab.
+        first: usize,
+        /// Its last slab.
+        last: usize,
+        /// Slabs composited so far.
+        composited: usize,
+    },
 }
 
 impl fmt::Display for RenderError {
@@ -114,6 +124,15 @@ impl fmt::Display for RenderError {
                 "a perspective frame needs per-voxel footprints (PerspectivePath); this path has one footprint per view",
             ),
             Self::Geometry(e) => write!(f, "a voxel's footprint: {e}"),
+            Self::SlabOrder {
+                first,
+                last,
+                composited,
+            } => write!(
+                f,
+                "a voxel overlapping slabs {first}..={last} came after {composited} slabs were \
+                 composited: feed voxels in the order of the slab they reach first"
+            ),
         }
     }
 }

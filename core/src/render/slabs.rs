@@ -45,7 +45,7 @@
 //! ([`SlabError::Perspective`]).
 
 use super::precision::float_over_row;
-use super::{RenderBuffers, RenderError, RenderStats};
+use super::{RenderError, RenderStats};
 use crate::composite::{over, RowSpan};
 use crate::frame::{FrameSetup, Order};
 use crate::geometry::box_corners;
@@ -58,6 +58,10 @@ use glam::Vec3;
 
 /// The most slabs a frame may have.
 pub const MAX_SLABS: usize = 1 << 16;
+
+/// The most slabs one kernel may span ([`SlabSetup::ring`]): slabs thinner than about a
+/// sixteenth of the kernel's depth are refused ([`SlabError::TooManySlabs`]).
+pub const MAX_RING: usize = 40;
 
 /// Why image-aligned slicing could not be set up.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -224,7 +228,7 @@ impl SlabSetup {
         if !(needed.is_finite() && t.is_finite()) {
             return Err(SlabError::Singular);
         }
-        if needed > MAX_SLABS as f32 {
+        if needed > MAX_SLABS as f32 || ring_for(z_reach, t) > MAX_RING as f32 {
             return Err(SlabError::TooManySlabs { needed });
         }
         Ok(SlabSetup {
@@ -242,6 +246,12 @@ impl SlabSetup {
             scale: world_per_z / (dl * r2),
             spacings: thickness,
         })
+    }
+
+    /// The most slabs one kernel overlaps (at most [`MAX_RING`]): how many slab accumulators a
+    /// renderer keeps ([`SlabBuffers`]).
+    pub fn ring(&self) -> usize {
+        (ring_for(self.z_reach, self.thickness) as usize).min(self.count)
     }
 
     /// Number of slabs, front (0) to back.
@@ -296,30 +306,60 @@ impl SlabSetup {
     }
 }
 
-/// Renders slabs into caller-owned buffers, float only. Like
-/// [`SheetRenderer`](super::SheetRenderer) it may own a band of image rows only, and each pixel
-/// receives the same additions in the same order whatever the band, so bands put together are
-/// bit-identical to one whole-image render.
+/// The caller-owned buffers of a slab render over a band of `rows` image rows of width `w`, for a
+/// setup whose kernels span at most `ring` = [`SlabSetup::ring`] slabs.
+#[derive(Debug)]
+pub struct SlabBuffers<'a> {
+    /// The ring of slab accumulators, pixel-major: `accumulators[(y·w + x)·ring + slot]`, at least
+    /// `ring × w × rows` long, all zero at the start (left all zero).
+    pub accumulators: &'a mut [[f32; 4]],
+    /// Working image, premultiplied RGBA, row-major, `w × rows`: the result.
+    pub image: &'a mut [[f32; 4]],
+    /// Per slot and row, the extent touched: `rows[slot·rows + y]`, at least `ring × rows` long.
+    pub rows: &'a mut [RowSpan],
+}
+
+/// Slabs a depth span of 2·`reach` can overlap, at thickness `t`: ⌊2·reach/t⌋ + 2.
+fn ring_for(reach: f32, t: f32) -> f32 {
+    math::floor(2.0 * reach / t) + 2.0
+}
+
+/// Renders slabs into caller-owned buffers, float only.
+///
+/// **Order of work.** Each voxel is splatted once ([`SlabRenderer::splat_voxel`]): its kernel's
+/// section in every slab it overlaps goes to that slab's accumulator, one of a ring of
+/// [`SlabSetup::ring`]. [`SlabRenderer::composite_next`] composites the next slab in compositing
+/// order (front to back: slab 0 first; back to front: the last first) and frees its slot. So the
+/// caller feeds voxels sorted by the slab they reach first in that order (their first slab front
+/// to back, their last back to front) and composites slab j once every voxel reaching it has
+/// been splatted; a voxel reaching a slab already composited is refused
+/// ([`RenderError::SlabOrder`]).
+///
+/// **Bands.** Like [`SheetRenderer`](super::SheetRenderer) it may own a band of image rows only;
+/// each pixel receives the same additions in the same order whatever the band, so bands put
+/// together are bit-identical to one whole-image render.
 pub struct SlabRenderer<'a, const R: usize, const T: usize> {
     setup: &'a SlabSetup,
     table: &'a SectionTable<R, T>,
     order: Order,
     band: (usize, usize),
-    buffers: RenderBuffers<'a>,
+    ring: usize,
+    buffers: SlabBuffers<'a>,
     background: Option<&'a [[f32; 4]]>,
+    /// Slabs composited so far.
+    done: usize,
     stats: RenderStats,
 }
 
 impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
     /// Starts a frame over image rows `rows` (`0..height` for the whole image): `buffers` (and
-    /// `background`) hold `rows.len()` rows. `order` says which end the caller starts from:
-    /// front to back means slab 0 first. `background` as for sheets (the starting image back to
-    /// front, composited under the result front to back).
+    /// `background`) hold `rows.len()` rows (see [`SlabBuffers`]). `background` as for sheets
+    /// (the starting image back to front, composited under the result front to back).
     pub fn with_band(
         setup: &'a SlabSetup,
         table: &'a SectionTable<R, T>,
         order: Order,
-        buffers: RenderBuffers<'a>,
+        buffers: SlabBuffers<'a>,
         background: Option<&'a [[f32; 4]]>,
         rows: core::ops::Range<usize>,
     ) -> Result<Self, RenderError> {
@@ -331,69 +371,87 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
                 height: h,
             });
         }
+        let ring = setup.ring();
         let n = w * rows.len();
-        for len in [
-            buffers.accumulator.len(),
-            buffers.image.len(),
-            background.map_or(n, <[_]>::len),
+        for (len, needed) in [
+            (buffers.accumulators.len(), ring * n),
+            (buffers.image.len(), n),
+            (background.map_or(n, <[_]>::len), n),
+            (buffers.rows.len(), ring * rows.len()),
         ] {
-            if len < n {
-                return Err(BufferError::TooSmall {
-                    needed: n,
-                    got: len,
-                }
-                .into());
+            if len < needed {
+                return Err(BufferError::TooSmall { needed, got: len }.into());
             }
-        }
-        if buffers.rows.len() < rows.len() {
-            return Err(BufferError::TooSmall {
-                needed: rows.len(),
-                got: buffers.rows.len(),
-            }
-            .into());
         }
         let r = SlabRenderer {
             setup,
             table,
             order,
             band: (rows.start, rows.len()),
+            ring,
             buffers,
             background,
+            done: 0,
             stats: RenderStats::default(),
         };
         match (order, background) {
             (Order::BackToFront, Some(bg)) => r.buffers.image[..n].copy_from_slice(&bg[..n]),
             _ => r.buffers.image[..n].fill([0.0; 4]),
         }
-        r.buffers.rows[..rows.len()].fill(RowSpan::EMPTY);
+        r.buffers.rows[..ring * rows.len()].fill(RowSpan::EMPTY);
         Ok(r)
     }
 
-    /// Counts so far (`sheets` counts slabs).
+    /// Counts so far (`sheets` counts slabs composited).
     pub fn stats(&self) -> RenderStats {
         self.stats
     }
 
-    /// Adds the section of `voxel`'s kernel inside slab `slab` to the slab accumulator (nothing
-    /// if the kernel misses the slab or the band).
-    pub fn splat_section(&mut self, slab: usize, voxel: &SlabVoxel) {
+    /// The next slab [`SlabRenderer::composite_next`] composites (`None` when all are done).
+    pub fn next_slab(&self) -> Option<usize> {
+        let c = self.setup.count;
+        (self.done < c).then(|| match self.order {
+            Order::FrontToBack => self.done,
+            Order::BackToFront => c - 1 - self.done,
+        })
+    }
+
+    /// Adds `voxel`'s kernel, cut by every slab it overlaps, to those slabs' accumulators
+    /// (nothing where it misses the band). Refused if it overlaps a slab already composited.
+    pub fn splat_voxel(&mut self, voxel: &SlabVoxel) -> Result<(), RenderError> {
         let s = self.setup;
         let [cx, cy, cz] = voxel.position;
+        let (first, last) = s.slabs_of(cz);
+        let composited = match (self.order, self.next_slab()) {
+            (_, None) => true,
+            (Order::FrontToBack, Some(n)) => first < n,
+            (Order::BackToFront, Some(n)) => last > n,
+        };
+        if composited {
+            return Err(RenderError::SlabOrder {
+                first,
+                last,
+                composited: self.done,
+            });
+        }
         let rows = s.rows_of(cy);
         let (b0, bn) = self.band;
         let (y0, y1) = (rows.start.max(b0), rows.end.min(b0 + bn));
-        if y0 >= y1 || slab >= s.count {
-            return;
+        if y0 >= y1 {
+            return Ok(());
         }
         self.stats.voxels += 1;
-        let w = s.size[0];
+        let (w, ring) = (s.size[0], self.ring);
         let value = voxel.value.map(|c| c * s.scale);
         let [qxx, qxy, qyy] = s.q;
-        // Chord coordinate of the slab's front at the voxel's own pixel offset (0, 0).
-        let za = s.front(slab) - cz;
-        let ta0 = s.kappa * za;
+        // Chord coordinate of the first slab's front at the voxel's own pixel offset (0, 0), and
+        // per slab boundary.
+        let t0 = s.kappa * (s.front(first) - cz);
         let dt = s.kappa * s.thickness;
         let (ka, kb) = (s.kappa * s.shear[0], s.kappa * s.shear[1]);
+        let slabs = last - first + 1;
+        let first_slot = first % ring;
+        let inv_dt = 1.0 / dt;
         let mut updates = 0u64;
         for y in y0..y1 {
             let dy = y as f32 + 0.5 - cy;
@@ -409,54 +467,76 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
             if x0 >= x1 {
                 continue;
             }
-            let row = &mut self.buffers.accumulator[(y - b0) * w..(y - b0 + 1) * w];
-            let ta_row = ta0 - kb * dy;
-            let mut touched = false;
-            for (x, px) in row[x0..x1].iter_mut().enumerate() {
+            let yl = y - b0;
+            let row = &mut self.buffers.accumulators[(yl * w + x0) * ring..(yl * w + x1) * ring];
+            let t_row = t0 - kb * dy;
+            let mut touched = [false; MAX_RING];
+            for (x, px) in row.chunks_exact_mut(ring).enumerate() {
                 let dx = (x + x0) as f32 + 0.5 - cx;
                 let rho2 = (qxx * dx + 2.0 * qxy * dy) * dx + qyy * dy * dy;
-                let ta = ta_row - ka * dx;
-                let g = self.table.section(rho2, ta, ta + dt);
-                if g != 0.0 {
-                    for (p, v) in px.iter_mut().zip(&value) {
-                        *p += v * g;
+                let Some(ray) = self.table.ray(rho2) else {
+                    continue;
+                };
+                // Skip the slabs before the chord starts (their sections are zero).
+                let t_front = t_row - ka * dx;
+                let c = ray.half_chord();
+                let skip = if t_front + c < 0.0 {
+                    (math::floor((-c - t_front) * inv_dt) as usize).min(slabs)
+                } else {
+                    0
+                };
+                let mut t = t_front + skip as f32 * dt;
+                let mut before = ray.at(t);
+                let mut slot = (first_slot + skip) % ring;
+                for hit in touched.iter_mut().take(slabs).skip(skip) {
+                    t += dt;
+                    let after = ray.at(t);
+                    let g = after - before;
+                    if g != 0.0 {
+                        for (p, v) in px[slot].iter_mut().zip(&value) {
+                            *p += v * g;
+                        }
+                        *hit = true;
                     }
-                    touched = true;
+                    if ray.past_end(t) {
+                        break;
+                    }
+                    before = after;
+                    slot = if slot + 1 == ring { 0 } else { slot + 1 };
                 }
+                updates += 1;
             }
-            if touched {
-                self.buffers.rows[y - b0].include(x0, x1 - 1);
-                updates += (x1 - x0) as u64;
+            for (k, _) in touched.iter().enumerate().take(slabs).filter(|(_, &t)| t) {
+                let slot = (first + k) % ring;
+                self.buffers.rows[slot * bn + yl].include(x0, x1 - 1);
             }
         }
         self.stats.pixel_updates += updates;
         self.stats.voxels_splatted += u64::from(updates > 0);
+        Ok(())
     }
 
-    /// Splats every voxel of `voxels` into slab `slab`, then composites it.
-    pub fn render_slab<'v>(
-        &mut self,
-        slab: usize,
-        voxels: impl IntoIterator<Item = &'v SlabVoxel>,
-    ) {
-        for v in voxels {
-            self.splat_section(slab, v);
-        }
-        self.composite_slab();
-    }
-
-    /// Composites the accumulated slab (opacity 1 − e^(−τ), colour E·(1 − e^(−τ))/τ) into the
-    /// image over the rows it touched, and clears what it used.
-    pub fn composite_slab(&mut self) {
-        let w = self.setup.size[0];
+    /// Composites the next slab in compositing order (opacity 1 − e^(−τ), colour
+    /// E·(1 − e^(−τ))/τ) into the image over the rows it touched, and clears its slot. Nothing
+    /// once every slab is done.
+    pub fn composite_next(&mut self) {
+        let Some(slab) = self.next_slab() else {
+            return;
+        };
+        let (w, ring, bn) = (self.setup.size[0], self.ring, self.band.1);
+        let slot = slab % ring;
         let order = self.order;
-        let (acc, img) = (&mut *self.buffers.accumulator, &mut *self.buffers.image);
-        for (y, span) in self.buffers.rows[..self.band.1].iter_mut().enumerate() {
+        let (acc, img) = (&mut *self.buffers.accumulators, &mut *self.buffers.image);
+        for (y, span) in self.buffers.rows[slot * bn..(slot + 1) * bn]
+            .iter_mut()
+            .enumerate()
+        {
             if span.is_empty() {
                 continue;
             }
             let (lo, hi) = (y * w + span.lo as usize, y * w + span.hi as usize + 1);
-            for (a, i) in acc[lo..hi].iter_mut().zip(&mut img[lo..hi]) {
+            for (p, i) in (lo..hi).zip(&mut img[lo..hi]) {
+                let a = &mut acc[p * ring + slot];
                 let layer = slab_layer(*a);
                 *a = [0.0; 4];
                 *i = match order {
@@ -467,12 +547,16 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
             self.stats.pixels_composited += u64::from(span.hi - span.lo + 1);
             *span = RowSpan::EMPTY;
         }
+        self.done += 1;
         self.stats.sheets += 1;
     }
 
-    /// Ends the frame (front to back: composites the background under the result); returns
-    /// the counts.
-    pub fn finish(self) -> RenderStats {
+    /// Ends the frame: composites the slabs not yet composited, then (front to back) the
+    /// background under the result; returns the counts.
+    pub fn finish(mut self) -> RenderStats {
+        while self.next_slab().is_some() {
+            self.composite_next();
+        }
         if let (Order::FrontToBack, Some(bg)) = (self.order, self.background) {
             let n = self.setup.size[0] * self.band.1;
             float_over_row(&mut self.buffers.image[..n], &bg[..n]);

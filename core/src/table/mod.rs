@@ -22,7 +22,7 @@ mod view;
 
 pub use format::{crc32, Crc32, TableError, FORMAT_VERSION, MAGIC};
 pub use generic::GenericTable;
-pub use section::{SectionError, SectionTable};
+pub use section::{SectionError, SectionRay, SectionTable};
 pub(crate) use view::for_each_view_node;
 pub use view::{box_fill, ViewLayout, ViewTable, MIN_BOX_FILL};
 

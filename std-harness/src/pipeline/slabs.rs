@@ -6,12 +6,14 @@
 //!    ([`SlabVoxel::from_unit_rgba`]), placed on screen, and sorted by the first slab each
 //!    overlaps (a counting sort: voxel order within a slab is sheet order, the same for any
 //!    thread count).
-//! 2. Each thread owns a band of image rows and walks the slabs in compositing order, keeping the
-//!    voxels whose kernels overlap the current slab (those that reach its band) in an active list:
-//!    a voxel enters at its first slab and leaves after its last.
+//! 2. Each thread owns a band of image rows and walks the slabs in compositing order: the voxels
+//!    that reach slab j first (that reach its band) are splatted into every slab they overlap,
+//!    then slab j is composited (the core's ring of slab accumulators).
 //!
 //! **Memory.** 40 bytes per visible voxel (its [`SlabVoxel`] and slab range) on top of the
-//! visible lists, one slab accumulator per band, and the 65 KiB section table. A slab of an oblique
+//! visible lists; per band a ring of `SlabSetup::ring` slab accumulators (16 bytes per pixel
+//! each: on an isotropic grid a kernel 1.6 voxels in radius spans at most 5 slabs of one
+//! spacing, 8 of half a spacing), and the 5 KiB section table. A slab of an oblique
 //! view crosses every sheet, so a streamed volume (`--stream`) is refused: feeding it from a
 //! bounded window of sheets is not possible (see the core module's docs).
 
@@ -23,15 +25,15 @@ use crate::args::{AccumArg, RenderArgs};
 use crate::CliError;
 use footprint::composite::RowSpan;
 use footprint::frame::Order;
-use footprint::render::{RenderBuffers, RenderStats, SlabRenderer, SlabSetup, SlabVoxel};
+use footprint::render::{RenderStats, SlabBuffers, SlabRenderer, SlabSetup, SlabVoxel};
 use footprint::shade::Lighting;
 use footprint::table::SectionTable;
 use std::time::Instant;
 
-/// The section table's nodes: ρ² and half-chord rows, positions along the chord (see
-/// `footprint::table::SectionTable`: 3.4·10⁻⁵ of the peak at worst).
-const ROWS: usize = 129;
-const COLUMNS: usize = 129;
+/// The section table's nodes: the radial factor over ρ², the depth integral over the chord (see
+/// `footprint::table::SectionTable`: 2.4·10⁻⁶ of the peak at worst, 5 KiB).
+const ROWS: usize = 257;
+const COLUMNS: usize = 1025;
 
 /// Renders one frame of `p` with image-aligned slabs `args.slab` voxel spacings thick.
 pub fn render_slabs(
@@ -135,8 +137,6 @@ pub fn render_slabs(
 /// sheet order within a slab).
 struct SlabVoxels {
     voxels: Vec<SlabVoxel>,
-    /// (first, last) slab of each voxel.
-    range: Vec<(u32, u32)>,
     /// `voxels[starts[j]..starts[j + 1]]` are those whose first slab is j.
     starts: Vec<usize>,
     /// Voxel indices by last slab (for back-to-front), `by_last[ends[j]..ends[j + 1]]` last in j.
@@ -199,6 +199,7 @@ fn slab_voxels(
     }
     let voxels: Vec<SlabVoxel> = order.iter().map(|&i| placed[i].0).collect();
     let range: Vec<(u32, u32)> = order.iter().map(|&i| placed[i].1).collect();
+    // Only the last slabs are needed from here on (back to front).
     let mut next = ends.clone();
     let mut by_last = vec![0u32; placed.len()];
     for (i, (_, b)) in range.iter().enumerate() {
@@ -207,14 +208,14 @@ fn slab_voxels(
     }
     Ok(SlabVoxels {
         voxels,
-        range,
         starts,
         by_last,
         ends,
     })
 }
 
-/// One band: every slab in compositing order, its active voxels splatted, then composited.
+/// One band: every slab in compositing order: the voxels that reach it first splatted (into every
+/// slab each overlaps), then the slab composited.
 fn render_band(
     p: &Prepared,
     setup: &SlabSetup,
@@ -225,11 +226,16 @@ fn render_band(
     rows: std::ops::Range<usize>,
 ) -> Result<(RenderStats, Phases), CliError> {
     let w = p.frame.size[0];
+    let ring = setup.ring();
     let n = w * rows.len();
-    let mut acc = crate::io::try_filled(n, [0.0f32; 4], "a band's slab accumulator")?;
-    let mut spans = vec![RowSpan::EMPTY; rows.len()];
-    let buffers = RenderBuffers {
-        accumulator: &mut acc,
+    let mut acc = crate::io::try_filled(
+        ring.saturating_mul(n),
+        [0.0f32; 4],
+        "a band's slab accumulators",
+    )?;
+    let mut spans = vec![RowSpan::EMPTY; ring * rows.len()];
+    let buffers = SlabBuffers {
+        accumulators: &mut acc,
         image,
         rows: &mut spans,
     };
@@ -241,38 +247,24 @@ fn render_band(
         SlabRenderer::with_band(setup, table, p.order, buffers, background, rows.clone())?;
     let mut phases = Phases::default();
     let count = setup.slab_count();
-    let mut active: Vec<u32> = Vec::new();
     for k in 0..count {
         let t0 = Instant::now();
-        match p.order {
-            Order::FrontToBack => {
-                let j = k;
-                active.retain(|&i| sv.range[i as usize].1 as usize >= j);
-                active.extend(
-                    (sv.starts[j]..sv.starts[j + 1])
-                        .filter(|&i| reaches(i))
-                        .map(|i| i as u32),
-                );
-                for &i in &active {
-                    renderer.splat_section(j, &sv.voxels[i as usize]);
-                }
-            }
+        let entering: &mut dyn Iterator<Item = usize> = match p.order {
+            Order::FrontToBack => &mut (sv.starts[k]..sv.starts[k + 1]),
             Order::BackToFront => {
                 let j = count - 1 - k;
-                active.retain(|&i| sv.range[i as usize].0 as usize <= j);
-                active.extend(
-                    sv.by_last[sv.ends[j]..sv.ends[j + 1]]
-                        .iter()
-                        .copied()
-                        .filter(|&i| reaches(i as usize)),
-                );
-                for &i in &active {
-                    renderer.splat_section(j, &sv.voxels[i as usize]);
-                }
+                &mut sv.by_last[sv.ends[j]..sv.ends[j + 1]]
+                    .iter()
+                    .map(|&i| i as usize)
+            }
+        };
+        for i in entering {
+            if reaches(i) {
+                renderer.splat_voxel(&sv.voxels[i])?;
             }
         }
         let t1 = Instant::now();
-        renderer.composite_slab();
+        renderer.composite_next();
         phases.splat += (t1 - t0).as_secs_f64();
         phases.composite += t1.elapsed().as_secs_f64();
     }
