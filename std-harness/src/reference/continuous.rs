@@ -10,7 +10,9 @@
 //! transmittance; α = 1 − T). The voxels are pre-classified: each voxel's colour cᵥ and opacity
 //! αᵥ *per world unit* come from the renderer's own shader (transfer function, and Phong with the
 //! voxel's gradient, at an opacity exponent of one world unit), and σᵥ = −ln(1 − αᵥ) is its
-//! extinction per world unit (αᵥ = 1 is taken as 1 − 10⁻⁹). The field is reconstructed with
+//! extinction per world unit (αᵥ is capped at `SlabVoxel::MAX_UNIT_ALPHA` = 1 − 10⁻⁶, σᵥ ≤ 13.8
+//! per world unit: an opaque voxel has no finite extinction, and the renderer's image slabs
+//! take the same cap, so that both model the same field). The field is reconstructed with
 //! - `Kernel`: the kernel itself, w(d) = h(|d|/R) / (R³ ∫_ball h), d in grid steps, so that the
 //!   weights of a lattice sum to one (the renderer's own model, integrated exactly instead of as
 //!   whole-kernel footprints in sheets); Gaussian kernels only (the others are 2D footprint
@@ -32,7 +34,7 @@
 use crate::CliError;
 use footprint::frame::FrameSetup;
 use footprint::render::gradient;
-use footprint::render::SheetWindow;
+use footprint::render::{SheetWindow, SlabVoxel};
 use footprint::shade::{Lighting, Shader};
 use footprint::Kernel;
 use glam::{DMat3, DVec3};
@@ -150,7 +152,7 @@ impl Field {
                         idx,
                         dims,
                     );
-                    let a = f64::from(rgba[3]).clamp(0.0, 1.0 - 1e-9);
+                    let a = f64::from(rgba[3]).clamp(0.0, f64::from(SlabVoxel::MAX_UNIT_ALPHA));
                     if !(a > 0.0) {
                         continue;
                     }
