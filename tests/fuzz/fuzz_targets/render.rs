@@ -18,10 +18,13 @@
 //!   (S itself is not 1: a kernel cut off sharply, sampled by a few pixels, sums to 1 only in the
 //!   limit.)
 //!
+//! Image-aligned slabs (`--slicing image`) are rendered too, checked for finite, valid colour.
+//!
 //! Input bytes are read as parameters in a fixed order (missing bytes read as 0).
 use footprint::fixed::{FixedTable, ONE};
 use footprint::frame::{FrameSetup, Order};
-use footprint::render::{FixedPath, FloatPath, PerspectivePath};
+use footprint::render::{FixedPath, FloatPath, PerspectivePath, SlabSetup};
+use footprint::table::SectionTable;
 use footprint::{FootprintOptions, GenericTable, Grid, Kernel, Lookup, View, ViewTable};
 use footprint_harness::reference::ReferenceFootprint;
 use libfuzzer_sys::fuzz_target;
@@ -134,6 +137,25 @@ fuzz_target!(|data: &[u8]| {
                 for order in [Order::BackToFront, Order::FrontToBack] {
                     let img = footprint_fuzz::render_volume(&frame, path, order, &samples, &lut);
                     check_image(&img, "perspective render");
+                }
+            }
+        }
+    }
+
+    // Image slicing: slabs 1/8 to 8 spacings thick; a setup that is accepted renders finite RGBA
+    // in [0, 1] both ways (kernels other than the Gaussian are refused).
+    let slab = b.log2(3.0);
+    if let Ok(view) = View::from_angles(angles, zoom, dims, &grid, size) {
+        if let Ok(frame) = FrameSetup::new(dims, &grid, &view, &kernel, options, size) {
+            if let Ok(setup) = SlabSetup::new(&frame, &kernel, slab) {
+                let mut table = Box::new(SectionTable::<257, 1025>::zeroed(kernel));
+                if table.build_into(kernel).is_ok() {
+                    for order in [Order::BackToFront, Order::FrontToBack] {
+                        let img = footprint_fuzz::render_slabs(
+                            &frame, &setup, &table, order, &samples, &lut,
+                        );
+                        check_image(&img, "slab render");
+                    }
                 }
             }
         }

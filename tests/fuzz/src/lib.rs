@@ -3,7 +3,12 @@
 
 use footprint::composite::RowSpan;
 use footprint::frame::{FrameSetup, Order};
-use footprint::render::{Precision, RenderBuffers, SheetRenderer, SheetRing};
+use footprint::render::{
+    Precision, RenderBuffers, SheetRenderer, SheetRing, SlabBuffers, SlabRenderer, SlabSetup,
+    SlabVoxel,
+};
+use footprint::shade::Lighting;
+use footprint::table::SectionTable;
 use footprint::shade::{Shader, Shading, TransferFunction};
 use footprint::source::render_from;
 use footprint::splat::ImageMut;
@@ -44,6 +49,74 @@ pub fn render_volume<P: Precision>(
     let mut ring = SheetRing::new(&mut storage, frame, order).expect("ring sized for the frame");
     let mut volume = MemoryVolume::new(samples, frame.dims).expect("samples match dims");
     render_from(&mut r, &mut ring, &mut volume).expect("in-memory source");
+    r.finish();
+    img
+}
+
+/// Renders `samples` as [`render_volume`] does, with image-aligned slabs: every voxel shaded for
+/// one world unit, fed in the order of the slab it reaches first, into a ring of slab
+/// accumulators. Any renderer error is a failure: the setup is valid.
+pub fn render_slabs<const R: usize, const T: usize>(
+    frame: &FrameSetup,
+    setup: &SlabSetup,
+    table: &SectionTable<R, T>,
+    order: Order,
+    samples: &[u8],
+    lut: &[[f32; 4]],
+) -> Vec<[f32; 4]> {
+    let shader = Shader {
+        tf: TransferFunction {
+            lut,
+            lo: 0.0,
+            hi: 255.0,
+        },
+        shading: Shading::Emission,
+    };
+    let mut unit = *frame;
+    unit.sheet_distance = unit.reference_distance;
+    let lighting = Lighting::new(&unit);
+    let d = frame.dims;
+    let mut voxels: Vec<(usize, SlabVoxel)> = Vec::new();
+    for k in 0..d[2] {
+        for j in 0..d[1] {
+            for i in 0..d[0] {
+                let value = f32::from(samples[(k * d[1] + j) * d[0] + i]);
+                let rgba = shader.shade(&lighting, value, || footprint::glam::Vec3::ZERO, [i, j, k], d);
+                let position = setup.position([i, j, k]);
+                if let Some(v) = SlabVoxel::from_unit_rgba(position, rgba) {
+                    let (a, b) = setup.slabs_of(position[2]);
+                    let key = match order {
+                        Order::FrontToBack => a,
+                        Order::BackToFront => setup.slab_count() - 1 - b,
+                    };
+                    voxels.push((key, v));
+                }
+            }
+        }
+    }
+    voxels.sort_by_key(|v| v.0);
+    let n = frame.image_len();
+    let ring = setup.ring();
+    let (mut acc, mut img, mut rows) = (
+        vec![[0.0f32; 4]; ring * n],
+        vec![[0.0f32; 4]; n],
+        vec![RowSpan::EMPTY; ring * frame.size[1]],
+    );
+    let buffers = SlabBuffers {
+        accumulators: &mut acc,
+        image: &mut img,
+        rows: &mut rows,
+    };
+    let mut r = SlabRenderer::with_band(setup, table, order, buffers, None, 0..frame.size[1])
+        .expect("buffers sized for the setup");
+    let mut next = 0;
+    for step in 0..setup.slab_count() {
+        while next < voxels.len() && voxels[next].0 == step {
+            r.splat_voxel(&voxels[next].1).expect("voxels in slab order");
+            next += 1;
+        }
+        r.composite_next();
+    }
     r.finish();
     img
 }
