@@ -279,6 +279,12 @@ pub fn apply_quality(
     let Some(q) = args.quality else {
         return Ok((args.clone(), None));
     };
+    if args.slicing == crate::args::SlicingArg::Image {
+        return Err(CliError::input(
+            "--quality chooses among the table configurations of object slicing (aiming at the \
+             sheet reference); image slicing has no table to choose: give --slab instead",
+        ));
+    }
     let choice = choose(p, q)?;
     let e = p.frame.footprint.half_extent;
     crate::say!("{}", choice.explain(2.0 * e[0].max(e[1])));
