@@ -222,7 +222,11 @@ mod tests {
             }
         }
         eprintln!("worst section error {worst:.2e} of peak");
-        assert!(worst < 3e-5, "worst section error {worst} of peak");
+        // The interpolation's 3·10⁻⁵, plus what the backend's erf and exp cost (micromath's are
+        // good to 3·10⁻³; a section is a difference of two erfs over about 2·erf(s/√2)).
+        let b = math::ERROR_BOUNDS;
+        let bound = 3e-5 + 1.1 * f64::from(b.erf_abs) + f64::from(b.exp_rel);
+        assert!(worst < bound, "worst section error {worst} of peak");
     }
 
     #[test]
