@@ -29,6 +29,49 @@ fn table(kernel: Kernel) -> Box<SectionTable<257, 1025>> {
     t
 }
 
+/// Caller buffers for a slab render of a `side`×`side` frame: the ring of slab accumulators, the
+/// image and the row spans, sized for `setup`.
+struct Ring {
+    acc: Vec<[f32; 4]>,
+    img: Vec<[f32; 4]>,
+    rows: Vec<RowSpan>,
+    ring: usize,
+    side: usize,
+}
+
+impl Ring {
+    fn new(setup: &SlabSetup, side: usize) -> Self {
+        let ring = setup.ring();
+        Ring {
+            acc: vec![[0.0; 4]; side * side * ring],
+            img: vec![[0.0; 4]; side * side],
+            rows: vec![RowSpan::EMPTY; side * ring],
+            ring,
+            side,
+        }
+    }
+
+    /// A front-to-back renderer over the whole frame.
+    fn renderer<'a>(
+        &'a mut self,
+        setup: &'a SlabSetup,
+        sec: &'a SectionTable<257, 1025>,
+    ) -> SlabRenderer<'a, 257, 1025> {
+        let buffers = SlabBuffers {
+            accumulators: &mut self.acc,
+            image: &mut self.img,
+            rows: &mut self.rows,
+        };
+        SlabRenderer::with_band(setup, sec, Order::FrontToBack, buffers, None, 0..self.side)
+            .unwrap()
+    }
+
+    /// What pixel (x, y) has accumulated in slab `slab` (not yet composited).
+    fn at(&self, x: usize, y: usize, slab: usize) -> [f32; 4] {
+        self.acc[(y * self.side + x) * self.ring + slab % self.ring]
+    }
+}
+
 /// One voxel's section in every slab, read back from the accumulator before compositing, against
 /// a Simpson integral of w = h(|q|/R)/(R³∫h) along each pixel's ray through the slab (grid
 /// coordinates from M⁻¹, world length from G): an anisotropic grid at an oblique view, where the
@@ -59,23 +102,8 @@ fn sections_are_line_integrals_of_the_kernel_through_the_slab() {
         let (first, last) = setup.slabs_of(voxel.position[2]);
         assert!(last > first, "a kernel spans several slabs");
         let (mut worst, mut peak, mut total) = (0.0f64, 0.0f64, 0.0f64);
-        let (n, ring) = (48 * 48, setup.ring());
-        let (mut acc, mut img, mut rows) = (
-            vec![[0.0f32; 4]; n * ring],
-            vec![[0.0f32; 4]; n],
-            vec![RowSpan::EMPTY; 48 * ring],
-        );
-        {
-            let buffers = SlabBuffers {
-                accumulators: &mut acc,
-                image: &mut img,
-                rows: &mut rows,
-            };
-            let mut rdr =
-                SlabRenderer::with_band(&setup, &sec, Order::FrontToBack, buffers, None, 0..48)
-                    .unwrap();
-            rdr.splat_voxel(&voxel).unwrap();
-        }
+        let mut bufs = Ring::new(&setup, 48);
+        bufs.renderer(&setup, &sec).splat_voxel(&voxel).unwrap();
         for slab in first..=last {
             // The slab's depth range, pixels: from its front, one thickness deep.
             let z0 = setup.front(slab) as f64;
@@ -85,7 +113,7 @@ fn sections_are_line_integrals_of_the_kernel_through_the_slab() {
                     let (dx, dy) = (x as f64 + 0.5 - c.x, y as f64 + 0.5 - c.y);
                     let want = simpson(|z| w(inv * DVec3::new(dx, dy, z - c.z)), z0, z1, 2000)
                         * world_per_z;
-                    let got = f64::from(acc[(y * 48 + x) * ring + slab % ring][3]);
+                    let got = f64::from(bufs.at(x, y, slab)[3]);
                     worst = worst.max((got - want).abs());
                     peak = peak.max(want);
                     total += got;
@@ -123,22 +151,10 @@ fn a_flat_field_accumulates_its_extinction_times_the_slab_length() {
         )
         .unwrap();
         let setup = SlabSetup::new(&f, &kernel, thickness).unwrap();
-        let (n, ring) = (64 * 64, setup.ring());
-        let (mut acc, mut img, mut rows) = (
-            vec![[0.0f32; 4]; n * ring],
-            vec![[0.0f32; 4]; n],
-            vec![RowSpan::EMPTY; 64 * ring],
-        );
+        let mut bufs = Ring::new(&setup, 64);
         let mid = setup.slab_count() / 2;
         {
-            let buffers = SlabBuffers {
-                accumulators: &mut acc,
-                image: &mut img,
-                rows: &mut rows,
-            };
-            let mut rdr =
-                SlabRenderer::with_band(&setup, &sec, Order::FrontToBack, buffers, None, 0..64)
-                    .unwrap();
+            let mut rdr = bufs.renderer(&setup, &sec);
             for k in 0..dims[2] {
                 for j in 0..dims[1] {
                     for i in 0..dims[0] {
@@ -156,7 +172,7 @@ fn a_flat_field_accumulates_its_extinction_times_the_slab_length() {
         }
         let min_spacing = spacing.iter().copied().fold(f32::INFINITY, f32::min);
         let length = f64::from(thickness * min_spacing);
-        let got = f64::from(acc[(32 * 64 + 32) * ring + mid % ring][3]);
+        let got = f64::from(bufs.at(32, 32, mid)[3]);
         // Brute force: Simpson along the centre pixel's ray through the slab, of the sum over
         // every voxel of w(q), q the grid offset from that voxel.
         let inv = f.grid_to_screen.as_dmat3().inverse();
@@ -236,19 +252,8 @@ fn what_slabs_cannot_do_is_refused() {
     // A voxel reaching a slab already composited.
     let setup = SlabSetup::new(&f, &gauss, 1.0).unwrap();
     let sec = table(gauss);
-    let (n, ring) = (48 * 48, setup.ring());
-    let (mut acc, mut img, mut rows) = (
-        vec![[0.0f32; 4]; n * ring],
-        vec![[0.0f32; 4]; n],
-        vec![RowSpan::EMPTY; 48 * ring],
-    );
-    let buffers = SlabBuffers {
-        accumulators: &mut acc,
-        image: &mut img,
-        rows: &mut rows,
-    };
-    let mut rdr =
-        SlabRenderer::with_band(&setup, &sec, Order::FrontToBack, buffers, None, 0..48).unwrap();
+    let mut bufs = Ring::new(&setup, 48);
+    let mut rdr = bufs.renderer(&setup, &sec);
     let front = SlabVoxel {
         position: setup.position([0, 0, 0]),
         value: [1.0; 4],
@@ -262,10 +267,11 @@ fn what_slabs_cannot_do_is_refused() {
         Err(footprint::render::RenderError::SlabOrder { .. })
     ));
     // Too small a ring buffer.
+    let n = 48 * 48;
     let (mut acc, mut img, mut rows) = (
         vec![[0.0f32; 4]; n],
         vec![[0.0f32; 4]; n],
-        vec![RowSpan::EMPTY; 48 * ring],
+        vec![RowSpan::EMPTY; 48 * setup.ring()],
     );
     let buffers = SlabBuffers {
         accumulators: &mut acc,

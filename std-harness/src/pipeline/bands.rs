@@ -67,25 +67,54 @@ where
     P::Pixel: Send + Sync,
     P::Acc: Send,
 {
-    let f = &p.frame;
-    let [w, h] = f.size;
+    on_bands(
+        p.frame.size,
+        threads,
+        P::CLEAR,
+        background,
+        |rows, band, bg| render_band(p, path, bg, lists, band, rows),
+    )
+}
+
+/// Cuts a `size` image of `clear` pixels into one band of rows per thread (at most `threads`)
+/// and runs `band(rows, band's pixels, band's background)` on each, on its own thread. Returns the
+/// image, the counts summed over bands (`sheets` and `voxels` are the last band's: every band
+/// visits every sheet and voxel) and the slowest band's splat and composite seconds.
+pub fn on_bands<X, F>(
+    size: [usize; 2],
+    threads: usize,
+    clear: X,
+    background: Option<&[X]>,
+    band: F,
+) -> Result<(Vec<X>, RenderStats, Phases), CliError>
+where
+    X: Copy + Send + Sync,
+    F: Fn(
+            std::ops::Range<usize>,
+            &mut [X],
+            Option<&[X]>,
+        ) -> Result<(RenderStats, Phases), CliError>
+        + Sync,
+{
+    let [w, h] = size;
     let bands = threads.clamp(1, h);
-    let mut image = crate::io::try_filled(w * h, P::CLEAR, "the image")?;
-    let mut chunks: Vec<&mut [P::Pixel]> = Vec::with_capacity(bands);
-    let mut rest: &mut [P::Pixel] = &mut image;
+    let mut image = crate::io::try_filled(w * h, clear, "the image")?;
+    let mut chunks: Vec<&mut [X]> = Vec::with_capacity(bands);
+    let mut rest: &mut [X] = &mut image;
     for t in 0..bands {
-        let (band, tail) = rest.split_at_mut(band_rows(h, bands, t).len() * w);
-        chunks.push(band);
+        let (chunk, tail) = rest.split_at_mut(band_rows(h, bands, t).len() * w);
+        chunks.push(chunk);
         rest = tail;
     }
+    let band = &band;
     let results: Vec<Result<(RenderStats, Phases), CliError>> = std::thread::scope(|scope| {
         let handles: Vec<_> = chunks
             .into_iter()
             .enumerate()
-            .map(|(t, band)| {
+            .map(|(t, chunk)| {
                 let rows = band_rows(h, bands, t);
                 let bg = background.map(|b| &b[rows.start * w..rows.end * w]);
-                scope.spawn(move || render_band(p, path, bg, lists, band, rows))
+                scope.spawn(move || band(rows, chunk, bg))
             })
             .collect();
         handles

@@ -17,7 +17,7 @@
 //! view crosses every sheet, so a streamed volume (`--stream`) is refused: feeding it from a
 //! bounded window of sheets is not possible (see the core module's docs).
 
-use super::bands::{band_rows, CoreFrame, Phases};
+use super::bands::{on_bands, CoreFrame, Phases};
 use super::prepare::Prepared;
 use super::supersample::downsample;
 use super::visible::FrameCache;
@@ -76,49 +76,21 @@ pub fn render_slabs(
     let voxels = slab_voxels(p, &setup, lists)?;
     let classify = classify_lists + t1.elapsed().as_secs_f64();
 
-    let [w, h] = p.frame.size;
-    let bands = threads.clamp(1, h);
-    let mut image = crate::io::try_filled(w * h, [0.0f32; 4], "the image")?;
-    let mut chunks: Vec<&mut [[f32; 4]]> = Vec::with_capacity(bands);
-    let mut rest: &mut [[f32; 4]] = &mut image;
-    for t in 0..bands {
-        let (band, tail) = rest.split_at_mut(band_rows(h, bands, t).len() * w);
-        chunks.push(band);
-        rest = tail;
-    }
-    let background = p.background.as_deref();
-    let (setup, table, voxels) = (&setup, &*table, &voxels);
-    let results: Vec<Result<(RenderStats, Phases), CliError>> = std::thread::scope(|scope| {
-        let handles: Vec<_> = chunks
-            .into_iter()
-            .enumerate()
-            .map(|(t, band)| {
-                let rows = band_rows(h, bands, t);
-                let bg = background.map(|b| &b[rows.start * w..rows.end * w]);
-                scope.spawn(move || render_band(p, setup, table, voxels, bg, band, rows))
-            })
-            .collect();
-        handles
-            .into_iter()
-            .map(|h| h.join().expect("a slab thread panicked"))
-            .collect()
-    });
-    let mut stats = RenderStats::default();
-    let mut phases = Phases {
+    let (setup, table, sv) = (&setup, &*table, &voxels);
+    let (image, mut stats, band_phases) = on_bands(
+        p.frame.size,
+        threads,
+        [0.0f32; 4],
+        p.background.as_deref(),
+        |rows, band, bg| render_band(p, setup, table, sv, bg, band, rows),
+    )?;
+    // Every band sees only the voxels that reach it: the frame's voxels are the visible ones.
+    stats.voxels = voxels.voxels.len() as u64;
+    let phases = Phases {
         classify,
         tables,
-        ..Phases::default()
+        ..band_phases
     };
-    for r in results {
-        let (s, ph) = r?;
-        stats.sheets = s.sheets;
-        stats.voxels += s.voxels;
-        stats.voxels_splatted += s.voxels_splatted;
-        stats.pixel_updates += s.pixel_updates;
-        stats.pixels_composited += s.pixels_composited;
-        phases.splat = phases.splat.max(ph.splat);
-        phases.composite = phases.composite.max(ph.composite);
-    }
     let image = match p.supersample {
         1 => image,
         k => downsample(&image, p.out_size(), k, |v| v as f32),
@@ -128,7 +100,7 @@ pub fn render_slabs(
         stats,
         seconds: start.elapsed().as_secs_f64(),
         phases,
-        threads: bands,
+        threads: threads.clamp(1, p.frame.size[1]),
         visible: Some(voxels.voxels.len()),
     })
 }

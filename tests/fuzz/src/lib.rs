@@ -15,6 +15,18 @@ use footprint::splat::ImageMut;
 use footprint::volume::MemoryVolume;
 use std::path::PathBuf;
 
+/// Emission through `lut` (straight RGBA over sample values 0..=255).
+fn emission(lut: &[[f32; 4]]) -> Shader<'_> {
+    Shader {
+        tf: TransferFunction {
+            lut,
+            lo: 0.0,
+            hi: 255.0,
+        },
+        shading: Shading::Emission,
+    }
+}
+
 /// Renders `samples` (u8, x fastest, `frame.dims`) through `lut` (straight RGBA over 0..=255),
 /// emission, with `path`; returns the image. Any renderer error is a failure: the frame is valid.
 pub fn render_volume<P: Precision>(
@@ -24,14 +36,7 @@ pub fn render_volume<P: Precision>(
     samples: &[u8],
     lut: &[[f32; 4]],
 ) -> Vec<P::Pixel> {
-    let shader = Shader {
-        tf: TransferFunction {
-            lut,
-            lo: 0.0,
-            hi: 255.0,
-        },
-        shading: Shading::Emission,
-    };
+    let shader = emission(lut);
     let n = frame.image_len();
     let (mut acc, mut img, mut rows) = (
         vec![P::ACC_ZERO; n],
@@ -64,14 +69,7 @@ pub fn render_slabs<const R: usize, const T: usize>(
     samples: &[u8],
     lut: &[[f32; 4]],
 ) -> Vec<[f32; 4]> {
-    let shader = Shader {
-        tf: TransferFunction {
-            lut,
-            lo: 0.0,
-            hi: 255.0,
-        },
-        shading: Shading::Emission,
-    };
+    let shader = emission(lut);
     let mut unit = *frame;
     unit.sheet_distance = unit.reference_distance;
     let lighting = Lighting::new(&unit);
