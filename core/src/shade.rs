@@ -207,6 +207,15 @@ impl Lighting {
             opacity_exponent: frame.sheet_distance / frame.reference_distance,
         }
     }
+
+    /// The lighting of `frame` with opacity per world unit (an exponent of one, no correction to
+    /// the sheet distance): what image slabs and the continuous reference integrate along a ray.
+    pub fn per_world_unit(frame: &FrameSetup) -> Self {
+        Lighting {
+            opacity_exponent: 1.0,
+            ..Lighting::new(frame)
+        }
+    }
 }
 
 impl Shader<'_> {

@@ -125,9 +125,7 @@ fn slab_voxels(
     let shader = p.shader();
     // Opacity per world unit: the shader at an exponent of one (the slab integrates σ along the
     // ray itself).
-    let mut unit = *f;
-    unit.sheet_distance = unit.reference_distance;
-    let lighting = Lighting::new(&unit);
+    let lighting = Lighting::per_world_unit(f);
     let needs_gradient = shader.shading.needs_gradient();
     let mut placed: Vec<(SlabVoxel, (u32, u32))> = Vec::new();
     placed

@@ -124,9 +124,7 @@ impl Field {
         })?;
         voxels.resize(n, [0.0f32; 4]);
         // Opacity per world unit: the shader at an exponent of one.
-        let mut unit = *f;
-        unit.sheet_distance = unit.reference_distance;
-        let lighting = Lighting::new(&unit);
+        let lighting = Lighting::per_world_unit(f);
         let (len, na, nb) = f.sheet_shape();
         let mut bufs = [vec![0.0f32; len], vec![0.0f32; len], vec![0.0f32; len]];
         for s in 0..f.sheet_count() {

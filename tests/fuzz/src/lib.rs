@@ -70,9 +70,7 @@ pub fn render_slabs<const R: usize, const T: usize>(
     lut: &[[f32; 4]],
 ) -> Vec<[f32; 4]> {
     let shader = emission(lut);
-    let mut unit = *frame;
-    unit.sheet_distance = unit.reference_distance;
-    let lighting = Lighting::new(&unit);
+    let lighting = Lighting::per_world_unit(frame);
     let d = frame.dims;
     let mut voxels: Vec<(usize, SlabVoxel)> = Vec::new();
     for k in 0..d[2] {
