@@ -95,7 +95,7 @@ fn sections_are_line_integrals_of_the_kernel_through_the_slab() {
         let norm = 1.0 / (r.powi(3) * ball_integral(gaussian_3d(2.5), 2000));
         let w = |q: DVec3| gaussian_3d(2.5)(q.length() / r) * norm;
         let voxel = SlabVoxel {
-            position: setup.position([1, 1, 1]),
+            position: f.affine_position([1.0; 3]).to_array(),
             value: [0.0, 0.0, 0.0, 1.0],
         };
         let c = DVec3::from_array(voxel.position.map(f64::from));
@@ -159,7 +159,7 @@ fn a_flat_field_accumulates_its_extinction_times_the_slab_length() {
                 for j in 0..dims[1] {
                     for i in 0..dims[0] {
                         let v = SlabVoxel {
-                            position: setup.position([i, j, k]),
+                            position: f.affine_position([i, j, k].map(|c| c as f32)).to_array(),
                             value: [0.5, 0.5, 0.5, 1.0],
                         };
                         let (a, b) = setup.slabs_of(v.position[2]);
@@ -255,7 +255,7 @@ fn what_slabs_cannot_do_is_refused() {
     let mut bufs = Ring::new(&setup, 48);
     let mut rdr = bufs.renderer(&setup, &sec);
     let front = SlabVoxel {
-        position: setup.position([0, 0, 0]),
+        position: f.affine_position([0.0; 3]).to_array(),
         value: [1.0; 4],
     };
     let first = setup.slabs_of(front.position[2]).0;

@@ -420,7 +420,7 @@ pub(crate) fn row_pixels(fp: &Footprint, cx: f32, qy: f32) -> Option<(i64, i64)>
 /// Inclusive range of pixel indices whose centres lie in [lo, hi] (screen pixels), clamped to
 /// ±2³¹ so later clipping stays exact.
 #[inline]
-fn pixel_range(lo: f32, hi: f32) -> (i64, i64) {
+pub(crate) fn pixel_range(lo: f32, hi: f32) -> (i64, i64) {
     (-floor_i64(-(lo - 0.5)), floor_i64(hi - 0.5))
 }
 

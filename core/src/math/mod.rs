@@ -104,12 +104,6 @@ pub fn ln(x: f32) -> f32 {
     backend::ln(x)
 }
 
-/// Smallest integer value not less than `x` (−floor(−x)).
-#[inline]
-pub fn ceil(x: f32) -> f32 {
-    -floor(-x)
-}
-
 /// Largest integer value not greater than `x`.
 #[inline]
 pub fn floor(x: f32) -> f32 {

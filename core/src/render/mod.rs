@@ -259,35 +259,18 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
         background: Option<&'a [P::Pixel]>,
         rows: core::ops::Range<usize>,
     ) -> Result<Self, RenderError> {
-        if rows.start > rows.end || rows.end > frame.size[1] {
-            return Err(RenderError::Band {
-                start: rows.start,
-                end: rows.end,
-                height: frame.size[1],
-            });
-        }
-        let band_rows = rows.end - rows.start;
+        let band_rows = rows.len();
         let n = frame.size[0] * band_rows;
-        for len in [
-            buffers.accumulator.len(),
-            buffers.image.len(),
-            background.map_or(n, <[_]>::len),
-        ] {
-            if len < n {
-                return Err(BufferError::TooSmall {
-                    needed: n,
-                    got: len,
-                }
-                .into());
-            }
-        }
-        if buffers.rows.len() < band_rows {
-            return Err(BufferError::TooSmall {
-                needed: band_rows,
-                got: buffers.rows.len(),
-            }
-            .into());
-        }
+        check_band(
+            &rows,
+            frame.size[1],
+            &[
+                (buffers.accumulator.len(), n),
+                (buffers.image.len(), n),
+                (background.map_or(n, <[_]>::len), n),
+                (buffers.rows.len(), band_rows),
+            ],
+        )?;
         shader.tf.check()?;
         if frame.camera().is_some() && !P::PERSPECTIVE {
             return Err(RenderError::Projection);
@@ -304,10 +287,7 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
             background,
             stats: RenderStats::default(),
         };
-        match (order, background) {
-            (Order::BackToFront, Some(bg)) => r.buffers.image[..n].copy_from_slice(&bg[..n]),
-            _ => r.buffers.image[..n].fill(P::CLEAR),
-        }
+        start_image(&mut r.buffers.image[..n], background, order, P::CLEAR);
         r.buffers.rows[..band_rows].fill(RowSpan::EMPTY);
         Ok(r)
     }
@@ -594,5 +574,41 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
             self.path.over_row(&mut self.buffers.image[..n], &bg[..n]);
         }
         self.stats
+    }
+}
+
+/// Checks that `rows` is a band of an image `height` rows high, and that every (length, needed)
+/// pair of a renderer's buffers holds what it needs (the first short one is the error).
+pub(crate) fn check_band(
+    rows: &core::ops::Range<usize>,
+    height: usize,
+    buffers: &[(usize, usize)],
+) -> Result<(), RenderError> {
+    if rows.start > rows.end || rows.end > height {
+        return Err(RenderError::Band {
+            start: rows.start,
+            end: rows.end,
+            height,
+        });
+    }
+    for &(got, needed) in buffers {
+        if got < needed {
+            return Err(BufferError::TooSmall { needed, got }.into());
+        }
+    }
+    Ok(())
+}
+
+/// A band's starting working image: the background when compositing back to front (the far
+/// layers go over it), else `clear` (front to back, the background goes under at the end).
+pub(crate) fn start_image<X: Copy>(
+    image: &mut [X],
+    background: Option<&[X]>,
+    order: Order,
+    clear: X,
+) {
+    match (order, background) {
+        (Order::BackToFront, Some(bg)) => image.copy_from_slice(&bg[..image.len()]),
+        _ => image.fill(clear),
     }
 }

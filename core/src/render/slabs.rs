@@ -45,16 +45,15 @@
 //! ([`SlabError::Perspective`]).
 
 use super::precision::float_over_row;
-use super::{RenderError, RenderStats};
+use super::{check_band, start_image, RenderError, RenderStats};
 use crate::composite::{over, RowSpan};
 use crate::frame::{FrameSetup, Order};
 use crate::geometry::box_corners;
 use crate::kernel::Kernel;
 use crate::math;
-use crate::splat::BufferError;
+use crate::splat::pixel_range;
 use crate::table::{SectionError, SectionTable};
 use core::fmt;
-use glam::Vec3;
 
 /// The most slabs a frame may have.
 pub const MAX_SLABS: usize = 1 << 16;
@@ -117,7 +116,8 @@ impl From<SectionError> for SlabError {
 /// One voxel ready for slab rendering: where it lands and what it emits and absorbs.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SlabVoxel {
-    /// Screen position, pixels (x right, y down, z depth growing away from the viewer).
+    /// Screen position, pixels (x right, y down, z depth growing away from the viewer):
+    /// [`FrameSetup::affine_position`] of the voxel's grid index.
     pub position: [f32; 3],
     /// [σr, σg, σb, σ]: extinction σ per world unit and σ times the straight colour.
     pub value: [f32; 4],
@@ -153,8 +153,6 @@ impl SlabVoxel {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SlabSetup {
     size: [usize; 2],
-    origin: Vec3,
-    columns: [Vec3; 3],
     /// ρ² = qxx·dx² + 2·qxy·dx·dy + qyy·dy².
     q: [f32; 3],
     /// z* = shear[0]·dx + shear[1]·dy.
@@ -233,8 +231,6 @@ impl SlabSetup {
         }
         Ok(SlabSetup {
             size: frame.size,
-            origin: frame.origin,
-            columns: [m.col(0), m.col(1), m.col(2)],
             q,
             shear: [a, b],
             kappa: dl / r,
@@ -274,14 +270,6 @@ impl SlabSetup {
         self.spacings
     }
 
-    /// Screen position (pixels, z depth) of grid point `index`.
-    #[inline]
-    pub fn position(&self, index: [usize; 3]) -> [f32; 3] {
-        let [c0, c1, c2] = self.columns;
-        let p = self.origin + c0 * index[0] as f32 + c1 * index[1] as f32 + c2 * index[2] as f32;
-        p.to_array()
-    }
-
     /// The first and last slab a kernel centred at depth `z` (pixels) overlaps, clamped to the
     /// frame's slabs.
     #[inline]
@@ -299,11 +287,18 @@ impl SlabSetup {
     /// half-height), as a possibly empty range.
     #[inline]
     pub fn rows_of(&self, y: f32) -> core::ops::Range<usize> {
-        let h = self.size[1] as f32;
-        let lo = math::ceil(y - self.half[1] - 0.5).max(0.0).min(h);
-        let hi = (math::floor(y + self.half[1] - 0.5) + 1.0).max(0.0).min(h);
-        lo as usize..(hi as usize).max(lo as usize)
+        centres_within(y - self.half[1], y + self.half[1], self.size[1])
     }
+}
+
+/// The pixels (or rows) of 0..`n` whose centres lie in [lo, hi] (screen pixels), the splat's own
+/// rule ([`pixel_range`]).
+#[inline]
+fn centres_within(lo: f32, hi: f32, n: usize) -> core::ops::Range<usize> {
+    let (a, b) = pixel_range(lo, hi);
+    let a = a.clamp(0, n as i64) as usize;
+    let b = (b + 1).clamp(0, n as i64) as usize;
+    a..b.max(a)
 }
 
 /// The caller-owned buffers of a slab render over a band of `rows` image rows of width `w`, for a
@@ -363,26 +358,18 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
         background: Option<&'a [[f32; 4]]>,
         rows: core::ops::Range<usize>,
     ) -> Result<Self, RenderError> {
-        let [w, h] = setup.size;
-        if rows.start > rows.end || rows.end > h {
-            return Err(RenderError::Band {
-                start: rows.start,
-                end: rows.end,
-                height: h,
-            });
-        }
         let ring = setup.ring();
-        let n = w * rows.len();
-        for (len, needed) in [
-            (buffers.accumulators.len(), ring * n),
-            (buffers.image.len(), n),
-            (background.map_or(n, <[_]>::len), n),
-            (buffers.rows.len(), ring * rows.len()),
-        ] {
-            if len < needed {
-                return Err(BufferError::TooSmall { needed, got: len }.into());
-            }
-        }
+        let n = setup.size[0] * rows.len();
+        check_band(
+            &rows,
+            setup.size[1],
+            &[
+                (buffers.accumulators.len(), ring * n),
+                (buffers.image.len(), n),
+                (background.map_or(n, <[_]>::len), n),
+                (buffers.rows.len(), ring * rows.len()),
+            ],
+        )?;
         let r = SlabRenderer {
             setup,
             table,
@@ -394,10 +381,7 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
             done: 0,
             stats: RenderStats::default(),
         };
-        match (order, background) {
-            (Order::BackToFront, Some(bg)) => r.buffers.image[..n].copy_from_slice(&bg[..n]),
-            _ => r.buffers.image[..n].fill([0.0; 4]),
-        }
+        start_image(&mut r.buffers.image[..n], background, order, [0.0; 4]);
         r.buffers.rows[..ring * rows.len()].fill(RowSpan::EMPTY);
         Ok(r)
     }
@@ -460,10 +444,12 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
                 continue;
             }
             let root = math::sqrt(disc);
-            let lo = cx + (-qxy * dy - root) / qxx - 0.5;
-            let hi = cx + (-qxy * dy + root) / qxx - 0.5;
-            let x0 = math::ceil(lo).max(0.0).min(w as f32) as usize;
-            let x1 = ((math::floor(hi) + 1.0).max(0.0).min(w as f32) as usize).max(x0);
+            let cols = centres_within(
+                cx + (-qxy * dy - root) / qxx,
+                cx + (-qxy * dy + root) / qxx,
+                w,
+            );
+            let (x0, x1) = (cols.start, cols.end);
             if x0 >= x1 {
                 continue;
             }

@@ -143,7 +143,7 @@ fn slab_voxels(
                 }
             };
             let rgba = shader.shade_with(&lighting, None, vox.value, g, idx, f.dims);
-            let position = setup.position(idx);
+            let position = f.affine_position(idx.map(|c| c as f32)).to_array();
             if let Some(v) = SlabVoxel::from_unit_rgba(position, rgba) {
                 let (a, b) = setup.slabs_of(position[2]);
                 placed.push((v, (a as u32, b as u32)));

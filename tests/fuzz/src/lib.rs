@@ -78,7 +78,9 @@ pub fn render_slabs<const R: usize, const T: usize>(
             for i in 0..d[0] {
                 let value = f32::from(samples[(k * d[1] + j) * d[0] + i]);
                 let rgba = shader.shade(&lighting, value, || footprint::glam::Vec3::ZERO, [i, j, k], d);
-                let position = setup.position([i, j, k]);
+                let position = frame
+                    .affine_position([i, j, k].map(|c| c as f32))
+                    .to_array();
                 if let Some(v) = SlabVoxel::from_unit_rgba(position, rgba) {
                     let (a, b) = setup.slabs_of(position[2]);
                     let key = match order {
