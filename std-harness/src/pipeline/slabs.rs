@@ -3,9 +3,9 @@
 //!
 //! 1. The visible lists (classified once per volume, as for sheets: [`super::visible`]) are
 //!    shaded for one world unit of thickness and turned into extinction and emission
-//!    ([`SlabVoxel::from_unit_rgba`]), placed on screen, and sorted by the first slab each
-//!    overlaps (a counting sort: voxel order within a slab is sheet order, the same for any
-//!    thread count).
+//!    ([`SlabVoxel::from_unit_rgba`]), placed on screen, and sorted by the slab each reaches
+//!    first in compositing order (counting sorts: the voxel order within a slab does not depend
+//!    on the thread count).
 //! 2. Each thread owns a band of image rows and walks the slabs in compositing order: the voxels
 //!    that reach slab j first (that reach its band) are splatted into every slab they overlap,
 //!    then slab j is composited (the core's ring of slab accumulators).
@@ -105,15 +105,14 @@ pub fn render_slabs(
     })
 }
 
-/// Every visible voxel as a [`SlabVoxel`] with its slab range, sorted by first slab (stable:
-/// sheet order within a slab).
+/// Every visible voxel as a [`SlabVoxel`], grouped by the compositing step at which it enters:
+/// its first slab front to back, its last back to front (a stable sort, so voxels keep the order
+/// of the sort before it: sheet order, then first slab).
 struct SlabVoxels {
     voxels: Vec<SlabVoxel>,
-    /// `voxels[starts[j]..starts[j + 1]]` are those whose first slab is j.
+    /// `voxels[starts[k]..starts[k + 1]]` enter at step k (slab k front to back, slab
+    /// count − 1 − k back to front).
     starts: Vec<usize>,
-    /// Voxel indices by last slab (for back-to-front), `by_last[ends[j]..ends[j + 1]]` last in j.
-    by_last: Vec<u32>,
-    ends: Vec<usize>,
 }
 
 fn slab_voxels(
@@ -123,11 +122,10 @@ fn slab_voxels(
 ) -> Result<SlabVoxels, CliError> {
     let f = &p.frame;
     let shader = p.shader();
-    // Opacity per world unit: the shader at an exponent of one (the slab integrates σ along the
-    // ray itself).
+    // Opacity per world unit (the slab integrates σ along the ray itself).
     let lighting = Lighting::per_world_unit(f);
     let needs_gradient = shader.shading.needs_gradient();
-    let mut placed: Vec<(SlabVoxel, (u32, u32))> = Vec::new();
+    let mut placed: Vec<(SlabVoxel, (usize, usize))> = Vec::new();
     placed
         .try_reserve_exact(lists.len())
         .map_err(|_| CliError::input("cannot allocate the slab voxel list"))?;
@@ -145,43 +143,40 @@ fn slab_voxels(
             let rgba = shader.shade_with(&lighting, None, vox.value, g, idx, f.dims);
             let position = f.affine_position(idx.map(|c| c as f32)).to_array();
             if let Some(v) = SlabVoxel::from_unit_rgba(position, rgba) {
-                let (a, b) = setup.slabs_of(position[2]);
-                placed.push((v, (a as u32, b as u32)));
+                placed.push((v, setup.slabs_of(position[2])));
             }
         }
     }
     let count = setup.slab_count();
+    let (mut order, mut starts) = buckets(placed.iter().map(|(_, (a, _))| *a), count);
+    if p.order == Order::BackToFront {
+        let (by_last, s) = buckets(order.iter().map(|&i| count - 1 - placed[i].1 .1), count);
+        order = by_last.into_iter().map(|j| order[j]).collect();
+        starts = s;
+    }
+    Ok(SlabVoxels {
+        voxels: order.into_iter().map(|i| placed[i].0).collect(),
+        starts,
+    })
+}
+
+/// A stable counting sort of `keys` (each below `count`): the positions in key order, and where
+/// each key's run starts (`count + 1` entries).
+fn buckets(keys: impl Iterator<Item = usize> + Clone, count: usize) -> (Vec<usize>, Vec<usize>) {
     let mut starts = vec![0usize; count + 1];
-    let mut ends = vec![0usize; count + 1];
-    for (_, (a, b)) in &placed {
-        starts[*a as usize + 1] += 1;
-        ends[*b as usize + 1] += 1;
+    for k in keys.clone() {
+        starts[k + 1] += 1;
     }
     for j in 0..count {
         starts[j + 1] += starts[j];
-        ends[j + 1] += ends[j];
     }
     let mut next = starts.clone();
-    let mut order = vec![0usize; placed.len()];
-    for (i, (_, (a, _))) in placed.iter().enumerate() {
-        order[next[*a as usize]] = i;
-        next[*a as usize] += 1;
+    let mut order = vec![0usize; starts[count]];
+    for (i, k) in keys.enumerate() {
+        order[next[k]] = i;
+        next[k] += 1;
     }
-    let voxels: Vec<SlabVoxel> = order.iter().map(|&i| placed[i].0).collect();
-    let range: Vec<(u32, u32)> = order.iter().map(|&i| placed[i].1).collect();
-    // Only the last slabs are needed from here on (back to front).
-    let mut next = ends.clone();
-    let mut by_last = vec![0u32; placed.len()];
-    for (i, (_, b)) in range.iter().enumerate() {
-        by_last[next[*b as usize]] = i as u32;
-        next[*b as usize] += 1;
-    }
-    Ok(SlabVoxels {
-        voxels,
-        starts,
-        by_last,
-        ends,
-    })
+    (order, starts)
 }
 
 /// One band: every slab in compositing order: the voxels that reach it first splatted (into every
@@ -209,28 +204,18 @@ fn render_band(
         image,
         rows: &mut spans,
     };
-    let reaches = |i: usize| {
-        let r = setup.rows_of(sv.voxels[i].position[1]);
+    let reaches = |v: &SlabVoxel| {
+        let r = setup.rows_of(v.position[1]);
         r.start < rows.end && r.end > rows.start
     };
     let mut renderer =
         SlabRenderer::with_band(setup, table, p.order, buffers, background, rows.clone())?;
     let mut phases = Phases::default();
-    let count = setup.slab_count();
-    for k in 0..count {
+    for k in 0..setup.slab_count() {
         let t0 = Instant::now();
-        let entering: &mut dyn Iterator<Item = usize> = match p.order {
-            Order::FrontToBack => &mut (sv.starts[k]..sv.starts[k + 1]),
-            Order::BackToFront => {
-                let j = count - 1 - k;
-                &mut sv.by_last[sv.ends[j]..sv.ends[j + 1]]
-                    .iter()
-                    .map(|&i| i as usize)
-            }
-        };
-        for i in entering {
-            if reaches(i) {
-                renderer.splat_voxel(&sv.voxels[i])?;
+        for v in sv.voxels[sv.starts[k]..sv.starts[k + 1]].iter() {
+            if reaches(v) {
+                renderer.splat_voxel(v)?;
             }
         }
         let t1 = Instant::now();
