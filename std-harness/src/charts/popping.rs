@@ -40,12 +40,19 @@ pub fn popping(
     let mut args = base.clone();
     let mut p = prepare(&args)?;
     let mut caches = [FrameCache::default(), FrameCache::default()];
-    let mut frames: [Vec<Vec<[f64; 4]>>; 3] = Default::default();
+    // The previous frame of each curve, and each new frame's change against it.
+    let mut previous: [Option<Vec<[f64; 4]>>; 3] = Default::default();
     let mut out = Popping {
         azimuths: Vec::new(),
         change_db: Default::default(),
         truth_db: Default::default(),
         slab: base.slab,
+    };
+    let mut advance = |out: &mut Popping, k: usize, now: &[[f32; 4]], now64: Vec<[f64; 4]>| {
+        if let Some(prev) = &previous[k] {
+            out.change_db[k].push(compare(now, prev).1.psnr_db);
+        }
+        previous[k] = Some(now64);
     };
     let total = (SWEEP.1 - SWEEP.0 + 1) as usize;
     for (i, tenth) in (SWEEP.0..=SWEEP.1).enumerate() {
@@ -60,19 +67,13 @@ pub fn popping(
         {
             args.slicing = slicing;
             let f = render_frame(&p, &args, AccumArg::Float, &mut caches[k])?;
-            let img: Vec<[f64; 4]> = f.image.iter().map(|c| c.map(f64::from)).collect();
             out.truth_db[k].push(compare(&f.image, &truth.image).1.psnr_db);
-            frames[k].push(img);
+            let img64 = f.image.iter().map(|c| c.map(f64::from)).collect();
+            advance(&mut out, k, &f.image, img64);
         }
-        frames[2].push(truth.image);
+        let truth32: Vec<[f32; 4]> = truth.image.iter().map(|c| c.map(|v| v as f32)).collect();
+        advance(&mut out, 2, &truth32, truth.image);
         out.azimuths.push(az);
-        for (k, set) in frames.iter_mut().enumerate() {
-            if set.len() == 2 {
-                let now: Vec<[f32; 4]> = set[1].iter().map(|c| c.map(|v| v as f32)).collect();
-                out.change_db[k].push(compare(&now, &set[0]).1.psnr_db);
-                set.remove(0);
-            }
-        }
         progress(i + 1, total);
     }
     Ok(out)
