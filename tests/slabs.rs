@@ -249,6 +249,14 @@ fn what_slabs_cannot_do_is_refused() {
         SlabSetup::new(&f, &gauss, 1e-7),
         Err(SlabError::TooManySlabs { .. })
     ));
+    // A grid eight times coarser along the view than its finest spacing: one kernel would span
+    // hundreds of slabs a twentieth of that spacing thick.
+    let deep = frame([4, 4, 4], [1.0, 1.0, 8.0], Mat3::IDENTITY, &gauss);
+    assert!(matches!(
+        SlabSetup::new(&deep, &gauss, 0.05),
+        Err(SlabError::KernelTooDeep { .. })
+    ));
+    assert!(SlabSetup::new(&deep, &gauss, 1.0).is_ok());
     // A voxel reaching a slab already composited.
     let setup = SlabSetup::new(&f, &gauss, 1.0).unwrap();
     let sec = table(gauss);

@@ -58,8 +58,9 @@ use core::fmt;
 /// The most slabs a frame may have.
 pub const MAX_SLABS: usize = 1 << 16;
 
-/// The most slabs one kernel may span ([`SlabSetup::ring`]): slabs thinner than about a
-/// sixteenth of the kernel's depth are refused ([`SlabError::TooManySlabs`]).
+/// The most slabs one kernel may span ([`SlabSetup::ring`], the ring of slab accumulators a
+/// renderer keeps): slabs thinner than about a twentieth of the kernel's depth along the ray are
+/// refused ([`SlabError::KernelTooDeep`]).
 pub const MAX_RING: usize = 40;
 
 /// Why image-aligned slicing could not be set up.
@@ -75,6 +76,12 @@ pub enum SlabError {
     TooManySlabs {
         /// Slabs the volume would need.
         needed: f32,
+    },
+    /// So thin a slab that one kernel spans more than [`MAX_RING`] of them (a kernel is deep
+    /// along the ray on a grid much coarser along it than its finest spacing).
+    KernelTooDeep {
+        /// Slabs one kernel would span.
+        slabs: f32,
     },
     /// The kernel cannot be cut ([`SectionError`]).
     Kernel(SectionError),
@@ -94,6 +101,11 @@ impl fmt::Display for SlabError {
             Self::TooManySlabs { needed } => write!(
                 f,
                 "slabs this thin would need {needed:.0} slabs (at most {MAX_SLABS}): thicken them"
+            ),
+            Self::KernelTooDeep { slabs } => write!(
+                f,
+                "slabs this thin would cut one kernel into {slabs:.0} (at most {MAX_RING}, the \
+                 ring of slab accumulators): thicken them"
             ),
             Self::Kernel(e) => e.fmt(f),
             Self::Perspective => f.write_str(
@@ -226,8 +238,12 @@ impl SlabSetup {
         if !(needed.is_finite() && t.is_finite()) {
             return Err(SlabError::Singular);
         }
-        if needed > MAX_SLABS as f32 || ring_for(z_reach, t) > MAX_RING as f32 {
+        if needed > MAX_SLABS as f32 {
             return Err(SlabError::TooManySlabs { needed });
+        }
+        let ring = ring_for(z_reach, t);
+        if ring > MAX_RING as f32 {
+            return Err(SlabError::KernelTooDeep { slabs: ring });
         }
         Ok(SlabSetup {
             size: frame.size,

@@ -4,12 +4,16 @@
 //!
 //! **Trade-off** (`DIR/tradeoff.csv`, `.svg`, `.png`): every configuration of table size
 //! N ∈ {5, 11, 21, 33, 65, 101, 129}, lookup (nearest, bilinear), method (`view`: the two-stage
-//! view table; `direct`) and accumulation (float, fixed) renders the scene `--runs` times. Time is
+//! view table; `direct`) and accumulation (float, fixed), and image-aligned slabs of the
+//! [`crate::pipeline::config::SLABS`] thicknesses the frame can run, renders the scene `--runs`
+//! times. Time is
 //! the whole frame as `render` does it (table build, every sheet), median and min–max; error is
 //! against the f64 reference of the same scene (PSNR over RGB, max abs), as in `verify`. The
 //! math backend is a build-time choice and is recorded in every row. A configuration is on the
 //! Pareto frontier when no other is at least as fast and at least as accurate, and strictly
-//! better in one of the two.
+//! better in one of the two. Every row is also measured against the continuous integral
+//! (`tradeoff-continuous.svg`, `.png`, with its own frontier); the sheet reference's chart and
+//! frontier hold object slicing only.
 //!
 //! **Stability** (`DIR/stability.svg`, `.png`): one voxel of the paper Gaussian against the exact
 //! footprint (max |core − reference| / reference peak), table 65, bilinear:

@@ -55,14 +55,13 @@ impl Config {
         v
     }
 
-    /// Image-aligned slicing at each of [`SLABS`] (for an orthographic frame and a Gaussian
-    /// kernel; none otherwise).
+    /// Image-aligned slicing at each of [`SLABS`] that `frame` and `kernel` can run (none for a
+    /// perspective frame or a footprint-model kernel; none thinner than a kernel's depth allows,
+    /// `footprint::render::slabs::MAX_RING`).
     pub fn slabs(frame: &footprint::frame::FrameSetup, kernel: &footprint::Kernel) -> Vec<Config> {
-        if frame.camera().is_some() || !matches!(kernel, footprint::Kernel::Gaussian { .. }) {
-            return Vec::new();
-        }
         SLABS
             .iter()
+            .filter(|&&t| footprint::render::SlabSetup::new(frame, kernel, t).is_ok())
             .map(|&t| Config {
                 table: 0,
                 lookup: LookupArg::Bilinear,
