@@ -181,8 +181,6 @@ pub struct SlabSetup {
     count: usize,
     /// |G·d| / (|d|·R²): a section's weight per unit of table difference.
     scale: f32,
-    /// The thickness asked for, voxel spacings.
-    spacings: f32,
 }
 
 impl SlabSetup {
@@ -256,7 +254,6 @@ impl SlabSetup {
             thickness: t,
             count: (math::floor(needed) as usize + 1).max(1),
             scale: world_per_z / (dl * r2),
-            spacings: thickness,
         })
     }
 
@@ -279,11 +276,6 @@ impl SlabSetup {
     /// Slab thickness, pixels of screen depth.
     pub fn thickness_px(&self) -> f32 {
         self.thickness
-    }
-
-    /// Slab thickness as asked, in smallest grid spacings (world units ÷ the smallest spacing).
-    pub fn thickness_spacings(&self) -> f32 {
-        self.spacings
     }
 
     /// The first and last slab a kernel centred at depth `z` (pixels) overlaps, clamped to the
