@@ -37,7 +37,7 @@ use crate::composite::RowSpan;
 use crate::frame::{FrameSetup, Order};
 use crate::shade::{Lighting, OpacityTable, Sample, Shader};
 use crate::splat::{BufferError, ImageMut, Splatter};
-use band::BandReach;
+use band::{check_band, start_image, BandReach};
 use core::fmt;
 
 /// Why a render step was refused.
@@ -574,41 +574,5 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
             self.path.over_row(&mut self.buffers.image[..n], &bg[..n]);
         }
         self.stats
-    }
-}
-
-/// Checks that `rows` is a band of an image `height` rows high, and that every (length, needed)
-/// pair of a renderer's buffers holds what it needs (the first short one is the error).
-pub(crate) fn check_band(
-    rows: &core::ops::Range<usize>,
-    height: usize,
-    buffers: &[(usize, usize)],
-) -> Result<(), RenderError> {
-    if rows.start > rows.end || rows.end > height {
-        return Err(RenderError::Band {
-            start: rows.start,
-            end: rows.end,
-            height,
-        });
-    }
-    for &(got, needed) in buffers {
-        if got < needed {
-            return Err(BufferError::TooSmall { needed, got }.into());
-        }
-    }
-    Ok(())
-}
-
-/// A band's starting working image: the background when compositing back to front (the far
-/// layers go over it), else `clear` (front to back, the background goes under at the end).
-pub(crate) fn start_image<X: Copy>(
-    image: &mut [X],
-    background: Option<&[X]>,
-    order: Order,
-    clear: X,
-) {
-    match (order, background) {
-        (Order::BackToFront, Some(bg)) => image.copy_from_slice(&bg[..image.len()]),
-        _ => image.fill(clear),
     }
 }

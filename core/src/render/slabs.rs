@@ -44,8 +44,9 @@
 //! variant (compositing takes an exponential per pixel and slab); perspective frames are refused
 //! ([`SlabError::Perspective`]).
 
+use super::band::{check_band, start_image};
 use super::precision::float_over_row;
-use super::{check_band, start_image, RenderError, RenderStats};
+use super::{RenderError, RenderStats};
 use crate::composite::{over, RowSpan};
 use crate::frame::{FrameSetup, Order};
 use crate::geometry::box_corners;
