@@ -60,6 +60,27 @@ pub enum SlicingArg {
     Image,
 }
 
+/// What `--quality DB` aims at (`--quality-reference`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum QualityReferenceArg {
+    /// The f64 renderer with the same sheets (`verify`'s `--reference sheets`): the table
+    /// configuration's error, predicted from one footprint in milliseconds.
+    Sheets,
+    /// The continuous volume-rendering integral (`verify`'s `--reference continuous`): the error
+    /// a user sees, measured on a pilot of sampled rays; chooses the slicing and slab too.
+    Continuous,
+}
+
+impl QualityReferenceArg {
+    /// The name the command line and the JSON use.
+    pub fn name(self) -> &'static str {
+        match self {
+            QualityReferenceArg::Sheets => "sheets",
+            QualityReferenceArg::Continuous => "continuous",
+        }
+    }
+}
+
 impl SlicingArg {
     /// The name the command line and the JSON use.
     pub fn name(self) -> &'static str {
@@ -389,10 +410,17 @@ pub struct RenderArgs {
     /// byte-identical for any number. A streamed volume renders on one thread.
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
-    /// Target PSNR against the f64 reference, dB: choose the cheapest table size, lookup, method
-    /// and accumulation predicted to reach it for this scene and view (overrides those flags).
-    #[arg(long, conflicts_with_all = ["table", "lookup", "method", "accum", "table_file"])]
+    /// Target PSNR, dB, against --quality-reference: choose the cheapest configuration expected
+    /// to reach it for this scene and view (overrides the table, lookup, method and
+    /// accumulation; with the continuous reference also the slab thickness).
+    #[arg(long, conflicts_with_all = ["table", "lookup", "method", "accum", "table_file", "slab"])]
     pub quality: Option<f64>,
+    /// What --quality aims at: `sheets`, the f64 renderer with the same sheets (table error only,
+    /// predicted in milliseconds), or `continuous`, the volume-rendering integral (the error a
+    /// user sees; measured on a pilot of about 4096 sampled rays, which costs seconds, and may
+    /// choose image slicing; with --slicing image only slab thicknesses are considered).
+    #[arg(long, value_enum, default_value_t = QualityReferenceArg::Sheets, requires = "quality")]
+    pub quality_reference: QualityReferenceArg,
     /// Transfer function: a preset (grey, ct-bone-skin, density) or a file of `t r g b a` lines.
     /// Default: density for the built-in scene, grey otherwise.
     #[arg(long)]

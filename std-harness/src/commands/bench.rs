@@ -11,8 +11,8 @@
 use crate::args::RenderArgs;
 use crate::io::{self, json::Json};
 use crate::pipeline::bands::Phases;
-use crate::pipeline::quality::{apply_quality, quality_json};
 use crate::pipeline::visible::FrameCache;
+use crate::pipeline::{choose::apply_quality, quality::quality_json};
 use crate::pipeline::{describe, prepare, render_frame};
 use crate::CliError;
 use clap::Args;

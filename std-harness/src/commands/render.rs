@@ -4,7 +4,7 @@
 use crate::args::{MethodArg, RenderArgs};
 use crate::io::image::{check_style, encode_rgb_for, RGB_EXTENSIONS};
 use crate::io::outputs::{self, Planned};
-use crate::pipeline::quality::{apply_quality, quality_json};
+use crate::pipeline::{choose::apply_quality, quality::quality_json};
 use crate::pipeline::{describe, prepare, render_core, render_ref};
 use crate::CliError;
 use std::path::PathBuf;

@@ -9,7 +9,7 @@ use crate::io::image::{check_style, encode_rgb_for, RGB_EXTENSIONS};
 use crate::io::json::Json;
 use crate::io::outputs::{self, Planned};
 use crate::metrics::compare;
-use crate::pipeline::quality::{apply_quality, quality_json};
+use crate::pipeline::{choose::apply_quality, quality::quality_json};
 use crate::pipeline::{
     describe, prepare, render_continuous_ref, render_core, render_core_with, render_ref,
 };

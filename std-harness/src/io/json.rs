@@ -53,6 +53,13 @@ impl Json {
             Value::Array(v.iter().map(|&x| Value::from(x)).collect()),
         )
     }
+    /// An array of objects.
+    pub fn arr_obj(self, key: &str, v: Vec<Json>) -> Self {
+        self.push(
+            key,
+            Value::Array(v.into_iter().map(|j| Value::Object(j.fields)).collect()),
+        )
+    }
     /// A nested object.
     pub fn obj(self, key: &str, v: Json) -> Self {
         self.push(key, Value::Object(v.fields))

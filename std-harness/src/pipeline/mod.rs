@@ -13,6 +13,9 @@
 //! - [`bands`]: a frame split into bands of rows, one per thread, byte-identical for any count.
 //! - [`config`]: one table configuration (size, lookup, method, accumulation).
 //! - [`quality`]: `--quality`, the cheapest configuration predicted to reach a PSNR.
+//! - [`choose`]: `--quality`'s entry: the sheet model or the pilot, as `--quality-reference` says.
+//! - [`pilot`]: `--quality DB --quality-reference continuous`, measured on a pilot of sampled
+//!   rays against the continuous integral.
 //! - [`slabs`]: `--slicing image`, the core's image-aligned slabs over the visible voxels.
 //! - [`single`]: one voxel rendered on its own (`footprint splat`, the stability charts).
 //!
@@ -20,8 +23,10 @@
 //! [`crate::reference`] and the core; it imports no command.
 
 pub mod bands;
+pub mod choose;
 pub mod config;
 pub mod load;
+pub mod pilot;
 pub mod prepare;
 pub mod quality;
 pub mod run;

@@ -1,5 +1,6 @@
 //! `--quality DB`: the cheapest configuration (table size, lookup, method, accumulation) expected
-//! to reach DB of PSNR against the f64 reference for this scene and view.
+//! to reach DB of PSNR against the f64 reference for this scene and view (the default,
+//! `--quality-reference sheets`; against the continuous integral, see [`super::pilot`]).
 //!
 //! # The model
 //! An image's error comes from its footprints' error: every pixel sums footprint weights, so a
@@ -25,7 +26,7 @@
 
 use super::config::Config;
 use super::prepare::Prepared;
-use crate::args::{AccumArg, LookupArg, MethodArg, RenderArgs};
+use crate::args::{AccumArg, LookupArg, MethodArg, QualityReferenceArg};
 use crate::io::json::Json;
 use crate::reference::ReferenceFootprint;
 use crate::{with_table_size, CliError};
@@ -81,12 +82,17 @@ pub const RELATIVE_COST: [(LookupArg, MethodArg, AccumArg, f64); 8] = [
 pub struct Choice {
     pub target_db: f64,
     pub config: Config,
-    /// Predicted PSNR of the choice, dB.
+    /// Predicted PSNR of the choice, dB: the footprint model's (sheets), or the pilot's bound
+    /// (continuous, [`super::pilot`]).
     pub predicted_db: f64,
-    /// Its footprint error at this view.
-    pub footprint_error: f64,
+    /// What the target is measured against.
+    pub reference: QualityReferenceArg,
+    /// Its footprint error at this view (sheets only).
+    pub footprint_error: Option<f64>,
     /// Cheaper candidates and their predictions, cheapest first.
     pub rejected: Vec<(Config, f64)>,
+    /// The pilot that measured the candidates (continuous only).
+    pub pilot: Option<Pilot>,
 }
 
 impl Choice {
@@ -94,21 +100,47 @@ impl Choice {
     pub fn explain(&self, footprint_px: f32) -> String {
         let rejected = match self.rejected.first() {
             Some((c, db)) => format!(
-                "; {} cheaper configurations predicted below it (the cheapest, {}, {:.1} dB)",
+                "; {} cheaper configuration{} {} below it (the cheapest, {}, {:.1} dB)",
                 self.rejected.len(),
+                if self.rejected.len() == 1 { "" } else { "s" },
+                if self.pilot.is_some() {
+                    "measured"
+                } else {
+                    "predicted"
+                },
                 c.label(),
                 db
             ),
             None => "; it is the cheapest configuration".into(),
         };
+        let why = match (&self.pilot, self.footprint_error) {
+            (Some(pilot), _) => format!(
+                "measured against the continuous integral on a pilot of {} sampled pixels (one \
+                 per {}x{} cell){}: estimate {:.1} dB, {:.1} dB at its bound; pilot reference \
+                 {:.2} s, candidate renders ({}) {:.2} s",
+                pilot.pixels,
+                pilot.stride,
+                pilot.stride,
+                if pilot.converged { "" } else { " (not converged)" },
+                pilot.tried.iter().find(|t| t.0 == self.config).map_or(f64::NAN, |t| t.1.estimate_db),
+                self.predicted_db,
+                pilot.reference_seconds,
+                pilot.tried.len(),
+                pilot.render_seconds
+            ),
+            (None, e) => format!(
+                "predicted {:.1} dB: footprint error {:.2e} at this view's {:.1}-px footprint, K = {:.1} dB",
+                self.predicted_db,
+                e.unwrap_or(f64::NAN),
+                footprint_px,
+                K_DB
+            ),
+        };
         format!(
-            "--quality {:.1} dB: chose {} (predicted {:.1} dB: footprint error {:.2e} at this view's {:.1}-px footprint, K = {:.1} dB){rejected}",
+            "--quality {:.1} dB ({}): chose {} ({why}){rejected}",
             self.target_db,
+            self.reference.name(),
             self.config.label(),
-            self.predicted_db,
-            self.footprint_error,
-            footprint_px,
-            K_DB
         )
     }
 }
@@ -220,14 +252,33 @@ fn one_footprint_error(
     Ok(worst)
 }
 
-/// The cheapest configuration predicted to reach `target_db` for `p`; the most accurate one if
-/// none is.
-pub fn choose(p: &Prepared, target_db: f64) -> Result<Choice, CliError> {
-    if !(target_db.is_finite() && target_db > 0.0) {
-        return Err(CliError::input(format!(
+/// `Ok` if `target_db` is a PSNR `--quality` can aim at.
+pub fn check_target(target_db: f64) -> Result<(), CliError> {
+    if target_db.is_finite() && target_db > 0.0 {
+        Ok(())
+    } else {
+        Err(CliError::input(format!(
             "--quality {target_db}: expected a PSNR in dB above 0"
-        )));
+        )))
     }
+}
+
+/// The cheapest configuration predicted to reach `target_db` against the sheet reference for
+/// `p`; the most accurate one if none is, said so.
+pub fn choose(p: &Prepared, target_db: f64) -> Result<Choice, CliError> {
+    let (choice, reached) = pick(p, target_db)?;
+    if !reached {
+        crate::say!(
+            "--quality {target_db:.1} dB: no configuration is predicted to reach it; using the most accurate ({:.1} dB)",
+            choice.predicted_db
+        );
+    }
+    Ok(choice)
+}
+
+/// [`choose`] without the message: the choice, and whether it is predicted to reach the target.
+pub fn pick(p: &Prepared, target_db: f64) -> Result<(Choice, bool), CliError> {
+    check_target(target_db)?;
     let mut rejected = Vec::new();
     let mut best: Option<(Config, f64, f64)> = None;
     let mut errors = std::collections::HashMap::new();
@@ -244,13 +295,16 @@ pub fn choose(p: &Prepared, target_db: f64) -> Result<Choice, CliError> {
         };
         let db = predict_db(e);
         if db >= target_db {
-            return Ok(Choice {
+            let choice = Choice {
                 target_db,
                 config: c,
                 predicted_db: db,
-                footprint_error: e,
+                reference: QualityReferenceArg::Sheets,
+                footprint_error: Some(e),
                 rejected,
-            });
+                pilot: None,
+            };
+            return Ok((choice, true));
         }
         if best.is_none_or(|b| db > b.2) {
             best = Some((c, e, db));
@@ -258,47 +312,80 @@ pub fn choose(p: &Prepared, target_db: f64) -> Result<Choice, CliError> {
         rejected.push((c, db));
     }
     let (config, e, db) = best.expect("at least one candidate");
-    crate::say!(
-        "--quality {target_db:.1} dB: no configuration is predicted to reach it; using the most accurate ({:.1} dB)",
-        db
-    );
-    Ok(Choice {
+    let choice = Choice {
         target_db,
         config,
         predicted_db: db,
-        footprint_error: e,
+        reference: QualityReferenceArg::Sheets,
+        footprint_error: Some(e),
         rejected: Vec::new(),
-    })
-}
-
-/// `args` with `--quality`'s choice applied (unchanged without `--quality`), and the choice.
-pub fn apply_quality(
-    p: &Prepared,
-    args: &RenderArgs,
-) -> Result<(RenderArgs, Option<Choice>), CliError> {
-    let Some(q) = args.quality else {
-        return Ok((args.clone(), None));
+        pilot: None,
     };
-    if args.slicing == crate::args::SlicingArg::Image {
-        return Err(CliError::input(
-            "--quality chooses among the table configurations of object slicing (aiming at the \
-             sheet reference); image slicing has no table to choose: give --slab instead",
-        ));
-    }
-    let choice = choose(p, q)?;
-    let e = p.frame.footprint.half_extent;
-    crate::say!("{}", choice.explain(2.0 * e[0].max(e[1])));
-    let mut chosen = choice.config.apply(args);
-    chosen.quality = None;
-    Ok((chosen, Some(choice)))
+    Ok((choice, false))
 }
 
-/// The JSON record of a `--quality` choice.
+/// The JSON record of a `--quality` choice: `target_db`, `reference` (`sheets` or
+/// `continuous`), `predicted_db`, `chosen`; with sheets `footprint_error` and `k_db`, with
+/// continuous `pilot` (`pixels`, `stride`, `converged`, seconds, and each candidate tried).
 pub fn quality_json(c: &Choice) -> Json {
-    Json::object()
+    let mut j = Json::object()
         .num("target_db", c.target_db)
-        .num("predicted_db", c.predicted_db)
-        .num("footprint_error", c.footprint_error)
-        .num("k_db", K_DB)
-        .str("chosen", &c.config.label())
+        .str("reference", c.reference.name())
+        .num("predicted_db", c.predicted_db);
+    if let Some(e) = c.footprint_error {
+        j = j.num("footprint_error", e).num("k_db", K_DB);
+    }
+    if let Some(p) = &c.pilot {
+        j = j.obj("pilot", pilot_json(p));
+    }
+    j.str("chosen", &c.config.label())
+}
+
+/// A candidate's error at the sampled pixels.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Estimate {
+    /// 10·log₁₀(1/m), m the sampled MSE (RGB), dB.
+    pub estimate_db: f64,
+    /// The same with the MSE's upper confidence bound (see the module docs): what is compared
+    /// with the target, dB.
+    pub bound_db: f64,
+}
+
+/// How the pilot went.
+#[derive(Clone, Debug)]
+pub struct Pilot {
+    /// Sampled output pixels (rays per pixel: the supersampling squared).
+    pub pixels: usize,
+    /// Cell side S, pixels.
+    pub stride: usize,
+    /// Whether the pilot reference converged (`reference::continuous::CONVERGED_DB`).
+    pub converged: bool,
+    /// Seconds of the pilot reference, and of the candidate renders.
+    pub reference_seconds: f64,
+    pub render_seconds: f64,
+    /// Every candidate rendered, in order, with its estimate.
+    pub tried: Vec<(Config, Estimate)>,
+}
+
+/// The JSON record of a pilot: `pixels`, `stride`, `converged`, `reference_seconds`,
+/// `render_seconds`, and `tried`, each candidate's `config`, `estimate_db` and `bound_db`.
+fn pilot_json(p: &Pilot) -> Json {
+    Json::object()
+        .num("pixels", p.pixels as f64)
+        .num("stride", p.stride as f64)
+        .bool("converged", p.converged)
+        .num("reference_seconds", p.reference_seconds)
+        .num("render_seconds", p.render_seconds)
+        .arr_obj(
+            "tried",
+            p.tried
+                .iter()
+                .map(|(c, e)| {
+                    Json::object()
+                        .str("config", &c.label())
+                        .num("estimate_db", e.estimate_db)
+                        .num("bound_db", e.bound_db)
+                })
+                .collect(),
+        )
 }

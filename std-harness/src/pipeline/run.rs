@@ -13,7 +13,8 @@ use crate::io::progress::sheets;
 use crate::io::stream::{FileSource, MemorySource, PipeSource};
 use crate::io::try_filled;
 use crate::reference::continuous::{
-    render_continuous, Continuous, ContinuousScene, Reconstruction, MAX_HALVINGS,
+    render_continuous, render_continuous_at, Continuous, ContinuousScene, Reconstruction,
+    MAX_HALVINGS,
 };
 use crate::reference::render::{render_reference, ReferenceScene};
 use crate::{with_table_size, CliError};
@@ -359,6 +360,54 @@ pub fn render_continuous_ref(
     )?;
     if p.supersample > 1 {
         c.image = downsample(&c.image, p.out_size(), p.supersample, |v| v);
+    }
+    Ok((c, start.elapsed().as_secs_f64()))
+}
+
+/// The continuous reference of `p` at the listed pixels of the *output* image only ((x, y), each
+/// below [`Prepared::out_size`]; a supersampled frame marches the k×k rays of each and averages
+/// them, as the renders are averaged): their values in the order given, how it converged, and
+/// its seconds. Kernel reconstruction. The volume must be in memory.
+pub fn continuous_at(p: &Prepared, pixels: &[[usize; 2]]) -> Result<(Continuous, f64), CliError> {
+    let volume = p.volume().ok_or_else(|| {
+        CliError::input("the continuous reference needs the volume in memory: drop --stream")
+    })?;
+    let start = Instant::now();
+    let scene = ContinuousScene {
+        frame: &p.frame,
+        kernel: &p.kernel,
+        shader: p.shader(),
+        background: p.background.as_deref(),
+        reconstruction: Reconstruction::Kernel,
+    };
+    let k = p.supersample;
+    let rays: Vec<[usize; 2]> = pixels
+        .iter()
+        .flat_map(|&[x, y]| (0..k * k).map(move |i| [x * k + i % k, y * k + i / k]))
+        .collect();
+    let mut bar = sheets("continuous pilot");
+    let axis = p.frame.sheet_axis;
+    let mut c = render_continuous_at(
+        &scene,
+        |s, out| volume.sheet_into(axis, s, out),
+        |pass, _| bar(pass, MAX_HALVINGS + 1),
+        &rays,
+    )?;
+    if k > 1 {
+        let scale = 1.0 / (k * k) as f64;
+        c.image = c
+            .image
+            .chunks(k * k)
+            .map(|block| {
+                let mut sum = [0.0f64; 4];
+                for v in block {
+                    for ch in 0..4 {
+                        sum[ch] += v[ch];
+                    }
+                }
+                sum.map(|v| v * scale)
+            })
+            .collect();
     }
     Ok((c, start.elapsed().as_secs_f64()))
 }

@@ -310,10 +310,34 @@ impl Field {
     }
 }
 
-/// Marches every pixel's ray with step `h` (world units) and returns the image.
-fn march(scene: &ContinuousScene<'_>, field: &Field, h: f64) -> Vec<[f64; 4]> {
+/// Which rays to march: every pixel's, or those through the listed pixels.
+#[derive(Clone, Copy)]
+enum Rays<'a> {
+    All,
+    Pixels(&'a [[usize; 2]]),
+}
+
+impl Rays<'_> {
+    fn count(self, f: &FrameSetup) -> usize {
+        match self {
+            Rays::All => f.size[0] * f.size[1],
+            Rays::Pixels(p) => p.len(),
+        }
+    }
+    /// The (x, y) pixel of ray `i`.
+    fn pixel(self, f: &FrameSetup, i: usize) -> (usize, usize) {
+        match self {
+            Rays::All => (i % f.size[0], i / f.size[0]),
+            Rays::Pixels(p) => (p[i][0], p[i][1]),
+        }
+    }
+}
+
+/// Marches the rays of `rays` with step `h` (world units) and returns their values, in the
+/// order of `rays`.
+fn march(scene: &ContinuousScene<'_>, field: &Field, h: f64, rays: Rays<'_>) -> Vec<[f64; 4]> {
     let f = scene.frame;
-    let (w, hgt) = (f.size[0], f.size[1]);
+    let w = f.size[0];
     let g2s: DMat3 = f.grid_to_screen.as_dmat3();
     let inv = g2s.inverse();
     let origin = f.origin.as_dvec3();
@@ -329,14 +353,15 @@ fn march(scene: &ContinuousScene<'_>, field: &Field, h: f64) -> Vec<[f64; 4]> {
     let threads = std::thread::available_parallelism()
         .map_or(1, |n| n.get())
         .clamp(1, 16);
-    let mut image = vec![[0.0f64; 4]; w * hgt];
-    let band = hgt.div_ceil(threads).max(1);
+    let count = rays.count(f);
+    let mut image = vec![[0.0f64; 4]; count];
+    let band = count.div_ceil(threads).max(1);
     std::thread::scope(|sc| {
-        for (t, chunk) in image.chunks_mut(band * w).enumerate() {
+        for (t, chunk) in image.chunks_mut(band).enumerate() {
             sc.spawn(move || {
                 let mut taps = field.taps();
                 for (i, px) in chunk.iter_mut().enumerate() {
-                    let (x, y) = (i % w, t * band + i / w);
+                    let (x, y) = rays.pixel(f, t * band + i);
                     let (xc, yc) = (x as f64 + 0.5, y as f64 + 0.5);
                     // The ray in affine screen units: P(t) = p0 + t·d, |d| = 1.
                     let (p0, d) = match camera {
@@ -435,8 +460,39 @@ fn change_db(a: &[[f64; 4]], b: &[[f64; 4]]) -> f64 {
 /// supplies (along the frame's sheet axis); `progress(pass, step)` after each pass.
 pub fn render_continuous(
     scene: &ContinuousScene<'_>,
+    sheet: impl FnMut(usize, &mut [f32]),
+    progress: impl FnMut(usize, f64),
+) -> Result<Continuous, CliError> {
+    converge(scene, sheet, progress, Rays::All)
+}
+
+/// [`render_continuous`] at the listed pixels only ((x, y) of the frame, each below its size):
+/// `image` holds their values in the order given, and convergence is judged on them. What
+/// `--quality-reference continuous` samples.
+pub fn render_continuous_at(
+    scene: &ContinuousScene<'_>,
+    sheet: impl FnMut(usize, &mut [f32]),
+    progress: impl FnMut(usize, f64),
+    pixels: &[[usize; 2]],
+) -> Result<Continuous, CliError> {
+    let f = scene.frame;
+    if let Some(p) = pixels
+        .iter()
+        .find(|p| p[0] >= f.size[0] || p[1] >= f.size[1])
+    {
+        return Err(CliError::input(format!(
+            "continuous reference: pixel ({}, {}) lies outside the {}x{} frame",
+            p[0], p[1], f.size[0], f.size[1]
+        )));
+    }
+    converge(scene, sheet, progress, Rays::Pixels(pixels))
+}
+
+fn converge(
+    scene: &ContinuousScene<'_>,
     mut sheet: impl FnMut(usize, &mut [f32]),
     mut progress: impl FnMut(usize, f64),
+    rays: Rays<'_>,
 ) -> Result<Continuous, CliError> {
     let field = Field::new(scene, &mut sheet)?;
     let smallest = scene
@@ -446,13 +502,13 @@ pub fn render_continuous(
         .copied()
         .fold(f32::INFINITY, f32::min);
     let mut h = 0.5 * f64::from(smallest);
-    let mut image = march(scene, &field, h);
+    let mut image = march(scene, &field, h, rays);
     progress(1, h);
     let mut passes = 1;
     let mut change = 0.0;
     for _ in 0..MAX_HALVINGS {
         h *= 0.5;
-        let finer = march(scene, &field, h);
+        let finer = march(scene, &field, h, rays);
         passes += 1;
         progress(passes, h);
         change = change_db(&image, &finer);

@@ -1,0 +1,267 @@
+//! `--quality DB --quality-reference continuous`: the cheapest configuration, slicing included,
+//! whose image is measured to reach DB of PSNR against the continuous volume-rendering integral.
+//!
+//! # Why a measurement, not a model
+//! Against the sheet reference the error is the table's, and one footprint predicts it
+//! ([`super::quality`]). Against the integral, object slicing's error is dominated by compositing
+//! each kernel whole in one sheet, which depends on the data along every ray (27.9–77.9 dB over
+//! the shared volumes at 256×256, README "Image-aligned slicing"): no one-voxel model sees it.
+//! So the choice is measured, on a **pilot**:
+//!
+//! 1. **Rays.** The output image is cut into S×S cells, S = ⌈√(W·H / [`PILOT_RAYS`])⌉, and one
+//!    pixel per cell, at a fixed pseudo-random position inside it, is taken (stratified
+//!    sampling: every part of the image is represented, and no sampling pattern can line up
+//!    with a periodic error). The continuous reference is marched through those pixels only
+//!    (each k×k block of a supersampled frame), converged as `verify --reference continuous`
+//!    converges (`reference::continuous`), about 1/S² of its cost.
+//! 2. **Candidates**, cheapest first: object slicing with the table configuration the sheet
+//!    model picks for DB, then the one it picks for DB + [`TABLE_HEADROOM_DB`] (so that the
+//!    table's share of the error is negligible) if it differs; then image slicing at each
+//!    thickness of `Config::SLABS` the frame accepts, thickest (fastest) first. With
+//!    `--slicing image` only the slabs are tried; a perspective frame or a non-Gaussian kernel
+//!    has no slabs.
+//! 3. **Measure.** Each candidate renders the whole frame; its squared error (RGB mean) at the n
+//!    sampled pixels has mean m and standard deviation s. The estimate is 10·log₁₀(1/m) and the
+//!    decision uses the upper confidence bound of the image's MSE, m + [`Z`]·s/√n·√(1 − n/N)
+//!    (N the image's pixels; the bound is m itself when every pixel is sampled). The first
+//!    candidate whose bound reaches DB is chosen; if none does, the most accurate one, said so.
+//!
+//! The winner is rendered again by the command (its pilot render is not kept), so `--quality
+//! DB --quality-reference continuous` costs the pilot reference, one frame per candidate tried,
+//! and the frame. The default stays `--quality-reference sheets`: it costs milliseconds, and the
+//! sheet reference is what the table configuration alone controls.
+
+use super::config::Config;
+use super::prepare::Prepared;
+use super::quality::{self, Choice, Estimate, Pilot};
+use super::run::{continuous_at, render_frame};
+use super::visible::FrameCache;
+use crate::args::{QualityReferenceArg, RenderArgs, SlicingArg};
+use crate::CliError;
+use std::time::Instant;
+
+/// Rays the pilot aims at: the image is sampled once per cell of about W·H / `PILOT_RAYS`
+/// pixels.
+pub const PILOT_RAYS: usize = 4096;
+/// Standard errors added to the sampled MSE before it is compared with the target.
+pub const Z: f64 = 3.0;
+/// The second object-slicing candidate aims the table model this much above the target, dB.
+pub const TABLE_HEADROOM_DB: f64 = 10.0;
+
+/// The stratified sample of a `w`×`h` image for about `rays` pixels: one pixel per S×S cell
+/// (S = ⌈√(w·h / rays)⌉, at least 1), at a position inside the cell fixed by a hash of the
+/// cell, row by row; and S.
+pub fn sample_pixels(w: usize, h: usize, rays: usize) -> (Vec<[usize; 2]>, usize) {
+    let area = (w * h) as f64 / rays.max(1) as f64;
+    let stride = (area.sqrt().ceil() as usize).max(1);
+    let mut out = Vec::new();
+    for cy in 0..h.div_ceil(stride) {
+        for cx in 0..w.div_ceil(stride) {
+            let (x0, y0) = (cx * stride, cy * stride);
+            let (cw, ch) = (stride.min(w - x0), stride.min(h - y0));
+            let r = mix(((cy as u64) << 32) | cx as u64);
+            out.push([
+                x0 + (r % cw as u64) as usize,
+                y0 + ((r >> 32) % ch as u64) as usize,
+            ]);
+        }
+    }
+    (out, stride)
+}
+
+/// SplitMix64's finaliser: a well-spread hash of one word.
+fn mix(mut z: u64) -> u64 {
+    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// `image` (`w` wide, premultiplied RGBA) against `reference` at `pixels` (the reference's
+/// values in that order), for an image of `total` pixels.
+pub fn estimate(
+    image: &[[f32; 4]],
+    w: usize,
+    pixels: &[[usize; 2]],
+    reference: &[[f64; 4]],
+    total: usize,
+) -> Estimate {
+    let errors: Vec<f64> = pixels
+        .iter()
+        .zip(reference)
+        .map(|(&[x, y], r)| {
+            let c = image[y * w + x];
+            (0..3)
+                .map(|ch| (f64::from(c[ch]) - r[ch]).powi(2))
+                .sum::<f64>()
+                / 3.0
+        })
+        .collect();
+    let n = errors.len().max(1) as f64;
+    let mean = errors.iter().sum::<f64>() / n;
+    let var = if errors.len() > 1 {
+        errors.iter().map(|e| (e - mean).powi(2)).sum::<f64>() / (n - 1.0)
+    } else {
+        0.0
+    };
+    let finite = (1.0 - n / total.max(1) as f64).max(0.0);
+    let bound = mean + Z * (var / n * finite).sqrt();
+    let db = |mse: f64| {
+        if mse > 0.0 {
+            -10.0 * mse.log10()
+        } else if mse == 0.0 {
+            f64::INFINITY
+        } else {
+            f64::NAN // a NaN pixel: never "reaches" anything
+        }
+    };
+    Estimate {
+        estimate_db: db(mean),
+        bound_db: db(bound),
+    }
+}
+
+/// The candidates for `p` aiming at `target_db` (see the module docs), cheapest first.
+fn candidates(p: &Prepared, args: &RenderArgs, target_db: f64) -> Result<Vec<Config>, CliError> {
+    let mut v: Vec<Config> = Vec::new();
+    if args.slicing == SlicingArg::Object {
+        for aim in [target_db, target_db + TABLE_HEADROOM_DB] {
+            let c = quality::pick(p, aim)?.0.config;
+            if !v.contains(&c) {
+                v.push(c);
+            }
+        }
+    }
+    let mut slabs = Config::slabs(&p.frame, &p.kernel);
+    slabs.sort_by_key(|c| std::cmp::Reverse(c.slab_quarters));
+    v.extend(slabs);
+    if v.is_empty() {
+        return Err(CliError::input(format!(
+            "{}: --quality-reference continuous with --slicing image: no slab thickness of {:?} \
+             spacings can render this frame (image slicing needs a gaussian kernel and an \
+             orthographic view)",
+            p.name,
+            super::config::SLABS
+        )));
+    }
+    Ok(v)
+}
+
+/// The cheapest candidate measured to reach `target_db` against the continuous integral.
+pub fn choose_continuous(
+    p: &Prepared,
+    args: &RenderArgs,
+    target_db: f64,
+) -> Result<Choice, CliError> {
+    quality::check_target(target_db)?;
+    let candidates = candidates(p, args, target_db)?;
+    let (w, h) = p.out_size();
+    let (pixels, stride) = sample_pixels(w, h, PILOT_RAYS);
+    let (reference, reference_seconds) = continuous_at(p, &pixels)?;
+    let start = Instant::now();
+    let mut cache = FrameCache::default();
+    let mut tried: Vec<(Config, Estimate)> = Vec::new();
+    let mut chosen = None;
+    for c in candidates {
+        let frame = render_frame(p, &c.apply(args), c.accum, &mut cache)?;
+        let e = estimate(&frame.image, w, &pixels, &reference.image, w * h);
+        tried.push((c, e));
+        if e.bound_db >= target_db {
+            chosen = Some(tried.len() - 1);
+            break;
+        }
+    }
+    let index = match chosen {
+        Some(i) => i,
+        None => {
+            let best = (0..tried.len())
+                .max_by(|&a, &b| tried[a].1.bound_db.total_cmp(&tried[b].1.bound_db))
+                .expect("at least one candidate");
+            let slabs = if tried.iter().any(|(c, _)| c.slab().is_some()) {
+                ""
+            } else {
+                " (image slicing cannot render this frame: it needs a gaussian kernel and an \
+                 orthographic view)"
+            };
+            crate::say!(
+                "--quality {target_db:.1} dB (continuous): no candidate was measured to reach it; \
+                 using the most accurate, {} ({:.1} dB on the pilot){slabs}",
+                tried[best].0.label(),
+                tried[best].1.bound_db
+            );
+            best
+        }
+    };
+    let (config, e) = tried[index];
+    let rejected = tried[..index.min(tried.len())]
+        .iter()
+        .filter(|(c, _)| *c != config)
+        .map(|(c, e)| (*c, e.bound_db))
+        .collect();
+    Ok(Choice {
+        target_db,
+        config,
+        predicted_db: e.bound_db,
+        reference: QualityReferenceArg::Continuous,
+        footprint_error: None,
+        rejected,
+        pilot: Some(Pilot {
+            pixels: pixels.len(),
+            stride,
+            converged: reference.converged,
+            reference_seconds,
+            render_seconds: start.elapsed().as_secs_f64(),
+            tried,
+        }),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_sample_has_one_pixel_per_cell_inside_the_image() {
+        for (w, h) in [(256, 256), (257, 100), (1, 1), (10, 3), (640, 480)] {
+            let (px, s) = sample_pixels(w, h, PILOT_RAYS);
+            assert_eq!(px.len(), w.div_ceil(s) * h.div_ceil(s));
+            assert!(px.len() <= PILOT_RAYS.max(w * h) + w + h);
+            let mut seen = std::collections::HashSet::new();
+            for &[x, y] in &px {
+                assert!(x < w && y < h);
+                assert!(seen.insert((x / s, y / s)), "two pixels in one cell");
+            }
+        }
+        // Small images are sampled whole.
+        let (px, s) = sample_pixels(64, 64, PILOT_RAYS);
+        assert_eq!((px.len(), s), (4096, 1));
+    }
+
+    #[test]
+    fn the_estimate_is_exact_on_a_whole_image_and_bounded_on_a_sample() {
+        // A 4x1 image against a reference: errors 0, 0.1, 0, 0.3 in every RGB channel.
+        let image = [
+            [0.0f32; 4],
+            [0.1, 0.1, 0.1, 0.0],
+            [0.0; 4],
+            [0.3, 0.3, 0.3, 0.0],
+        ];
+        let reference = [[0.0f64; 4]; 4];
+        let all = [[0, 0], [1, 0], [2, 0], [3, 0]];
+        let mse = (0.1f64 * 0.1 + 0.3 * 0.3) / 4.0;
+        let e = estimate(&image, 4, &all, &reference, 4);
+        let exact = -10.0 * mse.log10();
+        assert!((e.estimate_db - exact).abs() < 1e-4, "{e:?}");
+        assert_eq!(
+            e.estimate_db, e.bound_db,
+            "every pixel sampled: no sampling error"
+        );
+        // Two of them sampled from a larger image: the bound lies below the estimate.
+        let e = estimate(&image, 4, &all[2..], &reference[2..], 400);
+        assert!(e.bound_db < e.estimate_db, "{e:?}");
+        // A NaN pixel never reaches a target.
+        let bad = [[f32::NAN; 4]];
+        let e = estimate(&bad, 1, &all[..1], &reference[..1], 1);
+        assert!(!(e.bound_db >= 0.0));
+    }
+}
