@@ -24,6 +24,7 @@
 //! - [`render`]: the sheet renderer (`mod.rs`), its float and fixed precisions (`precision.rs`),
 //!   and the sheet window, ring and gradient (`sheets.rs`).
 //! - [`source`]: the `SheetSource` interface for voxels streamed from outside, and its driver.
+//! - [`lod`]: levels of detail, coarser levels built sheet by sheet from any `SheetSource`.
 //! - [`volume`]: a volume already in memory (`&[T]`, x fastest) as a `SheetSource`.
 //! - [`output`]: the result as 8-bit sRGB RGBA or RGB565 pixels.
 //!
@@ -92,6 +93,7 @@ pub mod fixed;
 pub mod frame;
 pub mod geometry;
 pub mod kernel;
+pub mod lod;
 pub mod math;
 pub mod output;
 pub mod render;

@@ -34,6 +34,24 @@ pub trait SheetSource {
     }
 }
 
+/// A source borrowed mutably is a source (so adaptors such as [`crate::lod::Coarsened`] can wrap
+/// a `&mut dyn SheetSource` and nest to a depth chosen at run time).
+impl<S: SheetSource + ?Sized> SheetSource for &mut S {
+    type Sample = S::Sample;
+    type Error = S::Error;
+    fn read_sheet(
+        &mut self,
+        axis: usize,
+        index: usize,
+        out: &mut [Self::Sample],
+    ) -> Result<(), Self::Error> {
+        (**self).read_sheet(axis, index, out)
+    }
+    fn sequential_axis(&self) -> Option<usize> {
+        (**self).sequential_axis()
+    }
+}
+
 /// Why a source cannot serve a frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct OrderMismatch {

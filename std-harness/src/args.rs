@@ -71,16 +71,6 @@ pub enum QualityReferenceArg {
     Continuous,
 }
 
-impl QualityReferenceArg {
-    /// The name the command line and the JSON use.
-    pub fn name(self) -> &'static str {
-        match self {
-            QualityReferenceArg::Sheets => "sheets",
-            QualityReferenceArg::Continuous => "continuous",
-        }
-    }
-}
-
 impl SlicingArg {
     /// The name the command line and the JSON use.
     pub fn name(self) -> &'static str {
@@ -293,6 +283,29 @@ pub enum Supersample {
     Fixed(usize),
 }
 
+/// `--lod`: `auto`, or a fixed level of detail.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Lod {
+    /// The level from the projected voxel size (`pipeline::lod::auto_level`).
+    Auto,
+    /// This level (0 = full resolution).
+    Level(u32),
+}
+
+/// Parses `auto` or a level 0 … `footprint::lod::MAX_LEVEL`.
+pub fn parse_lod(s: &str) -> Result<Lod, String> {
+    if s == "auto" {
+        return Ok(Lod::Auto);
+    }
+    match s.parse::<u32>() {
+        Ok(n) if n <= footprint::lod::MAX_LEVEL => Ok(Lod::Level(n)),
+        _ => Err(format!(
+            "'{s}': expected auto or a level 0..={} (0 = full resolution)",
+            footprint::lod::MAX_LEVEL
+        )),
+    }
+}
+
 /// Parses `auto` or a whole number 1 … 8.
 pub fn parse_supersample(s: &str) -> Result<Supersample, String> {
     if s == "auto" {
@@ -406,6 +419,13 @@ pub struct RenderArgs {
     /// the harness's `pipeline::supersample`); a number fixes k (1 = off).
     #[arg(long, default_value = "auto", value_parser = parse_supersample)]
     pub supersample: Supersample,
+    /// Level of detail: a number N splats level N (each level averages 2x2x2 samples of the one
+    /// above into one, the spacing doubled; 0 = full resolution, the default); `auto` the deepest
+    /// level whose samples still project at most 0.6 px apart. Orthographic views only (`auto`
+    /// keeps a perspective view at level 0). The references `verify` compares with render the
+    /// same level.
+    #[arg(long, default_value = "0", value_parser = parse_lod)]
+    pub lod: Lod,
     /// Threads (bands of image rows) for the core's render; 0 = every core. The image is
     /// byte-identical for any number. A streamed volume renders on one thread.
     #[arg(long, default_value_t = 0)]

@@ -25,7 +25,11 @@
 //! result) is drawn as a cross on the top edge. (d) popping ([`popping`], `DIR/popping.csv`):
 //! the scene turned through azimuth 40°–50° in 0.1° steps at `--popping-size`, the change between
 //! consecutive frames for object slicing, image slicing and the continuous reference.
+//!
+//! **Levels of detail** ([`lod`], `DIR/lod.csv`, `.svg`, `.png`): every level of the scene, its
+//! frame time and its PSNR against level 0 (`--lod 0`), and the level `--lod auto` picks.
 
+pub mod lod;
 pub mod plot;
 pub mod popping;
 pub mod stability;

@@ -30,7 +30,7 @@ pub fn register_font() -> Result<(), CliError> {
     }
 }
 
-fn plot_err<E: std::fmt::Display>(e: E) -> CliError {
+pub(crate) fn plot_err<E: std::fmt::Display>(e: E) -> CliError {
     CliError::input(format!("chart: {e}"))
 }
 
@@ -315,7 +315,7 @@ where
     Ok(())
 }
 
-fn write_svg_png(
+pub(crate) fn write_svg_png(
     dir: &Path,
     stem: &str,
     size: (u32, u32),

@@ -2,7 +2,7 @@
 //! [`crate::charts`] for what is swept and how it is measured).
 
 use crate::args::RenderArgs;
-use crate::charts::{plot, popping, stability, sweep};
+use crate::charts::{lod, plot, popping, stability, sweep};
 use crate::io;
 use crate::pipeline::config::Config;
 use crate::pipeline::{prepare, quality};
@@ -27,6 +27,12 @@ pub struct ChartArgs {
     /// Image size of the popping sweep, WxH pixels.
     #[arg(long, default_value = "128x128", value_parser = crate::args::parse_size)]
     pub popping_size: (usize, usize),
+    /// Skip the levels-of-detail sweep (lod.csv, lod.svg, lod.png).
+    #[arg(long)]
+    pub no_lod: bool,
+    /// Only the levels-of-detail sweep (no trade-off or stability charts).
+    #[arg(long, conflicts_with = "no_lod")]
+    pub lod_only: bool,
     /// Only print the `--quality` model's footprint error of every configuration at this view
     /// (CSV on standard output; no rendering).
     #[arg(long)]
@@ -55,19 +61,46 @@ pub fn run(args: &ChartArgs) -> Result<(), CliError> {
     let mut base = args.render.clone();
     base.out = None;
     base.json = None;
+    let name = base
+        .volume
+        .as_ref()
+        .or(base.stream.as_ref())
+        .and_then(|p| p.file_name())
+        .map_or("built-in scene".to_string(), |n| {
+            n.to_string_lossy().into_owned()
+        });
+    if !args.no_lod {
+        let (rows, auto) = lod::sweep(&base, args.runs)?;
+        io::write_atomic(&dir.join("lod.csv"), lod::csv(&rows, auto).as_bytes())?;
+        let title = format!(
+            "{name}, {}x{}: levels of detail, {} thread(s)",
+            base.size.0,
+            base.size.1,
+            base.thread_count()
+        );
+        lod::write_chart(&dir, &rows, auto, &title)?;
+        for r in &rows {
+            crate::say!(
+                "lod {}: {:?}, {:.4} s ({:.1}x level 0), {:.2} dB against level 0{}",
+                r.level,
+                r.dims,
+                r.median_s,
+                rows[0].median_s / r.median_s,
+                r.psnr_db,
+                if r.level == auto { " (auto)" } else { "" }
+            );
+        }
+        if args.lod_only {
+            crate::say!("wrote {}", dir.display());
+            return Ok(());
+        }
+    }
     let prepared = prepare(&base)?;
     let mut configs = Config::for_frame(&prepared.frame);
     configs.extend(Config::slabs(&prepared.frame, &prepared.kernel));
     drop(prepared);
     let rows = sweep::sweep(&base, &configs, args.runs)?;
     io::write_atomic(&dir.join("tradeoff.csv"), sweep::csv(&rows).as_bytes())?;
-    let name = base
-        .volume
-        .as_ref()
-        .and_then(|p| p.file_name())
-        .map_or("built-in scene".to_string(), |n| {
-            n.to_string_lossy().into_owned()
-        });
     let title = format!(
         "{name}, {}x{}: frame time against error ({} backend)",
         base.size.0,

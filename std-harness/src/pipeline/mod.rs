@@ -17,6 +17,7 @@
 //! - [`pilot`]: `--quality DB --quality-reference continuous`, measured on a pilot of sampled
 //!   rays against the continuous integral.
 //! - [`slabs`]: `--slicing image`, the core's image-aligned slabs over the visible voxels.
+//! - [`lod`]: `--lod`, levels of detail for minified volumes (coarser levels, built once or as they stream).
 //! - [`single`]: one voxel rendered on its own (`footprint splat`, the stability charts).
 //!
 //! It reads the shared argument structs of [`crate::args`] and calls down into [`crate::io`],
@@ -26,6 +27,7 @@ pub mod bands;
 pub mod choose;
 pub mod config;
 pub mod load;
+pub mod lod;
 pub mod pilot;
 pub mod prepare;
 pub mod quality;

@@ -9,12 +9,13 @@
 
 use super::load::{load_background, load_voxels, Loaded, Voxels};
 use super::supersample;
-use crate::args::RenderArgs;
+use crate::args::{Lod, RenderArgs};
 use crate::io::json::Json;
 use crate::io::volume::{SampleType, Volume};
 use crate::{tf, CliError};
 use footprint::frame::{FrameSetup, Order};
 use footprint::geometry::FootprintOptions;
+use footprint::lod::{level_frame, LodError};
 use footprint::shade::{Phong, Shader, Shading, TransferFunction};
 use footprint::{Grid, Kernel, View};
 
@@ -73,8 +74,13 @@ pub struct Prepared {
     pub voxels: Voxels,
     pub name: String,
     pub kernel: Kernel,
-    /// The volume's grid (voxel index → world).
+    /// The volume's grid at full resolution (voxel index → world).
     pub grid: Grid,
+    /// The volume's dims at full resolution (`frame.dims` are the level's).
+    pub fine_dims: [usize; 3],
+    /// The level of detail rendered (0 = full resolution; see [`super::lod`]). A volume in
+    /// memory is already coarsened to it; a streamed one is coarsened as it streams.
+    pub level: u32,
     pub frame: FrameSetup,
     pub lut: Vec<[f32; 4]>,
     pub window: [f32; 2],
@@ -93,11 +99,13 @@ pub struct Prepared {
 impl Prepared {
     /// The same volume, transfer function and shading seen with `args`' view (`--view`, `--zoom`,
     /// `--view-matrix`, `--size`): only the frame is set up again, nothing is loaded. The
-    /// compositing order stays as prepared.
+    /// compositing order and the level of detail stay as prepared.
     pub fn reframe(&mut self, args: &RenderArgs) -> Result<(), CliError> {
-        let (frame, k) = setup_frame(
-            args,
-            self.frame.dims,
+        let mut args = args.clone();
+        args.lod = Lod::Level(self.level);
+        let (frame, k, _) = setup_frame(
+            &args,
+            self.fine_dims,
             &self.grid,
             &self.kernel,
             self.options,
@@ -154,27 +162,44 @@ pub fn view_for(args: &RenderArgs, dims: [usize; 3], grid: &Grid) -> Result<View
 /// The frame for `args`' view, at the output size or, when [`supersample::factor`] asks for it,
 /// at k× that size (the view scaled by k, so the picture is the same); returns it and k.
 /// With `--perspective` the frame is a pinhole's (`perspective_frame`).
+///
+/// `dims` and `grid` are the volume's at full resolution; the frame returned is that of the level
+/// of detail `--lod` picks ([`super::lod`]), placed exactly where level 0 would be seen, and the
+/// level is returned third.
 pub fn setup_frame(
     args: &RenderArgs,
     dims: [usize; 3],
     grid: &Grid,
     kernel: &Kernel,
     options: FootprintOptions,
-) -> Result<(FrameSetup, usize), CliError> {
+) -> Result<(FrameSetup, usize, u32), CliError> {
     let view = view_for(args, dims, grid)?;
     let size = [args.size.0, args.size.1];
     if let Some(fovy) = args.perspective {
-        return perspective_frame(args, fovy, &view, dims, grid, kernel, options);
+        if let Lod::Level(n @ 1..) = args.lod {
+            return Err(CliError::input(format!(
+                "--lod {n}: {}; use --lod 0 or auto with --perspective",
+                LodError::Perspective
+            )));
+        }
+        let (frame, k) = perspective_frame(args, fovy, &view, dims, grid, kernel, options)?;
+        return Ok((frame, k, 0));
     }
-    let frame = FrameSetup::new(dims, grid, &view, kernel, options, size)?;
+    let fine = FrameSetup::new(dims, grid, &view, kernel, options, size)?;
+    let level = super::lod::choose_level(args.lod, &fine, kernel);
+    let at_level = |fine: &FrameSetup, view: &View| {
+        level_frame(fine, grid, view, kernel, options, level)
+            .map_err(|e| CliError::input(format!("--lod {level}: {e}")))
+    };
+    let frame = at_level(&fine, &view)?;
     let k = supersample::factor(args.supersample, &frame, options);
     if k == 1 {
-        return Ok((frame, 1));
+        return Ok((frame, 1, level));
     }
     let view = View::new(view.to_screen() * k as f32)
         .map_err(|e| CliError::input(format!("view: {e}")))?;
-    let frame = FrameSetup::new(dims, grid, &view, kernel, options, size.map(|n| n * k))?;
-    Ok((frame, k))
+    let fine = FrameSetup::new(dims, grid, &view, kernel, options, size.map(|n| n * k))?;
+    Ok((at_level(&fine, &view)?, k, level))
 }
 
 /// The perspective frame of `--perspective FOVY`: `view`'s rotation (its scale dropped), the eye
@@ -265,7 +290,8 @@ pub fn prepare(args: &RenderArgs) -> Result<Prepared, CliError> {
         mapping,
         min_radius_px: args.footprint.min_radius,
     };
-    let (frame, supersample) = setup_frame(args, dims, &grid, &kernel, options)?;
+    let (frame, supersample, level) = setup_frame(args, dims, &grid, &kernel, options)?;
+
     let order = match &voxels {
         Voxels::Stdin { .. } => {
             if frame.sheet_axis != 2 {
@@ -350,6 +376,19 @@ pub fn prepare(args: &RenderArgs) -> Result<Prepared, CliError> {
             crate::warn!("{w}");
         }
     }
+    // A coarser level of a volume in memory is built once, here; a streamed one as it streams.
+    let voxels = match voxels {
+        Voxels::Memory(v) if level > 0 => {
+            let tf = TransferFunction {
+                lut: &lut,
+                lo: window[0],
+                hi: window[1],
+            };
+            let averaging = super::lod::averaging_for(&shading, tf);
+            Voxels::Memory(super::lod::coarsen_volume(&v, level, &*averaging)?)
+        }
+        other => other,
+    };
     let background_out = args
         .background_file()
         .map(|p| load_background(p, args.size, args.gamma_curve()))
@@ -362,6 +401,8 @@ pub fn prepare(args: &RenderArgs) -> Result<Prepared, CliError> {
         name,
         kernel,
         grid,
+        fine_dims: dims,
+        level,
         frame,
         lut,
         window,
@@ -428,6 +469,8 @@ pub fn describe(p: &Prepared, args: &RenderArgs) -> Json {
                 .map(|e| f64::from(e) / p.supersample as f64),
         )
         .num("supersample", p.supersample as f64)
+        .num("lod", f64::from(p.level))
+        .arr_usize("lod_dims", &p.frame.dims)
         .str(
             "background",
             &match &args.background {

@@ -139,10 +139,17 @@ impl Choice {
         format!(
             "--quality {:.1} dB ({}): chose {} ({why}){rejected}",
             self.target_db,
-            self.reference.name(),
+            reference_name(self.reference),
             self.config.label(),
         )
     }
+}
+
+/// The name the command line and the JSON use for `r`.
+pub fn reference_name(r: QualityReferenceArg) -> String {
+    use clap::ValueEnum;
+    r.to_possible_value()
+        .map_or_else(String::new, |v| v.get_name().to_string())
 }
 
 /// PSNR predicted from a footprint error `e`.
@@ -330,7 +337,7 @@ pub fn pick(p: &Prepared, target_db: f64) -> Result<(Choice, bool), CliError> {
 pub fn quality_json(c: &Choice) -> Json {
     let mut j = Json::object()
         .num("target_db", c.target_db)
-        .str("reference", c.reference.name())
+        .str("reference", &reference_name(c.reference))
         .num("predicted_db", c.predicted_db);
     if let Some(e) = c.footprint_error {
         j = j.num("footprint_error", e).num("k_db", K_DB);

@@ -5,6 +5,7 @@
 pub use super::bands::CoreFrame;
 use super::bands::{run_bands, Phases};
 use super::load::Voxels;
+use super::lod::{with_level, DynSource};
 use super::prepare::Prepared;
 use super::supersample::downsample;
 use super::visible::FrameCache;
@@ -250,18 +251,21 @@ fn run_sheets<P: Precision>(
         count: f.sheet_count(),
         done: 0,
     };
+    // A streamed volume is coarsened to the frame's level as it streams (a volume in memory
+    // already was, when prepared).
+    let (axis, fine) = (f.sheet_axis, p.fine_dims);
+    let averaging = super::lod::averaging_for(&p.shading, p.shader().tf);
+    let mut render =
+        |src: &mut DynSource<'_>| render_from(&mut renderer, &mut ring, &mut show.wrap(src));
     match &p.voxels {
-        Voxels::Memory(v) => {
-            render_from(&mut renderer, &mut ring, &mut show.wrap(MemorySource(v)))?
+        Voxels::Memory(v) => render(&mut MemorySource(v))?,
+        Voxels::File(layout) => {
+            let mut src = FileSource::open(layout.clone())?;
+            with_level(&mut src, fine, p.level, axis, &*averaging, &mut render)?
         }
-        Voxels::File(layout) => render_from(
-            &mut renderer,
-            &mut ring,
-            &mut show.wrap(FileSource::open(layout.clone())?),
-        )?,
         Voxels::Stdin { .. } => {
-            let src = pipe.take().expect("made above for standard input");
-            render_from(&mut renderer, &mut ring, &mut show.wrap(src))?
+            let mut src = pipe.take().expect("made above for standard input");
+            with_level(&mut src, fine, p.level, axis, &*averaging, &mut render)?
         }
     }
     let stats = renderer.finish();

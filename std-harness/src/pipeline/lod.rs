@@ -1,0 +1,166 @@
+//! `--lod auto|N`: levels of detail for minified volumes (the core's `footprint::lod`).
+//!
+//! Level L averages each 2×2×2 block of level L − 1 into one sample with twice the spacing (the
+//! core's module docs justify the box). A volume in memory is coarsened once, when prepared, into
+//! an f32 volume of the level's dims; a streamed one is coarsened as it streams, through nested
+//! [`Coarsened`] adaptors, each holding two sheets of the level above it (so a streamed level-L
+//! render holds 2L more sheets than a level-0 one, each no larger than a level-0 sheet).
+//!
+//! **`auto`** picks the deepest level whose samples still project at most [`AUTO_SPACING_PX`]
+//! apart along the tightest direction (so every pixel still sees more than one sample in each
+//! direction), keeping at least [`MIN_SAMPLES`] samples along the longest axis; a perspective
+//! frame stays at level 0 (the levels are placed for orthographic frames).
+
+use crate::args::Lod;
+use crate::io::stream::MemorySource;
+use crate::io::try_filled;
+use crate::io::volume::{Samples, Volume};
+use crate::CliError;
+use footprint::frame::FrameSetup;
+use footprint::lod::{
+    coarse_dims, level_dims, Averaging, Coarsened, Extinction, Linear, MAX_LEVEL,
+};
+use footprint::shade::{Shading, TransferFunction};
+use footprint::source::SheetSource;
+use footprint::Kernel;
+
+/// `auto` coarsens while a level's samples project at most this far apart, pixels.
+pub const AUTO_SPACING_PX: f32 = 0.6;
+
+/// `auto` keeps at least this many samples along the volume's longest axis.
+pub const MIN_SAMPLES: usize = 8;
+
+/// A source of f32 sheets that reports the harness's errors.
+pub type DynSource<'a> = dyn SheetSource<Sample = f32, Error = CliError> + 'a;
+
+/// The level `lod` asks for, given level 0's frame `fine` at the output size and the kernel.
+pub fn choose_level(lod: Lod, fine: &FrameSetup, kernel: &Kernel) -> u32 {
+    match lod {
+        Lod::Level(n) => n,
+        Lod::Auto => auto_level(fine, kernel.spread()),
+    }
+}
+
+/// `auto`'s level for level 0's frame `fine` at the output size, reconstructed with a kernel of
+/// radius `spread` grid steps (see the module docs).
+pub fn auto_level(fine: &FrameSetup, spread: f32) -> u32 {
+    if fine.camera().is_some() {
+        return 0;
+    }
+    // The projected spacing along the tightest direction, pixels.
+    let spacing = fine.footprint.natural_minor_px / spread;
+    if !(spacing > 0.0 && spacing.is_finite()) {
+        return 0;
+    }
+    let longest = fine.dims.iter().copied().max().unwrap_or(1);
+    let mut level = 0;
+    while level < MAX_LEVEL && spacing * (2u64 << level) as f32 <= AUTO_SPACING_PX {
+        let next =
+            level_dims(fine.dims, level + 1).map_or(0, |d| d.iter().copied().max().unwrap_or(0));
+        if next < MIN_SAMPLES.min(longest) {
+            break;
+        }
+        level += 1;
+    }
+    level
+}
+
+/// How the levels average their samples: by extinction ([`Extinction`]) for emission and Phong
+/// shading through a transfer function whose opacity never decreases with the value; the values
+/// themselves otherwise (iso-surfaces and the texture shade from the value, not the opacity).
+pub fn averaging_for<'a>(shading: &Shading, tf: TransferFunction<'a>) -> Box<dyn Averaging + 'a> {
+    match shading {
+        Shading::Emission | Shading::Phong(_) => match Extinction::new(tf) {
+            Some(e) => Box::new(e),
+            None => Box::new(Linear),
+        },
+        _ => Box::new(Linear),
+    }
+}
+
+/// Runs `f` on `source` (a volume of `dims`) seen at `level` levels coarser, sheets along `axis`:
+/// nested [`Coarsened`] adaptors averaging with `averaging`, each holding two scratch sheets of
+/// the level above it.
+pub fn with_level<R>(
+    source: &mut DynSource<'_>,
+    dims: [usize; 3],
+    level: u32,
+    axis: usize,
+    averaging: &dyn Averaging,
+    f: &mut dyn FnMut(&mut DynSource<'_>) -> Result<R, CliError>,
+) -> Result<R, CliError> {
+    if level == 0 {
+        return f(source);
+    }
+    let len = Coarsened::<&mut DynSource<'_>>::scratch_len(dims, axis);
+    let mut lower = try_filled(len, 0.0f32, "a level-of-detail sheet")?;
+    let mut upper = try_filled(len, 0.0f32, "a level-of-detail sheet")?;
+    let mut coarse = Coarsened::new(source, dims, &mut lower, &mut upper).averaging(averaging);
+    with_level(
+        &mut coarse,
+        coarse_dims(dims),
+        level - 1,
+        axis,
+        averaging,
+        f,
+    )
+}
+
+/// Level `level` of `v`, as an f32 volume with 2ᴸ times the spacing, built sheet by sheet,
+/// averaging with `averaging`.
+pub fn coarsen_volume(
+    v: &Volume,
+    level: u32,
+    averaging: &dyn Averaging,
+) -> Result<Volume, CliError> {
+    let dims = level_dims(v.dims, level).ok_or_else(|| {
+        CliError::input(format!("--lod {level}: the deepest level is {MAX_LEVEL}"))
+    })?;
+    let sheet = dims[0] * dims[1];
+    let mut out = try_filled(sheet * dims[2], 0.0f32, "the level-of-detail volume")?;
+    let mut src = MemorySource(v);
+    with_level(&mut src, v.dims, level, 2, averaging, &mut |s| {
+        for (z, slice) in out.chunks_mut(sheet).enumerate() {
+            s.read_sheet(2, z, slice)?;
+        }
+        Ok(())
+    })?;
+    let scale = (1u64 << level) as f32;
+    Ok(Volume {
+        dims,
+        spacing: v.spacing.map(|s| s * scale),
+        directions: v.directions,
+        samples: Samples::F32(out),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_coarsened_volume_is_the_mean_of_its_blocks() {
+        let dims = [4usize, 3, 2];
+        let data: Vec<f32> = (0..24).map(|i| i as f32).collect();
+        let v = Volume::new(dims, [1.0, 2.0, 3.0], Samples::F32(data.clone()));
+        let c = coarsen_volume(&v, 1, &Linear).unwrap();
+        assert_eq!(c.dims, [2, 2, 1]);
+        assert_eq!(c.spacing, [2.0, 4.0, 6.0]);
+        let Samples::F32(s) = &c.samples else {
+            panic!("f32 samples")
+        };
+        // Coarse (1, 1, 0): fine x 2..3, y 2 (clamped: 2, 2), z 0..1.
+        let mut want = 0.0;
+        for z in 0..2 {
+            for y in [2, 2] {
+                for x in 2..4 {
+                    want += data[(z * 3 + y) * 4 + x];
+                }
+            }
+        }
+        assert_eq!(s[3], want / 8.0);
+        let c0 = coarsen_volume(&v, 0, &Linear).unwrap();
+        assert_eq!(c0.dims, dims);
+        assert!(coarsen_volume(&v, MAX_LEVEL + 1, &Linear).is_err());
+    }
+}
