@@ -110,3 +110,17 @@ fn levels_are_refused_where_they_are_not_placed() {
     .unwrap();
     assert_eq!(prepare(&a).unwrap().level, 0);
 }
+
+/// The chart's levels sweep on a scene levels are not placed for (perspective) charts level 0
+/// alone instead of failing.
+#[test]
+fn the_levels_sweep_stops_where_levels_stop() {
+    let a = parse_args(&[HEADSQ, "--perspective", "30", "--size", "24x24"]).unwrap();
+    let (rows, auto) = footprint_harness::charts::lod::sweep(&a, 1).unwrap();
+    assert_eq!((rows.len(), auto), (1, 0));
+    assert!(rows[0].psnr_db.is_infinite());
+    let a = parse_args(&[HEADSQ, "--size", "24x24"]).unwrap();
+    let (rows, _) = footprint_harness::charts::lod::sweep(&a, 1).unwrap();
+    assert!(rows.len() >= 3, "levels 0, 1, 2 at least: {}", rows.len());
+    assert!(rows[1].psnr_db.is_finite() && rows[1].dims == [32, 32, 47]);
+}

@@ -44,7 +44,18 @@ pub fn sweep(base: &RenderArgs, runs: usize) -> Result<(Vec<LevelRow>, u32), Cli
     let mut levels: Vec<(RenderArgs, Prepared)> = Vec::new();
     for level in 0..=MAX_CHARTED {
         let a = with(Lod::Level(level));
-        let p = prepare(&a)?;
+        let p = match prepare(&a) {
+            Ok(p) => p,
+            // A frame levels are not placed for (perspective): the sweep ends where they stop.
+            Err(e) if level > 0 => {
+                crate::say!(
+                    "levels of detail: the sweep stops at level {}: {e}",
+                    level - 1
+                );
+                break;
+            }
+            Err(e) => return Err(e),
+        };
         let longest = p.frame.dims.iter().copied().max().unwrap_or(0);
         let fine = p.fine_dims.iter().copied().max().unwrap_or(0);
         if level > 0 && longest < crate::pipeline::lod::MIN_SAMPLES.min(fine) {

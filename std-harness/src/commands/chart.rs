@@ -126,13 +126,24 @@ pub fn run(args: &ChartArgs) -> Result<(), CliError> {
         } else {
             let mut a = base.clone();
             a.size = args.popping_size;
-            let pop = popping::popping(&a, crate::io::progress::sheets("popping"))?;
-            io::write_atomic(&dir.join("popping.csv"), pop.csv().as_bytes())?;
-            for (k, name) in popping::NAMES.iter().enumerate() {
-                let (db, az) = pop.worst(k);
-                crate::say!("popping: {name:<21} largest change {db:.2} dB (PSNR) at {az:.1}°");
+            // A scene the sweep cannot render (a footprint-model kernel has no continuous
+            // reference or slabs; a perspective view no slabs) charts without panel (d).
+            match popping::popping(&a, crate::io::progress::sheets("popping")) {
+                Ok(pop) => {
+                    io::write_atomic(&dir.join("popping.csv"), pop.csv().as_bytes())?;
+                    for (k, name) in popping::NAMES.iter().enumerate() {
+                        let (db, az) = pop.worst(k);
+                        crate::say!(
+                            "popping: {name:<21} largest change {db:.2} dB (PSNR) at {az:.1}°"
+                        );
+                    }
+                    Some(pop)
+                }
+                Err(e) => {
+                    crate::warn!("the popping panel (d) is left out: {e}");
+                    None
+                }
             }
-            Some(pop)
         };
         plot::write_stability(&dir, &curves, pop.as_ref())?;
         for (panel, set) in ["rotation", "anisotropy", "footprint size"]
