@@ -492,13 +492,11 @@ mod tests {
 
     #[test]
     fn extinction_averaging_keeps_the_mean_extinction() {
-        // Opacity 0 → 0.9 over values 0 → 1, then flat.
-        let lut = [
-            [1.0, 1.0, 1.0, 0.0],
-            [1.0, 1.0, 1.0, 0.5],
-            [1.0, 1.0, 1.0, 0.9],
-            [1.0, 1.0, 1.0, 0.9],
-        ];
+        // White, opacity 0 → 0.9 over values 0 → 2, then flat to 3.
+        let white = |alphas: &[f32]| -> [[f32; 4]; 4] {
+            core::array::from_fn(|i| [1.0, 1.0, 1.0, alphas[i.min(alphas.len() - 1)]])
+        };
+        let lut = white(&[0.0, 0.5, 0.9, 0.9]);
         let tf = TransferFunction {
             lut: &lut,
             lo: 0.0,
@@ -530,16 +528,8 @@ mod tests {
         // On the flat top every value has the same extinction: the plain mean is kept.
         assert_eq!(e.block(1, &[[2.5, 2.5]; 4]), 2.5);
         // Opacity that falls somewhere has no inverse.
-        let bump = [
-            [1.0, 1.0, 1.0, 0.0],
-            [1.0, 1.0, 1.0, 0.5],
-            [1.0, 1.0, 1.0, 0.2],
-        ];
-        let bumpy = TransferFunction {
-            lut: &bump,
-            lo: 0.0,
-            hi: 1.0,
-        };
+        let bump = white(&[0.0, 0.5, 0.2]);
+        let bumpy = TransferFunction { lut: &bump, ..tf };
         assert!(Extinction::new(bumpy).is_none());
     }
 

@@ -338,16 +338,14 @@ pub fn render_ref(p: &Prepared) -> Result<(Vec<[f64; 4]>, f64), CliError> {
     Ok((img, start.elapsed().as_secs_f64()))
 }
 
-/// The continuous reference of `p` (see [`crate::reference::continuous`]): the converged image
-/// (at the output size) and how it converged, and its seconds. The volume must be in memory.
-pub fn render_continuous_ref(
+/// `p`'s volume (it must be in memory) and the continuous reference's scene of it.
+fn continuous_scene(
     p: &Prepared,
     reconstruction: Reconstruction,
-) -> Result<(Continuous, f64), CliError> {
+) -> Result<(&crate::io::volume::Volume, ContinuousScene<'_>), CliError> {
     let volume = p.volume().ok_or_else(|| {
         CliError::input("the continuous reference needs the volume in memory: drop --stream")
     })?;
-    let start = Instant::now();
     let scene = ContinuousScene {
         frame: &p.frame,
         kernel: &p.kernel,
@@ -355,6 +353,17 @@ pub fn render_continuous_ref(
         background: p.background.as_deref(),
         reconstruction,
     };
+    Ok((volume, scene))
+}
+
+/// The continuous reference of `p` (see [`crate::reference::continuous`]): the converged image
+/// (at the output size) and how it converged, and its seconds. The volume must be in memory.
+pub fn render_continuous_ref(
+    p: &Prepared,
+    reconstruction: Reconstruction,
+) -> Result<(Continuous, f64), CliError> {
+    let start = Instant::now();
+    let (volume, scene) = continuous_scene(p, reconstruction)?;
     let mut bar = sheets("continuous");
     let axis = p.frame.sheet_axis;
     let mut c = render_continuous(
@@ -373,17 +382,8 @@ pub fn render_continuous_ref(
 /// them, as the renders are averaged): their values in the order given, how it converged, and
 /// its seconds. Kernel reconstruction. The volume must be in memory.
 pub fn continuous_at(p: &Prepared, pixels: &[[usize; 2]]) -> Result<(Continuous, f64), CliError> {
-    let volume = p.volume().ok_or_else(|| {
-        CliError::input("the continuous reference needs the volume in memory: drop --stream")
-    })?;
     let start = Instant::now();
-    let scene = ContinuousScene {
-        frame: &p.frame,
-        kernel: &p.kernel,
-        shader: p.shader(),
-        background: p.background.as_deref(),
-        reconstruction: Reconstruction::Kernel,
-    };
+    let (volume, scene) = continuous_scene(p, Reconstruction::Kernel)?;
     let k = p.supersample;
     let rays: Vec<[usize; 2]> = pixels
         .iter()
