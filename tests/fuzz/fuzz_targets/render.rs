@@ -18,11 +18,13 @@
 //!   (S itself is not 1: a kernel cut off sharply, sampled by a few pixels, sums to 1 only in the
 //!   limit.)
 //!
-//! Image-aligned slabs (`--slicing image`) are rendered too, checked for finite, valid colour.
+//! Image-aligned slabs (`--slicing image`) and level of detail 1 (`--lod 1`) are rendered too,
+//! checked for finite, valid colour.
 //!
 //! Input bytes are read as parameters in a fixed order (missing bytes read as 0).
 use footprint::fixed::{FixedTable, ONE};
 use footprint::frame::{FrameSetup, Order};
+use footprint::lod::level_frame;
 use footprint::render::{FixedPath, FloatPath, PerspectivePath, SlabSetup};
 use footprint::table::SectionTable;
 use footprint::{FootprintOptions, GenericTable, Grid, Kernel, Lookup, View, ViewTable};
@@ -132,7 +134,8 @@ fuzz_target!(|data: &[u8]| {
     // a frame that is accepted renders finite RGBA in [0, 1] both ways.
     let eye = 8.0 * b.log2(6.0);
     if let Ok(view) = View::from_angles(angles, zoom, dims, &grid, size) {
-        if let Ok(frame) = FrameSetup::perspective(dims, &grid, &view, &kernel, options, size, eye) {
+        if let Ok(frame) = FrameSetup::perspective(dims, &grid, &view, &kernel, options, size, eye)
+        {
             if let Ok(path) = PerspectivePath::new(&frame, &kernel, options, &generic, lookup) {
                 for order in [Order::BackToFront, Order::FrontToBack] {
                     let img = footprint_fuzz::render_volume(&frame, path, order, &samples, &lut);
@@ -156,6 +159,27 @@ fuzz_target!(|data: &[u8]| {
                         );
                         check_image(&img, "slab render");
                     }
+                }
+            }
+        }
+    }
+
+    // Level of detail 1, coarsened as it streams and placed where level 0 is seen: a frame that
+    // is accepted renders finite RGBA in [0, 1] both ways.
+    if let Ok(view) = View::from_angles(angles, zoom, dims, &grid, size) {
+        if let Ok(fine) = FrameSetup::new(dims, &grid, &view, &kernel, options, size) {
+            if let Ok(level) = level_frame(&fine, &grid, &view, &kernel, options, 1) {
+                let table = ViewTable::<N>::build(&level.footprint, &generic, lookup, lookup);
+                for order in [Order::BackToFront, Order::FrontToBack] {
+                    let img = footprint_fuzz::render_level(
+                        &level,
+                        dims,
+                        FloatPath { sampler: &table },
+                        order,
+                        &samples,
+                        &lut,
+                    );
+                    check_image(&img, "level 1 render");
                 }
             }
         }

@@ -3,15 +3,16 @@
 
 use footprint::composite::RowSpan;
 use footprint::frame::{FrameSetup, Order};
+use footprint::lod::{Averaging, Coarsened, Extinction, Linear};
 use footprint::render::{
     Precision, RenderBuffers, SheetRenderer, SheetRing, SlabBuffers, SlabRenderer, SlabSetup,
     SlabVoxel,
 };
 use footprint::shade::Lighting;
-use footprint::table::SectionTable;
 use footprint::shade::{Shader, Shading, TransferFunction};
 use footprint::source::render_from;
 use footprint::splat::ImageMut;
+use footprint::table::SectionTable;
 use footprint::volume::MemoryVolume;
 use std::path::PathBuf;
 
@@ -58,6 +59,48 @@ pub fn render_volume<P: Precision>(
     img
 }
 
+/// Renders level 1 of `samples` (u8, x fastest, `fine_dims`) through `lut`, emission, with
+/// `path` and `frame` (level 1's, `footprint::lod::level_frame`): the level is built as it
+/// streams by [`Coarsened`], averaging by extinction when the opacity never falls. Any renderer
+/// error is a failure: the frame is valid.
+pub fn render_level<P: Precision>(
+    frame: &FrameSetup,
+    fine_dims: [usize; 3],
+    path: P,
+    order: Order,
+    samples: &[u8],
+    lut: &[[f32; 4]],
+) -> Vec<P::Pixel> {
+    let shader = emission(lut);
+    let extinction = Extinction::new(shader.tf);
+    let averaging: &dyn Averaging = match &extinction {
+        Some(e) => e,
+        None => &Linear,
+    };
+    let n = frame.image_len();
+    let (mut acc, mut img, mut rows) = (
+        vec![P::ACC_ZERO; n],
+        vec![P::CLEAR; n],
+        vec![RowSpan::EMPTY; frame.size[1]],
+    );
+    let buffers = RenderBuffers {
+        accumulator: &mut acc,
+        image: &mut img,
+        rows: &mut rows,
+    };
+    let mut r = SheetRenderer::with_path(frame, path, shader, order, buffers, None)
+        .expect("buffers sized for the frame");
+    let mut storage = vec![0.0f32; 3 * frame.sheet_shape().0];
+    let mut ring = SheetRing::new(&mut storage, frame, order).expect("ring sized for the frame");
+    let volume = MemoryVolume::new(samples, fine_dims).expect("samples match dims");
+    let len = Coarsened::<MemoryVolume<u8>>::scratch_len(fine_dims, frame.sheet_axis);
+    let (mut lower, mut upper) = (vec![0u8; len], vec![0u8; len]);
+    let mut source = Coarsened::new(volume, fine_dims, &mut lower, &mut upper).averaging(averaging);
+    render_from(&mut r, &mut ring, &mut source).expect("in-memory source");
+    r.finish();
+    img
+}
+
 /// Renders `samples` as [`render_volume`] does, with image-aligned slabs: every voxel shaded for
 /// one world unit, fed in the order of the slab it reaches first, into a ring of slab
 /// accumulators. Any renderer error is a failure: the setup is valid.
@@ -77,7 +120,13 @@ pub fn render_slabs<const R: usize, const T: usize>(
         for j in 0..d[1] {
             for i in 0..d[0] {
                 let value = f32::from(samples[(k * d[1] + j) * d[0] + i]);
-                let rgba = shader.shade(&lighting, value, || footprint::glam::Vec3::ZERO, [i, j, k], d);
+                let rgba = shader.shade(
+                    &lighting,
+                    value,
+                    || footprint::glam::Vec3::ZERO,
+                    [i, j, k],
+                    d,
+                );
                 let position = frame
                     .affine_position([i, j, k].map(|c| c as f32))
                     .to_array();
@@ -110,7 +159,8 @@ pub fn render_slabs<const R: usize, const T: usize>(
     let mut next = 0;
     for step in 0..setup.slab_count() {
         while next < voxels.len() && voxels[next].0 == step {
-            r.splat_voxel(&voxels[next].1).expect("voxels in slab order");
+            r.splat_voxel(&voxels[next].1)
+                .expect("voxels in slab order");
             next += 1;
         }
         r.composite_next();
