@@ -10,7 +10,7 @@ use footprint::render::{
 };
 use footprint::shade::Lighting;
 use footprint::shade::{Shader, Shading, TransferFunction};
-use footprint::source::render_from;
+use footprint::source::{render_from, SheetSource};
 use footprint::splat::ImageMut;
 use footprint::table::SectionTable;
 use footprint::volume::MemoryVolume;
@@ -28,16 +28,20 @@ fn emission(lut: &[[f32; 4]]) -> Shader<'_> {
     }
 }
 
-/// Renders `samples` (u8, x fastest, `frame.dims`) through `lut` (straight RGBA over 0..=255),
-/// emission, with `path`; returns the image. Any renderer error is a failure: the frame is valid.
-pub fn render_volume<P: Precision>(
+/// Renders every sheet `source` delivers for `frame` through `lut` (straight RGBA over
+/// 0..=255), emission, with `path`, through a sheet ring; returns the image. Any renderer error
+/// is a failure: the frame is valid.
+fn render_source<P: Precision, S: SheetSource>(
     frame: &FrameSetup,
     path: P,
     order: Order,
-    samples: &[u8],
     lut: &[[f32; 4]],
-) -> Vec<P::Pixel> {
-    let shader = emission(lut);
+    mut source: S,
+) -> Vec<P::Pixel>
+where
+    S::Sample: Default,
+    S::Error: std::fmt::Debug,
+{
     let n = frame.image_len();
     let (mut acc, mut img, mut rows) = (
         vec![P::ACC_ZERO; n],
@@ -49,14 +53,26 @@ pub fn render_volume<P: Precision>(
         image: &mut img,
         rows: &mut rows,
     };
-    let mut r = SheetRenderer::with_path(frame, path, shader, order, buffers, None)
+    let mut r = SheetRenderer::with_path(frame, path, emission(lut), order, buffers, None)
         .expect("buffers sized for the frame");
-    let mut storage = vec![0u8; 3 * frame.sheet_shape().0];
+    let mut storage = vec![S::Sample::default(); 3 * frame.sheet_shape().0];
     let mut ring = SheetRing::new(&mut storage, frame, order).expect("ring sized for the frame");
-    let mut volume = MemoryVolume::new(samples, frame.dims).expect("samples match dims");
-    render_from(&mut r, &mut ring, &mut volume).expect("in-memory source");
+    render_from(&mut r, &mut ring, &mut source).expect("in-memory source");
     r.finish();
     img
+}
+
+/// Renders `samples` (u8, x fastest, `frame.dims`) through `lut` (straight RGBA over 0..=255),
+/// emission, with `path`; returns the image. Any renderer error is a failure: the frame is valid.
+pub fn render_volume<P: Precision>(
+    frame: &FrameSetup,
+    path: P,
+    order: Order,
+    samples: &[u8],
+    lut: &[[f32; 4]],
+) -> Vec<P::Pixel> {
+    let volume = MemoryVolume::new(samples, frame.dims).expect("samples match dims");
+    render_source(frame, path, order, lut, volume)
 }
 
 /// Renders level 1 of `samples` (u8, x fastest, `fine_dims`) through `lut`, emission, with
@@ -71,34 +87,16 @@ pub fn render_level<P: Precision>(
     samples: &[u8],
     lut: &[[f32; 4]],
 ) -> Vec<P::Pixel> {
-    let shader = emission(lut);
-    let extinction = Extinction::new(shader.tf);
+    let extinction = Extinction::new(emission(lut).tf);
     let averaging: &dyn Averaging = match &extinction {
         Some(e) => e,
         None => &Linear,
     };
-    let n = frame.image_len();
-    let (mut acc, mut img, mut rows) = (
-        vec![P::ACC_ZERO; n],
-        vec![P::CLEAR; n],
-        vec![RowSpan::EMPTY; frame.size[1]],
-    );
-    let buffers = RenderBuffers {
-        accumulator: &mut acc,
-        image: &mut img,
-        rows: &mut rows,
-    };
-    let mut r = SheetRenderer::with_path(frame, path, shader, order, buffers, None)
-        .expect("buffers sized for the frame");
-    let mut storage = vec![0.0f32; 3 * frame.sheet_shape().0];
-    let mut ring = SheetRing::new(&mut storage, frame, order).expect("ring sized for the frame");
     let volume = MemoryVolume::new(samples, fine_dims).expect("samples match dims");
     let len = Coarsened::<MemoryVolume<u8>>::scratch_len(fine_dims, frame.sheet_axis);
     let (mut lower, mut upper) = (vec![0u8; len], vec![0u8; len]);
-    let mut source = Coarsened::new(volume, fine_dims, &mut lower, &mut upper).averaging(averaging);
-    render_from(&mut r, &mut ring, &mut source).expect("in-memory source");
-    r.finish();
-    img
+    let source = Coarsened::new(volume, fine_dims, &mut lower, &mut upper).averaging(averaging);
+    render_source(frame, path, order, lut, source)
 }
 
 /// Renders `samples` as [`render_volume`] does, with image-aligned slabs: every voxel shaded for
