@@ -193,9 +193,9 @@ pub fn choose_continuous(
         }
     };
     let (config, e) = tried[index];
-    let rejected = tried[..index.min(tried.len())]
+    // Candidates are distinct, so those tried before the choice are the cheaper ones.
+    let rejected = tried[..index]
         .iter()
-        .filter(|(c, _)| *c != config)
         .map(|(c, e)| (*c, e.bound_db))
         .collect();
     Ok(Choice {
