@@ -1,6 +1,6 @@
 //! The levels-of-detail sweep (`footprint chart`, `lod.csv` and `lod.svg`/`.png`): every level
-//! of the scene from 0 (full resolution) down while the longest axis keeps
-//! `pipeline::lod::MIN_SAMPLES` samples (at most [`MAX_CHARTED`]), each rendered with the
+//! of the scene from 0 (full resolution) down to `pipeline::lod::deepest_level` (at most
+//! [`MAX_CHARTED`]), each rendered with the
 //! chart's flags, its frame time (median over the runs, the levels timed in turn within each run
 //! so that drift hits them alike) and its PSNR (RGB) against level 0's image. `auto`'s pick is
 //! marked.
@@ -40,9 +40,11 @@ pub fn sweep(base: &RenderArgs, runs: usize) -> Result<(Vec<LevelRow>, u32), Cli
         a.quality = None;
         a
     };
-    let auto = prepare(&with(Lod::Auto))?.level;
+    let auto = prepare(&with(Lod::Auto))?;
+    let deepest = crate::pipeline::lod::deepest_level(auto.fine_dims).min(MAX_CHARTED);
+    let auto = auto.level;
     let mut levels: Vec<(RenderArgs, Prepared)> = Vec::new();
-    for level in 0..=MAX_CHARTED {
+    for level in 0..=deepest {
         let a = with(Lod::Level(level));
         let p = match prepare(&a) {
             Ok(p) => p,
@@ -56,11 +58,6 @@ pub fn sweep(base: &RenderArgs, runs: usize) -> Result<(Vec<LevelRow>, u32), Cli
             }
             Err(e) => return Err(e),
         };
-        let longest = p.frame.dims.iter().copied().max().unwrap_or(0);
-        let fine = p.fine_dims.iter().copied().max().unwrap_or(0);
-        if level > 0 && longest < crate::pipeline::lod::MIN_SAMPLES.min(fine) {
-            break;
-        }
         levels.push((a, p));
     }
     let mut caches: Vec<FrameCache> = levels.iter().map(|_| FrameCache::default()).collect();

@@ -52,14 +52,21 @@ pub fn auto_level(fine: &FrameSetup, spread: f32) -> u32 {
     if !(spacing > 0.0 && spacing.is_finite()) {
         return 0;
     }
-    let longest = fine.dims.iter().copied().max().unwrap_or(1);
+    let deepest = deepest_level(fine.dims);
     let mut level = 0;
-    while level < MAX_LEVEL && spacing * (2u64 << level) as f32 <= AUTO_SPACING_PX {
-        let next =
-            level_dims(fine.dims, level + 1).map_or(0, |d| d.iter().copied().max().unwrap_or(0));
-        if next < MIN_SAMPLES.min(longest) {
-            break;
-        }
+    while level < deepest && spacing * (2u64 << level) as f32 <= AUTO_SPACING_PX {
+        level += 1;
+    }
+    level
+}
+
+/// The deepest level of a `dims` volume whose longest axis keeps at least [`MIN_SAMPLES`]
+/// samples (or all of them, for a volume with fewer), at most [`MAX_LEVEL`].
+pub fn deepest_level(dims: [usize; 3]) -> u32 {
+    let longest = |d: [usize; 3]| d.iter().copied().max().unwrap_or(0);
+    let least = MIN_SAMPLES.min(longest(dims));
+    let mut level = 0;
+    while level < MAX_LEVEL && level_dims(dims, level + 1).is_some_and(|d| longest(d) >= least) {
         level += 1;
     }
     level
