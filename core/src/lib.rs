@@ -25,6 +25,8 @@
 //!   and the sheet window, ring and gradient (`sheets.rs`).
 //! - [`source`]: the `SheetSource` interface for voxels streamed from outside, and its driver.
 //! - [`lod`]: levels of detail, coarser levels built sheet by sheet from any `SheetSource`.
+//! - [`refine`]: the paper's adaptive re-sampling: refined axes, Catmull–Rom interpolation,
+//!   refinement factors (rendered by `render/refined.rs`).
 //! - [`volume`]: a volume already in memory (`&[T]`, x fastest) as a `SheetSource`.
 //! - [`output`]: the result as 8-bit sRGB RGBA or RGB565 pixels.
 //!
@@ -96,6 +98,7 @@ pub mod kernel;
 pub mod lod;
 pub mod math;
 pub mod output;
+pub mod refine;
 pub mod render;
 pub mod shade;
 pub mod source;

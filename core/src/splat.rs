@@ -27,6 +27,15 @@ pub trait Sampler {
             *w = self.weight([qx0 + k as f32, qy]);
         }
     }
+    /// Weights along any line of pixels: `out[k]` at offset `q0 + k·step`. Samplers that can
+    /// step through their table override it.
+    #[inline]
+    fn line_weights(&self, q0: [f32; 2], step: [f32; 2], out: &mut [f32]) {
+        for (k, w) in out.iter_mut().enumerate() {
+            let k = k as f32;
+            *w = self.weight([q0[0] + k * step[0], q0[1] + k * step[1]]);
+        }
+    }
 }
 
 impl<const M: usize> Sampler for ViewTable<M> {
@@ -40,6 +49,10 @@ impl<const M: usize> Sampler for ViewTable<M> {
     #[inline]
     fn row_weights(&self, qx0: f32, qy: f32, out: &mut [f32]) {
         ViewTable::row_weights(self, qx0, qy, out)
+    }
+    #[inline]
+    fn line_weights(&self, q0: [f32; 2], step: [f32; 2], out: &mut [f32]) {
+        ViewTable::line_weights(self, q0, step, out)
     }
 }
 

@@ -23,12 +23,16 @@
 mod band;
 mod perspective;
 mod precision;
+mod refined;
+mod scaled;
 mod sheets;
 pub mod slabs;
 mod visible;
 
 pub use perspective::PerspectivePath;
 pub use precision::{FixedPath, FloatPath, Precision};
+pub use refined::{key_spacings, rate_index, spacing_key, RefineTables, RefinedGrid, SPACING_KEYS};
+pub use scaled::{sheet_map, splat_scaled, ScaledFootprint};
 pub use sheets::{gradient, SheetRing, SheetWindow};
 pub use slabs::{SlabBuffers, SlabError, SlabRenderer, SlabSetup, SlabVoxel};
 pub use visible::{classify_sheet, VisibleSheet, VisibleVoxel};

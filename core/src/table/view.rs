@@ -252,15 +252,43 @@ impl<const M: usize> ViewTable<M> {
     /// [`ViewTable::row_weights`] in the unit layout.
     #[inline]
     fn unit_row_weights(&self, qx0: f32, qy: f32, out: &mut [f32]) {
+        self.line_weights([qx0, qy], [1.0, 0.0], out);
+    }
+
+    /// Weights along a line of pixels: `out[k]` at screen offset `q0 + k·step` (pixels) — what
+    /// [`ViewTable::weight`] gives there, with both table coordinates stepped per pixel in 16.16
+    /// fixed point (positions rounded to 2⁻¹⁶ of a node). [`ViewTable::row_weights`] is the
+    /// case `step` = (1, 0); a refined sample's footprint read at scaled coordinates
+    /// ([`crate::render::splat_scaled`]) walks other directions.
+    #[inline]
+    pub fn line_weights(&self, q0: [f32; 2], step: [f32; 2], out: &mut [f32]) {
         const ONE: f32 = 65536.0;
-        let half = 0.5 * (M - 1) as f32;
-        let m = &self.unit_map;
-        let t0 = [
-            m[0][0] * qx0 + m[0][1] * qy + half,
-            m[1][0] * qx0 + m[1][1] * qy + half,
-        ];
+        let (t0, dt) = match self.layout {
+            ViewLayout::Unit => {
+                let half = 0.5 * (M - 1) as f32;
+                let m = &self.unit_map;
+                (
+                    [
+                        m[0][0] * q0[0] + m[0][1] * q0[1] + half,
+                        m[1][0] * q0[0] + m[1][1] * q0[1] + half,
+                    ],
+                    [
+                        m[0][0] * step[0] + m[0][1] * step[1],
+                        m[1][0] * step[0] + m[1][1] * step[1],
+                    ],
+                )
+            }
+            ViewLayout::ScreenBox => {
+                let [ex, ey] = self.footprint.half_extent;
+                let n = self.nodes_per_px;
+                (
+                    [(q0[0] + ex) * n[0], (q0[1] + ey) * n[1]],
+                    [step[0] * n[0], step[1] * n[1]],
+                )
+            }
+        };
         let n = out.len() as f32;
-        let t1 = [t0[0] + n * m[0][0], t0[1] + n * m[1][0]];
+        let t1 = [t0[0] + n * dt[0], t0[1] + n * dt[1]];
         // The fixed-point walk must stay within ±2³¹ nodes; anything else (huge offsets, NaN)
         // takes the per-pixel path, which reads zero off the table.
         let bound = 16384.0;
@@ -270,14 +298,15 @@ impl<const M: usize> ViewTable<M> {
             && t1[1].abs() < bound)
         {
             for (k, w) in out.iter_mut().enumerate() {
-                *w = self.weight([qx0 + k as f32, qy]);
+                let k = k as f32;
+                *w = self.weight([q0[0] + k * step[0], q0[1] + k * step[1]]);
             }
             return;
         }
         let fx = |x: f32| (x * ONE + 0.5 * x.signum()) as i64;
         let last_fx = ((M - 1) as i64) << 16;
         let (mut tx, mut ty) = (fx(t0[0]), fx(t0[1]));
-        let (sx, sy) = (fx(m[0][0]), fx(m[1][0]));
+        let (sx, sy) = (fx(dt[0]), fx(dt[1]));
         for w in out.iter_mut() {
             let inside = (0..=last_fx).contains(&tx) && (0..=last_fx).contains(&ty);
             *w = if !inside {
