@@ -1,7 +1,9 @@
 //! The built-in default scene: an electron-density-like field, after the paper's Image 8 (the
 //! p-orbitals of copper chloride): |ψ|² of a hydrogen-like 3d_xy orbital (four lobes) plus a
 //! weaker 2p_z pair, tilted 30° about x and 20° about y so the default front view shows all of
-//! them, on a 64³ grid of spacing 1, normalised to a peak of 1.
+//! them, on a 64³ grid of spacing 1, normalised to a peak of 1. [`volume`] samples the same field
+//! on an n³ grid over the same box (spacing 63/(n − 1)), with the same normalisation, so grids of
+//! any side render to the same image up to their sampling.
 
 use crate::io::volume::{Samples, Volume};
 
@@ -10,7 +12,24 @@ pub const SIDE: usize = 64;
 
 /// Builds the default volume (f32 densities in [0, 1]).
 pub fn default_volume() -> Volume {
-    let n = SIDE;
+    volume(SIDE)
+}
+
+/// The field sampled on an `n`³ grid (n ≥ 2) over the default volume's box, divided by the
+/// default grid's peak (so another grid's peak may differ slightly from 1).
+pub fn volume(n: usize) -> Volume {
+    let (data, spacing) = sample(n);
+    let peak = if n == SIDE {
+        data.iter().copied().fold(0.0f32, f32::max)
+    } else {
+        sample(SIDE).0.into_iter().fold(0.0f32, f32::max)
+    };
+    let data = data.into_iter().map(|v| v / peak).collect();
+    Volume::new([n; 3], [spacing; 3], Samples::F32(data))
+}
+
+/// The unnormalised field on an `n`³ grid, and the grid's spacing (world units).
+fn sample(n: usize) -> (Vec<f32>, f32) {
     let c = (n as f32 - 1.0) / 2.0;
     // Grid spans ±18 Bohr radii.
     let s = 18.0 / c;
@@ -33,9 +52,5 @@ pub fn default_volume() -> Volume {
             }
         }
     }
-    let max = data.iter().copied().fold(0.0f32, f32::max);
-    for v in &mut data {
-        *v /= max;
-    }
-    Volume::new([n; 3], [1.0; 3], Samples::F32(data))
+    (data, (SIDE as f32 - 1.0) / (n as f32 - 1.0))
 }

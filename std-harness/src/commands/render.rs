@@ -4,8 +4,9 @@
 use crate::args::{MethodArg, RenderArgs};
 use crate::io::image::{check_style, encode_rgb_for, RGB_EXTENSIONS};
 use crate::io::outputs::{self, Planned};
+use crate::pipeline::visible::FrameCache;
 use crate::pipeline::{choose::apply_quality, quality::quality_json};
-use crate::pipeline::{describe, prepare, render_core, render_ref};
+use crate::pipeline::{describe, prepare, render_frame, render_ref};
 use crate::CliError;
 use std::path::PathBuf;
 
@@ -37,7 +38,20 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         crate::say!("{}: f64 reference render in {:.3} s", p.name, secs);
         (rgb, describe(&p, args).num("seconds", secs))
     } else {
-        let (img, stats, secs) = render_core(&p, args)?;
+        let frame = render_frame(&p, args, args.accum, &mut FrameCache::default())?;
+        let (img, stats, secs) = (frame.image, frame.stats, frame.seconds);
+        if let Some(r) = &frame.refine {
+            crate::say!(
+                "{}: refined at {}: {} samples from {} (intervals at factors 1/2/4 along i {:?}, j {:?}, k {:?})",
+                p.name,
+                r.threshold,
+                r.samples,
+                r.coarse_samples,
+                r.counts()[0],
+                r.counts()[1],
+                r.counts()[2]
+            );
+        }
         crate::say!(
             "{}: {}x{}{} in {:.3} s; {} sheets along {}, {} voxels ({} splatted), {} pixel updates, {} composites",
             p.name,
@@ -61,6 +75,10 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
             .num("voxels_splatted", stats.voxels_splatted as f64)
             .num("pixel_updates", stats.pixel_updates as f64)
             .num("pixels_composited", stats.pixels_composited as f64);
+        let j = match &frame.refine {
+            Some(r) => j.obj("refine", r.json()),
+            None => j,
+        };
         (img, j)
     };
     let summary = match &choice {

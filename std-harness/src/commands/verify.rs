@@ -73,6 +73,13 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
             "verify compares a table method with the reference: choose robust, paper or direct",
         ));
     }
+    if r.refine.is_some() {
+        return Err(CliError::input(
+            "verify's references render the grid as given, so they would measure --refine \
+             against the unrefined grid: chart refinement against a finer sampling with \
+             `footprint chart --refine-only` (the built-in scene)",
+        ));
+    }
     let mut planned = Vec::new();
     for (flag, path, extensions) in [
         ("--out", &r.out, &RGB_EXTENSIONS[..]),

@@ -42,6 +42,8 @@ pub struct CoreFrame {
     pub threads: usize,
     /// Visible voxels in the lists the frame rendered (`None` when streamed).
     pub visible: Option<usize>,
+    /// What `--refine` refined (`None` without it).
+    pub refine: Option<super::refinement::Refinement>,
 }
 
 /// The rows of band `t` of `bands` over an image `height` rows high: as equal as can be, the

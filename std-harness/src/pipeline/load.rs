@@ -80,6 +80,11 @@ pub(crate) struct Loaded {
 
 pub(crate) fn load_voxels(args: &RenderArgs) -> Result<Loaded, CliError> {
     let raw = raw_options(args)?;
+    if args.scene_size != scene::SIDE && (args.volume.is_some() || args.stream.is_some()) {
+        return Err(CliError::input(
+            "--scene-size samples the built-in scene: give no volume with it",
+        ));
+    }
     let Some(stream) = &args.stream else {
         let (volume, name) = match &args.volume {
             Some(path) => (
@@ -87,8 +92,11 @@ pub(crate) fn load_voxels(args: &RenderArgs) -> Result<Loaded, CliError> {
                 path.display().to_string(),
             ),
             None => (
-                scene::default_volume(),
-                "built-in electron-density scene".to_string(),
+                scene::volume(args.scene_size),
+                match args.scene_size {
+                    scene::SIDE => "built-in electron-density scene".to_string(),
+                    n => format!("built-in electron-density scene, {n}^3"),
+                },
             ),
         };
         let (dims, grid, range) = (volume.dims, volume.grid_to_world(), Some(volume.range()));

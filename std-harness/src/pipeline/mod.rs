@@ -18,6 +18,8 @@
 //!   rays against the continuous integral.
 //! - [`slabs`]: `--slicing image`, the core's image-aligned slabs over the visible voxels.
 //! - [`lod`]: `--lod`, levels of detail for minified volumes (coarser levels, built once or as they stream).
+//! - [`refine`]: `--refine`, the paper's adaptive re-sampling for magnified volumes
+//!   ([`refinement`]: what it refined, carried by a frame).
 //! - [`single`]: one voxel rendered on its own (`footprint splat`, the stability charts).
 //!
 //! It reads the shared argument structs of [`crate::args`] and calls down into [`crate::io`],
@@ -31,6 +33,8 @@ pub mod lod;
 pub mod pilot;
 pub mod prepare;
 pub mod quality;
+pub mod refine;
+pub mod refinement;
 pub mod run;
 pub mod single;
 pub mod slabs;

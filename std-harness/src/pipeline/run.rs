@@ -60,6 +60,16 @@ pub fn render_frame(
     accum: AccumArg,
     cache: &mut FrameCache,
 ) -> Result<CoreFrame, CliError> {
+    if let Some(threshold) = args.refine {
+        super::refine::check(
+            p,
+            &RenderArgs {
+                accum,
+                ..args.clone()
+            },
+        )?;
+        return super::refine::render_refined(p, args, threshold);
+    }
     if args.slicing == SlicingArg::Image {
         return super::slabs::render_slabs(p, args, accum, cache);
     }
@@ -148,6 +158,7 @@ pub fn render_frame(
             seconds: start.elapsed().as_secs_f64(),
             phases,
             threads: if visible.is_some() { threads.clamp(1, p.frame.size[1]) } else { 1 },
+            refine: None,
             visible,
         }
     })

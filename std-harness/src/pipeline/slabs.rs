@@ -102,6 +102,7 @@ pub fn render_slabs(
         phases,
         threads: threads.clamp(1, p.frame.size[1]),
         visible: Some(voxels.voxels.len()),
+        refine: None,
     })
 }
 

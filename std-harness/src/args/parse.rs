@@ -1,0 +1,159 @@
+//! Value parsers for the shared flags: lists, views, sizes, levels of detail, supersampling.
+
+/// Parses `a,b,c,…` into exactly `n` finite numbers.
+pub fn parse_list<const N: usize>(s: &str) -> Result<[f32; N], String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    if parts.len() != N {
+        return Err(format!(
+            "expected {N} comma-separated numbers, got {}",
+            parts.len()
+        ));
+    }
+    let mut out = [0.0f32; N];
+    for (o, p) in out.iter_mut().zip(parts) {
+        *o = p
+            .trim()
+            .parse()
+            .map_err(|_| format!("'{p}' is not a number"))?;
+        if !o.is_finite() {
+            return Err(format!("'{p}' is not finite"));
+        }
+    }
+    Ok(out)
+}
+
+/// ParaView's view-direction buttons as (azimuth, elevation, roll) of [`parse_view`]'s camera:
+/// "+x" looks along +x with +z up, and so on; ±z keep +y up.
+pub const VIEW_DIRECTIONS: [(&str, [f32; 3]); 6] = [
+    ("+x", [-90.0, 0.0, 90.0]),
+    ("-x", [90.0, 0.0, -90.0]),
+    ("+y", [0.0, -90.0, 0.0]),
+    ("-y", [0.0, 90.0, 180.0]),
+    ("+z", [180.0, 0.0, 0.0]),
+    ("-z", [0.0, 0.0, 0.0]),
+];
+
+/// Parses `--view`: `AZ,EL,ROLL` in degrees, or one of ParaView's directions
+/// ([`VIEW_DIRECTIONS`]).
+pub fn parse_view(s: &str) -> Result<[f32; 3], String> {
+    let t = s.trim().to_ascii_lowercase();
+    if let Some((_, a)) = VIEW_DIRECTIONS.iter().find(|(n, _)| *n == t) {
+        return Ok(*a);
+    }
+    parse_list::<3>(s).map_err(|e| format!("{e} (or one of +x, -x, +y, -y, +z, -z)"))
+}
+
+/// Parses `X,Y,Z` voxel spacing: three positive finite numbers (world units).
+pub fn parse_spacing(s: &str) -> Result<[f32; 3], String> {
+    let v = parse_list::<3>(s)?;
+    if let Some(bad) = v.iter().find(|x| !(**x > 0.0)) {
+        return Err(format!(
+            "spacing {bad} is not positive (expected X,Y,Z > 0)"
+        ));
+    }
+    Ok(v)
+}
+
+/// Parses a positive finite number (a zoom factor).
+pub fn parse_positive(s: &str) -> Result<f32, String> {
+    let [v] = parse_list::<1>(s)?;
+    if !(v > 0.0) {
+        return Err(format!("{v} is not a positive finite number"));
+    }
+    Ok(v)
+}
+
+/// Parses `--perspective`: a field of view in degrees, strictly between 0 and 180.
+pub fn parse_fov(s: &str) -> Result<f32, String> {
+    let [v] = parse_list::<1>(s)?;
+    if !(v > 0.0 && v < 180.0) {
+        return Err(format!("{v}: a field of view is degrees in (0, 180)"));
+    }
+    Ok(v)
+}
+
+/// Parses `--min-radius`: a finite number of pixels, at least the geometry's smallest.
+pub fn parse_min_radius(s: &str) -> Result<f32, String> {
+    let [v] = parse_list::<1>(s)?;
+    let least = footprint::geometry::MIN_MIN_RADIUS_PX;
+    if !(v >= least) {
+        return Err(format!("{v} px is outside [{least}, ∞) px"));
+    }
+    Ok(v)
+}
+
+/// `--supersample`: `auto`, or a fixed factor.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Supersample {
+    /// k from the footprint's natural size (1 when no widening is needed).
+    Auto,
+    /// This factor (1 = off).
+    Fixed(usize),
+}
+
+/// `--lod`: `auto`, or a fixed level of detail.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Lod {
+    /// The level from the projected voxel size (`pipeline::lod::auto_level`).
+    Auto,
+    /// This level (0 = full resolution).
+    Level(u32),
+}
+
+/// Parses `auto` or a level 0 … `footprint::lod::MAX_LEVEL`.
+pub fn parse_lod(s: &str) -> Result<Lod, String> {
+    if s == "auto" {
+        return Ok(Lod::Auto);
+    }
+    match s.parse::<u32>() {
+        Ok(n) if n <= footprint::lod::MAX_LEVEL => Ok(Lod::Level(n)),
+        _ => Err(format!(
+            "'{s}': expected auto or a level 0..={} (0 = full resolution)",
+            footprint::lod::MAX_LEVEL
+        )),
+    }
+}
+
+/// Parses `auto` or a whole number 1 … 8.
+pub fn parse_supersample(s: &str) -> Result<Supersample, String> {
+    if s == "auto" {
+        return Ok(Supersample::Auto);
+    }
+    match s.parse::<usize>() {
+        Ok(k @ 1..=8) => Ok(Supersample::Fixed(k)),
+        _ => Err(format!("'{s}': expected auto or a whole number 1..=8")),
+    }
+}
+
+/// Parses `WxH` (each 1 … 16384).
+pub fn parse_size(s: &str) -> Result<(usize, usize), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("'{s}' is not WxH"))?;
+    let parse = |v: &str| -> Result<usize, String> {
+        let n: usize = v
+            .parse()
+            .map_err(|_| format!("'{v}' is not a whole number in 1..=16384"))?;
+        if !(1..=16384).contains(&n) {
+            return Err(format!("image side {n} is outside 1..=16384"));
+        }
+        Ok(n)
+    };
+    Ok((parse(w)?, parse(h)?))
+}
+
+/// Parses `--refine`'s threshold: a finite number ≥ 0.
+pub fn parse_threshold(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
+        _ => Err(format!("{s:?} is not a finite number ≥ 0")),
+    }
+}
+
+/// Parses `--scene-size`: 2 ≤ N ≤ 512.
+pub fn parse_scene_size(s: &str) -> Result<usize, String> {
+    match s.trim().parse::<usize>() {
+        Ok(n) if (2..=512).contains(&n) => Ok(n),
+        _ => Err(format!("{s:?} is not a grid side in 2..=512")),
+    }
+}

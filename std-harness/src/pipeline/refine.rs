@@ -1,0 +1,363 @@
+//! `--refine THRESHOLD`: the paper's adaptive re-sampling for magnified volumes (the core's
+//! [`footprint::refine`] and `render/refined.rs`).
+//!
+//! 1. **Where.** Every coarse sample is classified through the transfer function (premultiplied
+//!    RGBA for one world unit, emission: the colours the paper's test compares). Along each grid
+//!    axis, interval i's variation is the largest channel difference between samples i and i + 1
+//!    over the whole plane of the interval; [`footprint::refine::factor_for`] turns it into 1, 2
+//!    or 4 steps. The volume is read once, a sheet at a time.
+//! 2. **How far.** A step never projects closer than [`MIN_STEP_PX`] pixels (the length of the
+//!    grid step on screen, depth included): below that the footprints get no sharper, only more
+//!    numerous.
+//! 3. **Tables.** One view table per rate ρ ∈ {¼, ½, 1, 2, 4} (the kernel scaled by ρ along the
+//!    sheet axis), built once per view.
+//! 4. **Render.** On bands of rows like every render ([`super::bands::on_bands`]): byte-identical
+//!    for any number of threads.
+
+use super::bands::{on_bands, CoreFrame, Phases};
+use super::prepare::Prepared;
+pub use super::refinement::Refinement;
+use super::supersample::downsample;
+use crate::args::{AccumArg, MethodArg, RenderArgs, SlicingArg};
+use crate::io::volume::Volume;
+use crate::{with_table_size, CliError};
+use footprint::composite::RowSpan;
+use footprint::refine::{factor_for, RefinedAxis};
+use footprint::render::{
+    key_spacings, rate_index, sheet_map, spacing_key, FloatPath, RefineTables, RefinedGrid,
+    RenderBuffers, ScaledFootprint, SheetRenderer, SPACING_KEYS,
+};
+use footprint::shade::{Lighting, Shader, Shading, OPACITY_TABLE_LEN};
+use footprint::splat::{BufferError, ImageMut, Pixel, SplatStats, Splatter};
+use footprint::stencil::{self, Stencils};
+use footprint::Sampler;
+use footprint::{Footprint, Lookup, ViewTable};
+use std::time::Instant;
+
+/// Most sub-pixel phases of a refined footprint's stencils.
+pub const REFINE_PHASES: usize = 8;
+
+/// The closest a refined step may project, pixels.
+pub const MIN_STEP_PX: f32 = 6.0;
+
+/// Checks that `args` can refine `p`, with a message saying what to drop if not.
+pub fn check(p: &Prepared, args: &RenderArgs) -> Result<(), CliError> {
+    let refuse = |why: &str| Err(CliError::input(format!("--refine: {why}")));
+    if args.accum != AccumArg::Float {
+        return refuse("float accumulation only (drop --accum fixed)");
+    }
+    if args.slicing != SlicingArg::Object {
+        return refuse("the paper's sheets only (drop --slicing image)");
+    }
+    if p.frame.camera().is_some() {
+        return refuse("orthographic views only (drop --perspective)");
+    }
+    if !matches!(args.footprint.method, MethodArg::Robust) {
+        return refuse(
+            "the rate tables are view tables built by the robust method (drop --method)",
+        );
+    }
+    if p.volume().is_none() {
+        return refuse("the volume must be in memory (drop --stream)");
+    }
+    Ok(())
+}
+
+/// The refinement factors of `volume` for `p`'s transfer function, view and `threshold`; the
+/// sheet axis stays unrefined unless `sheets`.
+pub fn choose(
+    p: &Prepared,
+    volume: &Volume,
+    threshold: f32,
+    sheets: bool,
+) -> Result<Refinement, CliError> {
+    let dims = volume.dims;
+    let shader = Shader {
+        shading: Shading::Emission,
+        ..p.shader()
+    };
+    let lighting = Lighting::per_world_unit(&p.frame);
+    let classify = |n: usize| {
+        shader.shade_with(
+            &lighting,
+            None,
+            volume.value(n),
+            || glam::Vec3::ZERO,
+            [0; 3],
+            [1; 3],
+        )
+    };
+    let diff = |a: [f32; 4], b: [f32; 4]| {
+        (0..4).fold(0.0f32, |m, c| {
+            let d = (a[c] - b[c]).abs();
+            if d.is_nan() {
+                m
+            } else {
+                m.max(d)
+            }
+        })
+    };
+    let [nx, ny, nz] = dims;
+    let mut var = [
+        vec![0.0f32; nx.saturating_sub(1)],
+        vec![0.0f32; ny.saturating_sub(1)],
+        vec![0.0f32; nz.saturating_sub(1)],
+    ];
+    let sheet = nx * ny;
+    let mut prev = crate::io::try_filled(sheet, [0.0f32; 4], "a classified sheet")?;
+    let mut cur = prev.clone();
+    for k in 0..nz {
+        for j in 0..ny {
+            for i in 0..nx {
+                let c = classify(i + nx * (j + ny * k));
+                let here = i + nx * j;
+                if i > 0 {
+                    var[0][i - 1] = var[0][i - 1].max(diff(c, cur[here - 1]));
+                }
+                if j > 0 {
+                    var[1][j - 1] = var[1][j - 1].max(diff(c, cur[here - nx]));
+                }
+                if k > 0 {
+                    var[2][k - 1] = var[2][k - 1].max(diff(c, prev[here]));
+                }
+                cur[here] = c;
+            }
+        }
+        std::mem::swap(&mut prev, &mut cur);
+    }
+    let mut factors: [Vec<u8>; 3] = Default::default();
+    for (axis, v) in var.iter().enumerate() {
+        let px = p.frame.grid_to_screen.col(axis).length();
+        let cap = if axis == p.frame.sheet_axis && !sheets {
+            1
+        } else {
+            (px / MIN_STEP_PX).clamp(1.0, 4.0) as u8
+        };
+        factors[axis] = v
+            .iter()
+            .map(|&x| factor_for(x, threshold, cap))
+            .collect::<Result<_, _>>()
+            .map_err(|e| CliError::input(format!("--refine: {e}")))?;
+    }
+    let coarse_samples = dims.iter().product();
+    let samples = (0..3)
+        .map(|a| 1 + factors[a].iter().map(|&f| usize::from(f)).sum::<usize>())
+        .product();
+    Ok(Refinement {
+        threshold,
+        sheets,
+        factors,
+        coarse_samples,
+        samples,
+    })
+}
+
+/// Renders `p` refined at `threshold` (see the module docs) on `args.threads` bands.
+pub fn render_refined(
+    p: &Prepared,
+    args: &RenderArgs,
+    threshold: f32,
+) -> Result<CoreFrame, CliError> {
+    check(p, args)?;
+    let volume = p.volume().expect("checked");
+    let start = Instant::now();
+    let refinement = choose(p, volume, threshold, args.refine_sheets)?;
+    let classify = start.elapsed().as_secs_f64();
+    let f = &p.frame;
+    let axis = |a: usize| {
+        RefinedAxis::new(a, f.dims[a], &refinement.factors[a])
+            .map_err(|e| CliError::input(format!("--refine: {e}")))
+    };
+    let grid = RefinedGrid {
+        axes: [axis(0)?, axis(1)?, axis(2)?],
+    };
+    let fa = &args.footprint;
+    let lookup = Lookup::from(fa.lookup);
+    let threads = args.thread_count();
+    let dims = volume.dims;
+    let value = |[i, j, k]: [usize; 3]| volume.value(i + dims[0] * (j + dims[1] * k));
+    with_table_size!(fa.table, N => {
+        let t0 = Instant::now();
+        let generic = fa.generic_table::<N>(&p.kernel)?;
+        let footprint_for = |m: &glam::Mat3| {
+            Footprint::with_sheet_axis(&p.kernel, m, p.options, f.sheet_axis)
+                .map_err(|e| CliError::input(format!("--refine: a local spacing's footprint: {e}")))
+        };
+        let (k, (a, b)) = (f.sheet_axis, f.in_sheet);
+        let map = sheet_map(f);
+        // Refined footprints are many and small: their stencils get at most REFINE_PHASES
+        // phases per pixel (a 1/16-px placement), which keeps building them cheap.
+        let phases = args.phases.min(REFINE_PHASES);
+        // Samples per spacing key (see the core's `spacing_key`).
+        let bins = |axis: usize| {
+            let mut c = [0usize; 9];
+            let _ = grid.axes[axis].for_each::<()>(true, |s| {
+                c[spacing_key(s.spacing, [1.0; 2], 1.0) % 9] += 1;
+                Ok(())
+            });
+            c
+        };
+        let (ca, cb) = (bins(a), bins(b));
+        let mut cz = [0usize; 3];
+        let _ = grid.axes[k].for_each::<()>(true, |s| {
+            cz[spacing_key([1.0; 2], [1.0; 2], s.width()) / 81] += 1;
+            Ok(())
+        });
+        let keys: Vec<(usize, usize)> = (0..SPACING_KEYS)
+            .map(|key| (key, ca[key % 9] * cb[(key / 9) % 9] * cz[key / 81]))
+            .filter(|&(_, n)| n > 0)
+            .collect();
+        let symmetric = |key: usize| {
+            let (sa, sb, _) = key_spacings(key);
+            sa[0] == sa[1] && sb[0] == sb[1]
+        };
+        // Rate tables: those some sample's scaled footprint reads.
+        let mut needed = rates_needed(&refinement, k, (a, b));
+        for &(key, _) in keys.iter().filter(|&&(key, _)| !symmetric(key)) {
+            let (sa, sb, w) = key_spacings(key);
+            needed[rate_index(sa, sb, w)] = true;
+        }
+        let mut rate_tables = Vec::with_capacity(5);
+        for (r, rho) in RefineTables::<ViewTable<N>, Exact<'_, N>>::RATES.into_iter().enumerate() {
+            if rho != 1.0 && !needed[r] {
+                continue;
+            }
+            let mut m = f.grid_to_screen;
+            *m.col_mut(k) *= rho;
+            let fp = if rho == 1.0 { f.footprint } else { footprint_for(&m)? };
+            rate_tables.push((r, Box::new(ViewTable::<N>::build(&fp, &generic, lookup, lookup))));
+        }
+        let base = &*rate_tables.iter().find(|(r, _)| *r == 2).expect("built").1;
+        let rates = [0, 1, 2, 3, 4].map(|r| rate_tables.iter().find(|(j, _)| *j == r).map_or(base, |t| &*t.1));
+        // Per key: a symmetric spacing's exact footprint, or the scaled rate footprint.
+        let mut exact_tables = Vec::new();
+        let mut scaled = Vec::new();
+        for &(key, n) in &keys {
+            let (sa, sb, w) = key_spacings(key);
+            if symmetric(key) {
+                let mut sigma = [1.0f32; 3];
+                (sigma[a], sigma[b], sigma[k]) = (sa[0], sb[0], w);
+                let m = f.grid_to_screen * glam::Mat3::from_diagonal(glam::Vec3::from_array(sigma));
+                let table = Box::new(ViewTable::<N>::build(&footprint_for(&m)?, &generic, lookup, lookup));
+                let len = stencil_len(table.footprint(), n, phases);
+                exact_tables.push((key, table, vec![0.0f32; len.unwrap_or(0)]));
+            } else if let Some(fp) = ScaledFootprint::new(rates[rate_index(sa, sb, w)], map, [sa, sb]) {
+                // A scaled footprint's read costs about twice a table's: half the samples' worth.
+                if let Some(len) = stencil_len(fp.footprint(), n / 2, phases) {
+                    scaled.push((key, fp, vec![0.0f32; len]));
+                }
+            }
+        }
+        let mut splatters: Vec<Option<Exact<'_, N>>> = (0..SPACING_KEYS).map(|_| None).collect();
+        for (key, table, buffer) in exact_tables.iter_mut() {
+            splatters[*key] = Some(if buffer.is_empty() {
+                Exact::Table(&**table)
+            } else {
+                Exact::Stencils(Stencils::build(&**table, phases, buffer)?)
+            });
+        }
+        for (key, fp, buffer) in scaled.iter_mut() {
+            splatters[*key] = Some(Exact::Scaled(Stencils::build(&*fp, phases, buffer)?));
+        }
+        let tables = RefineTables { rates, splatters: &splatters };
+        let table_secs = t0.elapsed().as_secs_f64();
+        let (image, stats, phases) = on_bands(
+            f.size,
+            threads,
+            [0.0f32; 4],
+            p.background.as_deref(),
+            |rows, image, bg| {
+                let n = f.size[0] * rows.len();
+                let mut acc = crate::io::try_filled(n, [0.0f32; 4], "a band's sheet accumulator")?;
+                let mut spans = vec![RowSpan::EMPTY; rows.len()];
+                let mut opacity = vec![0.0f32; OPACITY_TABLE_LEN];
+                let mut scratch = crate::io::try_filled(2 * f.sheet_shape().0, 0.0f32, "refinement scratch sheets")?;
+                let buffers = RenderBuffers { accumulator: &mut acc, image, rows: &mut spans };
+                let path = FloatPath { sampler: tables.rates[2] };
+                let mut r = SheetRenderer::with_band(f, path, p.shader(), p.order, buffers, bg, rows)?
+                    .with_opacity_table(&mut opacity)?;
+                let t = Instant::now();
+                r.render_refined(&grid, &tables, value, &mut scratch)?;
+                let splat = t.elapsed().as_secs_f64();
+                Ok((r.finish(), Phases { splat, ..Phases::default() }))
+            },
+        )?;
+        let image = match p.supersample {
+            1 => image,
+            k => downsample(&image, p.out_size(), k, |v| v as f32),
+        };
+        CoreFrame {
+                image,
+                stats,
+                seconds: start.elapsed().as_secs_f64(),
+                phases: Phases { classify, tables: table_secs, ..phases },
+                threads: threads.clamp(1, f.size[1]),
+                visible: None,
+                refine: Some(refinement),
+            }
+    })
+}
+
+/// One spacing's footprint: a symmetric spacing's exact footprint (its phase stencils, or its
+/// view table where stencils do not pay or apply), or the stencils of a scaled one.
+#[derive(Clone, Copy)]
+enum Exact<'a, const N: usize> {
+    Stencils(Stencils<'a, ViewTable<N>>),
+    Table(&'a ViewTable<N>),
+    Scaled(Stencils<'a, ScaledFootprint<'a, ViewTable<N>>>),
+}
+
+impl<const N: usize> Splatter for Exact<'_, N> {
+    fn splat_voxel<P: Pixel>(
+        &self,
+        center: [f32; 2],
+        value: &P,
+        image: &mut ImageMut<'_, P>,
+        touched: impl FnMut(usize, usize, usize),
+    ) -> Result<SplatStats, BufferError> {
+        match self {
+            Exact::Stencils(s) => s.splat_voxel(center, value, image, touched),
+            Exact::Table(t) => t.splat_voxel(center, value, image, touched),
+            Exact::Scaled(s) => s.splat_voxel(center, value, image, touched),
+        }
+    }
+}
+
+/// The distinct widths (mean of the two spacings, coarse steps) of an axis's refined samples.
+fn widths(factors: &[u8]) -> Vec<f32> {
+    let mut w: Vec<f32> = vec![1.0];
+    let step = |f: u8| 1.0 / f32::from(f);
+    for (i, &f) in factors.iter().enumerate() {
+        w.push(step(f));
+        if let Some(&g) = factors.get(i + 1) {
+            w.push(0.5 * (step(f) + step(g)));
+        }
+    }
+    w.sort_by(f32::total_cmp);
+    w.dedup();
+    w
+}
+
+/// Which rates ([`RefineTables::rate_index`]) some sample of `r` can ask for.
+fn rates_needed(r: &Refinement, sheet: usize, (a, b): (usize, usize)) -> [bool; 5] {
+    let mut needed = [false; 5];
+    for wz in widths(&r.factors[sheet]) {
+        for wa in widths(&r.factors[a]) {
+            for wb in widths(&r.factors[b]) {
+                needed[rate_index([wa; 2], [wb; 2], wz)] = true;
+            }
+        }
+    }
+    needed
+}
+
+/// Stencil floats for a footprint that `samples` samples share, if stencils pay: they cost
+/// (P + 1)² footprint reads per box pixel to build and save part of a table walk per pixel
+/// update (about a fifth of a read, measured on the refinement chart), so a spacing gets them when
+/// at least 8·(P + 1)² samples share it (and stencils apply).
+fn stencil_len(fp: &Footprint, samples: usize, phases: usize) -> Option<usize> {
+    let p = stencil::phases_for(fp, phases);
+    (phases > 0 && samples >= 8 * (p + 1) * (p + 1))
+        .then(|| stencil::len_for(fp, phases))
+        .flatten()
+}
