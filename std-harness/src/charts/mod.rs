@@ -28,9 +28,14 @@
 //!
 //! **Levels of detail** ([`lod`], `DIR/lod.csv`, `.svg`, `.png`): every level of the scene, its
 //! frame time and its PSNR against level 0 (`--lod 0`), and the level `--lod auto` picks.
+//!
+//! **Refinement** ([`refine`], `DIR/refine.csv`, `.svg`, `.png`, with `--refine-only`): the
+//! built-in scene at `--scene-size`, unrefined and at each `--refine` threshold, its frame time
+//! and its PSNR against the same field sampled at `--refine-reference`.
 
 pub mod lod;
 pub mod plot;
 pub mod popping;
+pub mod refine;
 pub mod stability;
 pub mod sweep;

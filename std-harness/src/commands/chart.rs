@@ -2,7 +2,7 @@
 //! [`crate::charts`] for what is swept and how it is measured).
 
 use crate::args::RenderArgs;
-use crate::charts::{lod, plot, popping, stability, sweep};
+use crate::charts::{lod, plot, popping, refine, stability, sweep};
 use crate::io;
 use crate::pipeline::config::Config;
 use crate::pipeline::{prepare, quality};
@@ -33,6 +33,13 @@ pub struct ChartArgs {
     /// Only the levels-of-detail sweep (no trade-off or stability charts).
     #[arg(long, conflicts_with = "no_lod")]
     pub lod_only: bool,
+    /// Only the refinement sweep (refine.csv, refine.svg, refine.png): the built-in scene at
+    /// --scene-size, unrefined and at each --refine threshold, against --refine-reference.
+    #[arg(long, conflicts_with = "lod_only")]
+    pub refine_only: bool,
+    /// The finer sampling the refinement sweep measures against, N×N×N.
+    #[arg(long, value_name = "N", default_value_t = 128, value_parser = crate::args::parse_scene_size)]
+    pub refine_reference: usize,
     /// Only print the `--quality` model's footprint error of every configuration at this view
     /// (CSV on standard output; no rendering).
     #[arg(long)]
@@ -69,6 +76,32 @@ pub fn run(args: &ChartArgs) -> Result<(), CliError> {
         .map_or("built-in scene".to_string(), |n| {
             n.to_string_lossy().into_owned()
         });
+    if args.refine_only {
+        let rows = refine::sweep(&base, args.refine_reference, args.runs)?;
+        io::write_atomic(&dir.join("refine.csv"), refine::csv(&rows).as_bytes())?;
+        let title = format!(
+            "built-in scene {n}^3 at {}x{}, against {r}^3: --refine, {} thread(s)",
+            base.size.0,
+            base.size.1,
+            base.thread_count(),
+            n = base.scene_size,
+            r = args.refine_reference,
+        );
+        refine::write_chart(&dir, &rows, &title)?;
+        for r in &rows {
+            crate::say!(
+                "refine {}: {} samples, {:.4} s ({:.2}x unrefined), {:.2} dB ({:+.2} dB)",
+                refine::label(r),
+                r.samples,
+                r.median_s,
+                r.median_s / rows[0].median_s,
+                r.psnr_db,
+                r.psnr_db - rows[0].psnr_db
+            );
+        }
+        crate::say!("wrote {}", dir.display());
+        return Ok(());
+    }
     if !args.no_lod {
         let (rows, auto) = lod::sweep(&base, args.runs)?;
         io::write_atomic(&dir.join("lod.csv"), lod::csv(&rows, auto).as_bytes())?;

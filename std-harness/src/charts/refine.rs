@@ -1,0 +1,231 @@
+//! The refinement sweep (`footprint chart --refine-only`, `refine.csv` and `refine.svg`/`.png`):
+//! the built-in scene's analytic field sampled at `--scene-size` (16 for issue 15's test) and
+//! rendered unrefined and with `--refine` at each of [`THRESHOLDS`], each point's frame time
+//! (median over the runs, the configurations timed in turn within each run so that drift hits
+//! them alike) and its PSNR (RGB) against the same field sampled at a finer grid
+//! (`--refine-reference`, 128 by default) rendered with the same flags. The paper calls the
+//! threshold "a time versus quality tradeoff control"; this is that trade-off, measured.
+
+use super::plot::{plot_err, write_svg_png};
+use crate::args::RenderArgs;
+use crate::metrics::compare;
+use crate::pipeline::visible::FrameCache;
+use crate::pipeline::{prepare, render_frame, Prepared};
+use crate::CliError;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::path::Path;
+
+/// The thresholds swept (premultiplied RGBA differences).
+pub const THRESHOLDS: [f32; 7] = [0.5, 0.3, 0.2, 0.1, 0.05, 0.02, 0.0];
+
+/// One configuration's row.
+#[derive(Clone, Debug)]
+pub struct RefineRow {
+    /// `None`: unrefined.
+    pub threshold: Option<f32>,
+    /// Whether the sheet axis was refined too.
+    pub sheets: bool,
+    /// Samples splatted (refined grid; the coarse grid unrefined).
+    pub samples: usize,
+    pub median_s: f64,
+    pub min_s: f64,
+    pub max_s: f64,
+    /// PSNR (RGB) against the finer sampling, dB.
+    pub psnr_db: f64,
+}
+
+/// The sweep over `base` (the built-in scene only), against the field sampled at `reference`³.
+pub fn sweep(base: &RenderArgs, reference: usize, runs: usize) -> Result<Vec<RefineRow>, CliError> {
+    if base.volume.is_some() || base.stream.is_some() {
+        return Err(CliError::input(
+            "the refinement chart measures against a finer sampling of the built-in scene's \
+             analytic field: give no volume (set the grid with --scene-size)",
+        ));
+    }
+    let mut fine = base.clone();
+    fine.scene_size = reference;
+    fine.refine = None;
+    fine.refine_sheets = false;
+    let pf = prepare(&fine)?;
+    let truth: Vec<[f64; 4]> = render_frame(&pf, &fine, fine.accum, &mut FrameCache::default())?
+        .image
+        .iter()
+        .map(|c| c.map(f64::from))
+        .collect();
+    drop(pf);
+    let mut configs: Vec<(RenderArgs, Option<f32>, bool)> = Vec::new();
+    let mut with = |t: Option<f32>, sheets: bool| {
+        let mut a = base.clone();
+        a.refine = t;
+        a.refine_sheets = sheets;
+        a.quality = None;
+        configs.push((a, t, sheets));
+    };
+    with(None, false);
+    for t in THRESHOLDS {
+        with(Some(t), false);
+    }
+    with(Some(0.0), true);
+    let prepared: Vec<Prepared> = configs
+        .iter()
+        .map(|(a, _, _)| prepare(a))
+        .collect::<Result<_, _>>()?;
+    let mut rows = Vec::new();
+    let mut times = vec![Vec::new(); configs.len()];
+    for run in 0..=runs.max(1) {
+        for (((a, t, sheets), p), times) in configs.iter().zip(&prepared).zip(&mut times) {
+            let f = render_frame(p, a, a.accum, &mut FrameCache::default())?;
+            if run == 0 {
+                // The first pass gives the image (and warms caches); the rest are timed.
+                rows.push(RefineRow {
+                    threshold: *t,
+                    sheets: *sheets,
+                    samples: f
+                        .refine
+                        .as_ref()
+                        .map_or(p.frame.dims.iter().product(), |r| r.samples),
+                    median_s: 0.0,
+                    min_s: 0.0,
+                    max_s: 0.0,
+                    psnr_db: compare(&f.image, &truth).1.psnr_db,
+                });
+            } else {
+                times.push(f.seconds);
+            }
+        }
+    }
+    for (r, t) in rows.iter_mut().zip(&mut times) {
+        t.sort_by(f64::total_cmp);
+        (r.median_s, r.min_s, r.max_s) = (t[t.len() / 2], t[0], t[t.len() - 1]);
+    }
+    Ok(rows)
+}
+
+/// A row's label: `unrefined`, `t=0.1`, or `t=0 +sheets`.
+pub fn label(r: &RefineRow) -> String {
+    match r.threshold {
+        None => "unrefined".into(),
+        Some(t) => format!("t={t}{}", if r.sheets { " +sheets" } else { "" }),
+    }
+}
+
+/// `threshold,sheets,samples,median_s,min_s,max_s,psnr_db,time_ratio,gain_db` (ratio and gain
+/// against the unrefined row; threshold empty for it).
+pub fn csv(rows: &[RefineRow]) -> String {
+    let mut s =
+        String::from("threshold,sheets,samples,median_s,min_s,max_s,psnr_db,time_ratio,gain_db\n");
+    let base = rows.first();
+    for r in rows {
+        s.push_str(&format!(
+            "{},{},{},{:.6},{:.6},{:.6},{:.3},{:.3},{:.3}\n",
+            r.threshold.map_or(String::new(), |t| t.to_string()),
+            r.sheets,
+            r.samples,
+            r.median_s,
+            r.min_s,
+            r.max_s,
+            r.psnr_db,
+            base.map_or(f64::NAN, |b| r.median_s / b.median_s),
+            base.map_or(f64::NAN, |b| r.psnr_db - b.psnr_db),
+        ));
+    }
+    s
+}
+
+/// `DIR/refine.svg` and `.png`: PSNR against the finer sampling over frame time, one point per
+/// threshold; dashed guides at twice the unrefined time and 3 dB above its PSNR (issue 15's bar).
+pub fn write_chart(dir: &Path, rows: &[RefineRow], title: &str) -> Result<(), CliError> {
+    write_svg_png(
+        dir,
+        "refine",
+        (900, 560),
+        |r| draw(r, rows, title),
+        |r| draw(r, rows, title),
+    )
+}
+
+fn draw<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    rows: &[RefineRow],
+    title: &str,
+) -> Result<(), CliError> {
+    root.fill(&WHITE).map_err(plot_err)?;
+    let Some(base) = rows.first() else {
+        return Ok(());
+    };
+    let ymax = rows.iter().map(|r| r.psnr_db).fold(f64::MIN, f64::max) + 3.0;
+    let ymin = rows.iter().map(|r| r.psnr_db).fold(f64::MAX, f64::min) - 3.0;
+    let tmin = rows
+        .iter()
+        .map(|r| r.min_s)
+        .fold(f64::INFINITY, f64::min)
+        .max(1e-6);
+    let tmax = rows
+        .iter()
+        .map(|r| r.max_s)
+        .fold(0.0, f64::max)
+        .max(tmin * 2.0);
+    let mut chart = ChartBuilder::on(root)
+        .caption(title, ("sans-serif", 20))
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(60)
+        .build_cartesian_2d((tmin * 0.8..tmax * 2.0).log_scale(), ymin..ymax)
+        .map_err(plot_err)?;
+    chart
+        .configure_mesh()
+        .x_desc("frame time, s (median; bar: min-max)")
+        .y_desc("PSNR against the finer sampling, dB")
+        .draw()
+        .map_err(plot_err)?;
+    let guide = BLACK.mix(0.4).stroke_width(1);
+    let (t2, g3) = (2.0 * base.median_s, base.psnr_db + 3.0);
+    chart
+        .draw_series(DashedLineSeries::new(
+            vec![(t2, ymin), (t2, ymax)],
+            6,
+            4,
+            guide,
+        ))
+        .map_err(plot_err)?;
+    chart
+        .draw_series(DashedLineSeries::new(
+            vec![(tmin * 0.8, g3), (tmax * 2.0, g3)],
+            6,
+            4,
+            guide,
+        ))
+        .map_err(plot_err)?;
+    chart
+        .draw_series(rows.iter().map(|r| {
+            PathElement::new(
+                vec![(r.min_s, r.psnr_db), (r.max_s, r.psnr_db)],
+                BLACK.stroke_width(1),
+            )
+        }))
+        .map_err(plot_err)?;
+    for r in rows {
+        let colour = match (r.threshold, r.sheets) {
+            (None, _) => RED,
+            (_, true) => MAGENTA,
+            _ => BLUE,
+        };
+        chart
+            .draw_series(std::iter::once(Circle::new(
+                (r.median_s, r.psnr_db),
+                5,
+                colour.filled(),
+            )))
+            .map_err(plot_err)?;
+        chart
+            .draw_series(std::iter::once(Text::new(
+                format!("{} ({} samples)", label(r), r.samples),
+                (r.median_s * 1.04, r.psnr_db + 0.4),
+                ("sans-serif", 13),
+            )))
+            .map_err(plot_err)?;
+    }
+    root.present().map_err(plot_err)?;
+    Ok(())
+}
