@@ -356,25 +356,31 @@ mod tests {
     use super::*;
     use crate::composite::RowSpan;
     use crate::frame::Order;
-    use crate::geometry::{Footprint, FootprintOptions, Grid, View};
-    use crate::kernel::Kernel;
+    use crate::render::scaled::tests::{frame, table, K};
+
+    /// A frame rendered into fresh buffers by `go`, back to front.
+    fn render_with(
+        f: &FrameSetup,
+        base: &ViewTable<65>,
+        shader: Shader<'_>,
+        go: impl for<'a> FnOnce(&mut SheetRenderer<'a, FloatPath<'a, ViewTable<65>>>),
+    ) -> std::vec::Vec<[f32; 4]> {
+        let n = f.size[0] * f.size[1];
+        let (mut acc, mut img) = (std::vec![[0.0f32; 4]; n], std::vec![[0.0f32; 4]; n]);
+        let mut rows = std::vec![RowSpan::EMPTY; f.size[1]];
+        let buffers = RenderBuffers {
+            accumulator: &mut acc,
+            image: &mut img,
+            rows: &mut rows,
+        };
+        let mut r = SheetRenderer::new(f, base, shader, Order::BackToFront, buffers, None).unwrap();
+        go(&mut r);
+        r.finish();
+        img
+    }
     use crate::render::{RenderBuffers, SheetRing};
     use crate::shade::{Shader, Shading, TransferFunction};
-    use crate::table::{GenericTable, Lookup, ViewTable};
-
-    const K: Kernel = Kernel::PAPER_GAUSSIAN;
-
-    fn frame(angles: [f32; 3], dims: [usize; 3], size: [usize; 2]) -> FrameSetup {
-        let grid = Grid::from_spacing([1.0; 3]).unwrap();
-        let view = View::from_angles(angles, 1.0, dims, &grid, size).unwrap();
-        FrameSetup::new(dims, &grid, &view, &K, FootprintOptions::default(), size).unwrap()
-    }
-
-    fn table(f: &FrameSetup, m: glam::Mat3, generic: &GenericTable<65>) -> ViewTable<65> {
-        let fp =
-            Footprint::with_sheet_axis(&K, &m, FootprintOptions::default(), f.sheet_axis).unwrap();
-        ViewTable::build(&fp, generic, Lookup::Bilinear, Lookup::Bilinear)
-    }
+    use crate::table::{GenericTable, ViewTable};
 
     /// With every factor 1 the refined render is the ordinary render (within table-walk
     /// rounding), whatever the order; with factors it renders, finite.
@@ -399,46 +405,27 @@ mod tests {
                 },
                 shading,
             };
-            let n = size[0] * size[1];
             let render = |factors: [&[u8]; 3]| {
-                let (mut acc, mut img) = (std::vec![[0.0f32; 4]; n], std::vec![[0.0f32; 4]; n]);
-                let mut rows = std::vec![RowSpan::EMPTY; size[1]];
-                let buffers = RenderBuffers {
-                    accumulator: &mut acc,
-                    image: &mut img,
-                    rows: &mut rows,
-                };
-                let mut r =
-                    SheetRenderer::new(&f, &base, shader, Order::BackToFront, buffers, None)
-                        .unwrap();
-                let grid = RefinedGrid {
-                    axes: [0, 1, 2].map(|a| RefinedAxis::new(a, dims[a], factors[a]).unwrap()),
-                };
-                let tables: RefineTables<'_, ViewTable<65>, ViewTable<65>> = RefineTables {
-                    rates: [&base; 5],
-                    splatters: &[],
-                };
-                let mut scratch = std::vec![0.0f32; 2 * f.sheet_shape().0];
-                r.render_refined(&grid, &tables, at, &mut scratch).unwrap();
-                r.finish();
-                img
+                render_with(&f, &base, shader, |r| {
+                    let grid = RefinedGrid {
+                        axes: [0, 1, 2].map(|a| RefinedAxis::new(a, dims[a], factors[a]).unwrap()),
+                    };
+                    let tables: RefineTables<'_, ViewTable<65>, ViewTable<65>> = RefineTables {
+                        rates: [&base; 5],
+                        splatters: &[],
+                    };
+                    let mut scratch = std::vec![0.0f32; 2 * f.sheet_shape().0];
+                    r.render_refined(&grid, &tables, at, &mut scratch).unwrap();
+                })
             };
             let ones = [&[1u8; 5][..], &[1u8; 6][..], &[1u8; 4][..]];
             let refined = render(ones);
-            let (mut acc, mut img) = (std::vec![[0.0f32; 4]; n], std::vec![[0.0f32; 4]; n]);
-            let mut rows = std::vec![RowSpan::EMPTY; size[1]];
-            let buffers = RenderBuffers {
-                accumulator: &mut acc,
-                image: &mut img,
-                rows: &mut rows,
-            };
-            let mut r =
-                SheetRenderer::new(&f, &base, shader, Order::BackToFront, buffers, None).unwrap();
-            let mut sheets = std::vec![0.0f32; 3 * f.sheet_shape().0];
-            let mut ring = SheetRing::new(&mut sheets, &f, Order::BackToFront).unwrap();
-            let mut vol = crate::volume::MemoryVolume::new(&data, dims).unwrap();
-            crate::source::render_from(&mut r, &mut ring, &mut vol).unwrap();
-            r.finish();
+            let img = render_with(&f, &base, shader, |r| {
+                let mut sheets = std::vec![0.0f32; 3 * f.sheet_shape().0];
+                let mut ring = SheetRing::new(&mut sheets, &f, Order::BackToFront).unwrap();
+                let mut vol = crate::volume::MemoryVolume::new(&data, dims).unwrap();
+                crate::source::render_from(r, &mut ring, &mut vol).unwrap();
+            });
             let d = refined
                 .iter()
                 .zip(&img)

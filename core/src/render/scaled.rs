@@ -213,7 +213,7 @@ pub fn sheet_map(frame: &FrameSetup) -> Mat2 {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::geometry::{FootprintOptions, Grid, View};
     use crate::kernel::Kernel;
@@ -221,15 +221,23 @@ mod tests {
     use crate::stencil::Stencils;
     use crate::table::{GenericTable, Lookup, ViewTable};
 
-    const K: Kernel = Kernel::PAPER_GAUSSIAN;
+    pub(in crate::render) const K: Kernel = Kernel::PAPER_GAUSSIAN;
 
-    fn frame(angles: [f32; 3], dims: [usize; 3], size: [usize; 2]) -> FrameSetup {
+    pub(in crate::render) fn frame(
+        angles: [f32; 3],
+        dims: [usize; 3],
+        size: [usize; 2],
+    ) -> FrameSetup {
         let grid = Grid::from_spacing([1.0; 3]).unwrap();
         let view = View::from_angles(angles, 1.0, dims, &grid, size).unwrap();
         FrameSetup::new(dims, &grid, &view, &K, FootprintOptions::default(), size).unwrap()
     }
 
-    fn table(f: &FrameSetup, m: glam::Mat3, generic: &GenericTable<65>) -> ViewTable<65> {
+    pub(in crate::render) fn table(
+        f: &FrameSetup,
+        m: glam::Mat3,
+        generic: &GenericTable<65>,
+    ) -> ViewTable<65> {
         let fp =
             Footprint::with_sheet_axis(&K, &m, FootprintOptions::default(), f.sheet_axis).unwrap();
         ViewTable::build(&fp, generic, Lookup::Bilinear, Lookup::Bilinear)

@@ -5,7 +5,7 @@
 //! so that drift hits them alike) and its PSNR (RGB) against level 0's image. `auto`'s pick is
 //! marked.
 
-use super::plot::{plot_err, write_svg_png};
+use super::plot::{plot_err, time_chart, time_spread, write_svg_png};
 use crate::args::{Lod, RenderArgs};
 use crate::metrics::compare;
 use crate::pipeline::visible::FrameCache;
@@ -144,29 +144,15 @@ fn draw<DB: DrawingBackend>(
         .collect();
     let ymax = finite.iter().copied().fold(20.0f64, f64::max) + 10.0;
     let ymin = finite.iter().copied().fold(ymax - 10.0, f64::min).min(30.0) - 5.0;
-    let tmin = rows
-        .iter()
-        .map(|r| r.min_s)
-        .fold(f64::INFINITY, f64::min)
-        .max(1e-6);
-    let tmax = rows
-        .iter()
-        .map(|r| r.max_s)
-        .fold(0.0, f64::max)
-        .max(tmin * 2.0);
-    let mut chart = ChartBuilder::on(root)
-        .caption(title, ("sans-serif", 20))
-        .margin(15)
-        .x_label_area_size(45)
-        .y_label_area_size(60)
-        .build_cartesian_2d((tmin * 0.7..tmax * 4.0).log_scale(), ymin..ymax)
-        .map_err(plot_err)?;
-    chart
-        .configure_mesh()
-        .x_desc("frame time, s (median; bar: min-max)")
-        .y_desc("PSNR against level 0, dB (level 0 drawn at the top)")
-        .draw()
-        .map_err(plot_err)?;
+    let times = time_spread(rows, |r| r.min_s, |r| r.max_s);
+    let mut chart = time_chart(
+        root,
+        title,
+        times,
+        (0.7, 4.0),
+        ymin..ymax,
+        "PSNR against level 0, dB (level 0 drawn at the top)",
+    )?;
     let y = |r: &LevelRow| {
         if r.psnr_db.is_finite() {
             r.psnr_db

@@ -346,6 +346,53 @@ pub(crate) fn write_svg_png(
 /// `DIR/tradeoff.svg` and `.png` (against the sheet reference, object slicing) and
 /// `DIR/tradeoff-continuous.svg` and `.png` (every configuration against the continuous
 /// integral, with that frontier).
+/// A chart over frame time (x, seconds, log scale, padded by `pad` = (below, above) factors
+/// around the spread `times` = (fastest min, slowest max)) and PSNR (y, `ys`), with its mesh and
+/// axis labels drawn: the levels-of-detail and refinement charts.
+pub fn time_chart<'a, DB: DrawingBackend>(
+    root: &'a DrawingArea<DB, Shift>,
+    title: &str,
+    times: (f64, f64),
+    pad: (f64, f64),
+    ys: std::ops::Range<f64>,
+    y_desc: &str,
+) -> Result<
+    ChartContext<
+        'a,
+        DB,
+        Cartesian2d<
+            plotters::coord::combinators::LogCoord<f64>,
+            plotters::coord::types::RangedCoordf64,
+        >,
+    >,
+    CliError,
+> {
+    let tmin = times.0.max(1e-6);
+    let tmax = times.1.max(tmin * 2.0);
+    let mut chart = ChartBuilder::on(root)
+        .caption(title, ("sans-serif", 20))
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(60)
+        .build_cartesian_2d((tmin * pad.0..tmax * pad.1).log_scale(), ys)
+        .map_err(plot_err)?;
+    chart
+        .configure_mesh()
+        .x_desc("frame time, s (median; bar: min-max)")
+        .y_desc(y_desc)
+        .draw()
+        .map_err(plot_err)?;
+    Ok(chart)
+}
+
+/// The fastest minimum and slowest maximum of timed rows.
+pub fn time_spread<T>(rows: &[T], min: impl Fn(&T) -> f64, max: impl Fn(&T) -> f64) -> (f64, f64) {
+    (
+        rows.iter().map(&min).fold(f64::INFINITY, f64::min),
+        rows.iter().map(&max).fold(0.0, f64::max),
+    )
+}
+
 pub fn write_tradeoff(dir: &Path, rows: &[Measured], title: &str) -> Result<(), CliError> {
     for (stem, truth) in [("tradeoff", false), ("tradeoff-continuous", true)] {
         write_svg_png(

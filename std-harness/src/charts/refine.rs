@@ -6,7 +6,7 @@
 //! (`--refine-reference`, 128 by default) rendered with the same flags. The paper calls the
 //! threshold "a time versus quality tradeoff control"; this is that trade-off, measured.
 
-use super::plot::{plot_err, write_svg_png};
+use super::plot::{plot_err, time_chart, time_spread, write_svg_png};
 use crate::args::RenderArgs;
 use crate::metrics::compare;
 use crate::pipeline::visible::FrameCache;
@@ -156,29 +156,15 @@ fn draw<DB: DrawingBackend>(
     };
     let ymax = rows.iter().map(|r| r.psnr_db).fold(f64::MIN, f64::max) + 3.0;
     let ymin = rows.iter().map(|r| r.psnr_db).fold(f64::MAX, f64::min) - 3.0;
-    let tmin = rows
-        .iter()
-        .map(|r| r.min_s)
-        .fold(f64::INFINITY, f64::min)
-        .max(1e-6);
-    let tmax = rows
-        .iter()
-        .map(|r| r.max_s)
-        .fold(0.0, f64::max)
-        .max(tmin * 2.0);
-    let mut chart = ChartBuilder::on(root)
-        .caption(title, ("sans-serif", 20))
-        .margin(15)
-        .x_label_area_size(45)
-        .y_label_area_size(60)
-        .build_cartesian_2d((tmin * 0.8..tmax * 2.0).log_scale(), ymin..ymax)
-        .map_err(plot_err)?;
-    chart
-        .configure_mesh()
-        .x_desc("frame time, s (median; bar: min-max)")
-        .y_desc("PSNR against the finer sampling, dB")
-        .draw()
-        .map_err(plot_err)?;
+    let (tmin, tmax) = time_spread(rows, |r| r.min_s, |r| r.max_s);
+    let mut chart = time_chart(
+        root,
+        title,
+        (tmin, tmax),
+        (0.8, 2.0),
+        ymin..ymax,
+        "PSNR against the finer sampling, dB",
+    )?;
     let guide = BLACK.mix(0.4).stroke_width(1);
     let (t2, g3) = (2.0 * base.median_s, base.psnr_db + 3.0);
     chart

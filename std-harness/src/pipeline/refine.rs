@@ -17,7 +17,7 @@
 use super::bands::{on_bands, CoreFrame, Phases};
 use super::prepare::Prepared;
 pub use super::refinement::Refinement;
-use super::supersample::downsample;
+use super::supersample::to_output;
 use crate::args::{AccumArg, MethodArg, RenderArgs, SlicingArg};
 use crate::io::volume::Volume;
 use crate::{with_table_size, CliError};
@@ -282,10 +282,7 @@ pub fn render_refined(
                 Ok((r.finish(), Phases { splat, ..Phases::default() }))
             },
         )?;
-        let image = match p.supersample {
-            1 => image,
-            k => downsample(&image, p.out_size(), k, |v| v as f32),
-        };
+        let image = to_output(image, p.out_size(), p.supersample);
         CoreFrame {
                 image,
                 stats,

@@ -7,7 +7,7 @@ use super::bands::{run_bands, Phases};
 use super::load::Voxels;
 use super::lod::{with_level, DynSource};
 use super::prepare::Prepared;
-use super::supersample::downsample;
+use super::supersample::{downsample, to_output};
 use super::visible::FrameCache;
 use crate::args::{AccumArg, MethodArg, RenderArgs, SlicingArg};
 use crate::io::progress::sheets;
@@ -148,10 +148,7 @@ pub fn render_frame(
         };
         phases.tables = phases.tables.max(0.0);
         // Supersampled: the mean of each k×k block (timed with the frame: it is part of it).
-        let image = match p.supersample {
-            1 => image,
-            k => downsample(&image, p.out_size(), k, |v| v as f32),
-        };
+        let image = to_output(image, p.out_size(), p.supersample);
         CoreFrame {
             image,
             stats,

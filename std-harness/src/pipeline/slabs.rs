@@ -19,7 +19,7 @@
 
 use super::bands::{on_bands, CoreFrame, Phases};
 use super::prepare::Prepared;
-use super::supersample::downsample;
+use super::supersample::to_output;
 use super::visible::FrameCache;
 use crate::args::{AccumArg, RenderArgs};
 use crate::CliError;
@@ -91,10 +91,7 @@ pub fn render_slabs(
         tables,
         ..band_phases
     };
-    let image = match p.supersample {
-        1 => image,
-        k => downsample(&image, p.out_size(), k, |v| v as f32),
-    };
+    let image = to_output(image, p.out_size(), p.supersample);
     Ok(CoreFrame {
         image,
         stats,

@@ -16,6 +16,15 @@ use crate::args::Supersample;
 use footprint::frame::FrameSetup;
 use footprint::geometry::FootprintOptions;
 
+/// A float frame rendered at k× the output size `out`, brought to it: the mean of each k×k block
+/// (k = 1: the image itself, untouched).
+pub fn to_output(image: Vec<[f32; 4]>, out: (usize, usize), k: usize) -> Vec<[f32; 4]> {
+    match k {
+        1 => image,
+        k => downsample(&image, out, k, |v| v as f32),
+    }
+}
+
 /// Largest factor `auto` picks (k² more pixels; beyond 4 the voxels are far below a pixel and the
 /// bias left at k = 4 is under 0.1 % in the cases above).
 pub const MAX_AUTO: usize = 4;
