@@ -18,8 +18,8 @@
 //!   (S itself is not 1: a kernel cut off sharply, sampled by a few pixels, sums to 1 only in the
 //!   limit.)
 //!
-//! Image-aligned slabs (`--slicing image`) and level of detail 1 (`--lod 1`) are rendered too,
-//! checked for finite, valid colour.
+//! Image-aligned slabs (`--slicing image`), level of detail 1 (`--lod 1`) and a refined grid
+//! (`--refine`) are rendered too, checked for finite, valid colour.
 //!
 //! Input bytes are read as parameters in a fixed order (missing bytes read as 0).
 use footprint::fixed::{FixedTable, ONE};
@@ -181,6 +181,25 @@ fuzz_target!(|data: &[u8]| {
                     );
                     check_image(&img, "level 1 render");
                 }
+            }
+        }
+    }
+
+    // Adaptive refinement: factors 1, 2 or 4 per interval from the input, border samples with
+    // different spacings on each side (the scaled read, and its stencils for one border key),
+    // Catmull-Rom values: finite RGBA in [0, 1] both ways.
+    let factors: [Vec<u8>; 3] = [0, 1, 2].map(|a| {
+        (1..dims[a])
+            .map(|_| [1, 2, 4][usize::from(b.u8() % 3)])
+            .collect()
+    });
+    if let Ok(view) = View::from_angles(angles, zoom, dims, &grid, size) {
+        if let Ok(frame) = FrameSetup::new(dims, &grid, &view, &kernel, options, size) {
+            let table = ViewTable::<N>::build(&frame.footprint, &generic, lookup, lookup);
+            for order in [Order::BackToFront, Order::FrontToBack] {
+                let img =
+                    footprint_fuzz::render_refined(&frame, &table, order, &samples, &lut, &factors);
+                check_image(&img, "refined render");
             }
         }
     }

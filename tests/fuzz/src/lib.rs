@@ -4,16 +4,20 @@
 use footprint::composite::RowSpan;
 use footprint::frame::{FrameSetup, Order};
 use footprint::lod::{Averaging, Coarsened, Extinction, Linear};
+use footprint::refine::RefinedAxis;
 use footprint::render::{
-    Precision, RenderBuffers, SheetRenderer, SheetRing, SlabBuffers, SlabRenderer, SlabSetup,
-    SlabVoxel,
+    sheet_map, spacing_key, FloatPath, Precision, RefineTables, RefinedGrid, RenderBuffers,
+    ScaledFootprint, SheetRenderer, SheetRing, SlabBuffers, SlabRenderer, SlabSetup, SlabVoxel,
+    SPACING_KEYS,
 };
 use footprint::shade::Lighting;
 use footprint::shade::{Shader, Shading, TransferFunction};
 use footprint::source::{render_from, SheetSource};
 use footprint::splat::ImageMut;
+use footprint::stencil::{self, Stencils};
 use footprint::table::SectionTable;
 use footprint::volume::MemoryVolume;
+use footprint::ViewTable;
 use std::path::PathBuf;
 
 /// Emission through `lut` (straight RGBA over sample values 0..=255).
@@ -97,6 +101,66 @@ pub fn render_level<P: Precision>(
     let (mut lower, mut upper) = (vec![0u8; len], vec![0u8; len]);
     let source = Coarsened::new(volume, fine_dims, &mut lower, &mut upper).averaging(averaging);
     render_source(frame, path, order, lut, source)
+}
+
+/// Renders `samples` (u8, x fastest, `frame.dims`) through `lut`, emission, refined by
+/// `factors` (1, 2 or 4 per interval of each grid axis): every sample through the scaled read of
+/// `table`, except the border key (1, ½) × (½, ¼), splatted through [`ScaledFootprint`]
+/// stencils when they apply. Any renderer error is a failure: the frame and factors are valid.
+pub fn render_refined<const N: usize>(
+    frame: &FrameSetup,
+    table: &ViewTable<N>,
+    order: Order,
+    samples: &[u8],
+    lut: &[[f32; 4]],
+    factors: &[Vec<u8>; 3],
+) -> Vec<[f32; 4]> {
+    let n = frame.image_len();
+    let (mut acc, mut img) = (vec![[0.0f32; 4]; n], vec![[0.0f32; 4]; n]);
+    let mut rows = vec![RowSpan::EMPTY; frame.size[1]];
+    let buffers = RenderBuffers {
+        accumulator: &mut acc,
+        image: &mut img,
+        rows: &mut rows,
+    };
+    let path = FloatPath { sampler: table };
+    let mut r = SheetRenderer::with_path(frame, path, emission(lut), order, buffers, None)
+        .expect("valid frame");
+    let axis = |a: usize| RefinedAxis::new(a, frame.dims[a], &factors[a]).expect("factors 1, 2, 4");
+    let grid = RefinedGrid {
+        axes: [axis(0), axis(1), axis(2)],
+    };
+    let scales = [[1.0, 0.5], [0.5, 0.25]];
+    let scaled = ScaledFootprint::new(table, sheet_map(frame), scales);
+    let mut buffer = vec![
+        0.0f32;
+        scaled
+            .as_ref()
+            .and_then(|s| stencil::len_for(footprint::Sampler::footprint(s), 4))
+            .unwrap_or(0)
+    ];
+    let stencils = match &scaled {
+        Some(s) if !buffer.is_empty() => Stencils::build(s, 4, &mut buffer).ok(),
+        _ => None,
+    };
+    let mut splatters: Vec<Option<Stencils<'_, ScaledFootprint<'_, ViewTable<N>>>>> =
+        (0..SPACING_KEYS).map(|_| None).collect();
+    splatters[spacing_key(scales[0], scales[1], 1.0)] = stencils;
+    let tables = RefineTables {
+        rates: [table; 5],
+        splatters: &splatters,
+    };
+    let d = frame.dims;
+    let mut scratch = vec![0.0f32; 2 * frame.sheet_shape().0];
+    r.render_refined(
+        &grid,
+        &tables,
+        |[i, j, k]| f32::from(samples[i + d[0] * (j + d[1] * k)]),
+        &mut scratch,
+    )
+    .expect("refined render");
+    r.finish();
+    img
 }
 
 /// Renders `samples` as [`render_volume`] does, with image-aligned slabs: every voxel shaded for
