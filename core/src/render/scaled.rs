@@ -376,7 +376,8 @@ pub(super) mod tests {
         );
     }
 
-    /// Stencils over a [`ScaledFootprint`] give the weights [`splat_scaled`] reads.
+    /// Stencils over a [`ScaledFootprint`], and a table resampled from it, give the weights
+    /// [`splat_scaled`] reads.
     #[test]
     fn scaled_footprint_stencils_match_the_walk() {
         let size = [96, 96];
@@ -408,5 +409,15 @@ pub(super) mod tests {
         assert!(peak > 0.0 && d < 0.02, "max diff {d} of peak");
         let (total_w, total_s): (f32, f32) = (walk.iter().sum(), stencils.iter().sum());
         assert!((total_w - total_s).abs() < 0.01 * total_w);
+        // Resampled into a table of its own, splatted by the row walk.
+        let mut own = ViewTable::<65>::zeroed(*fp.footprint());
+        own.resample_into(&fp, Lookup::Bilinear);
+        let resampled = splat_into(size, |img| {
+            own.splat_voxel(c, &v, img, |_, _, _| {}).unwrap();
+        });
+        let (d, _) = max_diff(&resampled, &walk);
+        assert!(d < 0.02, "resampled: max diff {d} of peak");
+        let total_r: f32 = resampled.iter().sum();
+        assert!((total_w - total_r).abs() < 0.01 * total_w);
     }
 }

@@ -153,6 +153,33 @@ impl<const M: usize> ViewTable<M> {
         self.lookup = sample;
     }
 
+    /// Samples `sampler`'s weights at the nodes of its footprint's screen box (layout
+    /// [`ViewLayout::ScreenBox`]), to be read with `sample` lookup: a table of any footprint a
+    /// [`Sampler`](crate::splat::Sampler) gives, such as a refined sample's scaled one
+    /// ([`crate::render::ScaledFootprint`]), so that it splats through the row walk.
+    pub fn resample_into<S: crate::splat::Sampler + ?Sized>(
+        &mut self,
+        sampler: &S,
+        sample: Lookup,
+    ) {
+        let footprint = *sampler.footprint();
+        let [ex, ey] = footprint.half_extent;
+        let steps = (M - 1) as f32;
+        for (row, line) in self.data.iter_mut().enumerate() {
+            let y = -ey + 2.0 * ey * row as f32 / steps;
+            for (col, value) in line.iter_mut().enumerate() {
+                let x = -ex + 2.0 * ex * col as f32 / steps;
+                *value = sampler.weight([x, y]);
+            }
+        }
+        self.footprint = footprint;
+        self.layout = ViewLayout::ScreenBox;
+        self.nodes_per_px = [steps / (2.0 * ex), steps / (2.0 * ey)];
+        let half = 0.5 * steps;
+        self.unit_map = footprint.to_unit.map(|row| row.map(|a| a * half));
+        self.lookup = sample;
+    }
+
     /// Where this table's nodes lie.
     pub fn layout(&self) -> ViewLayout {
         self.layout

@@ -34,6 +34,10 @@ use footprint::Sampler;
 use footprint::{Footprint, Lookup, ViewTable};
 use std::time::Instant;
 
+/// Samples that must share a border spacing for its scaled footprint to be resampled into a
+/// table of its own (M² reads, then the row walk per pixel instead of the scaled walk).
+pub const RESAMPLE_SAMPLES: usize = 32;
+
 /// Most sub-pixel phases of a refined footprint's stencils.
 pub const REFINE_PHASES: usize = 8;
 
@@ -242,9 +246,14 @@ pub fn render_refined(
                 let len = stencil_len(table.footprint(), n, phases);
                 exact_tables.push((key, table, vec![0.0f32; len.unwrap_or(0)]));
             } else if let Some(fp) = ScaledFootprint::new(rates[rate_index(sa, sb, w)], map, [sa, sb]) {
-                // A scaled footprint's read costs about twice a table's: half the samples' worth.
+                // A scaled footprint's read costs about twice a table's: half the samples' worth
+                // for stencils; else, shared by a few samples, its own table (the row walk).
                 if let Some(len) = stencil_len(fp.footprint(), n / 2, phases) {
                     scaled.push((key, fp, vec![0.0f32; len]));
+                } else if n >= RESAMPLE_SAMPLES {
+                    let mut t = Box::new(ViewTable::<N>::zeroed(*fp.footprint()));
+                    t.resample_into(&fp, lookup);
+                    exact_tables.push((key, t, Vec::new()));
                 }
             }
         }
