@@ -397,3 +397,40 @@ fn an_srgb_background_comes_back_unchanged() {
     assert_ne!(before, after, "the volume shows in the middle");
     std::fs::remove_dir_all(&d).unwrap();
 }
+
+/// An output naming a device or a FIFO is written into it, never replaced by a regular file (a
+/// rename over `--json /dev/null`, as root, once turned this machine's `/dev/null` into a file).
+#[cfg(unix)]
+#[test]
+fn devices_and_fifos_are_written_in_place() {
+    use std::os::unix::fs::FileTypeExt;
+    assert!(outputs::is_special(Path::new("/dev/null")));
+    let d = tmpdir("fifo");
+    let fifo = d.join("summary.json");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    if !made.is_ok_and(|s| s.success()) {
+        eprintln!("mkfifo unavailable: skipped");
+        return;
+    }
+    let reader = {
+        let fifo = fifo.clone();
+        std::thread::spawn(move || std::fs::read(&fifo).unwrap())
+    };
+    let png = d.join("x.png");
+    let code = run(&[
+        "render",
+        "--size",
+        "16x16",
+        "--out",
+        png.to_str().unwrap(),
+        "--json",
+        fifo.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0);
+    // Checked before joining: a replaced FIFO would leave the reader waiting forever.
+    assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo());
+    let json = String::from_utf8(reader.join().unwrap()).unwrap();
+    assert!(json.contains("\"seconds\""), "{json}");
+    assert!(png.is_file());
+    assert_eq!(listing(&d), ["summary.json", "x.png"]);
+}

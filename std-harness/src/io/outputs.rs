@@ -9,6 +9,11 @@
 //! under the command (a folder removed or made read-only between the check and the rename); the
 //! files renamed before it then stay, and the error names the one that failed.
 //!
+//! **Devices and pipes.** An output naming an existing file that is neither a regular file nor a
+//! folder (`/dev/null`, `/dev/stdout`, a FIFO) is written in place, after every regular output is
+//! renamed into place: renaming a temporary over it would replace the device with a regular file
+//! (as root, `--json /dev/null` did exactly that to this machine's `/dev/null`).
+//!
 //! **After SIGKILL.** A kill between a temporary's creation and its rename leaves
 //! `.NAME.tmp-PID` beside the output (never a partial `NAME`). The next run that writes `NAME`
 //! removes such leftovers ([`clean_leftovers`]): those whose process no longer runs (on Linux,
@@ -28,6 +33,13 @@ pub struct Planned<'a> {
     pub path: &'a Path,
     /// Lower-case extensions accepted, e.g. `["png", "pfm"]`; empty accepts any.
     pub extensions: &'a [&'a str],
+}
+
+/// Whether `path` names an existing file that is neither a regular file nor a folder (a device
+/// such as `/dev/null`, a FIFO; symbolic links followed, so `/dev/stdout` counts): written in
+/// place, never replaced (see the module docs).
+pub fn is_special(path: &Path) -> bool {
+    std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir())
 }
 
 /// The lower-case extension of `path`, if any.
@@ -125,22 +137,25 @@ pub fn check(outputs: &[Planned<'_>]) -> Result<(), CliError> {
             }
         }
         let dir = folder(o.path);
-        if !dir.is_dir() {
+        if is_special(o.path) {
+            // Written in place: no folder probe (a temporary beside a device is never made).
+        } else if !dir.is_dir() {
             return Err(CliError::input(format!(
                 "{flag} {shown}: directory {} does not exist",
                 dir.display()
             )));
+        } else {
+            // Probe: the same temporary name the write will use, created and removed.
+            let tmp = temporary(o.path)?;
+            std::fs::File::create(&tmp)
+                .and_then(|_| std::fs::remove_file(&tmp))
+                .map_err(|e| {
+                    CliError::input(format!(
+                        "{flag} {shown}: cannot write in {}: {e}",
+                        dir.display()
+                    ))
+                })?;
         }
-        // Probe: the same temporary name the write will use, created and removed.
-        let tmp = temporary(o.path)?;
-        std::fs::File::create(&tmp)
-            .and_then(|_| std::fs::remove_file(&tmp))
-            .map_err(|e| {
-                CliError::input(format!(
-                    "{flag} {shown}: cannot write in {}: {e}",
-                    dir.display()
-                ))
-            })?;
         for other in &outputs[..i] {
             if same_file(other.path, o.path) {
                 return Err(CliError::input(format!(
@@ -167,7 +182,7 @@ pub fn write_all<B: AsRef<[u8]>>(files: &[(&Path, B)]) -> Result<(), CliError> {
             let _ = std::fs::remove_file(tmp);
         }
     };
-    for (path, bytes) in files {
+    for (path, bytes) in files.iter().filter(|(p, _)| !is_special(p)) {
         let (path, bytes) = (*path, bytes.as_ref());
         let tmp = match temporary(path) {
             Ok(t) => t,
@@ -199,6 +214,13 @@ pub fn write_all<B: AsRef<[u8]>>(files: &[(&Path, B)]) -> Result<(), CliError> {
                 path.display()
             )));
         }
+    }
+    for (path, bytes) in files.iter().filter(|(p, _)| is_special(p)) {
+        std::fs::OpenOptions::new()
+            .write(true)
+            .open(path)
+            .and_then(|mut f| f.write_all(bytes.as_ref()))
+            .map_err(|e| CliError::input(format!("{}: cannot write: {e}", path.display())))?;
     }
     Ok(())
 }
