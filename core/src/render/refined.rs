@@ -52,17 +52,21 @@ impl RefinedGrid<'_> {
 /// Spacing keys: (σₐ₋, σₐ₊) × (σ_b₋, σ_b₊) × sheet width, each of 1, ½, ¼ ([`spacing_key`]).
 pub const SPACING_KEYS: usize = 243;
 
+/// How many of the log-scale midpoints between ¼, ½, 1, 2, 4 (2^(k − 1.5), k = 0..4) lie below
+/// `x`: the index of the power of two in ¼…4 nearest `x` (0 for NaN or x ≤ 2^−1.5).
+#[inline]
+fn octave(x: f32) -> usize {
+    use core::f32::consts::{FRAC_1_SQRT_2, SQRT_2};
+    [0.5 * FRAC_1_SQRT_2, FRAC_1_SQRT_2, SQRT_2, 2.0 * SQRT_2]
+        .iter()
+        .filter(|&&m| x > m)
+        .count()
+}
+
 /// 0, 1, 2 for a spacing nearest (in log scale) to 1, ½, ¼.
 #[inline]
 fn level(s: f32) -> usize {
-    use core::f32::consts::FRAC_1_SQRT_2;
-    if s > FRAC_1_SQRT_2 {
-        0
-    } else if s > 0.5 * FRAC_1_SQRT_2 {
-        1
-    } else {
-        2
-    }
+    2 - octave(s).min(2)
 }
 
 /// The key of a sample's spacings: `a` and `b` its (previous, next) spacings along the in-sheet
@@ -91,12 +95,7 @@ pub fn rate_index(a: [f32; 2], b: [f32; 2], width: f32) -> usize {
     if !(rho > 0.0) {
         return 2;
     }
-    // Midpoints in log scale: 2^(k − 1.5).
-    use core::f32::consts::{FRAC_1_SQRT_2, SQRT_2};
-    [0.5 * FRAC_1_SQRT_2, FRAC_1_SQRT_2, SQRT_2, 2.0 * SQRT_2]
-        .iter()
-        .filter(|&&m| rho > m)
-        .count()
+    octave(rho)
 }
 
 /// The footprints a refined render splats with (see the module docs).

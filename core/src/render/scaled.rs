@@ -30,6 +30,9 @@ pub struct ScaledFootprint<'a, T: ?Sized> {
     map: Mat2,
     inv: Mat2,
     inv_scale: [[f32; 2]; 2],
+    /// The box around the scaled support, offsets from the centre, pixels.
+    lo: Vec2,
+    hi: Vec2,
     footprint: Footprint,
 }
 
@@ -54,6 +57,8 @@ impl<'a, T: Sampler + ?Sized> ScaledFootprint<'a, T> {
             map: sheet_map,
             inv: sheet_map.inverse(),
             inv_scale: scales.map(|s| [1.0 / s[0], 1.0 / s[1]]),
+            lo,
+            hi,
             footprint,
         })
     }
@@ -110,7 +115,8 @@ fn scaled_box(base: &Footprint, sheet_map: Mat2, scales: [[f32; 2]; 2]) -> Optio
 /// scaled per side in sheet coordinates: `scales[0]` = (σₐ₋, σₐ₊), `scales[1]` = (σ_b₋, σ_b₊),
 /// coarse steps; `sheet_map` = P (columns: the screen x, y of one step along a and along b).
 /// `acc`'s first row is image row `row0`; `touched(y, x0, x1)` reports each row's updated span
-/// (relative to `acc`). The value is scaled by `area` (the coarse cell's |det P|).
+/// (relative to `acc`). The value is scaled by `area` (the coarse cell's |det P|). Nothing for a
+/// singular P or a non-positive scale. [`ScaledFootprint::splat`] of a footprint built here.
 #[allow(clippy::too_many_arguments)]
 pub fn splat_scaled<T: Sampler + ?Sized>(
     sampler: &T,
@@ -121,88 +127,102 @@ pub fn splat_scaled<T: Sampler + ?Sized>(
     value: &[f32; 4],
     row0: usize,
     acc: &mut ImageMut<'_, [f32; 4]>,
-    mut touched: impl FnMut(usize, usize, usize),
+    touched: impl FnMut(usize, usize, usize),
 ) -> SplatStats {
-    let mut stats = SplatStats::default();
-    let Some((lo, hi)) = scaled_box(sampler.footprint(), sheet_map, scales) else {
-        return stats;
-    };
-    let inv = sheet_map.inverse();
-    let (w, h) = (acc.width(), acc.height());
-    let stride = acc.stride();
-    let (x0, x1) = pixel_range(centre[0] + lo.x, centre[0] + hi.x);
-    let (y0, y1) = pixel_range(centre[1] + lo.y, centre[1] + hi.y);
-    let x0 = x0.max(0) as usize;
-    let x1 = (x1 + 1).clamp(0, w as i64) as usize;
-    let y0 = (y0.max(row0 as i64) as usize).max(row0);
-    let y1 = (y1 + 1).clamp(0, (row0 + h) as i64) as usize;
-    if x0 >= x1 || y0 >= y1 {
-        return stats;
-    }
-    let value = value.map(|c| c * area);
-    let inv_scale = [
-        [1.0 / scales[0][0], 1.0 / scales[0][1]],
-        [1.0 / scales[1][0], 1.0 / scales[1][1]],
-    ];
-    let data = acc.data_mut();
-    let along = inv.col(0); // ∂s/∂x per pixel
-    let mut weights = [0.0f32; 256];
-    for y in y0..y1 {
-        let qy = y as f32 + 0.5 - centre[1];
-        let row = (y - row0) * stride;
-        let (mut first, mut last) = (usize::MAX, 0);
-        // Runs of pixels in one quadrant of the sheet plane (split where s·x or s·y changes
-        // sign; the footprint is continuous there, both scales giving 0): one line walk each.
-        let s_row = inv * Vec2::new(x0 as f32 + 0.5 - centre[0], qy);
-        let mut cuts = [x1; 2];
-        for (c, (s0, ds)) in cuts
-            .iter_mut()
-            .zip([(s_row.x, along.x), (s_row.y, along.y)])
-        {
-            if ds != 0.0 {
-                let t = -s0 / ds;
-                if t > 0.0 && t < (x1 - x0) as f32 {
-                    *c = x0 + (math::floor(t) as usize + 1).min(x1 - x0);
-                }
-            }
+    ScaledFootprint::new(sampler, sheet_map, scales).map_or_else(SplatStats::default, |s| {
+        s.splat(centre, area, value, row0, acc, touched)
+    })
+}
+
+impl<T: Sampler + ?Sized> ScaledFootprint<'_, T> {
+    /// Splats `value` × `area` of a sample projected to `centre` (absolute pixels) into `acc`
+    /// (first row: image row `row0`), reading the base footprint along runs of pixels in one
+    /// quadrant of the sheet plane (one line walk each, [`Sampler::line_weights`]) rather than
+    /// per pixel; `touched(y, x0, x1)` reports each row's updated span (relative to `acc`).
+    pub fn splat(
+        &self,
+        centre: [f32; 2],
+        area: f32,
+        value: &[f32; 4],
+        row0: usize,
+        acc: &mut ImageMut<'_, [f32; 4]>,
+        mut touched: impl FnMut(usize, usize, usize),
+    ) -> SplatStats {
+        let mut stats = SplatStats::default();
+        let (lo, hi, inv, inv_scale) = (self.lo, self.hi, self.inv, self.inv_scale);
+        let (sampler, sheet_map) = (self.base, self.map);
+        let (w, h) = (acc.width(), acc.height());
+        let stride = acc.stride();
+        let (x0, x1) = pixel_range(centre[0] + lo.x, centre[0] + hi.x);
+        let (y0, y1) = pixel_range(centre[1] + lo.y, centre[1] + hi.y);
+        let x0 = x0.max(0) as usize;
+        let x1 = (x1 + 1).clamp(0, w as i64) as usize;
+        let y0 = (y0.max(row0 as i64) as usize).max(row0);
+        let y1 = (y1 + 1).clamp(0, (row0 + h) as i64) as usize;
+        if x0 >= x1 || y0 >= y1 {
+            return stats;
         }
-        if cuts[0] > cuts[1] {
-            cuts.swap(0, 1);
-        }
-        let mut x = x0;
-        for end in [cuts[0], cuts[1], x1] {
-            while x < end {
-                let stop = end.min(x + weights.len());
-                let s0 = s_row + along * (x - x0) as f32;
-                let mid = s0 + along * (0.5 * (stop - x - 1) as f32);
-                let d = Vec2::new(
-                    inv_scale[0][usize::from(mid.x >= 0.0)],
-                    inv_scale[1][usize::from(mid.y >= 0.0)],
-                );
-                let q0 = sheet_map * (s0 * d);
-                let step = sheet_map * (along * d);
-                let out = &mut weights[..stop - x];
-                sampler.line_weights([q0.x, q0.y], [step.x, step.y], out);
-                for (k, &wgt) in out.iter().enumerate() {
-                    if wgt != 0.0 {
-                        let p = &mut data[row + x + k];
-                        for (c, v) in p.iter_mut().zip(&value) {
-                            *c += v * wgt;
-                        }
-                        stats.pixels_updated += 1;
-                        first = first.min(x + k);
-                        last = x + k;
+        let value = value.map(|c| c * area);
+        let data = acc.data_mut();
+        let along = inv.col(0); // ∂s/∂x per pixel
+        let mut weights = [0.0f32; 256];
+        for y in y0..y1 {
+            let qy = y as f32 + 0.5 - centre[1];
+            let row = (y - row0) * stride;
+            let (mut first, mut last) = (usize::MAX, 0);
+            // Runs of pixels in one quadrant of the sheet plane (split where s·x or s·y changes
+            // sign; the footprint is continuous there, both scales giving 0): one line walk each.
+            let s_row = inv * Vec2::new(x0 as f32 + 0.5 - centre[0], qy);
+            let mut cuts = [x1; 2];
+            for (c, (s0, ds)) in cuts
+                .iter_mut()
+                .zip([(s_row.x, along.x), (s_row.y, along.y)])
+            {
+                if ds != 0.0 {
+                    let t = -s0 / ds;
+                    if t > 0.0 && t < (x1 - x0) as f32 {
+                        *c = x0 + (math::floor(t) as usize + 1).min(x1 - x0);
                     }
                 }
-                stats.pixels_visited += (stop - x) as u32;
-                x = stop;
+            }
+            if cuts[0] > cuts[1] {
+                cuts.swap(0, 1);
+            }
+            let mut x = x0;
+            for end in [cuts[0], cuts[1], x1] {
+                while x < end {
+                    let stop = end.min(x + weights.len());
+                    let s0 = s_row + along * (x - x0) as f32;
+                    let mid = s0 + along * (0.5 * (stop - x - 1) as f32);
+                    let d = Vec2::new(
+                        inv_scale[0][usize::from(mid.x >= 0.0)],
+                        inv_scale[1][usize::from(mid.y >= 0.0)],
+                    );
+                    let q0 = sheet_map * (s0 * d);
+                    let step = sheet_map * (along * d);
+                    let out = &mut weights[..stop - x];
+                    sampler.line_weights([q0.x, q0.y], [step.x, step.y], out);
+                    for (k, &wgt) in out.iter().enumerate() {
+                        if wgt != 0.0 {
+                            let p = &mut data[row + x + k];
+                            for (c, v) in p.iter_mut().zip(&value) {
+                                *c += v * wgt;
+                            }
+                            stats.pixels_updated += 1;
+                            first = first.min(x + k);
+                            last = x + k;
+                        }
+                    }
+                    stats.pixels_visited += (stop - x) as u32;
+                    x = stop;
+                }
+            }
+            if first <= last {
+                touched(y - row0, first, last);
             }
         }
-        if first <= last {
-            touched(y - row0, first, last);
-        }
+        stats
     }
-    stats
 }
 
 /// The screen x, y of one grid step along each in-sheet axis: P of [`splat_scaled`].

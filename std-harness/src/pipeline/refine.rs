@@ -50,10 +50,11 @@ pub const REFINE_PHASES: usize = 8;
 /// The closest a refined step may project, pixels.
 pub const MIN_STEP_PX: f32 = 6.0;
 
-/// Checks that `args` can refine `p`, with a message saying what to drop if not.
-pub fn check(p: &Prepared, args: &RenderArgs) -> Result<(), CliError> {
+/// Checks that `args` can refine `p` with accumulation `accum`, with a message saying what to
+/// drop if not.
+pub fn check(p: &Prepared, args: &RenderArgs, accum: AccumArg) -> Result<(), CliError> {
     let refuse = |why: &str| Err(CliError::input(format!("--refine: {why}")));
-    if args.accum != AccumArg::Float {
+    if accum != AccumArg::Float {
         return refuse("float accumulation only (drop --accum fixed)");
     }
     if args.slicing != SlicingArg::Object {
@@ -162,13 +163,15 @@ pub fn choose(
     })
 }
 
-/// Renders `p` refined at `threshold` (see the module docs) on `args.threads` bands.
+/// Renders `p` refined at `threshold` (see the module docs) on `args.threads` bands, after
+/// [`check`]ing that it can with accumulation `accum`.
 pub fn render_refined(
     p: &Prepared,
     args: &RenderArgs,
+    accum: AccumArg,
     threshold: f32,
 ) -> Result<CoreFrame, CliError> {
-    check(p, args)?;
+    check(p, args, accum)?;
     let volume = p.volume().expect("checked");
     let start = Instant::now();
     let refinement = choose(p, volume, threshold, args.refine_sheets)?;

@@ -39,9 +39,8 @@ impl Refinement {
 
     /// Per axis, how many intervals got factors 1, 2 and 4.
     pub fn counts(&self) -> [[usize; 3]; 3] {
-        self.factors.clone().map(|f| {
-            let n = |k: u8| f.iter().filter(|&&x| x == k).count();
-            [n(1), n(2), n(4)]
+        std::array::from_fn(|a| {
+            [1, 2, 4].map(|k| self.factors[a].iter().filter(|&&x| x == k).count())
         })
     }
 }

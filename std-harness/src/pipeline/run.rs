@@ -61,14 +61,7 @@ pub fn render_frame(
     cache: &mut FrameCache,
 ) -> Result<CoreFrame, CliError> {
     if let Some(threshold) = args.refine {
-        super::refine::check(
-            p,
-            &RenderArgs {
-                accum,
-                ..args.clone()
-            },
-        )?;
-        return super::refine::render_refined(p, args, threshold);
+        return super::refine::render_refined(p, args, accum, threshold);
     }
     if args.slicing == SlicingArg::Image {
         return super::slabs::render_slabs(p, args, accum, cache);
