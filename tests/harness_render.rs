@@ -493,7 +493,18 @@ fn tables_file_and_tf_file_are_used() {
     );
     let (a, b) = (d.join("a.png"), d.join("b.png"));
     assert_eq!(
-        run(&["render", "--size", "64x64", "--table", "33", "--out", s(&a)]),
+        // Level 0: a coarser level narrows a built table's kernel, never a file's.
+        run(&[
+            "render",
+            "--size",
+            "64x64",
+            "--lod",
+            "0",
+            "--table",
+            "33",
+            "--out",
+            s(&a)
+        ]),
         0
     );
     assert_eq!(
@@ -501,6 +512,8 @@ fn tables_file_and_tf_file_are_used() {
             "render",
             "--size",
             "64x64",
+            "--lod",
+            "0",
             "--table",
             "33",
             "--table-file",

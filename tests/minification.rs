@@ -89,6 +89,9 @@ fn check(volume: &str, raw: &[&str], view: &str) {
                 ss,
                 "--tf",
                 "grey",
+                // Supersampling at full resolution is what this measures (`auto` would coarsen).
+                "--lod",
+                "0",
             ]
             .iter()
             .map(|s| s.to_string()),

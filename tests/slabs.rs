@@ -424,6 +424,9 @@ fn opaque_voxels_converge_too() {
         "0,300",
         "--threads",
         "2",
+        // The continuous reference integrates full resolution.
+        "--lod",
+        "0",
     ];
     let args = parse_args(&base).unwrap();
     let p = prepare(&args).unwrap();

@@ -246,7 +246,26 @@ impl Shader<'_> {
         index: [usize; 3],
         dims: [usize; 3],
     ) -> [f32; 4] {
-        let Some((rgb, alpha, phong, g)) = self.classify(value, gradient, index, dims) else {
+        self.shade_coloured(lighting, table, value, None, gradient, index, dims)
+    }
+
+    /// [`Shader::shade_with`] for a sample that may carry its own straight colour (see
+    /// [`Sample::colour`]): emission and Phong use `colour`, when given, instead of the transfer
+    /// function's colour at `value` (the opacity still comes from `value`); iso-surfaces and the
+    /// texture colour as always.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    pub fn shade_coloured(
+        &self,
+        lighting: &Lighting,
+        table: Option<&OpacityTable<'_>>,
+        value: f32,
+        colour: Option<[f32; 3]>,
+        gradient: impl FnOnce() -> Vec3,
+        index: [usize; 3],
+        dims: [usize; 3],
+    ) -> [f32; 4] {
+        let Some((mut rgb, alpha, phong, g)) = self.classify(value, gradient, index, dims) else {
             return [0.0; 4];
         };
         let mut light = 1.0;
@@ -264,6 +283,9 @@ impl Shader<'_> {
                 light = p.ambient + p.diffuse;
                 spec = 0.0;
             }
+        }
+        if let (Some(c), Shading::Emission | Shading::Phong(_)) = (colour, self.shading) {
+            rgb = c;
         }
         let corrected = match table {
             Some(t) => t.correct(alpha),
@@ -345,8 +367,19 @@ impl Shader<'_> {
 
 /// A voxel sample type the renderer reads: anything the harness loads, converted to f32.
 pub trait Sample: Copy {
+    /// Whether samples of this type may carry a colour ([`Sample::colour`]).
+    const COLOURED: bool = false;
+
     /// The sample as f32 (NaN for a missing value is allowed: it classifies as transparent).
     fn to_f32(self) -> f32;
+
+    /// A straight colour (each channel in [0, 1]) the sample carries, to be used instead of the
+    /// transfer function's colour at its value by emission and Phong shading: what a pre-filtered
+    /// level of detail carries (`crate::lod::Coloured`). `None`, the default, for plain data.
+    #[inline]
+    fn colour(self) -> Option<[f32; 3]> {
+        None
+    }
 }
 
 macro_rules! sample_as_f32 {

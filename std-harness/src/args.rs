@@ -281,11 +281,12 @@ pub struct RenderArgs {
     #[arg(long, default_value = "auto", value_parser = parse_supersample)]
     pub supersample: Supersample,
     /// Level of detail: a number N splats level N (each level averages 2x2x2 samples of the one
-    /// above into one, the spacing doubled; 0 = full resolution, the default); `auto` the deepest
-    /// level whose samples still project at most 0.6 px apart. Orthographic views only (`auto`
-    /// keeps a perspective view at level 0). The references `verify` compares with render the
-    /// same level.
-    #[arg(long, default_value = "0", value_parser = parse_lod)]
+    /// above into one, the spacing doubled, carrying the block's colour; 0 = full resolution);
+    /// `auto`, the default, the deepest level L with 4^L x (level 0's projected spacing) <= 3 px
+    /// (README, "Levels of detail"). Orthographic views only (`auto` keeps a perspective view, and
+    /// --refine, at level 0). The f64 reference `verify` compares with renders the same level;
+    /// the continuous reference integrates full resolution (`auto` then means level 0).
+    #[arg(long, default_value = "auto", value_parser = parse_lod)]
     pub lod: Lod,
     /// The paper's adaptive re-sampling for magnified volumes: along each grid axis, intervals
     /// whose neighbouring samples' classified colours (premultiplied RGBA, 0..1) differ by more

@@ -339,11 +339,12 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
         ];
         let (path, opacity) = (&self.path, self.opacity);
         let shade = |u: usize, v: usize| {
-            let value = window.current[v * na + u].to_f32();
-            path.value(shader.shade_with(
+            let sample = window.current[v * na + u];
+            path.value(shader.shade_coloured(
                 &lighting,
                 opacity.as_ref(),
-                value,
+                sample.to_f32(),
+                sample.colour(),
                 || gradient(f, &window, u, v),
                 f.grid_index(index, u, v),
                 f.dims,
@@ -419,10 +420,11 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
                     glam::Vec3::ZERO
                 }
             };
-            let value = self.path.value(shader.shade_with(
+            let value = self.path.value(shader.shade_coloured(
                 &lighting,
                 opacity.as_ref(),
                 vox.value,
+                visible.colours.get(k).copied(),
                 g,
                 f.grid_index(index, u, v),
                 f.dims,

@@ -32,13 +32,18 @@ pub struct VisibleSheet<'s> {
     pub voxels: &'s [VisibleVoxel],
     /// One gradient per voxel when the shading needs gradients; may be empty otherwise.
     pub gradients: &'s [[f32; 3]],
+    /// One straight colour per voxel when the samples carry colours ([`Sample::colour`], a
+    /// level of detail's); empty otherwise (the transfer function colours them).
+    pub colours: &'s [[f32; 3]],
 }
 
 /// Writes the visible voxels of sheet `index` (with its neighbours in `window`, for gradients)
-/// into `voxels`, and their gradients into `gradients` when `shader` needs them, in render
-/// order; returns how many. `voxels` (and `gradients`, when needed) must hold a whole sheet's
-/// worth in the worst case (`dims[a] × dims[b]`); sheets wider than 65 536 voxels along an axis
-/// are refused.
+/// into `voxels`, their gradients into `gradients` when `shader` needs them, and their colours
+/// into `colours` when the sample type carries colours ([`Sample::COLOURED`]; a sample without
+/// one gets the transfer function's), in render order; returns how many. `voxels` (and `gradients` and `colours`,
+/// when needed) must hold a whole sheet's worth in the worst case (`dims[a] × dims[b]`); sheets
+/// wider than 65 536 voxels along an axis are refused. A sample type without colours leaves
+/// `colours` alone (it may then be empty).
 pub fn classify_sheet<T: Sample>(
     frame: &FrameSetup,
     shader: &Shader<'_>,
@@ -46,6 +51,7 @@ pub fn classify_sheet<T: Sample>(
     window: SheetWindow<'_, T>,
     voxels: &mut [VisibleVoxel],
     gradients: &mut [[f32; 3]],
+    colours: &mut [[f32; 3]],
 ) -> Result<usize, RenderError> {
     let count = frame.sheet_count();
     if index >= count {
@@ -84,10 +90,19 @@ pub fn classify_sheet<T: Sample>(
         }
         .into());
     }
+    let coloured = T::COLOURED;
+    if coloured && colours.len() < len {
+        return Err(BufferError::TooSmall {
+            needed: len,
+            got: colours.len(),
+        }
+        .into());
+    }
     let mut n = 0;
     for v in 0..nb {
         for u in 0..na {
-            let value = window.current[v * na + u].to_f32();
+            let sample = window.current[v * na + u];
+            let value = sample.to_f32();
             let mut g = glam::Vec3::ZERO;
             let seen = shader.visible(value, || {
                 g = gradient(frame, &window, u, v);
@@ -104,6 +119,14 @@ pub fn classify_sheet<T: Sample>(
             if needs_gradient {
                 // Emission never asks for the gradient; every other shading computed it above.
                 gradients[n] = g.to_array();
+            }
+            if coloured {
+                // A sample of a coloured type without a colour of its own takes the transfer
+                // function's, as the renderer would give it.
+                colours[n] = sample.colour().unwrap_or_else(|| {
+                    let c = shader.tf.lookup(value);
+                    [c[0], c[1], c[2]]
+                });
             }
             n += 1;
         }

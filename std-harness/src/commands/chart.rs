@@ -1,7 +1,7 @@
 //! `footprint chart`: speed against accuracy on one scene, and stability where methods fail (see
 //! [`crate::charts`] for what is swept and how it is measured).
 
-use crate::args::RenderArgs;
+use crate::args::{Lod, RenderArgs};
 use crate::charts::{lod, plot, popping, refine, stability, sweep};
 use crate::io;
 use crate::pipeline::config::Config;
@@ -68,6 +68,12 @@ pub fn run(args: &ChartArgs) -> Result<(), CliError> {
     let mut base = args.render.clone();
     base.out = None;
     base.json = None;
+    // The trade-off, stability, popping and refinement charts measure the method against the
+    // continuous reference, which integrates full resolution: `--lod auto` means level 0 there
+    // (the levels-of-detail sweep sets its own levels).
+    if base.lod == Lod::Auto {
+        base.lod = Lod::Level(0);
+    }
     let name = base
         .volume
         .as_ref()

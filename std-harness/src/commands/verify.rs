@@ -4,7 +4,7 @@
 //! Colour space: the renderers' output, linear premultiplied RGBA in [0, 1], composited over the
 //! background (transparent black if none); the measures are [`crate::metrics`]'.
 
-use crate::args::{AccumArg, MethodArg, RenderArgs};
+use crate::args::{AccumArg, Lod, MethodArg, RenderArgs};
 use crate::io::image::{check_style, encode_rgb_for, RGB_EXTENSIONS};
 use crate::io::json::Json;
 use crate::io::outputs::{self, Planned};
@@ -98,6 +98,18 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
     for path in [&r.out, &args.reference_out].into_iter().flatten() {
         check_style(path, r.png_style())?;
     }
+    // The continuous reference integrates full resolution: `--lod auto` then renders level 0
+    // (an explicit level is compared with it as asked, and refused by it).
+    let full;
+    let r = if matches!(args.reference, ReferenceArg::Continuous) && r.lod == Lod::Auto {
+        full = RenderArgs {
+            lod: Lod::Level(0),
+            ..r.clone()
+        };
+        &full
+    } else {
+        r
+    };
     let p = prepare(r)?;
     let (chosen, choice) = apply_quality(&p, r)?;
     let r = &chosen;

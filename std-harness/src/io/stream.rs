@@ -4,6 +4,7 @@
 
 use crate::io::volume::{SampleType, Volume};
 use crate::CliError;
+use footprint::lod::Coloured;
 use footprint::render::RenderError;
 use footprint::source::SheetSource;
 use std::io::Read;
@@ -51,6 +52,24 @@ impl SheetSource for MemorySource<'_> {
     type Error = CliError;
     fn read_sheet(&mut self, axis: usize, index: usize, out: &mut [f32]) -> Result<(), CliError> {
         self.0.sheet_into(axis, index, out);
+        Ok(())
+    }
+}
+
+/// A volume in memory as a source of [`Coloured`] samples (the colours a level of detail carries;
+/// `None` for plain data).
+pub struct ColouredMemorySource<'a>(pub &'a Volume);
+
+impl SheetSource for ColouredMemorySource<'_> {
+    type Sample = Coloured;
+    type Error = CliError;
+    fn read_sheet(
+        &mut self,
+        axis: usize,
+        index: usize,
+        out: &mut [Coloured],
+    ) -> Result<(), CliError> {
+        self.0.coloured_sheet_into(axis, index, out);
         Ok(())
     }
 }

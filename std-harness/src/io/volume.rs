@@ -4,6 +4,7 @@
 //! Data are x-fastest: sample (i, j, k) is at `i + dims[0]·(j + dims[1]·k)`.
 
 use crate::CliError;
+use footprint::lod::Coloured;
 use std::path::Path;
 
 /// Sample storage, by type.
@@ -17,6 +18,9 @@ pub enum Samples {
     I32(Vec<i32>),
     F32(Vec<f32>),
     F64(Vec<f64>),
+    /// A coarser level of detail averaged by extinction: values with the straight colour of
+    /// their block (the core's `lod::Coloured`); never read from a file.
+    Coloured(Vec<Coloured>),
 }
 
 /// A sample type name as written on the command line and in NRRD headers.
@@ -108,6 +112,7 @@ impl Volume {
             Samples::I32(v) => v[n] as f32,
             Samples::F32(v) => v[n],
             Samples::F64(v) => v[n] as f32,
+            Samples::Coloured(v) => v[n].value,
         }
     }
 
@@ -149,6 +154,31 @@ impl Volume {
             Samples::I32(v) => copy_sheet(v, d, a, s, out, |x| x as f32),
             Samples::F32(v) => copy_sheet(v, d, a, s, out, |x| x),
             Samples::F64(v) => copy_sheet(v, d, a, s, out, |x| x as f32),
+            Samples::Coloured(v) => copy_sheet(v, d, a, s, out, |x| x.value),
+        }
+    }
+
+    /// Whether the samples carry their own colours (a level of detail's, [`Samples::Coloured`]).
+    pub fn is_coloured(&self) -> bool {
+        matches!(self.samples, Samples::Coloured(_))
+    }
+
+    /// [`Volume::sheet_into`] keeping the colours samples carry (`None` for plain data).
+    pub fn coloured_sheet_into(&self, axis: usize, s: usize, out: &mut [Coloured]) {
+        use footprint::volume::copy_sheet;
+        match &self.samples {
+            Samples::Coloured(v) => copy_sheet(v, self.dims, axis, s, out, |x| x),
+            _ => {
+                // Plain data: the values, one sheet-sized scratch at a time.
+                let mut values = vec![0.0f32; out.len()];
+                self.sheet_into(axis, s, &mut values);
+                for (o, v) in out.iter_mut().zip(values) {
+                    *o = Coloured {
+                        value: v,
+                        colour: None,
+                    };
+                }
+            }
         }
     }
 }

@@ -15,7 +15,7 @@ use crate::io::volume::{SampleType, Volume};
 use crate::{tf, CliError};
 use footprint::frame::{FrameSetup, Order};
 use footprint::geometry::FootprintOptions;
-use footprint::lod::{level_frame, LodError};
+use footprint::lod::{level_frame, level_kernel, LodError};
 use footprint::shade::{Phong, Shader, Shading, TransferFunction};
 use footprint::{Grid, Kernel, View};
 
@@ -159,6 +159,16 @@ pub fn view_for(args: &RenderArgs, dims: [usize; 3], grid: &Grid) -> Result<View
     Ok(view)
 }
 
+/// The kernel level `level` is reconstructed with: a narrower one for a coarser level (the core's
+/// `lod::level_kernel`), unless `--table-file` fixes the table (and so the kernel) as given.
+fn kernel_at(args: &RenderArgs, kernel: &Kernel, level: u32) -> Kernel {
+    if args.footprint.table_file.is_some() {
+        *kernel
+    } else {
+        level_kernel(kernel, level)
+    }
+}
+
 /// The frame for `args`' view, at the output size or, when [`supersample::factor`] asks for it,
 /// at k× that size (the view scaled by k, so the picture is the same); returns it and k.
 /// With `--perspective` the frame is a pinhole's (`perspective_frame`).
@@ -186,9 +196,20 @@ pub fn setup_frame(
         return Ok((frame, k, 0));
     }
     let fine = FrameSetup::new(dims, grid, &view, kernel, options, size)?;
-    let level = super::lod::choose_level(args.lod, &fine, kernel);
+    if let (Some(t), Lod::Level(n @ 1..)) = (args.refine, args.lod) {
+        return Err(CliError::input(format!(
+            "--refine {t} adds samples to full resolution; --lod {n} removes them: give --lod 0 \
+             or auto"
+        )));
+    }
+    let level = match args.refine {
+        // Refinement is for magnified volumes: it always starts from full resolution.
+        Some(_) => 0,
+        None => super::lod::choose_level(args.lod, &fine, kernel),
+    };
+    let coarse_kernel = kernel_at(args, kernel, level);
     let at_level = |fine: &FrameSetup, view: &View| {
-        level_frame(fine, grid, view, kernel, options, level)
+        level_frame(fine, grid, view, &coarse_kernel, options, level)
             .map_err(|e| CliError::input(format!("--lod {level}: {e}")))
     };
     let frame = at_level(&fine, &view)?;
@@ -291,6 +312,7 @@ pub fn prepare(args: &RenderArgs) -> Result<Prepared, CliError> {
         min_radius_px: args.footprint.min_radius,
     };
     let (frame, supersample, level) = setup_frame(args, dims, &grid, &kernel, options)?;
+    let kernel = kernel_at(args, &kernel, level);
 
     let order = match &voxels {
         Voxels::Stdin { .. } => {

@@ -5,13 +5,13 @@
 pub use super::bands::CoreFrame;
 use super::bands::{run_bands, Phases};
 use super::load::Voxels;
-use super::lod::{with_level, DynSource};
+use super::lod::with_level;
 use super::prepare::Prepared;
 use super::supersample::{downsample, to_output};
 use super::visible::FrameCache;
 use crate::args::{AccumArg, MethodArg, RenderArgs, SlicingArg};
 use crate::io::progress::sheets;
-use crate::io::stream::{FileSource, MemorySource, PipeSource};
+use crate::io::stream::{ColouredMemorySource, FileSource, MemorySource, PipeSource};
 use crate::io::try_filled;
 use crate::reference::continuous::{
     render_continuous, render_continuous_at, Continuous, ContinuousScene, Reconstruction,
@@ -25,7 +25,7 @@ use footprint::render::{
     FixedPath, FloatPath, PerspectivePath, Precision, RenderBuffers, RenderStats, SheetRenderer,
     SheetRing,
 };
-use footprint::shade::OPACITY_TABLE_LEN;
+use footprint::shade::{Sample, OPACITY_TABLE_LEN};
 use footprint::source::{render_from, SheetSource};
 use footprint::splat::Direct;
 use footprint::stencil::{self, Stencils};
@@ -241,12 +241,6 @@ fn run_sheets<P: Precision>(
     let mut opacity = vec![0.0f32; OPACITY_TABLE_LEN];
     let mut renderer = SheetRenderer::with_path(f, path, p.shader(), p.order, buffers, background)?
         .with_opacity_table(&mut opacity)?;
-    let mut storage = try_filled(
-        3usize.saturating_mul(f.sheet_shape().0),
-        0.0f32,
-        "three sheets of the volume",
-    )?;
-    let mut ring = SheetRing::new(&mut storage, f, p.order)?;
     let mut show = Progress {
         inner: sheets("render"),
         count: f.sheet_count(),
@@ -254,23 +248,51 @@ fn run_sheets<P: Precision>(
     };
     // A streamed volume is coarsened to the frame's level as it streams (a volume in memory
     // already was, when prepared).
-    let (axis, fine) = (f.sheet_axis, p.fine_dims);
+    let (axis, fine, level) = (f.sheet_axis, p.fine_dims, p.level);
     let averaging = super::lod::averaging_for(&p.shading, p.shader().tf);
-    let mut render =
-        |src: &mut DynSource<'_>| render_from(&mut renderer, &mut ring, &mut show.wrap(src));
+    let (r, s) = (&mut renderer, &mut show);
     match &p.voxels {
-        Voxels::Memory(v) => render(&mut MemorySource(v))?,
+        Voxels::Memory(v) if v.is_coloured() => stream(r, s, &mut ColouredMemorySource(v))?,
+        Voxels::Memory(v) => stream(r, s, &mut MemorySource(v))?,
         Voxels::File(layout) => {
             let mut src = FileSource::open(layout.clone())?;
-            with_level(&mut src, fine, p.level, axis, &*averaging, &mut render)?
+            if level == 0 {
+                stream(r, s, &mut src)?
+            } else {
+                with_level(&mut src, fine, level, axis, &*averaging, &mut |c| {
+                    stream(r, s, c)
+                })?
+            }
         }
         Voxels::Stdin { .. } => {
             let mut src = pipe.take().expect("made above for standard input");
-            with_level(&mut src, fine, p.level, axis, &*averaging, &mut render)?
+            if level == 0 {
+                stream(r, s, &mut src)?
+            } else {
+                with_level(&mut src, fine, level, axis, &*averaging, &mut |c| {
+                    stream(r, s, c)
+                })?
+            }
         }
     }
     let stats = renderer.finish();
     Ok((image, stats))
+}
+
+/// Renders every sheet `source` delivers through a ring of three sheets of its samples.
+fn stream<P: Precision, T: Sample + Default>(
+    renderer: &mut SheetRenderer<'_, P>,
+    show: &mut Progress<impl FnMut(usize, usize)>,
+    source: &mut (impl SheetSource<Sample = T, Error = CliError> + ?Sized),
+) -> Result<(), CliError> {
+    let f = renderer.frame();
+    let mut storage = try_filled(
+        3usize.saturating_mul(f.sheet_shape().0),
+        T::default(),
+        "three sheets of the volume",
+    )?;
+    let mut ring = SheetRing::new(&mut storage, f, renderer.order())?;
+    render_from(renderer, &mut ring, &mut show.wrap(source))
 }
 
 /// Shows progress as a source delivers sheets.
@@ -295,12 +317,15 @@ impl<F: FnMut(usize, usize)> Progress<F> {
     }
 }
 
-impl<S: SheetSource<Sample = f32, Error = CliError>, F: FnMut(usize, usize)> SheetSource
-    for Reporting<'_, S, F>
-{
-    type Sample = f32;
+impl<S: SheetSource<Error = CliError>, F: FnMut(usize, usize)> SheetSource for Reporting<'_, S, F> {
+    type Sample = S::Sample;
     type Error = CliError;
-    fn read_sheet(&mut self, axis: usize, index: usize, out: &mut [f32]) -> Result<(), CliError> {
+    fn read_sheet(
+        &mut self,
+        axis: usize,
+        index: usize,
+        out: &mut [S::Sample],
+    ) -> Result<(), CliError> {
         self.source.read_sheet(axis, index, out)?;
         let p = &mut *self.progress;
         p.done += 1;
@@ -329,7 +354,7 @@ pub fn render_ref(p: &Prepared) -> Result<(Vec<[f64; 4]>, f64), CliError> {
     let axis = p.frame.sheet_axis;
     let img = render_reference(
         &scene,
-        |s, out| volume.sheet_into(axis, s, out),
+        |s, out| volume.coloured_sheet_into(axis, s, out),
         sheets("reference"),
     )?;
     let img = match p.supersample {
@@ -347,6 +372,13 @@ fn continuous_scene(
     let volume = p.volume().ok_or_else(|| {
         CliError::input("the continuous reference needs the volume in memory: drop --stream")
     })?;
+    if volume.is_coloured() {
+        return Err(CliError::input(format!(
+            "the continuous reference integrates the volume at full resolution, not level {} of \
+             it: give --lod 0",
+            p.level
+        )));
+    }
     let scene = ContinuousScene {
         frame: &p.frame,
         kernel: &p.kernel,

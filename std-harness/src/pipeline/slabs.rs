@@ -138,7 +138,8 @@ fn slab_voxels(
                     glam::Vec3::ZERO
                 }
             };
-            let rgba = shader.shade_with(&lighting, None, vox.value, g, idx, f.dims);
+            let colour = sheet.colours.get(k).copied();
+            let rgba = shader.shade_coloured(&lighting, None, vox.value, colour, g, idx, f.dims);
             let position = f.affine_position(idx.map(|c| c as f32)).to_array();
             if let Some(v) = SlabVoxel::from_unit_rgba(position, rgba) {
                 placed.push((v, setup.slabs_of(position[2])));

@@ -5,6 +5,7 @@
 use super::prepare::Prepared;
 use crate::io::volume::Volume;
 use crate::CliError;
+use footprint::lod::Coloured;
 use footprint::render::{classify_sheet, SheetWindow, VisibleSheet, VisibleVoxel};
 
 /// The visible voxels of every sheet along one axis, in sheet index order.
@@ -18,6 +19,8 @@ pub struct VisibleLists {
     pub voxels: Vec<VisibleVoxel>,
     /// Their world-space gradients, when the shading needs them (else empty).
     pub gradients: Vec<[f32; 3]>,
+    /// Their straight colours, when the volume carries colours (a level of detail's; else empty).
+    pub colours: Vec<[f32; 3]>,
 }
 
 impl VisibleLists {
@@ -30,6 +33,11 @@ impl VisibleLists {
                 &[]
             } else {
                 &self.gradients[a..b]
+            },
+            colours: if self.colours.is_empty() {
+                &[]
+            } else {
+                &self.colours[a..b]
             },
         }
     }
@@ -102,6 +110,7 @@ pub fn classify(p: &Prepared, volume: &Volume, threads: usize) -> Result<Visible
             .extend(part.offsets[1..].iter().map(|&o| o + base));
         out.voxels.extend_from_slice(&part.voxels);
         out.gradients.extend_from_slice(&part.gradients);
+        out.colours.extend_from_slice(&part.colours);
     }
     Ok(out)
 }
@@ -116,9 +125,10 @@ fn classify_range(
     let shader = p.shader();
     let needs_gradient = shader.shading.needs_gradient();
     let (len, axis, count) = (f.sheet_shape().0, f.sheet_axis, f.sheet_count());
+    let coloured = volume.is_coloured();
     let read = |s: usize| {
-        let mut buf = vec![0.0f32; len];
-        volume.sheet_into(axis, s, &mut buf);
+        let mut buf = vec![Coloured::default(); len];
+        volume.coloured_sheet_into(axis, s, &mut buf);
         buf
     };
     let mut out = VisibleLists {
@@ -135,10 +145,11 @@ fn classify_range(
         len
     ];
     let mut gradients = vec![[0.0f32; 3]; if needs_gradient { len } else { 0 }];
+    let mut colours = vec![[0.0f32; 3]; len];
     // The window of neighbours slides along the range (read only when gradients need them).
-    let mut lower: Option<Vec<f32>> = None;
+    let mut lower: Option<Vec<Coloured>> = None;
     let mut current = range.clone().next().map(read);
-    let mut upper: Option<Vec<f32>> = None;
+    let mut upper: Option<Vec<Coloured>> = None;
     for s in range.clone() {
         let cur = current.take().expect("the sheet was read");
         if needs_gradient {
@@ -152,10 +163,21 @@ fn classify_range(
             current: &cur,
             upper: upper.as_deref(),
         };
-        let n = classify_sheet(f, &shader, s, window, &mut voxels, &mut gradients)?;
+        let n = classify_sheet(
+            f,
+            &shader,
+            s,
+            window,
+            &mut voxels,
+            &mut gradients,
+            &mut colours,
+        )?;
         out.voxels.extend_from_slice(&voxels[..n]);
         if needs_gradient {
             out.gradients.extend_from_slice(&gradients[..n]);
+        }
+        if coloured {
+            out.colours.extend_from_slice(&colours[..n]);
         }
         out.offsets.push(out.voxels.len());
         if s + 1 < range.end {

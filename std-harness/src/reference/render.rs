@@ -7,6 +7,7 @@ use super::perspective::PerspectiveVoxel;
 use super::ReferenceFootprint;
 use crate::CliError;
 use footprint::frame::{FrameSetup, Order};
+use footprint::lod::Coloured;
 use footprint::render::{gradient, SheetWindow};
 use footprint::shade::{Lighting, Shader};
 use footprint::Kernel;
@@ -24,10 +25,11 @@ pub struct ReferenceScene<'a> {
 }
 
 /// Renders the sheets `sheet(s, buffer)` supplies and returns the premultiplied RGBA image (f64,
-/// row-major, top row first); `progress(done, total)` after each sheet.
+/// row-major, top row first); `progress(done, total)` after each sheet. Samples that carry a
+/// colour (a level of detail's) are shaded with it, as the core shades them.
 pub fn render_reference(
     scene: &ReferenceScene<'_>,
-    mut sheet: impl FnMut(usize, &mut [f32]),
+    mut sheet: impl FnMut(usize, &mut [Coloured]),
     mut progress: impl FnMut(usize, usize),
 ) -> Result<Vec<[f64; 4]>, CliError> {
     let ReferenceScene {
@@ -62,9 +64,11 @@ pub fn render_reference(
     let camera = frame.camera();
     let min_r = f64::from(min_radius_px);
     let failed = std::sync::Mutex::new(false);
-    let mut bufs = [vec![0.0f32; len], vec![0.0f32; len], vec![0.0f32; len]];
-    let load =
-        |s: usize, buf: &mut Vec<f32>, sheet: &mut dyn FnMut(usize, &mut [f32])| sheet(s, buf);
+    let blank = Coloured::default();
+    let mut bufs = [vec![blank; len], vec![blank; len], vec![blank; len]];
+    let load = |s: usize,
+                buf: &mut Vec<Coloured>,
+                sheet: &mut dyn FnMut(usize, &mut [Coloured])| sheet(s, buf);
     for step in 0..count {
         let s = frame.sheet_at(order, step);
         // Sheets s−1, s, s+1 (read directly: the reference does not need to stream).
@@ -100,10 +104,12 @@ pub fn render_reference(
                     let first = rows.start * w;
                     for v in 0..nb {
                         for u in 0..na {
-                            let value = window.current[v * na + u];
-                            let rgba = shader.shade(
+                            let sample = window.current[v * na + u];
+                            let rgba = shader.shade_coloured(
                                 lighting,
-                                value,
+                                None,
+                                sample.value,
+                                sample.colour,
                                 || gradient(frame, window, u, v),
                                 frame.grid_index(s, u, v),
                                 frame.dims,
