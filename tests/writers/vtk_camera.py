@@ -138,7 +138,7 @@ def main(fp, out):
         fpath = os.path.join(out, f"footprint_{label}.png")
         vtk_render(data, view, vpath)
         subprocess.run([fp, "render", nhdr, "--view", label, "--size", f"{SIZE[0]}x{SIZE[1]}",
-                        "--tf", tf, "--window", "0,100", "--out", fpath],
+                        "--tf", tf, "--window", "0,100", "--lod", "0", "--out", fpath],
                        check=True, stdout=subprocess.DEVNULL)
         a = read_png(vpath)[..., 0] > 127
         b = read_png(fpath)[..., 0] > 127
