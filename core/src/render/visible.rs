@@ -40,9 +40,9 @@ pub struct VisibleSheet<'s> {
 /// Writes the visible voxels of sheet `index` (with its neighbours in `window`, for gradients)
 /// into `voxels`, their gradients into `gradients` when `shader` needs them, and their colours
 /// into `colours` when the sample type carries colours ([`Sample::COLOURED`]; a sample without
-/// one gets the transfer function's), in render order; returns how many. `voxels` (and `gradients` and `colours`,
-/// when needed) must hold a whole sheet's worth in the worst case (`dims[a] × dims[b]`); sheets
-/// wider than 65 536 voxels along an axis are refused. A sample type without colours leaves
+/// one gets the transfer function's), in render order; returns how many. `voxels` (and
+/// `gradients` and `colours`, when needed) must hold a whole sheet's worth in the worst case
+/// (`dims[a] × dims[b]`); sheets wider than 65 536 voxels along an axis are refused. A sample type without colours leaves
 /// `colours` alone (it may then be empty).
 pub fn classify_sheet<T: Sample>(
     frame: &FrameSetup,

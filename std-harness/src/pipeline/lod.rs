@@ -115,45 +115,34 @@ pub fn with_level<R>(
             "level 0 is the volume itself: it has no coarser level to stream",
         ));
     }
-    let len = Coarsened::<&mut DynSource<'_>>::scratch_len(dims, axis);
-    let mut lower = try_filled(len, 0.0f32, "a level-of-detail sheet")?;
-    let mut upper = try_filled(len, 0.0f32, "a level-of-detail sheet")?;
-    let mut coarse = Coarsened::new(source, dims, &mut lower, &mut upper).averaging(averaging);
-    deeper(
-        &mut coarse,
-        coarse_dims(dims),
-        level - 1,
-        axis,
-        averaging,
-        f,
-    )
+    coarsen_once(source, dims, level - 1, axis, averaging, f)
 }
 
-/// [`with_level`] below the first level: `level` more levels under a coloured `source`.
-fn deeper<R>(
-    source: &mut ColouredSource<'_>,
+/// `source` (a volume of `dims`, f32 or coloured samples) one level coarser through a
+/// [`Coarsened`] adaptor with its two scratch sheets, then `more` levels below that, then `f`.
+fn coarsen_once<S, R>(
+    source: &mut S,
     dims: [usize; 3],
-    level: u32,
+    more: u32,
     axis: usize,
     averaging: &dyn Averaging,
     f: &mut dyn FnMut(&mut ColouredSource<'_>) -> Result<R, CliError>,
-) -> Result<R, CliError> {
-    if level == 0 {
-        return f(source);
-    }
-    let len = Coarsened::<&mut ColouredSource<'_>>::scratch_len(dims, axis);
-    let blank = Coloured::default();
+) -> Result<R, CliError>
+where
+    S: SheetSource<Error = CliError> + ?Sized,
+    S::Sample: Default,
+{
+    let len = Coarsened::<&mut S>::scratch_len(dims, axis);
+    let blank = S::Sample::default();
     let mut lower = try_filled(len, blank, "a level-of-detail sheet")?;
     let mut upper = try_filled(len, blank, "a level-of-detail sheet")?;
     let mut coarse = Coarsened::new(source, dims, &mut lower, &mut upper).averaging(averaging);
-    deeper(
-        &mut coarse,
-        coarse_dims(dims),
-        level - 1,
-        axis,
-        averaging,
-        f,
-    )
+    let (coarse_source, dims): (&mut ColouredSource<'_>, _) = (&mut coarse, coarse_dims(dims));
+    if more == 0 {
+        f(coarse_source)
+    } else {
+        coarsen_once(coarse_source, dims, more - 1, axis, averaging, f)
+    }
 }
 
 /// Level `level` of `v`, in memory with 2ᴸ times the spacing, built sheet by sheet, averaging

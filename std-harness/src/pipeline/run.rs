@@ -5,7 +5,7 @@
 pub use super::bands::CoreFrame;
 use super::bands::{run_bands, Phases};
 use super::load::Voxels;
-use super::lod::with_level;
+use super::lod::{with_level, DynSource};
 use super::prepare::Prepared;
 use super::supersample::{downsample, to_output};
 use super::visible::FrameCache;
@@ -254,22 +254,22 @@ fn run_sheets<P: Precision>(
     match &p.voxels {
         Voxels::Memory(v) if v.is_coloured() => stream(r, s, &mut ColouredMemorySource(v))?,
         Voxels::Memory(v) => stream(r, s, &mut MemorySource(v))?,
-        Voxels::File(layout) => {
-            let mut src = FileSource::open(layout.clone())?;
+        streamed => {
+            let (mut file, mut piped);
+            let src: &mut DynSource<'_> = match streamed {
+                Voxels::File(layout) => {
+                    file = FileSource::open(layout.clone())?;
+                    &mut file
+                }
+                _ => {
+                    piped = pipe.take().expect("made above for standard input");
+                    &mut piped
+                }
+            };
             if level == 0 {
-                stream(r, s, &mut src)?
+                stream(r, s, src)?
             } else {
-                with_level(&mut src, fine, level, axis, &*averaging, &mut |c| {
-                    stream(r, s, c)
-                })?
-            }
-        }
-        Voxels::Stdin { .. } => {
-            let mut src = pipe.take().expect("made above for standard input");
-            if level == 0 {
-                stream(r, s, &mut src)?
-            } else {
-                with_level(&mut src, fine, level, axis, &*averaging, &mut |c| {
+                with_level(src, fine, level, axis, &*averaging, &mut |c| {
                     stream(r, s, c)
                 })?
             }

@@ -7,6 +7,7 @@ use crate::io::volume::Volume;
 use crate::CliError;
 use footprint::lod::Coloured;
 use footprint::render::{classify_sheet, SheetWindow, VisibleSheet, VisibleVoxel};
+use footprint::shade::Sample;
 
 /// The visible voxels of every sheet along one axis, in sheet index order.
 #[derive(Clone, Debug, Default)]
@@ -115,20 +116,38 @@ pub fn classify(p: &Prepared, volume: &Volume, threads: usize) -> Result<Visible
     Ok(out)
 }
 
-/// Classifies sheets `range` of `p`'s axis (offsets relative to the range's first sheet).
+/// Classifies sheets `range` of `p`'s axis (offsets relative to the range's first sheet): a
+/// level's [`Coloured`] samples with their colours, plain data as f32.
 fn classify_range(
     p: &Prepared,
     volume: &Volume,
     range: std::ops::Range<usize>,
 ) -> Result<VisibleLists, CliError> {
+    let axis = p.frame.sheet_axis;
+    if volume.is_coloured() {
+        classify_sheets(p, range, |s, buf: &mut [Coloured]| {
+            volume.coloured_sheet_into(axis, s, buf)
+        })
+    } else {
+        classify_sheets(p, range, |s, buf: &mut [f32]| {
+            volume.sheet_into(axis, s, buf)
+        })
+    }
+}
+
+/// [`classify_range`] over the samples `fill(s, sheet)` writes.
+fn classify_sheets<T: Sample + Default>(
+    p: &Prepared,
+    range: std::ops::Range<usize>,
+    fill: impl Fn(usize, &mut [T]),
+) -> Result<VisibleLists, CliError> {
     let f = &p.frame;
     let shader = p.shader();
     let needs_gradient = shader.shading.needs_gradient();
     let (len, axis, count) = (f.sheet_shape().0, f.sheet_axis, f.sheet_count());
-    let coloured = volume.is_coloured();
     let read = |s: usize| {
-        let mut buf = vec![Coloured::default(); len];
-        volume.coloured_sheet_into(axis, s, &mut buf);
+        let mut buf = vec![T::default(); len];
+        fill(s, &mut buf);
         buf
     };
     let mut out = VisibleLists {
@@ -145,11 +164,11 @@ fn classify_range(
         len
     ];
     let mut gradients = vec![[0.0f32; 3]; if needs_gradient { len } else { 0 }];
-    let mut colours = vec![[0.0f32; 3]; len];
+    let mut colours = vec![[0.0f32; 3]; if T::COLOURED { len } else { 0 }];
     // The window of neighbours slides along the range (read only when gradients need them).
-    let mut lower: Option<Vec<Coloured>> = None;
+    let mut lower: Option<Vec<T>> = None;
     let mut current = range.clone().next().map(read);
-    let mut upper: Option<Vec<Coloured>> = None;
+    let mut upper: Option<Vec<T>> = None;
     for s in range.clone() {
         let cur = current.take().expect("the sheet was read");
         if needs_gradient {
@@ -176,7 +195,7 @@ fn classify_range(
         if needs_gradient {
             out.gradients.extend_from_slice(&gradients[..n]);
         }
-        if coloured {
+        if T::COLOURED {
             out.colours.extend_from_slice(&colours[..n]);
         }
         out.offsets.push(out.voxels.len());
