@@ -110,7 +110,9 @@ fn the_flags_are_checked() {
     assert!(parse_args(&[HEART, "--quality", "40", "--slab", "1"]).is_err());
     // Image slicing with the default (sheet) reference has no table to choose: a typed error.
     let (args, p) = heart(&["--quality", "40", "--slicing", "image"]);
-    let e = footprint_harness::pipeline::choose::apply_quality(&p, &args).unwrap_err();
+    let e = footprint_harness::pipeline::choose::apply_quality(p, &args)
+        .err()
+        .expect("image slicing has no table to choose");
     assert!(
         e.to_string().contains("--quality-reference continuous"),
         "{e}"

@@ -284,8 +284,10 @@ pub struct RenderArgs {
     /// above into one, the spacing doubled, carrying the block's colour; 0 = full resolution);
     /// `auto`, the default, the deepest level L with 4^L x (level 0's projected spacing) <= 3 px
     /// (README, "Levels of detail"). Orthographic views only (`auto` keeps a perspective view, and
-    /// --refine, at level 0). The f64 reference `verify` compares with renders the same level;
-    /// the continuous reference integrates full resolution (`auto` then means level 0).
+    /// --refine, at level 0). The f64 reference `verify` compares with renders the same level
+    /// (and, for a level >= 1, also level 0: `full res`); the continuous reference integrates
+    /// full resolution (`auto` then means level 0). With --quality, `auto` means the level the
+    /// quality pilot measures to hold the target against full resolution.
     #[arg(long, default_value = "auto", value_parser = parse_lod)]
     pub lod: Lod,
     /// The paper's adaptive re-sampling for magnified volumes: along each grid axis, intervals
@@ -310,11 +312,14 @@ pub struct RenderArgs {
     pub threads: usize,
     /// Target PSNR, dB, against --quality-reference: choose the cheapest configuration expected
     /// to reach it for this scene and view (overrides the table, lookup, method and
-    /// accumulation; with the continuous reference also the slab thickness).
+    /// accumulation; with the continuous reference also the slab thickness). Against the sheet
+    /// reference it aims at full resolution and also chooses the level of detail (`--lod auto`),
+    /// measured on a pilot of image rows when the volume is minified.
     #[arg(long, conflicts_with_all = ["table", "lookup", "method", "accum", "table_file", "slab"])]
     pub quality: Option<f64>,
-    /// What --quality aims at: `sheets`, the f64 renderer with the same sheets (table error only,
-    /// predicted in milliseconds), or `continuous`, the volume-rendering integral (the error a
+    /// What --quality aims at: `sheets`, the f64 renderer of the volume's sheets at full
+    /// resolution (the table's error predicted in milliseconds; a coarser level's measured on a
+    /// pilot of rows, about one full-resolution frame), or `continuous`, the volume-rendering integral (the error a
     /// user sees; measured on a pilot of about 4096 sampled rays, which costs seconds, and may
     /// choose image slicing; with --slicing image only slab thicknesses are considered).
     #[arg(long, value_enum, default_value_t = QualityReferenceArg::Sheets, requires = "quality")]

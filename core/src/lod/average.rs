@@ -158,19 +158,18 @@ impl Averaging for Extinction<'_> {
         let (mut weighted, mut weights) = ([0.0f32; 3], 0.0f32);
         for x in columns.iter().flatten() {
             if x.value.is_finite() {
-                let sigma = self.sigma(x.value);
-                if sigma > 0.0 {
-                    let c = x.colour.unwrap_or_else(|| {
-                        let c = self.tf.lookup(x.value);
-                        [c[0], c[1], c[2]]
-                    });
-                    let wt = self.alpha(x.value);
+                // One lookup per sample: its opacity (as `alpha`), extinction (as `sigma`) and
+                // colour.
+                let rgba = self.tf.lookup(x.value);
+                let wt = rgba[3].clamp(0.0, MAX_ALPHA);
+                if wt > 0.0 {
+                    let c = x.colour.unwrap_or([rgba[0], rgba[1], rgba[2]]);
                     for (w, c) in weighted.iter_mut().zip(c) {
                         *w += wt * c;
                     }
                     weights += wt;
+                    sum += -crate::math::ln(1.0 - wt);
                 }
-                sum += sigma;
                 n += 1;
             }
         }

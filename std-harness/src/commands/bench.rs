@@ -60,8 +60,7 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
     if let Some(out) = &args.render.out {
         io::image::check_style(out, args.render.png_style())?;
     }
-    let mut p = prepare(&args.render)?;
-    let (base, choice) = apply_quality(&p, &args.render)?;
+    let (mut p, base, choice) = apply_quality(prepare(&args.render)?, &args.render)?;
     let mut cache = FrameCache::default();
     let mut times = Vec::with_capacity(args.frames);
     let mut phases = Vec::with_capacity(args.frames);

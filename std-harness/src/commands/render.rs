@@ -29,8 +29,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     }
     outputs::check(&planned)?;
     check_style(&out, args.png_style())?;
-    let p = prepare(args)?;
-    let (args, choice) = apply_quality(&p, args)?;
+    let (p, args, choice) = apply_quality(prepare(args)?, args)?;
     let args = &args;
     let (rgb, summary) = if args.footprint.method == MethodArg::Reference {
         let (img, secs) = render_ref(&p)?;

@@ -1,34 +1,173 @@
 //! `--quality DB`'s entry point: the choice against the reference `--quality-reference` names,
 //! from the sheet model ([`super::quality`], the default) or the continuous pilot
 //! ([`super::pilot`]), applied to the render's arguments.
+//!
+//! # Against the sheet reference, with levels of detail
+//! `--quality DB` aims at the f64 sheet reference **at full resolution**: a level's own error
+//! counts. The volume is prepared at level 0; the levels `--lod` allows (every level whose
+//! samples project at most [`MAX_SPACING_PX`] apart for `auto`, the one given otherwise) are
+//! measured against level 0 on a pilot of rows ([`super::level_pilot`]); the table is then chosen
+//! for what the level leaves. Errors add at most as RMSEs do (the triangle inequality), so with
+//! r(x) = 10^(−x/20) the RMSE of a PSNR x:
+//!
+//! r(DB) ≥ r(level's bound) + t₀(0) + t₀(L) + t(L),
+//!
+//! where t₀ is the RMSE the footprint model predicts for the configuration the pilot renders
+//! with (the default table, at level 0 and at level L: the pilot compares those two images, not
+//! the references) and t(L) the chosen configuration's at level L. A level is accepted when that
+//! holds with t(L) = t₀(L) (the pilot's own table is always available); the deepest accepted level
+//! is rendered, with the cheapest configuration whose t(L) fits what is left. A level is never
+//! chosen for a perspective view or a streamed volume (read once; an explicit `--lod N` with
+//! `--quality` is refused there), and `auto` tries nothing where level 0's samples are already
+//! more than a pixel apart.
+//!
+//! [`MAX_SPACING_PX`]: super::level_pilot::MAX_SPACING_PX
 
+use super::config::Config;
+use super::level_pilot::{candidate_levels, measure};
 use super::prepare::Prepared;
-use super::quality::{choose, Choice};
-use crate::args::{QualityReferenceArg, RenderArgs};
+use super::quality::{self, choose, footprint_error, predict_db, Choice};
+use crate::args::{Lod, MethodArg, QualityReferenceArg, RenderArgs, SlicingArg};
 use crate::CliError;
 
-/// `args` with `--quality`'s choice applied (unchanged without `--quality`), and the choice.
+/// `args` with `--quality`'s choice applied (unchanged without `--quality`), the prepared render
+/// at the level chosen (`p` itself at level 0), and the choice.
 pub fn apply_quality(
-    p: &Prepared,
+    p: Prepared,
     args: &RenderArgs,
-) -> Result<(RenderArgs, Option<Choice>), CliError> {
+) -> Result<(Prepared, RenderArgs, Option<Choice>), CliError> {
     let Some(q) = args.quality else {
-        return Ok((args.clone(), None));
+        return Ok((p, args.clone(), None));
     };
-    let choice = match args.quality_reference {
-        QualityReferenceArg::Sheets if args.slicing == crate::args::SlicingArg::Image => {
+    let (p, choice) = match args.quality_reference {
+        QualityReferenceArg::Sheets if args.slicing == SlicingArg::Image => {
             return Err(CliError::input(
                 "--quality aims at the sheet reference by default and chooses among the table \
                  configurations of object slicing; image slicing has no table to choose: give \
                  --slab, or --quality-reference continuous to choose the slab",
             ));
         }
-        QualityReferenceArg::Sheets => choose(p, q)?,
-        QualityReferenceArg::Continuous => super::pilot::choose_continuous(p, args, q)?,
+        QualityReferenceArg::Sheets => choose_sheets(p, args, q)?,
+        QualityReferenceArg::Continuous => {
+            if let Lod::Level(n @ 1..) = args.lod {
+                return Err(CliError::input(format!(
+                    "--quality-reference continuous measures against the integral at full \
+                     resolution and chooses among full-resolution renders: drop --lod {n}"
+                )));
+            }
+            let c = super::pilot::choose_continuous(&p, args, q)?;
+            (p, c)
+        }
     };
     let e = p.frame.footprint.half_extent;
     crate::say!("{}", choice.explain(2.0 * e[0].max(e[1])));
     let mut chosen = choice.config.apply(args);
     chosen.quality = None;
-    Ok((chosen, Some(choice)))
+    chosen.lod = Lod::Level(p.level);
+    Ok((p, chosen, Some(choice)))
+}
+
+/// r(x): the RMSE of a PSNR of x dB (peak 1).
+fn rmse(db: f64) -> f64 {
+    10f64.powf(-db / 20.0)
+}
+
+/// The PSNR of an RMSE, dB.
+fn db_of(rmse: f64) -> f64 {
+    if rmse > 0.0 {
+        -20.0 * rmse.log10()
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// The footprint model's predicted RMSE of configuration `c` at `p`'s frame.
+fn table_rmse(p: &Prepared, c: &Config) -> Result<f64, CliError> {
+    Ok(rmse(predict_db(footprint_error(p, c)?)))
+}
+
+/// The level and the table against the sheet reference at full resolution (see the module docs).
+fn choose_sheets(
+    p0: Prepared,
+    args: &RenderArgs,
+    target: f64,
+) -> Result<(Prepared, Choice), CliError> {
+    quality::check_target(target)?;
+    let explicit = match args.lod {
+        Lod::Level(n) => Some(n),
+        Lod::Auto => None,
+    };
+    if p0.volume().is_none() {
+        if let Some(n @ 1..) = explicit {
+            return Err(CliError::input(format!(
+                "--quality measures level {n}'s error against full resolution, which a streamed \
+                 volume (read once) cannot give: load it (a volume argument instead of --stream) \
+                 or drop --lod {n} (level 0)"
+            )));
+        }
+        let c = choose(&p0, target)?;
+        return Ok((p0, c));
+    }
+    if let (Some(n @ 1..), Some(_)) = (explicit, p0.frame.camera()) {
+        return Err(CliError::input(format!(
+            "--lod {n}: {}; use --lod 0 or auto with --perspective",
+            footprint::lod::LodError::Perspective
+        )));
+    }
+    let levels = candidate_levels(&p0, explicit);
+    if levels.is_empty() {
+        let c = choose(&p0, target)?;
+        return Ok((p0, c));
+    }
+    // What the pilot renders with: `args`' table (the default; --quality overrides the flags).
+    let c0 = Config {
+        table: args.footprint.table,
+        lookup: args.footprint.lookup,
+        method: MethodArg::Robust,
+        accum: crate::args::AccumArg::Float,
+        slab_quarters: None,
+    };
+    let allowed = rmse(target);
+    let t00 = table_rmse(&p0, &c0)?;
+    // Per level tried: the RMSE it spends (its bound and the pilot's two table errors), and
+    // the pilot table's own error at that level (the least a final table is sure to need).
+    let mut spends: Vec<(f64, f64)> = Vec::new();
+    let (pilot, mut accepted) = measure(&p0, args, &levels, |_, p, e| {
+        let t0l = table_rmse(p, &c0)?;
+        let spent = rmse(e.bound_db) + t00 + t0l;
+        spends.push((spent, t0l));
+        // An explicit level is rendered whatever it measures (said below).
+        Ok(explicit.is_some() || spent + t0l <= allowed)
+    })?;
+    if let (Some(n), Some(&(spent, t0l))) = (explicit, spends.first()) {
+        if !(spent + t0l <= allowed) {
+            crate::say!(
+                "--quality {target:.1} dB: --lod {n} is measured at {:.1} dB against full                  resolution (pilot bound); rendering it as asked",
+                pilot.tried[0].1.bound_db
+            );
+        }
+    }
+    let (p, spent) = match accepted.pop() {
+        Some(p) => {
+            let i = pilot.tried.iter().position(|t| t.0 == p.level).unwrap_or(0);
+            (p, spends[i].0)
+        }
+        None => (p0, 0.0),
+    };
+    let left = allowed - spent;
+    let table_target = if left > 0.0 { db_of(left) } else { f64::MAX };
+    let (mut choice, _) = quality::pick(&p, table_target.min(1e3))?;
+    let table = rmse(choice.predicted_db);
+    choice.target_db = target;
+    choice.predicted_db = db_of(spent + table);
+    if choice.predicted_db < target && explicit.is_none() {
+        crate::say!(
+            "--quality {target:.1} dB: no configuration is predicted to reach it; using the most \
+             accurate ({:.1} dB)",
+            choice.predicted_db
+        );
+    }
+    choice.level = p.level;
+    choice.level_pilot = Some(pilot);
+    Ok((p, choice))
 }

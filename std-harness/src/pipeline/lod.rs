@@ -23,7 +23,7 @@
 //! (README, "Levels of detail").
 
 use crate::args::Lod;
-use crate::io::stream::MemorySource;
+use crate::io::stream::{ColouredMemorySource, MemorySource};
 use crate::io::try_filled;
 use crate::io::volume::{Samples, Volume};
 use crate::CliError;
@@ -89,7 +89,10 @@ pub fn deepest_level(dims: [usize; 3]) -> u32 {
 /// How the levels average their samples: by extinction ([`Extinction`]) for emission and Phong
 /// shading through a transfer function whose opacity never decreases with the value; the values
 /// themselves otherwise (iso-surfaces and the texture shade from the value, not the opacity).
-pub fn averaging_for<'a>(shading: &Shading, tf: TransferFunction<'a>) -> Box<dyn Averaging + 'a> {
+pub fn averaging_for<'a>(
+    shading: &Shading,
+    tf: TransferFunction<'a>,
+) -> Box<dyn Averaging + Sync + 'a> {
     match shading {
         Shading::Emission | Shading::Phong(_) => match Extinction::new(tf) {
             Some(e) => Box::new(e),
@@ -147,11 +150,13 @@ where
 
 /// Level `level` of `v`, in memory with 2ᴸ times the spacing, built sheet by sheet, averaging
 /// with `averaging`: [`Samples::Coloured`] (values and the colours extinction averaging carries)
-/// for a level ≥ 1, `v` itself for level 0.
+/// for a level ≥ 1, `v` itself for level 0. `v` may itself be a level (coloured samples): its
+/// level `level` is then the volume's level `v`'s + `level`, the same samples the nested
+/// adaptors of a stream deliver.
 pub fn coarsen_volume(
     v: &Volume,
     level: u32,
-    averaging: &dyn Averaging,
+    averaging: &(dyn Averaging + Sync),
 ) -> Result<Volume, CliError> {
     let dims = level_dims(v.dims, level).ok_or_else(|| {
         CliError::input(format!("--lod {level}: the deepest level is {MAX_LEVEL}"))
@@ -165,13 +170,40 @@ pub fn coarsen_volume(
         Coloured::default(),
         "the level-of-detail volume",
     )?;
-    let mut src = MemorySource(v);
-    with_level(&mut src, v.dims, level, 2, averaging, &mut |s| {
-        for (z, slice) in out.chunks_mut(sheet).enumerate() {
-            s.read_sheet(2, z, slice)?;
-        }
-        Ok(())
-    })?;
+    // Coarse z-sheets are independent (each reads its own blocks of fine sheets): contiguous
+    // runs of them are built on separate cores, each through its own adaptors. The samples do
+    // not depend on the split.
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .clamp(1, dims[2]);
+    let per = dims[2].div_ceil(threads);
+    let results: Vec<Result<(), CliError>> = std::thread::scope(|scope| {
+        let handles: Vec<_> = out
+            .chunks_mut(per * sheet)
+            .enumerate()
+            .map(|(t, run)| {
+                scope.spawn(move || {
+                    let mut fill = |s: &mut ColouredSource<'_>| {
+                        for (i, slice) in run.chunks_mut(sheet).enumerate() {
+                            s.read_sheet(2, t * per + i, slice)?;
+                        }
+                        Ok(())
+                    };
+                    if v.is_coloured() {
+                        let mut src = ColouredMemorySource(v);
+                        coarsen_once(&mut src, v.dims, level - 1, 2, averaging, &mut fill)
+                    } else {
+                        with_level(&mut MemorySource(v), v.dims, level, 2, averaging, &mut fill)
+                    }
+                })
+            })
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().expect("a level-building thread panicked"))
+            .collect()
+    });
+    results.into_iter().collect::<Result<(), CliError>>()?;
     let scale = (1u64 << level) as f32;
     Ok(Volume {
         dims,
@@ -207,6 +239,22 @@ mod tests {
             }
         }
         assert_eq!(s[3], want / 8.0);
+        // Level 2 of the volume is level 1 of its level 1.
+        let data: Vec<f32> = (0..8 * 6 * 4).map(|i| ((i * 37) % 11) as f32).collect();
+        let big = Volume::new([8, 6, 4], [1.0; 3], Samples::F32(data));
+        let two = coarsen_volume(&big, 2, &Linear).unwrap();
+        let one = coarsen_volume(&big, 1, &Linear).unwrap();
+        assert_eq!(coarsen_volume(&one, 1, &Linear).unwrap(), two);
+        // Built on several cores, the level is the one the adaptors deliver in sequence.
+        let mut sequential = vec![Coloured::default(); 4 * 3 * 2];
+        with_level(&mut MemorySource(&big), big.dims, 1, 2, &Linear, &mut |s| {
+            for (z, slice) in sequential.chunks_mut(12).enumerate() {
+                s.read_sheet(2, z, slice)?;
+            }
+            Ok(())
+        })
+        .unwrap();
+        assert_eq!(one.samples, Samples::Coloured(sequential));
         let c0 = coarsen_volume(&v, 0, &Linear).unwrap();
         assert_eq!(c0, v);
         assert!(coarsen_volume(&v, MAX_LEVEL + 1, &Linear).is_err());

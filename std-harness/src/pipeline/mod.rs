@@ -14,8 +14,11 @@
 //! - [`config`]: one table configuration (size, lookup, method, accumulation).
 //! - [`quality`]: `--quality`, the cheapest configuration predicted to reach a PSNR.
 //! - [`choose`]: `--quality`'s entry: the sheet model or the pilot, as `--quality-reference` says.
+//! - [`level_pilot`]: `--quality`'s level of detail, measured against full resolution on a pilot
+//!   of image rows.
 //! - [`pilot`]: `--quality DB --quality-reference continuous`, measured on a pilot of sampled
 //!   rays against the continuous integral.
+//! - [`sampling`]: what the pilots share (a hash placing samples, an estimate's figures).
 //! - [`slabs`]: `--slicing image`, the core's image-aligned slabs over the visible voxels.
 //! - [`lod`]: `--lod`, levels of detail for minified volumes (coarser levels, built once or as they stream).
 //! - [`refine`]: `--refine`, the paper's adaptive re-sampling for magnified volumes
@@ -28,6 +31,7 @@
 pub mod bands;
 pub mod choose;
 pub mod config;
+pub mod level_pilot;
 pub mod load;
 pub mod lod;
 pub mod pilot;
@@ -36,6 +40,7 @@ pub mod quality;
 pub mod refine;
 pub mod refinement;
 pub mod run;
+pub mod sampling;
 pub mod single;
 pub mod slabs;
 pub mod supersample;

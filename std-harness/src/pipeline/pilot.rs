@@ -35,6 +35,7 @@ use super::config::Config;
 use super::prepare::Prepared;
 use super::quality::{self, Choice, Estimate, Pilot};
 use super::run::{continuous_at, render_frame};
+use super::sampling::mix;
 use super::visible::FrameCache;
 use crate::args::{QualityReferenceArg, RenderArgs, SlicingArg};
 use crate::CliError;
@@ -69,14 +70,6 @@ pub fn sample_pixels(w: usize, h: usize, rays: usize) -> (Vec<[usize; 2]>, usize
     (out, stride)
 }
 
-/// SplitMix64's finaliser: a well-spread hash of one word.
-fn mix(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
-
 /// `image` (`w` wide, premultiplied RGBA) against `reference` at `pixels` (the reference's
 /// values in that order), for an image of `total` pixels.
 pub fn estimate(
@@ -97,28 +90,7 @@ pub fn estimate(
                 / 3.0
         })
         .collect();
-    let n = errors.len().max(1) as f64;
-    let mean = errors.iter().sum::<f64>() / n;
-    let var = if errors.len() > 1 {
-        errors.iter().map(|e| (e - mean).powi(2)).sum::<f64>() / (n - 1.0)
-    } else {
-        0.0
-    };
-    let finite = (1.0 - n / total.max(1) as f64).max(0.0);
-    let bound = mean + Z * (var / n * finite).sqrt();
-    let db = |mse: f64| {
-        if mse > 0.0 {
-            -10.0 * mse.log10()
-        } else if mse == 0.0 {
-            f64::INFINITY
-        } else {
-            f64::NAN // a NaN pixel: never "reaches" anything
-        }
-    };
-    Estimate {
-        estimate_db: db(mean),
-        bound_db: db(bound),
-    }
+    Estimate::of(&errors, total, Z)
 }
 
 /// The candidates for `p` aiming at `target_db` (see the module docs), cheapest first.
@@ -213,6 +185,8 @@ pub fn choose_continuous(
             render_seconds: start.elapsed().as_secs_f64(),
             tried,
         }),
+        level: 0,
+        level_pilot: None,
     })
 }
 

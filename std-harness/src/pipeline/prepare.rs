@@ -119,6 +119,66 @@ impl Prepared {
         Ok(())
     }
 
+    /// This volume (prepared in memory at level 0) at level `level` ≥ 1 for `args`' view: that
+    /// level's frame, supersampling, kernel and shading, its volume coarsened from `from` (a
+    /// shallower level of this volume, prepared by this function) when given, else from this one.
+    /// Nothing is loaded again.
+    pub fn at_level(
+        &self,
+        args: &RenderArgs,
+        level: u32,
+        from: Option<&Prepared>,
+    ) -> Result<Prepared, CliError> {
+        let Voxels::Memory(fine) = &self.voxels else {
+            return Err(CliError::input(
+                "a level of a streamed volume is built as it streams, not from a prepared one",
+            ));
+        };
+        if self.level != 0 || level == 0 {
+            return Err(CliError::input(format!(
+                "level {level} is built from level 0 (this is level {})",
+                self.level
+            )));
+        }
+        let mut a = args.clone();
+        a.lod = Lod::Level(level);
+        let (frame, supersample, _) =
+            setup_frame(&a, self.fine_dims, &self.grid, &self.kernel, self.options)?;
+        let kernel = kernel_at(&a, &self.kernel, level);
+        let min_spacing = frame.spacing.iter().copied().fold(f32::INFINITY, f32::min);
+        let shading = parse_shading(&args.shading, min_spacing)?;
+        let averaging = super::lod::averaging_for(&shading, self.shader().tf);
+        let volume = match from {
+            Some(Prepared {
+                voxels: Voxels::Memory(v),
+                level: l @ 1..,
+                ..
+            }) if *l < level => super::lod::coarsen_volume(v, level - l, &*averaging)?,
+            _ => super::lod::coarsen_volume(fine, level, &*averaging)?,
+        };
+        Ok(Prepared {
+            voxels: Voxels::Memory(volume),
+            name: self.name.clone(),
+            kernel,
+            grid: self.grid,
+            fine_dims: self.fine_dims,
+            level,
+            frame,
+            lut: self.lut.clone(),
+            window: self.window,
+            shading,
+            tf_name: self.tf_name.clone(),
+            background: self
+                .background_out
+                .as_ref()
+                .map(|b| supersample::upsample(b, args.size, supersample)),
+            background_out: self.background_out.clone(),
+            order: self.order,
+            options: self.options,
+            supersample,
+        })
+    }
+
     /// The output image's width and height, pixels: the frame's, divided by the supersampling.
     pub fn out_size(&self) -> (usize, usize) {
         (
@@ -311,7 +371,19 @@ pub fn prepare(args: &RenderArgs) -> Result<Prepared, CliError> {
         mapping,
         min_radius_px: args.footprint.min_radius,
     };
-    let (frame, supersample, level) = setup_frame(args, dims, &grid, &kernel, options)?;
+    // With --quality the volume is prepared at full resolution: the choice measures the levels
+    // against it and builds the one it picks (`super::choose`).
+    let at_full;
+    let framing = if args.quality.is_some() {
+        at_full = RenderArgs {
+            lod: Lod::Level(0),
+            ..args.clone()
+        };
+        &at_full
+    } else {
+        args
+    };
+    let (frame, supersample, level) = setup_frame(framing, dims, &grid, &kernel, options)?;
     let kernel = kernel_at(args, &kernel, level);
 
     let order = match &voxels {

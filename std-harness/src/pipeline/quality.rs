@@ -25,7 +25,9 @@
 //! relative to the fastest configuration (same sweeps); a smaller table wins a tie.
 
 use super::config::Config;
+use super::level_pilot::LevelPilot;
 use super::prepare::Prepared;
+pub use super::sampling::Estimate;
 use crate::args::{AccumArg, LookupArg, MethodArg, QualityReferenceArg};
 use crate::io::json::Json;
 use crate::reference::ReferenceFootprint;
@@ -93,6 +95,11 @@ pub struct Choice {
     pub rejected: Vec<(Config, f64)>,
     /// The pilot that measured the candidates (continuous only).
     pub pilot: Option<Pilot>,
+    /// The level of detail rendered (0 = full resolution).
+    pub level: u32,
+    /// The pilot that measured the levels against full resolution (sheets, when levels were
+    /// candidates; see [`super::level_pilot`]).
+    pub level_pilot: Option<LevelPilot>,
 }
 
 impl Choice {
@@ -137,10 +144,41 @@ impl Choice {
             ),
         };
         format!(
-            "--quality {:.1} dB ({}): chose {} ({why}){rejected}",
+            "--quality {:.1} dB ({}): chose {}{} ({why}){rejected}{}",
             self.target_db,
             reference_name(self.reference),
             self.config.label(),
+            match self.level {
+                0 => String::new(),
+                l => format!(" at level {l}"),
+            },
+            self.level_reason(),
+        )
+    }
+
+    /// What the level pilot measured, for the terminal (empty without one).
+    fn level_reason(&self) -> String {
+        let Some(lp) = &self.level_pilot else {
+            return String::new();
+        };
+        let tried: Vec<String> = lp
+            .tried
+            .iter()
+            .map(|(l, e)| {
+                format!(
+                    "level {l} {:.1} dB (bound {:.1}){}",
+                    e.estimate_db,
+                    e.bound_db,
+                    if *l > self.level { ", refused" } else { "" }
+                )
+            })
+            .collect();
+        format!(
+            "; levels measured against level 0 on {} of {} rows ({:.2} s): {}",
+            lp.rows,
+            lp.height,
+            lp.seconds,
+            tried.join(", ")
         )
     }
 }
@@ -310,6 +348,8 @@ pub fn pick(p: &Prepared, target_db: f64) -> Result<(Choice, bool), CliError> {
                 footprint_error: Some(e),
                 rejected,
                 pilot: None,
+                level: 0,
+                level_pilot: None,
             };
             return Ok((choice, true));
         }
@@ -327,12 +367,15 @@ pub fn pick(p: &Prepared, target_db: f64) -> Result<(Choice, bool), CliError> {
         footprint_error: Some(e),
         rejected: Vec::new(),
         pilot: None,
+        level: 0,
+        level_pilot: None,
     };
     Ok((choice, false))
 }
 
 /// The JSON record of a `--quality` choice: `target_db`, `reference` (`sheets` or
-/// `continuous`), `predicted_db`, `chosen`; with sheets `footprint_error` and `k_db`, with
+/// `continuous`), `predicted_db`, `level`, `chosen`; with sheets `footprint_error` and `k_db`
+/// (the table's, at the level chosen) and, when levels were measured, `level_pilot`; with
 /// continuous `pilot` (`pixels`, `stride`, `converged`, seconds, and each candidate tried).
 pub fn quality_json(c: &Choice) -> Json {
     let mut j = Json::object()
@@ -345,17 +388,33 @@ pub fn quality_json(c: &Choice) -> Json {
     if let Some(p) = &c.pilot {
         j = j.obj("pilot", pilot_json(p));
     }
-    j.str("chosen", &c.config.label())
+    if let Some(lp) = &c.level_pilot {
+        j = j.obj("level_pilot", level_pilot_json(lp));
+    }
+    j.num("level", f64::from(c.level))
+        .str("chosen", &c.config.label())
 }
 
-/// A candidate's error at the sampled pixels.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Estimate {
-    /// 10·log₁₀(1/m), m the sampled MSE (RGB), dB.
-    pub estimate_db: f64,
-    /// The same with the MSE's upper confidence bound (see the module docs): what is compared
-    /// with the target, dB.
-    pub bound_db: f64,
+/// The JSON record of a level pilot: `rows`, `height`, `base_seconds`, `seconds`, and `tried`,
+/// each level's `level`, `estimate_db` and `bound_db` against level 0.
+fn level_pilot_json(p: &LevelPilot) -> Json {
+    Json::object()
+        .num("rows", p.rows as f64)
+        .num("height", p.height as f64)
+        .num("base_seconds", p.base_seconds)
+        .num("seconds", p.seconds)
+        .arr_obj(
+            "tried",
+            p.tried
+                .iter()
+                .map(|(l, e)| {
+                    Json::object()
+                        .num("level", f64::from(*l))
+                        .num("estimate_db", e.estimate_db)
+                        .num("bound_db", e.bound_db)
+                })
+                .collect(),
+        )
 }
 
 /// How the pilot went.

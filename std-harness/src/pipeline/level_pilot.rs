@@ -1,0 +1,336 @@
+//! `--quality DB`'s level of detail: how far each coarser level is from full resolution,
+//! measured on a pilot of image rows.
+//!
+//! # Why a measurement
+//! A level's error is the data's: one value and one colour per 2×2×2 block cannot stand in for
+//! eight samples composited along a ray where a block holds structure (a thin shell beside empty
+//! space, voxel-scale noise). `--lod auto`'s rule on the projected spacing does not see that: it
+//! keeps the walnut's level 1 at 39.7 dB at 128×128, and gave 34.5 dB on voxel-scale speckle
+//! (README, "Levels of detail"). So `--quality` renders the candidates and compares them.
+//!
+//! # The pilot
+//! 1. **Rows.** The output image's H rows are cut into R = min(H, [`PILOT_ROWS`]) strata of about
+//!    H/R rows and one row per stratum, at a position fixed by a hash of the stratum, is taken.
+//! 2. **Renders.** Level 0 and each candidate level render those rows only (each output row is a
+//!    band of k rows of a k×-supersampled frame; the core's bands give exactly the rows of the
+//!    whole frame, bit for bit, and skip the voxels that cannot reach them), float through the
+//!    frame's view table (`--table`, `--lookup`: the defaults, since `--quality` overrides them).
+//! 3. **Estimate.** Rows are the sampling units (pixels along a row are not independent): each
+//!    sampled row's mean squared error (RGB) m_r, their mean m and standard deviation s; the
+//!    image's MSE is bounded by m + [`Z`]·s/√R·√(1 − R/H) (m itself when every row is sampled).
+//!
+//! Candidates are the levels 1, 2, … whose samples project at most [`MAX_SPACING_PX`] apart (a
+//! level is for minified volumes); the first that fails its budget ends the search, since a
+//! deeper level averages the failing level's blocks again. The caller
+//! ([`super::choose`]) splits the target between the level and the table.
+
+use super::load::Voxels;
+use super::prepare::Prepared;
+use super::sampling::{mix, Estimate};
+use super::supersample::downsample;
+use crate::args::RenderArgs;
+use crate::io::stream::{ColouredMemorySource, MemorySource};
+use crate::io::try_filled;
+use crate::{with_table_size, CliError};
+use footprint::composite::RowSpan;
+use footprint::render::{FloatPath, RenderBuffers, SheetRenderer, SheetRing};
+use footprint::shade::{Sample, OPACITY_TABLE_LEN};
+use footprint::source::SheetSource;
+use footprint::splat::Splatter;
+use footprint::stencil::{self, Stencils};
+use footprint::{Lookup, ViewTable};
+use std::time::Instant;
+
+/// Rows the pilot samples (all of them in an image no taller).
+pub const PILOT_ROWS: usize = 16;
+/// Standard errors added to the sampled MSE before it is compared with the budget.
+pub const Z: f64 = 3.0;
+/// Levels whose samples project farther apart than this, pixels, are not tried.
+pub const MAX_SPACING_PX: f32 = 2.0;
+
+/// How the level pilot went.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LevelPilot {
+    /// Output rows sampled, of `height`.
+    pub rows: usize,
+    pub height: usize,
+    /// Seconds: level 0's rows, and everything (levels built and rendered included).
+    pub base_seconds: f64,
+    pub seconds: f64,
+    /// Each level tried, in order, with its estimate against level 0.
+    pub tried: Vec<(u32, Estimate)>,
+}
+
+/// The sampled rows of an image `h` rows high: one per stratum of about h/n rows, at a position
+/// inside it fixed by a hash of the stratum, ascending; every row when h ≤ n.
+pub fn pilot_rows(h: usize, n: usize) -> Vec<usize> {
+    if h <= n {
+        return (0..h).collect();
+    }
+    (0..n)
+        .map(|i| {
+            let (lo, hi) = (i * h / n, (i + 1) * h / n);
+            lo + (mix(i as u64 ^ 0x6c65_7665_6c73) % (hi - lo) as u64) as usize
+        })
+        .collect()
+}
+
+/// `got` against `want` (both `rows` output rows of `w` pixels, premultiplied RGBA), sampled from
+/// an image `height` rows high (see the module docs).
+pub fn row_estimate(got: &[[f32; 4]], want: &[[f32; 4]], w: usize, height: usize) -> Estimate {
+    let per_row: Vec<f64> = got
+        .chunks(w.max(1))
+        .zip(want.chunks(w.max(1)))
+        .map(|(a, b)| {
+            let sum: f64 = a
+                .iter()
+                .zip(b)
+                .map(|(p, q)| {
+                    (0..3)
+                        .map(|c| (f64::from(p[c]) - f64::from(q[c])).powi(2))
+                        .sum::<f64>()
+                })
+                .sum();
+            sum / (3 * w.max(1)) as f64
+        })
+        .collect();
+    Estimate::of(&per_row, height, Z)
+}
+
+/// The core's float render of `p` (in memory) at output rows `rows` only, with `args`' table
+/// size, lookup and phases through the view table (the robust method): `rows.len()` rows of the
+/// output width, in the order given. Each equals that row of the whole frame's float render with
+/// the same flags, bit for bit.
+pub fn render_rows(
+    p: &Prepared,
+    args: &RenderArgs,
+    rows: &[usize],
+) -> Result<Vec<[f32; 4]>, CliError> {
+    let Voxels::Memory(volume) = &p.voxels else {
+        return Err(CliError::input(
+            "the level pilot renders a volume in memory: drop --stream",
+        ));
+    };
+    let (f, k) = (&p.frame, p.supersample);
+    let (w, h) = p.out_size();
+    if let Some(&y) = rows.iter().find(|&&y| y >= h) {
+        return Err(CliError::input(format!(
+            "pilot row {y} is outside an image {h} rows high"
+        )));
+    }
+    let fa = &args.footprint;
+    let lookup = Lookup::from(fa.lookup);
+    with_table_size!(fa.table, N => {
+        let generic = fa.generic_table::<N>(&p.kernel)?;
+        let table = Box::new(ViewTable::<N>::build(&f.footprint, &generic, lookup, lookup));
+        // The sampler the whole frame's render uses (`super::run`): phase stencils where the
+        // footprint allows them, else the view table.
+        let len = (args.phases > 0)
+            .then(|| stencil::len_for(&f.footprint, args.phases))
+            .flatten();
+        let threads = args.thread_count();
+        let bands = match len {
+            Some(len) => {
+                let mut buffer = vec![0.0f32; len];
+                let stencils = Stencils::build(&*table, args.phases, &mut buffer)?;
+                split_rows(p, &stencils, volume, rows, threads)?
+            }
+            None => split_rows(p, &*table, volume, rows, threads)?,
+        };
+        let mut out = Vec::with_capacity(rows.len() * w);
+        for band in bands {
+            out.extend(downsample(&band, (w, 1), k, |v| v as f32));
+        }
+        out
+    })
+}
+
+/// [`bands_from`] with `rows` split between `threads` cores, each reading the sheets for its
+/// own rows.
+fn split_rows<S: Splatter + Sync + ?Sized>(
+    p: &Prepared,
+    sampler: &S,
+    volume: &crate::io::volume::Volume,
+    rows: &[usize],
+    threads: usize,
+) -> Result<Vec<Vec<[f32; 4]>>, CliError> {
+    let per = rows
+        .len()
+        .div_ceil(threads.clamp(1, rows.len().max(1)))
+        .max(1);
+    let parts: Vec<Result<Vec<Vec<[f32; 4]>>, CliError>> = std::thread::scope(|scope| {
+        let handles: Vec<_> = rows
+            .chunks(per)
+            .map(|part| {
+                scope.spawn(move || {
+                    if volume.is_coloured() {
+                        bands_from(p, sampler, &mut ColouredMemorySource(volume), part)
+                    } else {
+                        bands_from(p, sampler, &mut MemorySource(volume), part)
+                    }
+                })
+            })
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().expect("a pilot thread panicked"))
+            .collect()
+    });
+    let mut bands = Vec::with_capacity(rows.len());
+    for part in parts {
+        bands.extend(part?);
+    }
+    Ok(bands)
+}
+
+/// One renderer per output row of `rows` (a band of k frame rows), all fed from one pass over
+/// `source`'s sheets: each band's k×-wide pixels.
+fn bands_from<S, T>(
+    p: &Prepared,
+    sampler: &S,
+    source: &mut (impl SheetSource<Sample = T, Error = CliError> + ?Sized),
+    rows: &[usize],
+) -> Result<Vec<Vec<[f32; 4]>>, CliError>
+where
+    S: Splatter + ?Sized,
+    T: Sample + Default,
+{
+    let (f, k) = (&p.frame, p.supersample);
+    let n = f.size[0] * k;
+    let mut buffers = Vec::with_capacity(rows.len());
+    for _ in rows {
+        buffers.push((
+            try_filled(n, [0.0f32; 4], "a pilot band's accumulator")?,
+            try_filled(n, [0.0f32; 4], "a pilot band")?,
+            vec![RowSpan::EMPTY; k],
+            vec![0.0f32; OPACITY_TABLE_LEN],
+        ));
+    }
+    let mut renderers = Vec::with_capacity(rows.len());
+    for ((acc, image, spans, opacity), &y) in buffers.iter_mut().zip(rows) {
+        let band = y * k..(y + 1) * k;
+        let bg = p
+            .background
+            .as_deref()
+            .map(|b| &b[band.start * f.size[0]..band.end * f.size[0]]);
+        let buffers = RenderBuffers {
+            accumulator: &mut acc[..],
+            image: &mut image[..],
+            rows: &mut spans[..],
+        };
+        let path = FloatPath { sampler };
+        renderers.push(
+            SheetRenderer::with_band(f, path, p.shader(), p.order, buffers, bg, band)?
+                .with_opacity_table(&mut opacity[..])?,
+        );
+    }
+    let mut storage = try_filled(3 * f.sheet_shape().0, T::default(), "three sheets")?;
+    let mut ring = SheetRing::new(&mut storage, f, p.order)?;
+    for step in 0..f.sheet_count() {
+        let s = ring.sheet_index(step);
+        if let Some(done) = ring.push_with(|slot| source.read_sheet(f.sheet_axis, s, slot))? {
+            for r in &mut renderers {
+                r.render_sheet(ring.sheet_index(done), ring.window(done))?;
+            }
+        }
+    }
+    for r in &mut renderers {
+        ring.finish(r)?;
+    }
+    for r in renderers {
+        r.finish();
+    }
+    Ok(buffers.into_iter().map(|b| b.1).collect())
+}
+
+/// The levels `--quality` may try for `p` (prepared at level 0, in memory, orthographic), in
+/// order: `Some(n)` for an explicit `--lod n` (just n), else 1, 2, … while the level's samples
+/// project at most [`MAX_SPACING_PX`] apart, down to the deepest `--lod` allows.
+pub fn candidate_levels(p: &Prepared, explicit: Option<u32>) -> Vec<u32> {
+    if let Some(n) = explicit {
+        return if n == 0 { Vec::new() } else { vec![n] };
+    }
+    if p.frame.camera().is_some() || p.volume().is_none() {
+        return Vec::new();
+    }
+    let spacing = p.frame.footprint.natural_minor_px / p.kernel.spread() / p.supersample as f32;
+    if !(spacing > 0.0 && spacing.is_finite()) {
+        return Vec::new();
+    }
+    (1..=super::lod::deepest_level(p.fine_dims))
+        .take_while(|&l| spacing * (1u64 << l) as f32 <= MAX_SPACING_PX)
+        .collect()
+}
+
+/// Measures `levels` of `p0` (level 0, in memory) in order against level 0 on the pilot rows,
+/// keeping each level's prepared render; stops after the first level `accept` refuses.
+/// Returns the pilot and the prepared levels accepted, in order.
+pub fn measure(
+    p0: &Prepared,
+    args: &RenderArgs,
+    levels: &[u32],
+    mut accept: impl FnMut(u32, &Prepared, &Estimate) -> Result<bool, CliError>,
+) -> Result<(LevelPilot, Vec<Prepared>), CliError> {
+    let start = Instant::now();
+    let (_, h) = p0.out_size();
+    let rows = pilot_rows(h, PILOT_ROWS);
+    let w = p0.out_size().0;
+    let base = render_rows(p0, args, &rows)?;
+    let base_seconds = start.elapsed().as_secs_f64();
+    let mut tried = Vec::new();
+    let mut accepted: Vec<Prepared> = Vec::new();
+    for &level in levels {
+        let p = p0.at_level(args, level, accepted.last())?;
+        let got = render_rows(&p, args, &rows)?;
+        let e = row_estimate(&got, &base, w, h);
+        tried.push((level, e));
+        if !accept(level, &p, &e)? {
+            break;
+        }
+        accepted.push(p);
+    }
+    let pilot = LevelPilot {
+        rows: rows.len(),
+        height: h,
+        base_seconds,
+        seconds: start.elapsed().as_secs_f64(),
+        tried,
+    };
+    Ok((pilot, accepted))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pilot_rows_take_one_row_per_stratum() {
+        for (h, n) in [(64, 16), (512, 16), (17, 16), (1000, 7)] {
+            let r = pilot_rows(h, n);
+            assert_eq!(r.len(), n);
+            for (i, &y) in r.iter().enumerate() {
+                assert!((i * h / n..(i + 1) * h / n).contains(&y), "{h} {n}: {r:?}");
+            }
+        }
+        assert_eq!(pilot_rows(5, 16), vec![0, 1, 2, 3, 4]);
+    }
+
+    #[test]
+    fn the_row_estimate_is_exact_on_every_row_and_bounded_on_a_sample() {
+        // Two rows of two pixels: squared errors 0.01 and 0.09 in every RGB channel of row 1.
+        let want = [[0.0f32; 4]; 4];
+        let got = [
+            [0.0; 4],
+            [0.0; 4],
+            [0.1, 0.1, 0.1, 0.0],
+            [0.3, 0.3, 0.3, 0.0],
+        ];
+        let mse = (0.01f64 + 0.09) / 4.0;
+        let e = row_estimate(&got, &want, 2, 2);
+        assert!((e.estimate_db - -10.0 * mse.log10()).abs() < 1e-4, "{e:?}");
+        assert_eq!(e.estimate_db, e.bound_db);
+        let sampled = row_estimate(&got, &want, 2, 40);
+        assert!(sampled.bound_db < sampled.estimate_db, "{sampled:?}");
+        assert_eq!(row_estimate(&want, &want, 2, 2).bound_db, f64::INFINITY);
+    }
+}

@@ -1,0 +1,188 @@
+//! `--quality DB` and levels of detail (issue 15, part 3): the level pilot's rows are exactly the
+//! frame's rows; `--quality` takes a coarser level where the level holds the target against full
+//! resolution and not where voxel-scale detail breaks it, and the image then meets the target
+//! against the f64 reference at level 0; streamed volumes stay at level 0.
+
+use footprint_harness::args::parse_args;
+use footprint_harness::metrics::compare;
+use footprint_harness::pipeline::choose::apply_quality;
+use footprint_harness::pipeline::level_pilot::{pilot_rows, render_rows, PILOT_ROWS};
+use footprint_harness::pipeline::{prepare, render_core, render_ref};
+use footprint_suite::tmpdir;
+
+const HEADSQ: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/tests/data/headsq_64x64x93_int16_le.nhdr"
+);
+
+#[test]
+fn pilot_rows_are_the_frames_rows_bit_for_bit() {
+    for (lod, shading) in [("0", "emission"), ("1", "phong"), ("2", "emission")] {
+        let args = parse_args(&[
+            HEADSQ,
+            "--size",
+            "40x40",
+            "--view",
+            "30,20,0",
+            "--lod",
+            lod,
+            "--shading",
+            shading,
+        ])
+        .unwrap();
+        let p = prepare(&args).unwrap();
+        assert!(
+            p.supersample > 1 || lod != "0",
+            "level 0 at 40x40 supersamples"
+        );
+        let (whole, _, _) = render_core(&p, &args).unwrap();
+        let rows = [0usize, 7, 8, 23, 39];
+        let got = render_rows(&p, &args, &rows).unwrap();
+        for (i, &y) in rows.iter().enumerate() {
+            assert_eq!(
+                &got[i * 40..(i + 1) * 40],
+                &whole[y * 40..(y + 1) * 40],
+                "lod {lod}, row {y}"
+            );
+        }
+    }
+    assert_eq!(pilot_rows(40, PILOT_ROWS).len(), PILOT_ROWS);
+}
+
+/// A u8 volume of side `n` from `f` (position in [-1, 1]³ → [0, 1]), written raw; the file's
+/// path as given to `--dims n,n,n --type u8`.
+fn volume(name: &str, n: usize, f: impl Fn([f32; 3], [usize; 3]) -> f32) -> String {
+    let mut v = Vec::with_capacity(n * n * n);
+    for z in 0..n {
+        for y in 0..n {
+            for x in 0..n {
+                let p = [x, y, z].map(|c| c as f32 / (n - 1) as f32 * 2.0 - 1.0);
+                v.push((f(p, [x, y, z]).clamp(0.0, 1.0) * 255.0) as u8);
+            }
+        }
+    }
+    let path = tmpdir(&format!("quality-lod-{name}")).join(name);
+    std::fs::write(&path, v).unwrap();
+    path.to_str().unwrap().to_string()
+}
+
+/// `--quality 40` on `raw` (side `n`) at `size`: the level chosen and the image's PSNR against
+/// the f64 reference of level 0.
+fn quality_40(raw: &str, n: usize, size: &str) -> (u32, f64) {
+    let dims = format!("{n},{n},{n}");
+    let flags = [
+        raw, "--dims", &dims, "--type", "u8", "--size", size, "--view", "30,20,0",
+    ];
+    let mut q = flags.to_vec();
+    q.extend_from_slice(&["--quality", "40"]);
+    let args = parse_args(&q).unwrap();
+    let (p, chosen, choice) = apply_quality(prepare(&args).unwrap(), &args).unwrap();
+    let choice = choice.expect("--quality was given");
+    assert_eq!(choice.level, p.level);
+    assert!(choice.level_pilot.is_some(), "levels were candidates");
+    let (img, _, _) = render_core(&p, &chosen).unwrap();
+    let mut full = flags.to_vec();
+    full.extend_from_slice(&["--lod", "0"]);
+    let (reference, _) = render_ref(&prepare(&parse_args(&full).unwrap()).unwrap()).unwrap();
+    (p.level, compare(&img, &reference).1.psnr_db)
+}
+
+#[test]
+fn quality_coarsens_a_smooth_volume_and_meets_its_target_at_full_resolution() {
+    // A Gaussian blob and a soft shell, 96³ at 32×32: samples about 0.17 px apart.
+    let raw = volume("smooth.raw", 96, |p, _| {
+        let r2 = p.iter().map(|c| c * c).sum::<f32>();
+        (-r2 / (2.0 * 0.15 * 0.15)).exp() + 0.6 * (-((r2.sqrt() - 0.8).powi(2)) / 0.005).exp()
+    });
+    let (level, db) = quality_40(&raw, 96, "32x32");
+    assert!(level >= 1, "a smooth minified volume takes a level");
+    assert!(
+        db >= 40.0,
+        "level {level}: {db:.1} dB against full resolution"
+    );
+}
+
+#[test]
+fn quality_meets_its_target_where_voxel_scale_detail_breaks_levels() {
+    // Thin shells and a hashed speckle (the minification test's kind of volume), 96³ at 48×48:
+    // one value and colour per block cannot stand in for the speckle.
+    let raw = volume("speckle.raw", 96, |p, [x, y, z]| {
+        let r = (p[0] * p[0] + 0.8 * p[1] * p[1] + 1.2 * p[2] * p[2]).sqrt() * 48.0;
+        let shell = [22.0f32, 31.0, 40.0]
+            .iter()
+            .map(|s| (1.0 - (r - s).abs()).max(0.0))
+            .fold(0.0, f32::max);
+        let h = ((x * 73_856_093) ^ (y * 19_349_663) ^ (z * 83_492_791)) % 997;
+        shell.max(if r < 18.0 && h < 120 { 0.7 } else { 0.0 })
+    });
+    let (level, db) = quality_40(&raw, 96, "48x48");
+    assert!(
+        db >= 40.0,
+        "level {level}: {db:.1} dB against full resolution"
+    );
+    // `--lod auto` alone takes a level here and misses the target: the choice is the pilot's.
+    let dims = "96,96,96";
+    let base = [
+        &raw[..],
+        "--dims",
+        dims,
+        "--type",
+        "u8",
+        "--size",
+        "48x48",
+        "--view",
+        "30,20,0",
+    ];
+    let auto = parse_args(&base).unwrap();
+    let p = prepare(&auto).unwrap();
+    let (img, _, _) = render_core(&p, &auto).unwrap();
+    let mut full = base.to_vec();
+    full.extend_from_slice(&["--lod", "0"]);
+    let (reference, _) = render_ref(&prepare(&parse_args(&full).unwrap()).unwrap()).unwrap();
+    let auto_db = compare(&img, &reference).1.psnr_db;
+    assert!(
+        p.level >= 1 && auto_db < 40.0,
+        "auto: level {}, {auto_db:.1} dB",
+        p.level
+    );
+}
+
+#[test]
+fn streamed_and_perspective_renders_keep_level_0_and_refuse_an_explicit_level() {
+    let args = parse_args(&["--stream", HEADSQ, "--size", "32x32", "--quality", "40"]).unwrap();
+    let (p, chosen, choice) = apply_quality(prepare(&args).unwrap(), &args).unwrap();
+    assert_eq!((p.level, choice.unwrap().level), (0, 0));
+    assert!(render_core(&p, &chosen).is_ok());
+    let explicit = parse_args(&[
+        "--stream",
+        HEADSQ,
+        "--size",
+        "32x32",
+        "--quality",
+        "40",
+        "--lod",
+        "1",
+    ])
+    .unwrap();
+    let err = apply_quality(prepare(&explicit).unwrap(), &explicit)
+        .err()
+        .expect("a streamed level cannot be measured");
+    assert!(err.to_string().contains("streamed"), "{err}");
+    // A level is not placed for a perspective view: refused as without --quality.
+    let perspective = parse_args(&[
+        HEADSQ,
+        "--size",
+        "32x32",
+        "--quality",
+        "40",
+        "--lod",
+        "1",
+        "--perspective",
+        "40",
+    ])
+    .unwrap();
+    let err = apply_quality(prepare(&perspective).unwrap(), &perspective)
+        .err()
+        .expect("no level with perspective");
+    assert!(err.to_string().contains("--perspective"), "{err}");
+}
