@@ -149,40 +149,28 @@ fn quality_meets_its_target_where_voxel_scale_detail_breaks_levels() {
 
 #[test]
 fn streamed_and_perspective_renders_keep_level_0_and_refuse_an_explicit_level() {
-    let args = parse_args(&["--stream", HEADSQ, "--size", "32x32", "--quality", "40"]).unwrap();
-    let (p, chosen, choice) = apply_quality(prepare(&args).unwrap(), &args).unwrap();
-    assert_eq!((p.level, choice.unwrap().level), (0, 0));
-    assert!(render_core(&p, &chosen).is_ok());
-    let explicit = parse_args(&[
-        "--stream",
-        HEADSQ,
-        "--size",
-        "32x32",
-        "--quality",
-        "40",
-        "--lod",
-        "1",
-    ])
-    .unwrap();
-    let err = apply_quality(prepare(&explicit).unwrap(), &explicit)
-        .err()
-        .expect("a streamed level cannot be measured");
-    assert!(err.to_string().contains("streamed"), "{err}");
-    // A level is not placed for a perspective view: refused as without --quality.
-    let perspective = parse_args(&[
-        HEADSQ,
-        "--size",
-        "32x32",
-        "--quality",
-        "40",
-        "--lod",
-        "1",
-        "--perspective",
-        "40",
-    ])
-    .unwrap();
-    let err = apply_quality(prepare(&perspective).unwrap(), &perspective)
-        .err()
-        .expect("no level with perspective");
-    assert!(err.to_string().contains("--perspective"), "{err}");
+    for first in [&["--stream", HEADSQ][..], &[HEADSQ, "--perspective", "40"]] {
+        let mut a = first.to_vec();
+        a.extend_from_slice(&["--size", "32x32", "--quality", "40"]);
+        let args = parse_args(&a).unwrap();
+        let (p, chosen, choice) = apply_quality(prepare(&args).unwrap(), &args).unwrap();
+        assert_eq!((p.level, choice.unwrap().level), (0, 0), "{first:?}");
+        assert!(render_core(&p, &chosen).is_ok());
+    }
+    // An explicit level cannot be measured on a stream, nor placed for a perspective view.
+    let streamed = refusal(&["--stream", HEADSQ, "--lod", "1"]);
+    assert!(streamed.contains("streamed"), "{streamed}");
+    let perspective = refusal(&[HEADSQ, "--lod", "1", "--perspective", "40"]);
+    assert!(perspective.contains("--perspective"), "{perspective}");
+}
+
+/// `--quality 40` at 32×32 with `flags`: the error it is refused with.
+fn refusal(flags: &[&str]) -> String {
+    let mut a = flags.to_vec();
+    a.extend_from_slice(&["--size", "32x32", "--quality", "40"]);
+    let args = parse_args(&a).unwrap();
+    match apply_quality(prepare(&args).unwrap(), &args) {
+        Ok(_) => panic!("{flags:?}: accepted"),
+        Err(e) => e.to_string(),
+    }
 }

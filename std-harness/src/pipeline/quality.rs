@@ -395,6 +395,12 @@ pub fn quality_json(c: &Choice) -> Json {
         .str("chosen", &c.config.label())
 }
 
+/// `j` with an estimate's `estimate_db` and `bound_db`.
+fn with_estimate(j: Json, e: &Estimate) -> Json {
+    j.num("estimate_db", e.estimate_db)
+        .num("bound_db", e.bound_db)
+}
+
 /// The JSON record of a level pilot: `rows`, `height`, `base_seconds`, `seconds`, and `tried`,
 /// each level's `level`, `estimate_db` and `bound_db` against level 0.
 fn level_pilot_json(p: &LevelPilot) -> Json {
@@ -407,12 +413,7 @@ fn level_pilot_json(p: &LevelPilot) -> Json {
             "tried",
             p.tried
                 .iter()
-                .map(|(l, e)| {
-                    Json::object()
-                        .num("level", f64::from(*l))
-                        .num("estimate_db", e.estimate_db)
-                        .num("bound_db", e.bound_db)
-                })
+                .map(|(l, e)| with_estimate(Json::object().num("level", f64::from(*l)), e))
                 .collect(),
         )
 }
@@ -446,12 +447,7 @@ fn pilot_json(p: &Pilot) -> Json {
             "tried",
             p.tried
                 .iter()
-                .map(|(c, e)| {
-                    Json::object()
-                        .str("config", &c.label())
-                        .num("estimate_db", e.estimate_db)
-                        .num("bound_db", e.bound_db)
-                })
+                .map(|(c, e)| with_estimate(Json::object().str("config", &c.label()), e))
                 .collect(),
         )
 }
