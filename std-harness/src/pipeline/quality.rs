@@ -45,37 +45,39 @@ pub const CALIBRATED_K_DB: f64 = 21.8;
 /// Safety margin below the calibrated value, dB.
 pub const MARGIN_DB: f64 = 1.0;
 
-/// Frame time relative to the fastest class, by (lookup, method, accumulation): medians over the
-/// calibration sweeps at view 0,0,0 of each class's frame time over the sweep's fastest. Table
-/// size hardly matters within a class (the per-pixel work does not depend on it).
+/// Frame time relative to the fastest class, by (lookup, method, accumulation): for each class,
+/// the median over its configurations of frame time over the chart's fastest configuration, in
+/// `footprint chart` of the built-in scene and of `headsq` at 512×512 (2026-11-24, both cores;
+/// `docs/charts/default`, `docs/charts/headsq`). Table size hardly matters within a class, and,
+/// since the view table is sampled into phase stencils once per view, neither does the lookup.
 pub const RELATIVE_COST: [(LookupArg, MethodArg, AccumArg, f64); 8] = [
-    (LookupArg::Nearest, MethodArg::Robust, AccumArg::Float, 1.0),
     (
         LookupArg::Bilinear,
         MethodArg::Robust,
         AccumArg::Float,
-        1.33,
+        1.01,
     ),
-    (LookupArg::Nearest, MethodArg::Direct, AccumArg::Float, 1.46),
-    (LookupArg::Nearest, MethodArg::Direct, AccumArg::Fixed, 1.55),
-    (LookupArg::Nearest, MethodArg::Robust, AccumArg::Fixed, 1.62),
-    (
-        LookupArg::Bilinear,
-        MethodArg::Direct,
-        AccumArg::Float,
-        1.99,
-    ),
+    (LookupArg::Nearest, MethodArg::Robust, AccumArg::Float, 1.03),
+    (LookupArg::Nearest, MethodArg::Robust, AccumArg::Fixed, 1.82),
+    (LookupArg::Nearest, MethodArg::Direct, AccumArg::Float, 1.82),
     (
         LookupArg::Bilinear,
         MethodArg::Robust,
         AccumArg::Fixed,
-        2.02,
+        1.86,
+    ),
+    (LookupArg::Nearest, MethodArg::Direct, AccumArg::Fixed, 2.25),
+    (
+        LookupArg::Bilinear,
+        MethodArg::Direct,
+        AccumArg::Float,
+        2.28,
     ),
     (
         LookupArg::Bilinear,
         MethodArg::Direct,
         AccumArg::Fixed,
-        2.03,
+        2.85,
     ),
 ];
 
