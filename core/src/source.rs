@@ -91,14 +91,35 @@ where
     P: Precision,
     Src: SheetSource,
 {
-    let axis = renderer.frame().sheet_axis;
-    let count = renderer.frame().sheet_count();
+    render_all_from(core::slice::from_mut(renderer), ring, source)
+}
+
+/// [`render_from`] for several renderers of one frame and compositing order (the bands of an
+/// image, say, or a few bands sampled from it), every sheet read once and rendered by each in
+/// turn. The first renderer's frame sets the sheets; no renderer, nothing read.
+pub fn render_all_from<P, Src>(
+    renderers: &mut [SheetRenderer<'_, P>],
+    ring: &mut SheetRing<'_, Src::Sample>,
+    source: &mut Src,
+) -> Result<(), Src::Error>
+where
+    P: Precision,
+    Src: SheetSource,
+{
+    let Some(first) = renderers.first() else {
+        return Ok(());
+    };
+    let (axis, count) = (first.frame().sheet_axis, first.frame().sheet_count());
     for step in 0..count {
         let s = ring.sheet_index(step);
         if let Some(done) = ring.push_with(|slot| source.read_sheet(axis, s, slot))? {
-            renderer.render_sheet(ring.sheet_index(done), ring.window(done))?;
+            for r in renderers.iter_mut() {
+                r.render_sheet(ring.sheet_index(done), ring.window(done))?;
+            }
         }
     }
-    ring.finish(renderer)?;
+    for r in renderers.iter_mut() {
+        ring.finish(r)?;
+    }
     Ok(())
 }

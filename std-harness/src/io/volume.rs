@@ -143,18 +143,23 @@ impl Volume {
     /// Copies sheet `s` of `axis` (row-major over the other two axes, lower axis fastest) into `out`
     /// as f32.
     pub fn sheet_into(&self, axis: usize, s: usize, out: &mut [f32]) {
+        self.sheet_as(axis, s, out, |x| x);
+    }
+
+    /// Sheet `s` of `axis` into `out`, each sample's value (as f32) through `to`.
+    fn sheet_as<O>(&self, axis: usize, s: usize, out: &mut [O], to: impl Fn(f32) -> O) {
         use footprint::volume::copy_sheet;
         let (d, a) = (self.dims, axis);
         match &self.samples {
-            Samples::U8(v) => copy_sheet(v, d, a, s, out, f32::from),
-            Samples::I8(v) => copy_sheet(v, d, a, s, out, f32::from),
-            Samples::U16(v) => copy_sheet(v, d, a, s, out, f32::from),
-            Samples::I16(v) => copy_sheet(v, d, a, s, out, f32::from),
-            Samples::U32(v) => copy_sheet(v, d, a, s, out, |x| x as f32),
-            Samples::I32(v) => copy_sheet(v, d, a, s, out, |x| x as f32),
-            Samples::F32(v) => copy_sheet(v, d, a, s, out, |x| x),
-            Samples::F64(v) => copy_sheet(v, d, a, s, out, |x| x as f32),
-            Samples::Coloured(v) => copy_sheet(v, d, a, s, out, |x| x.value),
+            Samples::U8(v) => copy_sheet(v, d, a, s, out, |x| to(f32::from(x))),
+            Samples::I8(v) => copy_sheet(v, d, a, s, out, |x| to(f32::from(x))),
+            Samples::U16(v) => copy_sheet(v, d, a, s, out, |x| to(f32::from(x))),
+            Samples::I16(v) => copy_sheet(v, d, a, s, out, |x| to(f32::from(x))),
+            Samples::U32(v) => copy_sheet(v, d, a, s, out, |x| to(x as f32)),
+            Samples::I32(v) => copy_sheet(v, d, a, s, out, |x| to(x as f32)),
+            Samples::F32(v) => copy_sheet(v, d, a, s, out, &to),
+            Samples::F64(v) => copy_sheet(v, d, a, s, out, |x| to(x as f32)),
+            Samples::Coloured(v) => copy_sheet(v, d, a, s, out, |x| to(x.value)),
         }
     }
 
@@ -168,17 +173,10 @@ impl Volume {
         use footprint::volume::copy_sheet;
         match &self.samples {
             Samples::Coloured(v) => copy_sheet(v, self.dims, axis, s, out, |x| x),
-            _ => {
-                // Plain data: the values, one sheet-sized scratch at a time.
-                let mut values = vec![0.0f32; out.len()];
-                self.sheet_into(axis, s, &mut values);
-                for (o, v) in out.iter_mut().zip(values) {
-                    *o = Coloured {
-                        value: v,
-                        colour: None,
-                    };
-                }
-            }
+            _ => self.sheet_as(axis, s, out, |value| Coloured {
+                value,
+                colour: None,
+            }),
         }
     }
 }

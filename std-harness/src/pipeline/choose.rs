@@ -109,10 +109,7 @@ fn choose_sheets(
         return Ok((p0, c));
     }
     if let (Some(n @ 1..), Some(_)) = (explicit, p0.frame.camera()) {
-        return Err(CliError::input(format!(
-            "--lod {n}: {}; use --lod 0 or auto with --perspective",
-            footprint::lod::LodError::Perspective
-        )));
+        return Err(super::prepare::no_level_in_perspective(n));
     }
     let levels = candidate_levels(&p0, explicit);
     if levels.is_empty() {

@@ -26,6 +26,7 @@
 
 use super::load::Voxels;
 use super::prepare::Prepared;
+use super::run::stencil_len;
 use super::sampling::{mix, Estimate};
 use super::supersample::downsample;
 use crate::args::RenderArgs;
@@ -35,9 +36,9 @@ use crate::{with_table_size, CliError};
 use footprint::composite::RowSpan;
 use footprint::render::{FloatPath, RenderBuffers, SheetRenderer, SheetRing};
 use footprint::shade::{Sample, OPACITY_TABLE_LEN};
-use footprint::source::SheetSource;
+use footprint::source::{render_all_from, SheetSource};
 use footprint::splat::Splatter;
-use footprint::stencil::{self, Stencils};
+use footprint::stencil::Stencils;
 use footprint::{Lookup, ViewTable};
 use std::time::Instant;
 
@@ -125,9 +126,7 @@ pub fn render_rows(
         let table = Box::new(ViewTable::<N>::build(&f.footprint, &generic, lookup, lookup));
         // The sampler the whole frame's render uses (`super::run`): phase stencils where the
         // footprint allows them, else the view table.
-        let len = (args.phases > 0)
-            .then(|| stencil::len_for(&f.footprint, args.phases))
-            .flatten();
+        let len = stencil_len(p, args);
         let threads = args.thread_count();
         let bands = match len {
             Some(len) => {
@@ -188,7 +187,7 @@ fn split_rows<S: Splatter + Sync + ?Sized>(
 fn bands_from<S, T>(
     p: &Prepared,
     sampler: &S,
-    source: &mut (impl SheetSource<Sample = T, Error = CliError> + ?Sized),
+    source: &mut impl SheetSource<Sample = T, Error = CliError>,
     rows: &[usize],
 ) -> Result<Vec<Vec<[f32; 4]>>, CliError>
 where
@@ -226,17 +225,7 @@ where
     }
     let mut storage = try_filled(3 * f.sheet_shape().0, T::default(), "three sheets")?;
     let mut ring = SheetRing::new(&mut storage, f, p.order)?;
-    for step in 0..f.sheet_count() {
-        let s = ring.sheet_index(step);
-        if let Some(done) = ring.push_with(|slot| source.read_sheet(f.sheet_axis, s, slot))? {
-            for r in &mut renderers {
-                r.render_sheet(ring.sheet_index(done), ring.window(done))?;
-            }
-        }
-    }
-    for r in &mut renderers {
-        ring.finish(r)?;
-    }
+    render_all_from(&mut renderers, &mut ring, source)?;
     for r in renderers {
         r.finish();
     }
@@ -250,13 +239,10 @@ pub fn candidate_levels(p: &Prepared, explicit: Option<u32>) -> Vec<u32> {
     if let Some(n) = explicit {
         return if n == 0 { Vec::new() } else { vec![n] };
     }
-    if p.frame.camera().is_some() || p.volume().is_none() {
-        return Vec::new();
-    }
-    let spacing = p.frame.footprint.natural_minor_px / p.kernel.spread() / p.supersample as f32;
-    if !(spacing > 0.0 && spacing.is_finite()) {
-        return Vec::new();
-    }
+    let spacing = match super::lod::projected_spacing(&p.frame, p.kernel.spread(), p.supersample) {
+        Some(d) if p.volume().is_some() => d,
+        _ => return Vec::new(),
+    };
     (1..=super::lod::deepest_level(p.fine_dims))
         .take_while(|&l| spacing * (1u64 << l) as f32 <= MAX_SPACING_PX)
         .collect()

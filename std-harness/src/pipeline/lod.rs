@@ -58,20 +58,27 @@ pub fn choose_level(lod: Lod, fine: &FrameSetup, kernel: &Kernel) -> u32 {
 /// `auto`'s level for level 0's frame `fine` at the output size, reconstructed with a kernel of
 /// radius `spread` grid steps (see the module docs).
 pub fn auto_level(fine: &FrameSetup, spread: f32) -> u32 {
-    if fine.camera().is_some() {
+    let Some(spacing) = projected_spacing(fine, spread, 1) else {
         return 0;
-    }
-    // The projected spacing along the tightest direction, pixels.
-    let spacing = fine.footprint.natural_minor_px / spread;
-    if !(spacing > 0.0 && spacing.is_finite()) {
-        return 0;
-    }
+    };
     let deepest = deepest_level(fine.dims);
     let mut level = 0;
     while level < deepest && spacing * (4u64 << (2 * level)) as f32 <= AUTO_BUDGET_PX {
         level += 1;
     }
     level
+}
+
+/// Level 0's samples' projected spacing along the tightest direction, output pixels, for
+/// `frame` (orthographic, set up at `supersample` times the output size) reconstructed with a
+/// kernel of radius `spread` grid steps; `None` for a perspective frame (its spacing varies) or
+/// a degenerate one.
+pub fn projected_spacing(frame: &FrameSetup, spread: f32, supersample: usize) -> Option<f32> {
+    if frame.camera().is_some() {
+        return None;
+    }
+    let spacing = frame.footprint.natural_minor_px / spread / supersample as f32;
+    (spacing > 0.0 && spacing.is_finite()).then_some(spacing)
 }
 
 /// The deepest level of a `dims` volume whose longest axis keeps at least [`MIN_SAMPLES`]

@@ -247,10 +247,7 @@ pub fn setup_frame(
     let size = [args.size.0, args.size.1];
     if let Some(fovy) = args.perspective {
         if let Lod::Level(n @ 1..) = args.lod {
-            return Err(CliError::input(format!(
-                "--lod {n}: {}; use --lod 0 or auto with --perspective",
-                LodError::Perspective
-            )));
+            return Err(no_level_in_perspective(n));
         }
         let (frame, k) = perspective_frame(args, fovy, &view, dims, grid, kernel, options)?;
         return Ok((frame, k, 0));
@@ -281,6 +278,14 @@ pub fn setup_frame(
         .map_err(|e| CliError::input(format!("view: {e}")))?;
     let fine = FrameSetup::new(dims, grid, &view, kernel, options, size.map(|n| n * k))?;
     Ok((at_level(&fine, &view)?, k, level))
+}
+
+/// Why `--lod n` (n ≥ 1) cannot render with `--perspective`.
+pub fn no_level_in_perspective(n: u32) -> CliError {
+    CliError::input(format!(
+        "--lod {n}: {}; use --lod 0 or auto with --perspective",
+        LodError::Perspective
+    ))
 }
 
 /// The perspective frame of `--perspective FOVY`: `view`'s rotation (its scale dropped), the eye

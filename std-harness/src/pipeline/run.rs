@@ -92,10 +92,7 @@ pub fn render_frame(
             }
             (AccumArg::Float, _) => {
                 let table = Box::new(ViewTable::<N>::build(&p.frame.footprint, &generic, lookup, lookup));
-                let len = (args.phases > 0)
-                    .then(|| stencil::len_for(&p.frame.footprint, args.phases))
-                    .flatten();
-                let r = if let Some(len) = len {
+                let r = if let Some(len) = stencil_len(p, args) {
                     // Footprints up to 128 px across: the view table sampled once per phase.
                     let mut buffer = vec![0.0f32; len];
                     let stencils = Stencils::build(&*table, args.phases, &mut buffer)?;
@@ -152,6 +149,14 @@ pub fn render_frame(
             visible,
         }
     })
+}
+
+/// The buffer length of the float path's phase stencils for `p`'s footprint with `args`'
+/// `--phases` (`None`: `--phases 0`, or a footprint too large for them; the view table serves).
+pub fn stencil_len(p: &Prepared, args: &RenderArgs) -> Option<usize> {
+    (args.phases > 0)
+        .then(|| stencil::len_for(&p.frame.footprint, args.phases))
+        .flatten()
 }
 
 type PathResult<X> = (Vec<X>, RenderStats, Phases, Option<usize>);
