@@ -342,14 +342,15 @@ fn resolved_sheet_pixels_are_valid_premultiplied_colours() {
 /// the interpolation error over 1/P px, which for a narrow footprint is largest at the support's
 /// edge, where the truncated Gaussian drops from 4.4 % of its peak to zero between phases, and
 /// for renormalised footprints, whose normalisation changes between phases: within 1.2·10⁻² of
-/// the peak (measured up to 8.2·10⁻³; wide footprints, whose edge is read exactly, 6.9·10⁻⁴).
+/// the peak (measured up to 8.2·10⁻³; wide footprints blended up to the edge, 7.9·10⁻³; edged ones,
+/// whose edge is read exactly, 6.9·10⁻⁴).
 /// The float stencils blend the same way, and `verify` measures the effect on whole images. A
 /// renormalised voxel's total deposit equals the walk's up to per-pixel rounding.
 #[test]
 fn integer_stencils_match_the_table_walk() {
     use footprint::fixed::stencil::{len_for, FixedStencils};
     let generic = GenericTable::<65>::build(Kernel::PAPER_GAUSSIAN);
-    let mut checked = 0;
+    let (mut checked, mut blended_checked) = (0, 0);
     for (zoom, shear) in [
         (0.6f32, 0.0f32),
         (1.0, 0.3),
@@ -373,74 +374,96 @@ fn integer_stencils_match_the_table_walk() {
         table
             .build_view(&f, &generic, Lookup::Bilinear, Lookup::Bilinear)
             .unwrap();
-        // As the harness picks them: 32 for narrow footprints, fewer for wide ones.
-        let p = footprint::stencil::phases_for(&f.footprint, 32) as i64;
-        let Some(len) = len_for(&table, p as usize) else {
-            panic!("zoom {zoom}: expected stencils")
-        };
-        let mut buffer = vec![0i32; len];
-        let stencils = FixedStencils::build(&table, p as usize, &mut buffer).unwrap();
-        let mut most = 0.0f64;
-        let mut at_nodes = 0.0f64;
-        for k in 0..97i64 {
-            // Q24 positions spread over the pixel, phase cells and their edges included; every
-            // fourth exactly on a phase node (a · 2²⁴ / P, rounded down as the stencils are).
-            let node = k % 4 == 0;
-            let center = if node {
-                [
-                    (31 << 24) + ((k % (p + 1)) << 24) / p,
-                    (32 << 24) + ((k * 7 % (p + 1)) << 24) / p,
-                ]
+        // As the harness picks them: 32 for narrow footprints, fewer for wide ones, edged and
+        // (where the float plan blends them) blended up to the edge.
+        let plan = footprint::stencil::plan_for(&f.footprint, 32).unwrap();
+        let wide = plan.side > footprint::stencil::NARROW_SIDE;
+        for blended in [false, true] {
+            if blended && (plan.edged || !wide) {
+                continue;
+            }
+            let p = if blended {
+                plan.phases as i64
             } else {
-                [
-                    (31 << 24) + (k * 0x2F_5A3B) % (1 << 24),
-                    (32 << 24) + (k * 0x61_C88F + (k & 3) * (1 << 22)) % (1 << 24),
-                ]
+                footprint::stencil::edged_phases_for(&f.footprint, 32) as i64
             };
-            let value = [ONE / 3, ONE / 2, ONE / 4, ONE];
-            let splat = |use_stencils: bool| {
-                let mut acc = vec![[0i64; 4]; 64 * 64];
-                let mut img = ImageMut::new(&mut acc, 64, 64, 64).unwrap();
-                if use_stencils {
-                    stencils.splat(center, &value, &mut img, |_, _, _| {});
+            let Some(len) = len_for(&table, p as usize) else {
+                panic!("zoom {zoom}: expected stencils")
+            };
+            let mut buffer = vec![0i32; len];
+            let build = if blended {
+                FixedStencils::build_blended
+            } else {
+                FixedStencils::build
+            };
+            let stencils = build(&table, p as usize, &mut buffer).unwrap();
+            blended_checked += usize::from(blended);
+            let mut most = 0.0f64;
+            let mut at_nodes = 0.0f64;
+            for k in 0..97i64 {
+                // Q24 positions spread over the pixel, phase cells and their edges included; every
+                // fourth exactly on a phase node (a · 2²⁴ / P, rounded down as the stencils are).
+                let node = k % 4 == 0;
+                let center = if node {
+                    [
+                        (31 << 24) + ((k % (p + 1)) << 24) / p,
+                        (32 << 24) + ((k * 7 % (p + 1)) << 24) / p,
+                    ]
                 } else {
-                    fixed::splat::splat(&table, center, &value, &mut img, |_, _, _| {});
+                    [
+                        (31 << 24) + (k * 0x2F_5A3B) % (1 << 24),
+                        (32 << 24) + (k * 0x61_C88F + (k & 3) * (1 << 22)) % (1 << 24),
+                    ]
+                };
+                let value = [ONE / 3, ONE / 2, ONE / 4, ONE];
+                let splat = |use_stencils: bool| {
+                    let mut acc = vec![[0i64; 4]; 64 * 64];
+                    let mut img = ImageMut::new(&mut acc, 64, 64, 64).unwrap();
+                    if use_stencils {
+                        stencils.splat(center, &value, &mut img, |_, _, _| {});
+                    } else {
+                        fixed::splat::splat(&table, center, &value, &mut img, |_, _, _| {});
+                    }
+                    acc
+                };
+                let (walk, st) = (splat(false), splat(true));
+                let peak = walk.iter().map(|p| p[3]).max().unwrap() as f64;
+                let worst = walk
+                    .iter()
+                    .zip(&st)
+                    .flat_map(|(a, b)| (0..4).map(move |c| (a[c] - b[c]).abs() as f64))
+                    .fold(0.0, f64::max);
+                let what = format!("zoom {zoom} shear {shear} k {k}");
+                if node {
+                    at_nodes = at_nodes.max(worst / peak);
+                    // Exact up to rounding for P a power of two; otherwise a node a·2²⁴/P rounds
+                    // down to 255/256 of the way from the node before it.
+                    let bound = if p.count_ones() == 1 { 1e-5 } else { 2e-4 };
+                    assert_le(worst, bound * peak, &what);
+                } else {
+                    most = most.max(worst / peak);
+                    assert_le(worst, 1.2e-2 * peak, &what);
                 }
-                acc
-            };
-            let (walk, st) = (splat(false), splat(true));
-            let peak = walk.iter().map(|p| p[3]).max().unwrap() as f64;
-            let worst = walk
-                .iter()
-                .zip(&st)
-                .flat_map(|(a, b)| (0..4).map(move |c| (a[c] - b[c]).abs() as f64))
-                .fold(0.0, f64::max);
-            let what = format!("zoom {zoom} shear {shear} k {k}");
-            if node {
-                at_nodes = at_nodes.max(worst / peak);
-                // Exact up to rounding for P a power of two; otherwise a node a·2²⁴/P rounds
-                // down to 255/256 of the way from the node before it.
-                let bound = if p.count_ones() == 1 { 1e-5 } else { 2e-4 };
-                assert_le(worst, bound * peak, &what);
-            } else {
-                most = most.max(worst / peak);
-                assert_le(worst, 1.2e-2 * peak, &what);
+                let total = |a: &[[i64; 4]]| a.iter().map(|p| p[3] as f64).sum::<f64>();
+                if f.footprint.renormalise {
+                    // Both deposit the cell area's share exactly, up to per-pixel rounding.
+                    assert_le(
+                        (total(&walk) - total(&st)).abs(),
+                        1e-6 * total(&walk),
+                        &format!("zoom {zoom} total"),
+                    );
+                }
+                checked += 1;
             }
-            let total = |a: &[[i64; 4]]| a.iter().map(|p| p[3] as f64).sum::<f64>();
-            if f.footprint.renormalise {
-                // Both deposit the cell area's share exactly, up to per-pixel rounding.
-                assert_le(
-                    (total(&walk) - total(&st)).abs(),
-                    1e-6 * total(&walk),
-                    &format!("zoom {zoom} total"),
-                );
-            }
-            checked += 1;
-        }
-        eprintln!(
-            "zoom {zoom} shear {shear}: half-extent {:?} px, {p} phases, box {} px, renormalised {}, max |stencils − walk| = {most:.2e} of peak ({at_nodes:.2e} at phase nodes)",
+            eprintln!(
+            "zoom {zoom} shear {shear} (blended to the edge: {blended}): half-extent {:?} px, {p} phases, box {} px, renormalised {}, max |stencils − walk| = {most:.2e} of peak ({at_nodes:.2e} at phase nodes)",
             f.footprint.half_extent, stencils.side(), f.footprint.renormalise
         );
+        }
     }
-    assert_eq!(checked, 7 * 97);
+    assert_eq!(checked, (7 + blended_checked) * 97);
+    assert!(
+        blended_checked >= 2,
+        "{blended_checked} wide footprints blended to the edge"
+    );
 }

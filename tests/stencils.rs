@@ -12,7 +12,7 @@
 use footprint::geometry::{Footprint, FootprintOptions};
 use footprint::splat::{splat, ImageMut};
 use footprint::stencil::{
-    self, minor_semi_axis, Stencils, DEFAULT_PHASES, MAX_STENCIL_SIDE, PHASE_REACH,
+    self, minor_semi_axis, Stencils, BLEND_REACH, DEFAULT_PHASES, MAX_STENCIL_SIDE, PHASE_REACH,
 };
 use footprint::{GenericTable, Kernel, Lookup, ViewTable};
 use glam::Mat3;
@@ -57,6 +57,8 @@ fn phase(c: f32, i: i64, p: usize) -> (usize, f32) {
 fn stencils_cover_every_size_and_skip_only_zeros() {
     let generic = GenericTable::<129>::build(Kernel::PAPER_GAUSSIAN);
     let mut covered = 0;
+    // Boxes wider than 16 px blended to the edge, and read at the edge.
+    let mut kinds = [0, 0];
     for &(s, a, deg) in &SHAPES {
         let fp = footprint(s, a, deg);
         let table = ViewTable::<129>::build(&fp, &generic, Lookup::Bilinear, Lookup::Bilinear);
@@ -73,10 +75,13 @@ fn stencils_cover_every_size_and_skip_only_zeros() {
         let st = Stencils::build(&table, DEFAULT_PHASES, &mut buffer).unwrap();
         let r = minor_semi_axis(&fp);
         let p = st.phases();
+        let wide = stencil::is_wide(&fp, DEFAULT_PHASES);
+        let reach = if wide { PHASE_REACH } else { BLEND_REACH };
         assert!(
-            p == DEFAULT_PHASES || p as f32 * r >= PHASE_REACH,
+            p == DEFAULT_PHASES || p as f32 * r >= reach,
             "P = {p} at r = {r}"
         );
+        kinds[usize::from(wide)] += usize::from(st.side() > 16);
         println!(
             "scale {s}, {a}:1 at {deg}°: half-extents {:?} px, minor semi-axis {r:.2} px, B = {}, P = {p}, {} KiB",
             fp.half_extent,
@@ -134,7 +139,6 @@ fn stencils_cover_every_size_and_skip_only_zeros() {
             );
             let mut want = vec![0.0f32; SIZE * SIZE];
             let b = st.side() as i64;
-            let wide = stencil::is_wide(&fp);
             for my in 0..b {
                 for mx in 0..b {
                     let (x, y) = (ix - reach + mx, iy - reach + my);
@@ -174,6 +178,10 @@ fn stencils_cover_every_size_and_skip_only_zeros() {
     assert!(
         covered >= 2,
         "no footprint wider than the old 16 px limit was tested"
+    );
+    assert!(
+        kinds[0] >= 1 && kinds[1] >= 1,
+        "wide footprints blended to the edge and read at the edge: {kinds:?}"
     );
 }
 

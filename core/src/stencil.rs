@@ -10,37 +10,45 @@
 //! voxel deposits exactly one unit. A voxel's weights are the bilinear blend of the four stencils
 //! around its phase; since every stencil sums to one, so does the blend.
 //!
-//! **Narrow and wide footprints.** A *narrow* footprint (box side B ≤ [`NARROW_SIDE`], 16 px) is
-//! blended at P = P_max phases (the caller's, 32 in the harness) over every pixel where a corner
-//! stencil is non-zero. A *wide* one varies slowly per pixel, so it needs fewer phases for the
-//! same blending error: P = min(P_max, ⌈[`PHASE_REACH`] / r⌉), r the shorter semi-axis
-//! ([`minor_semi_axis`]), so P·r ≥ 128 px; it visits exactly the pixel centres inside its support
-//! (as the table walk does), blends where all four corner stencils are non-zero and reads the
-//! sampler at the few edge pixels where one is not. (The footprint is not smooth at its support's
-//! edge, and a blend across it is off by a share of the edge weight: blended there at P·r = 64,
-//! `verify` lost up to 1.5 dB against the table walk; with the edge read exactly and P·r ≥ 128 it
-//! stays within 0.32 dB of it on every README volume and view.) Stencils that would exceed
-//! [`MAX_STENCIL_FLOATS`] (long thin footprints needing many phases) are not built: the table
-//! walk serves those.
+//! **Narrow, blended and edged footprints.** A *narrow* footprint (box side B ≤ [`NARROW_SIDE`],
+//! 16 px) is blended at P = P_max phases (the caller's, 32 in the harness) over every pixel where a
+//! corner stencil is non-zero. A wider one varies more slowly per pixel, so it needs fewer phases
+//! for the same blending error: it is blended the same way at P = min(P_max, ⌈[`BLEND_REACH`] /
+//! r⌉), r the shorter semi-axis ([`minor_semi_axis`]), so P·r ≥ 224 px, when those stencils fit in
+//! [`MAX_STENCIL_FLOATS`]; otherwise (a long thin footprint) it is *edged*: P = min(P_max,
+//! ⌈[`PHASE_REACH`] / r⌉) (P·r ≥ 128), it visits exactly the pixel centres inside its support (as
+//! the table walk does), blends where all four corner stencils are non-zero and reads the sampler
+//! at the few edge pixels where one is not ([`plan_for`] decides). The footprint is not smooth at
+//! its support's edge (the truncated Gaussian drops there from 4 % of its peak to nothing), and a
+//! blend across it is off by a share of the edge weight on a sliver 1/P px wide, a fraction of the
+//! pixels that falls as 1/(P·r): blended at P·r = 64, `verify` lost up to 1.5 dB against the table
+//! walk, which is why wide footprints were once always edged. Blended at P·r ≥ 224 they lose
+//! nothing: against edging at P·r ≥ 128, `verify` (f64 reference, view 30,20,0) went from 102.22
+//! to 102.76 dB on headsq at 512² (half-extent 8 px), 102.31 to 102.76 dB at 2048² (32 px), 98.40
+//! to 98.75 dB on the walnut at 1024² (8.4 px), 99.49 to 100.66 dB on the built-in scene at
+//! 1024² (15 px), and frames got 1.4–1.9× faster (no sampler reads, no per-row support solve:
+//! `footprint bench`, the two builds alternated, 1 thread). Stencils that would exceed
+//! [`MAX_STENCIL_FLOATS`] either way are not built: the table walk serves those.
 //!
 //! **Accuracy.** Blending between phases adds the error of linear interpolation over a phase step
 //! of 1/P px: at most (1/P)²/8 · |∂²w/∂φ²|. For a Gaussian of standard deviation σ ≈ r/2.5
 //! (the default kernel) |∂²w/∂φ²| ≤ peak/σ², so the error is at most (2.5/(P·r))²/8 of the peak:
-//! 3.4·10⁻⁴ for the smallest footprint (r = 1.5 px at P = 32), 4.8·10⁻⁵ for a wide one. The
+//! 3.4·10⁻⁴ for the smallest footprint (r = 1.5 px at P = 32), 1.6·10⁻⁵ for a blended wide one
+//! (P·r ≥ 224), 4.8·10⁻⁵ for an edged one. The
 //! harness's `verify` measures it with the rest; `tests/stencils.rs` checks it against the table
 //! walk and checks every pixel against brute force.
 //!
 //! **Only the support is visited.** For each phase cell (a, b) the stencils store, per box row, the
-//! first and last pixel where any of the cell's four corner stencils is non-zero (narrow) or where
-//! all four are (wide); a narrow splat visits only the former (about π/4 of the box for an
+//! first and last pixel where any of the cell's four corner stencils is non-zero (blended) or where
+//! all four are (edged); a blended splat visits only the former (about π/4 of the box for an
 //! ellipse, less for a thin one). Every pixel skipped would have received a weight of exactly
 //! zero, so this changes no pixel.
 //!
 //! **Memory.** (P + 1)² · B² + P² · B floats, built once per view in caller storage:
 //! [`len_for`]. For P_max = 32 and round footprints: 126 KiB at e = 1.5 px (B = 5), 236 KiB at
-//! e = 2 px (B = 7), 571 KiB at e = 4.2 px (B = 11), 427 KiB at e = 8 px (B = 19, P = 16), 397 KiB
-//! at e = 16 px (B = 35, P = 8), 443 KiB at e = 32 px (B = 67, P = 4), 1.0 MiB at the largest,
-//! e = 63 px (B = 129, P = 3).
+//! e = 2 px (B = 7), 559 KiB at e = 4.2 px (B = 11), 1.2 MiB at e = 8 px (B = 19, P = 28),
+//! 1.1 MiB at e = 16 px (B = 35, P = 14) and at e = 32 px (B = 67, P = 7), 1.6 MiB at the
+//! largest, e = 63 px (B = 129, P = 4).
 
 use crate::geometry::Footprint;
 use crate::math;
@@ -49,11 +57,11 @@ use crate::splat::{
 };
 
 /// Largest number of phases per pixel the harness uses ([`phases_for`] lowers it for
-/// wide footprints).
+/// footprints wider than [`NARROW_SIDE`]).
 pub const DEFAULT_PHASES: usize = 32;
 
-/// For a wide footprint, phases × shorter semi-axis (px) kept at least this large:
-/// P = ⌈`PHASE_REACH` / r⌉, capped by the caller's maximum (see the module docs for the error
+/// For an edged footprint ([`Plan::edged`]), phases × shorter semi-axis (px) kept at least this
+/// large: P = ⌈`PHASE_REACH` / r⌉, capped by the caller's maximum (see the module docs for the error
 /// it bounds).
 pub const PHASE_REACH: f32 = 128.0;
 
@@ -76,13 +84,93 @@ pub fn minor_semi_axis(footprint: &Footprint) -> f32 {
 }
 
 /// Footprints whose box side is at most this many pixels are *narrow*: blended at every phase the
-/// caller allows, up to the support's edge. Wider ones are *wide* (see the module docs).
+/// caller allows, up to the support's edge. Wider ones get fewer phases, and are blended up to
+/// the edge or edged ([`plan_for`], the module docs).
 pub const NARROW_SIDE: usize = 16;
 
-/// Whether `footprint` is splatted as a wide one: box side above [`NARROW_SIDE`] (such footprints
-/// are never renormalised: their half-extents exceed 4 px).
-pub fn is_wide(footprint: &Footprint) -> bool {
-    side_for(footprint).is_none_or(|b| b > NARROW_SIDE)
+/// For a footprint wider than [`NARROW_SIDE`] blended everywhere: phases × shorter semi-axis (px)
+/// kept at least this large, P = ⌈`BLEND_REACH` / r⌉ capped by the caller's maximum (see the
+/// module docs for what it bounds).
+pub const BLEND_REACH: f32 = 224.0;
+
+/// How a footprint's stencils are laid out and splatted: box side B, phases P, and whether the
+/// splat reads the edge from the sampler (*edged*) instead of blending up to it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Plan {
+    /// Box side B, pixels.
+    pub side: usize,
+    /// Phases per pixel P.
+    pub phases: usize,
+    /// Blended only where all four corner stencils are non-zero, the rest read exactly.
+    pub edged: bool,
+}
+
+impl Plan {
+    /// Floats the stencils take: (P + 1)² · B² + P² · B.
+    pub fn floats(&self) -> usize {
+        let (p, b) = (self.phases, self.side);
+        (p + 1) * (p + 1) * b * b + p * p * b
+    }
+}
+
+/// The stencils for `footprint` with at most `max_phases` (≥ 1) phases per pixel, if any fit in
+/// [`MAX_STENCIL_FLOATS`]: a narrow footprint (B ≤ [`NARROW_SIDE`]) blended at `max_phases`;
+/// a wider one blended at P = ⌈[`BLEND_REACH`] / r⌉ when that fits, else edged at
+/// P = ⌈[`PHASE_REACH`] / r⌉ (r the shorter semi-axis, [`minor_semi_axis`]; both capped by
+/// `max_phases`).
+pub fn plan_for(footprint: &Footprint, max_phases: usize) -> Option<Plan> {
+    let side = side_for(footprint)?;
+    let max_phases = max_phases.max(1);
+    let fits = |p: Plan| (p.floats() <= MAX_STENCIL_FLOATS).then_some(p);
+    let r = minor_semi_axis(footprint);
+    if side <= NARROW_SIDE || !(r > 0.0) {
+        return fits(Plan {
+            side,
+            phases: max_phases,
+            edged: side > NARROW_SIDE,
+        });
+    }
+    let at = |reach| phases_at(reach, r, max_phases);
+    fits(Plan {
+        side,
+        phases: at(BLEND_REACH),
+        edged: false,
+    })
+    .or_else(|| {
+        fits(Plan {
+            side,
+            phases: at(PHASE_REACH),
+            edged: true,
+        })
+    })
+}
+
+/// min(`max_phases`, ⌈`reach` / r⌉), at least 1.
+fn phases_at(reach: f32, r: f32, max_phases: usize) -> usize {
+    let p = -math::floor(-(reach / r)); // ⌈reach / r⌉
+    if p >= max_phases as f32 {
+        max_phases
+    } else {
+        (p as usize).max(1)
+    }
+}
+
+/// Phases for stencils that always read a wide footprint's edge (the fixed path's,
+/// [`crate::fixed::stencil`]): `max_phases` for a box side up to [`NARROW_SIDE`], else
+/// min(`max_phases`, ⌈[`PHASE_REACH`] / r⌉).
+pub fn edged_phases_for(footprint: &Footprint, max_phases: usize) -> usize {
+    let max_phases = max_phases.max(1);
+    let r = minor_semi_axis(footprint);
+    match side_for(footprint) {
+        Some(side) if side > NARROW_SIDE && r > 0.0 => phases_at(PHASE_REACH, r, max_phases),
+        _ => max_phases,
+    }
+}
+
+/// Whether `footprint` is splatted with its edge read from the sampler ([`Plan::edged`]); true
+/// also when no stencils fit.
+pub fn is_wide(footprint: &Footprint, max_phases: usize) -> bool {
+    plan_for(footprint, max_phases).is_none_or(|p| p.edged)
 }
 
 /// Largest box side (pixels) stencils are built for (half-extent up to 63.5 px); wider
@@ -100,22 +188,12 @@ pub fn side_for(footprint: &Footprint) -> Option<usize> {
     (side <= MAX_STENCIL_SIDE as f32).then_some(side as usize)
 }
 
-/// Phases per pixel P for `footprint` when the caller allows at most `max_phases` (≥ 1):
-/// min(`max_phases`, ⌈[`PHASE_REACH`] / r⌉), r the footprint's shorter semi-axis
-/// ([`minor_semi_axis`]; the weight varies fastest across it), for a wide footprint
-/// ([`is_wide`]); a narrow one always gets `max_phases`.
+/// Phases per pixel P of [`plan_for`]'s stencils for `footprint` when the caller allows at most
+/// `max_phases` (≥ 1): `max_phases` for a narrow footprint, fewer for a wider one (the weight
+/// varies fastest across the shorter semi-axis, [`minor_semi_axis`]); `max_phases` also when no
+/// stencils fit.
 pub fn phases_for(footprint: &Footprint, max_phases: usize) -> usize {
-    let max_phases = max_phases.max(1);
-    let r = minor_semi_axis(footprint);
-    if !is_wide(footprint) || !(r > 0.0) {
-        return max_phases;
-    }
-    let p = -math::floor(-(PHASE_REACH / r)); // ⌈128 / r⌉
-    if p >= max_phases as f32 {
-        max_phases
-    } else {
-        (p as usize).max(1)
-    }
+    plan_for(footprint, max_phases).map_or(max_phases.max(1), |p| p.phases)
 }
 
 /// Floats needed for `footprint`'s stencils with at most `max_phases` phases per pixel, if
@@ -123,10 +201,7 @@ pub fn phases_for(footprint: &Footprint, max_phases: usize) -> usize {
 /// `None` also when that would exceed [`MAX_STENCIL_FLOATS`] (a long thin footprint that
 /// needs many phases: the table walk serves it).
 pub fn len_for(footprint: &Footprint, max_phases: usize) -> Option<usize> {
-    let side = side_for(footprint)?;
-    let p = phases_for(footprint, max_phases);
-    let len = (p + 1) * (p + 1) * side * side + p * p * side;
-    (len <= MAX_STENCIL_FLOATS).then_some(len)
+    plan_for(footprint, max_phases).map(|p| p.floats())
 }
 
 /// The four stencils at the corners of phase cell `c` = a + b·P (indices into the (P + 1)² grid of
@@ -156,11 +231,11 @@ pub(crate) fn nonzero_run<W: PartialEq + Default>(row: &[W]) -> Option<(usize, u
 }
 
 /// One view's phase stencils (see the module docs), in caller storage, with the sampler they were
-/// built from (a wide footprint reads it at the support's edge).
+/// built from (an edged footprint reads it at the support's edge).
 #[derive(Debug)]
 pub struct Stencils<'a, S: ?Sized> {
     sampler: &'a S,
-    /// Whether the footprint is wide ([`is_wide`]).
+    /// Whether the footprint is edged ([`Plan::edged`]).
     wide: bool,
     /// (P + 1)² stencils of B² weights, then P² cells of B row ranges (first | last << 16, kept
     /// as the bits of an f32: a tiny positive number, never NaN).
@@ -189,8 +264,7 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
         buffer: &'a mut [f32],
     ) -> Result<Self, BufferError> {
         let fp = sampler.footprint();
-        let phases = phases_for(fp, max_phases);
-        let (Some(side), Some(len)) = (side_for(fp), len_for(fp, max_phases)) else {
+        let Some(plan) = plan_for(fp, max_phases) else {
             let e = fp.half_extent[0].max(fp.half_extent[1]);
             let side = (2.0 * e + 2.0).min(1e9) as usize;
             return Err(BufferError::TooLarge {
@@ -198,6 +272,7 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
                 height: side,
             });
         };
+        let (side, phases, len) = (plan.side, plan.phases, plan.floats());
         if buffer.len() < len {
             return Err(BufferError::TooSmall {
                 needed: len,
@@ -238,7 +313,7 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
         // Per phase cell and box row: the first and last pixel where one of the cell's four
         // corner stencils is non-zero (narrow footprints: the pixels a splat visits), or where
         // all four are (wide ones: the pixels it blends); first > last when there are none.
-        let wide = is_wide(fp);
+        let wide = plan.edged;
         let weights = &*weights;
         let nonzero = |stencil: usize, my: usize| {
             nonzero_run(&weights[stencil * cells + my * side..][..side])
@@ -298,8 +373,8 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
 
     /// Spreads `value` of a voxel projected to `center` (pixels, absolute) into `image`, calling
     /// `touched(y, x0, x1)` for each row it visited: the blend of the four stencils around the
-    /// centre's sub-pixel phase. A narrow footprint visits the pixels where one of them is
-    /// non-zero; a wide one visits the pixel centres inside its support, as the table walk
+    /// centre's sub-pixel phase. A blended footprint visits the pixels where one of them is
+    /// non-zero; an edged one ([`Plan::edged`]) visits the pixel centres inside its support, as the table walk
     /// ([`crate::splat::splat_rows`]) does, blending where all four are non-zero and reading the
     /// sampler at the few edge pixels where one is not (the footprint is not smooth at its
     /// support's edge, so a blend across it is off by a share of the edge weight).
@@ -349,7 +424,7 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
         let mut weights = [0.0f32; MAX_STENCIL_SIDE];
         let wide = self.wide;
         if !wide {
-            // Narrow: the runs are short (a few pixels), so weight and deposit in one pass.
+            // Blended: weight and deposit in one pass over the stored runs.
             for (my, span) in spans.iter().enumerate().take(my1).skip(my0) {
                 let (first, last) = run(span);
                 let (lo, hi) = (first.max(0), last.min(w - 1));

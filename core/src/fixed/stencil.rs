@@ -15,7 +15,7 @@
 //! **Narrow and wide.** A *narrow* footprint (box side ≤ [`crate::stencil::NARROW_SIDE`]) is
 //! blended over every pixel where a corner stencil is non-zero, as the float path does. A *wide*
 //! one (up to [`MAX_STENCIL_SIDE`] px, and [`MAX_STENCIL_FLOATS`] entries, with the fewer phases
-//! the caller picks for it, see [`crate::stencil::phases_for`]) is blended only where all four
+//! the caller picks for it, see [`crate::stencil::edged_phases_for`]) is blended only where all four
 //! corner stencils are non-zero; at the support's edge, where one of them is zero (the truncated
 //! kernel drops there from a few per cent of its peak to nothing), the pixel takes the walk's
 //! own weight, so no blend crosses the edge. Rows and runs are widened by a pixel so that an edge
@@ -82,7 +82,7 @@ pub fn side_for<const M: usize>(table: &FixedTable<M>) -> Option<usize> {
 
 /// `i32`s needed for `table`'s stencils at `phases` phases per pixel, if stencils apply:
 /// (P + 1)² · B² + P² · B ≤ [`MAX_STENCIL_FLOATS`]. A wide footprint should be given the fewer
-/// phases [`crate::stencil::phases_for`] picks for it.
+/// phases [`crate::stencil::edged_phases_for`] picks for it.
 pub fn len_for<const M: usize>(table: &FixedTable<M>, phases: usize) -> Option<usize> {
     let side = side_for(table)?;
     let len = (phases + 1) * (phases + 1) * side * side + phases * phases * side;
@@ -114,19 +114,41 @@ impl<const M: usize> Copy for FixedStencils<'_, M> {}
 
 impl<'a, const M: usize> FixedStencils<'a, M> {
     /// Samples `table`'s footprint at every phase (`phases` ≥ 1 per pixel) into `buffer` (at
-    /// least [`len_for`] long).
+    /// least [`len_for`] long). A footprint wider than [`NARROW_SIDE`] is edged: blended only
+    /// where all four corners are non-zero, its edge pixels weighted by the walk.
     pub fn build(
         table: &'a FixedTable<M>,
         phases: usize,
         buffer: &'a mut [i32],
+    ) -> Result<Self, StencilError> {
+        Self::build_as(table, phases, buffer, true)
+    }
+
+    /// [`FixedStencils::build`], but a footprint wider than [`NARROW_SIDE`] is blended up to its
+    /// edge as a narrow one is (the float stencils' *blended* plan,
+    /// [`crate::stencil::plan_for`]: give it that plan's phases, P·r ≥
+    /// [`crate::stencil::BLEND_REACH`]).
+    pub fn build_blended(
+        table: &'a FixedTable<M>,
+        phases: usize,
+        buffer: &'a mut [i32],
+    ) -> Result<Self, StencilError> {
+        Self::build_as(table, phases, buffer, false)
+    }
+
+    fn build_as(
+        table: &'a FixedTable<M>,
+        phases: usize,
+        buffer: &'a mut [i32],
+        edged: bool,
     ) -> Result<Self, StencilError> {
         if phases == 0 {
             return Err(StencilError::NoPhases);
         }
         let side = side_for(table).ok_or(StencilError::Wide)?;
         let len = len_for(table, phases).ok_or(StencilError::Wide)?;
-        let wide = side > NARROW_SIDE;
-        if wide && table.renorm != 0 {
+        let wide = side > NARROW_SIDE && edged;
+        if side > NARROW_SIDE && table.renorm != 0 {
             // Renormalised footprints are a few pixels wide; a wide one is not expected.
             return Err(StencilError::Wide);
         }

@@ -118,12 +118,19 @@ pub fn render_frame(
                 // Footprints up to 128 px across: the integer table sampled once per phase (as
                 // the float path's stencils, with as many phases); wider ones, or --phases 0, walk
                 // the table.
-                let phases = stencil::phases_for(&p.frame.footprint, args.phases);
+                // Blended to the edge where the float stencils are (the same phases), else edged.
+                let plan = stencil::plan_for(&p.frame.footprint, args.phases);
+                let blended = plan.is_some_and(|q| !q.edged);
+                let phases = match plan {
+                    Some(q) if blended => q.phases,
+                    _ => stencil::edged_phases_for(&p.frame.footprint, args.phases),
+                };
                 let len = (args.phases > 0 && method != MethodArg::Direct)
                     .then(|| fixed::stencil::len_for(&table, phases))
                     .flatten();
                 let mut buffer = vec![0i32; len.unwrap_or(0)];
-                let path = match len.map(|_| FixedStencils::build(&table, phases, &mut buffer)) {
+                let build = if blended { FixedStencils::build_blended } else { FixedStencils::build };
+                let path = match len.map(|_| build(&table, phases, &mut buffer)) {
                     Some(Ok(stencils)) => path.with_stencils(stencils),
                     // --phases 0, the direct method, a footprint past the stencils' limits, or
                     // renormalised weights too large for 32 bits: the walk serves this view.
