@@ -22,6 +22,52 @@ pub struct VisibleLists {
     pub gradients: Vec<[f32; 3]>,
     /// Their straight colours, when the volume carries colours (a level of detail's; else empty).
     pub colours: Vec<[f32; 3]>,
+    /// Per sheet row that holds visible voxels, where they lie: `runs[run_offsets[s]..
+    /// run_offsets[s + 1]]` are sheet s's, in row order (what [`super::bands`] balances its
+    /// bands with).
+    pub runs: Vec<RowRun>,
+    /// Where each sheet's runs start in `runs` (one more entry than sheets).
+    pub run_offsets: Vec<usize>,
+}
+
+/// The visible voxels of one sheet row: row `v`, `count` voxels with u in `u0..=u1`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RowRun {
+    /// The sheet row (index along the second in-sheet axis).
+    pub v: u16,
+    /// First visible voxel's u.
+    pub u0: u16,
+    /// Last visible voxel's u.
+    pub u1: u16,
+    /// Visible voxels in the row.
+    pub count: u32,
+}
+
+/// `lists`' runs: one pass over each sheet's voxels (in row order).
+fn summarise(offsets: &[usize], voxels: &[VisibleVoxel]) -> (Vec<RowRun>, Vec<usize>) {
+    let mut runs: Vec<RowRun> = Vec::new();
+    let mut run_offsets = vec![0];
+    for w in offsets.windows(2) {
+        let first = runs.len();
+        for vox in &voxels[w[0]..w[1]] {
+            let open = runs.len() > first;
+            match runs.last_mut() {
+                Some(r) if open && r.v == vox.v => {
+                    r.u0 = r.u0.min(vox.u);
+                    r.u1 = r.u1.max(vox.u);
+                    r.count += 1;
+                }
+                _ => runs.push(RowRun {
+                    v: vox.v,
+                    u0: vox.u,
+                    u1: vox.u,
+                    count: 1,
+                }),
+            }
+        }
+        run_offsets.push(runs.len());
+    }
+    (runs, run_offsets)
 }
 
 impl VisibleLists {
@@ -113,6 +159,7 @@ pub fn classify(p: &Prepared, volume: &Volume, threads: usize) -> Result<Visible
         out.gradients.extend_from_slice(&part.gradients);
         out.colours.extend_from_slice(&part.colours);
     }
+    (out.runs, out.run_offsets) = summarise(&out.offsets, &out.voxels);
     Ok(out)
 }
 
