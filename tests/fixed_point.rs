@@ -467,3 +467,107 @@ fn integer_stencils_match_the_table_walk() {
         "{blended_checked} wide footprints blended to the edge"
     );
 }
+
+/// With a value bound (`FixedPath::with_value_bound`) the integer stencils add without
+/// saturating where the bound proves every pixel's sum stays inside `i64`: the image is the
+/// saturating path's, bit for bit, from minified to magnified footprints (narrow, blended and
+/// edged); a voxel above the bound is refused with a typed error, not splatted.
+#[test]
+fn unsaturated_stencil_adds_match_saturating_ones() {
+    use footprint::fixed::stencil::{len_for, FixedStencils};
+    use footprint::render::{RenderBuffers, RenderError, SheetRenderer};
+    use footprint::shade::{Shader, Shading, TransferFunction};
+    let generic = GenericTable::<65>::build(Kernel::PAPER_GAUSSIAN);
+    let mut unsaturated = 0;
+    for zoom in [0.3f32, 1.0, 2.5, 7.0, 14.0] {
+        let f = frame([9, 8, 7], zoom, 96);
+        let mut table = Box::new(FixedTable::<65>::zeroed());
+        table
+            .build_view(&f, &generic, Lookup::Bilinear, Lookup::Bilinear)
+            .unwrap();
+        for blended in [false, true] {
+            let p = if blended {
+                footprint::stencil::phases_for(&f.footprint, 32)
+            } else {
+                footprint::stencil::edged_phases_for(&f.footprint, 32)
+            };
+            let Some(len) = len_for(&table, p) else {
+                continue;
+            };
+            let mut buffer = vec![0i32; len];
+            let build = if blended {
+                FixedStencils::build_blended
+            } else {
+                FixedStencils::build
+            };
+            let Ok(st) = build(&table, p, &mut buffer) else {
+                continue;
+            };
+            let (_, na, nb) = f.sheet_shape();
+            let sheet = |s: usize| -> Vec<[f32; 4]> {
+                (0..na * nb)
+                    .map(|i| {
+                        let a = ((i * 37 + s * 11) % 17) as f32 / 16.0;
+                        [a * 0.9, a * 0.5, a * 0.2, a]
+                    })
+                    .collect()
+            };
+            let path = || FixedPath::new(&f, &*table).unwrap().with_stencils(st);
+            let bounded = path().with_value_bound(ONE);
+            unsaturated += usize::from(bounded.unsaturated());
+            assert_eq!(
+                render_with(&f, path(), Order::BackToFront, &sheet),
+                render_with(&f, bounded, Order::BackToFront, &sheet),
+                "zoom {zoom}, blended {blended}"
+            );
+        }
+    }
+    assert!(
+        unsaturated >= 6,
+        "{unsaturated} configurations added unsaturated"
+    );
+
+    // Above the bound: refused.
+    let f = frame([9, 8, 7], 2.5, 96);
+    let mut table = Box::new(FixedTable::<65>::zeroed());
+    table
+        .build_view(&f, &generic, Lookup::Bilinear, Lookup::Bilinear)
+        .unwrap();
+    let mut buffer = vec![0i32; len_for(&table, 32).unwrap()];
+    let st = FixedStencils::build(&table, 32, &mut buffer).unwrap();
+    let path = FixedPath::new(&f, &*table)
+        .unwrap()
+        .with_stencils(st)
+        .with_value_bound(ONE / 2);
+    assert!(path.unsaturated());
+    let lut = [[0.0f32; 4], [1.0; 4]];
+    let shader = Shader {
+        tf: TransferFunction {
+            lut: &lut,
+            lo: 0.0,
+            hi: 1.0,
+        },
+        shading: Shading::Emission,
+    };
+    let n = f.image_len();
+    let (mut acc, mut img, mut rows) = (
+        vec![[0i64; 4]; n],
+        vec![[0u32; 4]; n],
+        vec![footprint::composite::RowSpan::EMPTY; f.size[1]],
+    );
+    let buffers = RenderBuffers {
+        accumulator: &mut acc,
+        image: &mut img,
+        rows: &mut rows,
+    };
+    let mut r =
+        SheetRenderer::with_path(&f, path, shader, Order::BackToFront, buffers, None).unwrap();
+    let (len, _, _) = f.sheet_shape();
+    let err = r
+        .render_shaded_sheet(0, &vec![[0.9, 0.9, 0.9, 0.9]; len])
+        .unwrap_err();
+    assert!(
+        matches!(err, RenderError::ValueAboveBound { bound, .. } if bound == ONE / 2),
+        "{err}"
+    );
+}

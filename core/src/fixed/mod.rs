@@ -31,7 +31,12 @@
 //!   therefore accumulate to about 2²⁴⁺²⁸ = 2⁵², leaving 2¹¹ = 2048-fold headroom, however large
 //!   the footprints (a 1000-px footprint spreads the same total over more pixels) and however
 //!   many voxels overlap. Past that, adds saturate, and `tests/fixed_point.rs` drives an
-//!   accumulator into saturation to show it stops instead of wrapping.
+//!   accumulator into saturation to show it stops instead of wrapping. A saturating `i64` add
+//!   costs a compare and select per channel, so where the caller bounds the voxel values
+//!   ([`crate::render::FixedPath::with_value_bound`]) and the bound, the stencils' largest
+//!   weight and the number of voxels whose box can hold one pixel prove that no pixel's sum can
+//!   pass 2⁶² ([`stencil::FixedStencils::exact_below`]), the stencils add with plain (wrapping)
+//!   adds: the same bits, since none can wrap; a voxel above the bound is refused.
 //! - Accumulated sheets are rounded to Q24 and clamped to [0, [`ONE`]] before compositing, so the
 //!   working image's alpha never exceeds [`ONE`], and for valid premultiplied input (colour ≤
 //!   alpha) neither does any colour. Invalid input grows a colour by at most [`ONE`] per sheet

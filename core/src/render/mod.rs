@@ -99,6 +99,14 @@ pub enum RenderError {
         /// Slabs composited so far.
         composited: usize,
     },
+    /// A voxel above the channel bound a [`FixedPath`] was promised
+    /// ([`FixedPath::with_value_bound`]).
+    ValueAboveBound {
+        /// The channel value (Q24).
+        value: u32,
+        /// The bound.
+        bound: u32,
+    },
 }
 
 impl fmt::Display for RenderError {
@@ -136,6 +144,10 @@ impl fmt::Display for RenderError {
                 f,
                 "a voxel overlapping slabs {first}..={last} came after {composited} slabs were \
                  composited: feed voxels in the order of the slab they reach first"
+            ),
+            Self::ValueAboveBound { value, bound } => write!(
+                f,
+                "a voxel channel of {value} (Q24) is above the bound {bound} the fixed path was given"
             ),
         }
     }

@@ -148,6 +148,10 @@ pub struct FixedPath<'a, const M: usize> {
     table: &'a FixedTable<M>,
     stencils: Option<FixedStencils<'a, M>>,
     place: Placement,
+    /// The caller's bound on voxel channel values ([`FixedPath::with_value_bound`]).
+    value_bound: Option<u32>,
+    /// Whether the stencils may add without saturating (the bound keeps every sum in range).
+    unsaturated: bool,
 }
 
 impl<'a, const M: usize> FixedPath<'a, M> {
@@ -163,7 +167,33 @@ impl<'a, const M: usize> FixedPath<'a, M> {
             table,
             stencils: None,
             place: Placement::new(frame)?,
+            value_bound: None,
+            unsaturated: false,
         })
+    }
+
+    /// Promises that no voxel this path splats has a channel above `bound` (Q24; a shaded voxel
+    /// is at most [`fixed::ONE`]). Where that keeps every pixel's sum within the `i64`
+    /// accumulator ([`FixedStencils::exact_below`]), the stencils add without saturating, which
+    /// gives the same bits faster; a voxel above the bound is then refused
+    /// ([`RenderError::ValueAboveBound`]) rather than risk a wrapped sum.
+    pub fn with_value_bound(mut self, bound: u32) -> Self {
+        self.value_bound = Some(bound);
+        self.settle();
+        self
+    }
+
+    /// Whether the stencils add without saturating (see [`FixedPath::with_value_bound`]).
+    pub fn unsaturated(&self) -> bool {
+        self.unsaturated
+    }
+
+    fn settle(&mut self) {
+        let (a, b) = (self.place.along_a, self.place.along_b);
+        self.unsaturated = match (&self.stencils, self.value_bound) {
+            (Some(s), Some(bound)) => s.exact_below(a, b).is_some_and(|m| u64::from(bound) <= m),
+            _ => false,
+        };
     }
 
     /// Splats through `stencils` (built from this path's table: [`FixedStencils::build`])
@@ -171,6 +201,7 @@ impl<'a, const M: usize> FixedPath<'a, M> {
     /// bits as the walk (the blend between phases differs from the walk's lookup).
     pub fn with_stencils(mut self, stencils: FixedStencils<'a, M>) -> Self {
         self.stencils = Some(stencils);
+        self.settle();
         self
     }
 }
@@ -206,6 +237,13 @@ impl<const M: usize> Precision for FixedPath<'_, M> {
         let mut center = self.place.at(sheet, u, v);
         center[1] -= (row0 as i64) << fixed::POS_FRAC;
         Ok(match &self.stencils {
+            Some(s) if self.unsaturated => {
+                let bound = self.value_bound.unwrap_or(0);
+                if let Some(&c) = value.iter().find(|&&c| c > bound) {
+                    return Err(RenderError::ValueAboveBound { value: c, bound });
+                }
+                s.splat_unsaturated(center, value, acc, touched)
+            }
             Some(s) => s.splat(center, value, acc, touched),
             None => fixed::splat::splat(self.table, center, value, acc, touched),
         })

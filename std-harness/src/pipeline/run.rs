@@ -114,7 +114,11 @@ pub fn render_frame(
                     _ => table.build_view(&p.frame, &generic, lookup, lookup),
                 }
                 .map_err(fixed_range)?;
-                let path = FixedPath::new(&p.frame, &*table).map_err(fixed_range)?;
+                // Shaded voxels never exceed opacity 1: the stencils may add unsaturated where
+                // that keeps every sum in range (the same bits).
+                let path = FixedPath::new(&p.frame, &*table)
+                    .map_err(fixed_range)?
+                    .with_value_bound(fixed::ONE);
                 // Footprints up to 128 px across: the integer table sampled once per phase (as
                 // the float path's stencils, with as many phases); wider ones, or --phases 0, walk
                 // the table.
