@@ -218,8 +218,12 @@ pub(crate) fn cell_corners(c: usize, phases: usize) -> [usize; 4] {
 
 /// Where the four stencils around phase cell (`ka`, `kb`) start in the stencil data (stencils of
 /// `cells` weights on a (P + 1)² grid): (ka, kb), (ka + 1, kb), (ka, kb + 1), (ka + 1, kb + 1).
+/// (Written out rather than through [`cell_corners`]: that divides, and this runs per voxel.)
+#[inline]
 pub(crate) fn corner_offsets(ka: usize, kb: usize, phases: usize, cells: usize) -> [usize; 4] {
-    cell_corners(kb * phases + ka, phases).map(|s| s * cells)
+    let s00 = (kb * (phases + 1) + ka) * cells;
+    let s01 = s00 + (phases + 1) * cells;
+    [s00, s00 + cells, s01, s01 + cells]
 }
 
 /// The first and last index of a non-zero weight in `row`, if any.
