@@ -475,8 +475,7 @@ fn integer_stencils_match_the_table_walk() {
 #[test]
 fn unsaturated_stencil_adds_match_saturating_ones() {
     use footprint::fixed::stencil::{len_for, FixedStencils};
-    use footprint::render::{RenderBuffers, RenderError, SheetRenderer};
-    use footprint::shade::{Shader, Shading, TransferFunction};
+    use footprint::render::RenderError;
     let generic = GenericTable::<65>::build(Kernel::PAPER_GAUSSIAN);
     let mut unsaturated = 0;
     for zoom in [0.3f32, 1.0, 2.5, 7.0, 14.0] {
@@ -540,32 +539,11 @@ fn unsaturated_stencil_adds_match_saturating_ones() {
         .with_stencils(st)
         .with_value_bound(ONE / 2);
     assert!(path.unsaturated());
-    let lut = [[0.0f32; 4], [1.0; 4]];
-    let shader = Shader {
-        tf: TransferFunction {
-            lut: &lut,
-            lo: 0.0,
-            hi: 1.0,
-        },
-        shading: Shading::Emission,
-    };
-    let n = f.image_len();
-    let (mut acc, mut img, mut rows) = (
-        vec![[0i64; 4]; n],
-        vec![[0u32; 4]; n],
-        vec![footprint::composite::RowSpan::EMPTY; f.size[1]],
-    );
-    let buffers = RenderBuffers {
-        accumulator: &mut acc,
-        image: &mut img,
-        rows: &mut rows,
-    };
-    let mut r =
-        SheetRenderer::with_path(&f, path, shader, Order::BackToFront, buffers, None).unwrap();
     let (len, _, _) = f.sheet_shape();
-    let err = r
-        .render_shaded_sheet(0, &vec![[0.9, 0.9, 0.9, 0.9]; len])
-        .unwrap_err();
+    let err = footprint_suite::try_render_with(&f, path, Order::BackToFront, &|_| {
+        vec![[0.9, 0.9, 0.9, 0.9]; len]
+    })
+    .unwrap_err();
     assert!(
         matches!(err, RenderError::ValueAboveBound { bound, .. } if bound == ONE / 2),
         "{err}"

@@ -140,6 +140,16 @@ pub fn render_with<P: footprint::render::Precision>(
     order: footprint::frame::Order,
     sheet: &dyn Fn(usize) -> Vec<[f32; 4]>,
 ) -> Vec<P::Pixel> {
+    try_render_with(f, path, order, sheet).unwrap()
+}
+
+/// [`render_with`], returning the renderer's first error instead of panicking on it.
+pub fn try_render_with<P: footprint::render::Precision>(
+    f: &footprint::frame::FrameSetup,
+    path: P,
+    order: footprint::frame::Order,
+    sheet: &dyn Fn(usize) -> Vec<[f32; 4]>,
+) -> Result<Vec<P::Pixel>, footprint::render::RenderError> {
     use footprint::render::{RenderBuffers, SheetRenderer};
     use footprint::shade::{Shader, Shading, TransferFunction};
     let shader = Shader {
@@ -161,13 +171,13 @@ pub fn render_with<P: footprint::render::Precision>(
         image: &mut img,
         rows: &mut rows,
     };
-    let mut r = SheetRenderer::with_path(f, path, shader, order, buffers, None).unwrap();
+    let mut r = SheetRenderer::with_path(f, path, shader, order, buffers, None)?;
     for step in 0..f.sheet_count() {
         let s = f.sheet_at(order, step);
-        r.render_shaded_sheet(s, &sheet(s)).unwrap();
+        r.render_shaded_sheet(s, &sheet(s))?;
     }
     r.finish();
-    img
+    Ok(img)
 }
 
 /// An empty folder for one test, `fp-NAME-PID` in the system's temporary folder (emptied first if

@@ -54,6 +54,12 @@ pub fn band_rows(height: usize, bands: usize, t: usize) -> std::ops::Range<usize
     start..start + base + usize::from(t < extra)
 }
 
+/// `threads` bands of [`band_rows`] (at most one per row).
+pub fn equal_bands(height: usize, threads: usize) -> Vec<std::ops::Range<usize>> {
+    let bands = threads.clamp(1, height.max(1));
+    (0..bands).map(|t| band_rows(height, bands, t)).collect()
+}
+
 /// Renders `lists` through `path` on `threads` bands. Returns the image, the counts summed over
 /// bands (`voxels_splatted` counts a voxel once per band it reached) and the slowest band's
 /// splat and composite seconds.
@@ -70,7 +76,7 @@ where
     P::Acc: Send,
 {
     let ranges = balanced_rows(&p.frame, lists, threads);
-    on_ranges(
+    on_bands(
         p.frame.size,
         ranges,
         P::CLEAR,
@@ -96,7 +102,7 @@ pub fn balanced_rows(
 ) -> Vec<std::ops::Range<usize>> {
     let h = f.size[1];
     let bands = bands.clamp(1, h.max(1));
-    let equal = || (0..bands).map(|t| band_rows(h, bands, t)).collect();
+    let equal = || equal_bands(h, bands);
     if bands == 1 || f.camera().is_some() || lists.run_offsets.len() < 2 {
         return equal();
     }
@@ -149,34 +155,12 @@ pub fn balanced_rows(
     ranges
 }
 
-/// Cuts a `size` image of `clear` pixels into one band of rows per thread (at most `threads`)
-/// and runs `band(rows, band's pixels, band's background)` on each, on its own thread. Returns the
-/// image, the counts summed over bands (`sheets` and `voxels` are the last band's: every band
-/// visits every sheet and voxel) and the slowest band's splat and composite seconds.
+/// Cuts a `size` image of `clear` pixels into the bands of rows `ranges` (in order, tiling the
+/// image: [`equal_bands`] or [`balanced_rows`]) and runs `band(rows, band's pixels, band's
+/// background)` on each, on its own thread. Returns the image, the counts summed over bands
+/// (`sheets` and `voxels` are the last band's: every band visits every sheet and voxel) and the
+/// slowest band's splat and composite seconds.
 pub fn on_bands<X, F>(
-    size: [usize; 2],
-    threads: usize,
-    clear: X,
-    background: Option<&[X]>,
-    band: F,
-) -> Result<(Vec<X>, RenderStats, Phases), CliError>
-where
-    X: Copy + Send + Sync,
-    F: Fn(
-            std::ops::Range<usize>,
-            &mut [X],
-            Option<&[X]>,
-        ) -> Result<(RenderStats, Phases), CliError>
-        + Sync,
-{
-    let h = size[1];
-    let bands = threads.clamp(1, h);
-    let ranges = (0..bands).map(|t| band_rows(h, bands, t)).collect();
-    on_ranges(size, ranges, clear, background, band)
-}
-
-/// [`on_bands`] with the bands given: `ranges` tile the image's rows in order.
-fn on_ranges<X, F>(
     size: [usize; 2],
     ranges: Vec<std::ops::Range<usize>>,
     clear: X,

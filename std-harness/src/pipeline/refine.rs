@@ -20,7 +20,7 @@
 //! 4. **Render.** On bands of rows like every render ([`super::bands::on_bands`]): byte-identical
 //!    for any number of threads.
 
-use super::bands::{on_bands, CoreFrame, Phases};
+use super::bands::{equal_bands, on_bands, CoreFrame, Phases};
 use super::prepare::Prepared;
 pub use super::refinement::Refinement;
 use super::supersample::to_output;
@@ -281,7 +281,7 @@ pub fn render_refined(
         let table_secs = t0.elapsed().as_secs_f64();
         let (image, stats, phases) = on_bands(
             f.size,
-            threads,
+            equal_bands(f.size[1], threads),
             [0.0f32; 4],
             p.background.as_deref(),
             |rows, image, bg| {

@@ -17,7 +17,7 @@
 //! view crosses every sheet, so a streamed volume (`--stream`) is refused: feeding it from a
 //! bounded window of sheets is not possible (see the core module's docs).
 
-use super::bands::{on_bands, CoreFrame, Phases};
+use super::bands::{equal_bands, on_bands, CoreFrame, Phases};
 use super::prepare::Prepared;
 use super::supersample::to_output;
 use super::visible::FrameCache;
@@ -79,7 +79,7 @@ pub fn render_slabs(
     let (setup, table, sv) = (&setup, &*table, &voxels);
     let (image, mut stats, band_phases) = on_bands(
         p.frame.size,
-        threads,
+        equal_bands(p.frame.size[1], threads),
         [0.0f32; 4],
         p.background.as_deref(),
         |rows, band, bg| render_band(p, setup, table, sv, bg, band, rows),
