@@ -243,3 +243,49 @@ fn wide_footprints_match_the_table_walk() {
         worst.0, worst.1
     );
 }
+
+/// `Stencils::build_split` gives `build`'s stencils bit for bit however the caller splits the
+/// sampling (here: in reverse order, and on two threads of uneven halves).
+#[test]
+fn split_builds_are_the_same_bits() {
+    let generic = GenericTable::<129>::build(Kernel::PAPER_GAUSSIAN);
+    for &(s, a, deg) in &SHAPES {
+        let fp = footprint(s, a, deg);
+        let table = ViewTable::<129>::build(&fp, &generic, Lookup::Bilinear, Lookup::Bilinear);
+        let Some(len) = stencil::len_for(&fp, DEFAULT_PHASES) else {
+            continue;
+        };
+        let mut plain = vec![0.0f32; len];
+        Stencils::build(&table, DEFAULT_PHASES, &mut plain).unwrap();
+        let mut reversed = vec![f32::NAN; len];
+        Stencils::build_split(&table, DEFAULT_PHASES, &mut reversed, |w, fill| {
+            let cells = fill.cells();
+            for (k, st) in w.chunks_exact_mut(cells).enumerate().rev() {
+                fill.fill(k, st);
+            }
+        })
+        .unwrap();
+        let mut threaded = vec![f32::NAN; len];
+        Stencils::build_split(&table, DEFAULT_PHASES, &mut threaded, |w, fill| {
+            let cells = fill.cells();
+            let cut = (w.len() / cells / 3) * cells;
+            let (x, y) = w.split_at_mut(cut);
+            std::thread::scope(|scope| {
+                scope.spawn(|| {
+                    for (k, st) in x.chunks_exact_mut(cells).enumerate() {
+                        fill.fill(k, st);
+                    }
+                });
+                scope.spawn(|| {
+                    for (k, st) in y.chunks_exact_mut(cells).enumerate() {
+                        fill.fill(cut / cells + k, st);
+                    }
+                });
+            });
+        })
+        .unwrap();
+        let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&plain), bits(&reversed), "scale {s}, {a}:1 at {deg}°");
+        assert_eq!(bits(&plain), bits(&threaded), "scale {s}, {a}:1 at {deg}°");
+    }
+}

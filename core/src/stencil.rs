@@ -251,6 +251,55 @@ pub struct Stencils<'a, S: ?Sized> {
     phases: usize,
 }
 
+/// Samples single stencils of a view's phase stencils for [`Stencils::build_split`].
+#[derive(Debug)]
+pub struct StencilFill<'a, S: ?Sized> {
+    sampler: &'a S,
+    side: usize,
+    phases: usize,
+    reach: i64,
+}
+
+impl<S: Sampler + ?Sized> StencilFill<'_, S> {
+    /// Weights per stencil, B².
+    pub fn cells(&self) -> usize {
+        self.side * self.side
+    }
+
+    /// Fills stencil `k` (phase (k mod (P + 1), k div (P + 1)) on the (P + 1)² grid; `stencil`
+    /// holds [`StencilFill::cells`] weights): the sampler's weight (px⁻²) at each box pixel inside
+    /// the support, zero outside, divided by the sum for a renormalised footprint.
+    pub fn fill(&self, k: usize, stencil: &mut [f32]) {
+        let (sampler, side, phases, reach) = (self.sampler, self.side, self.phases, self.reach);
+        let fp = sampler.footprint();
+        let (pa, pb) = (k % (phases + 1), k / (phases + 1));
+        let phase = [pa as f32 / phases as f32, pb as f32 / phases as f32];
+        let mut sum = 0.0f32;
+        for (my, row) in stencil.chunks_exact_mut(side).enumerate() {
+            let qy = (my as i64 - reach) as f32 + 0.5 - phase[1];
+            for (mx, w) in row.iter_mut().enumerate() {
+                let q = [(mx as i64 - reach) as f32 + 0.5 - phase[0], qy];
+                *w = if fp.contains(q) {
+                    sampler.weight(q)
+                } else {
+                    0.0
+                };
+                sum += *w;
+            }
+        }
+        if fp.renormalise {
+            if sum > 0.0 {
+                let inv = 1.0 / sum;
+                stencil.iter_mut().for_each(|w| *w *= inv);
+            } else {
+                // No pixel centre saw the footprint: the whole voxel goes to its own pixel.
+                stencil.fill(0.0);
+                stencil[reach as usize * side + reach as usize] = 1.0;
+            }
+        }
+    }
+}
+
 impl<S: ?Sized> Clone for Stencils<'_, S> {
     fn clone(&self) -> Self {
         *self
@@ -266,6 +315,24 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
         sampler: &'a S,
         max_phases: usize,
         buffer: &'a mut [f32],
+    ) -> Result<Self, BufferError> {
+        Self::build_split(sampler, max_phases, buffer, |weights, fill| {
+            for (k, stencil) in weights.chunks_exact_mut(fill.cells()).enumerate() {
+                fill.fill(k, stencil);
+            }
+        })
+    }
+
+    /// [`Stencils::build`], with the sampling of the stencils (nearly all of the work) handed
+    /// to `run(weights, fill)`, which must call `fill.fill(k, stencil)` for every stencil k of
+    /// `weights.chunks_exact_mut(fill.cells())`, in any order and on any threads (each stencil
+    /// depends on nothing else): a caller with threads splits them, and the stencils are the
+    /// same bits however it does. A stencil `run` skips keeps whatever `buffer` held.
+    pub fn build_split(
+        sampler: &'a S,
+        max_phases: usize,
+        buffer: &'a mut [f32],
+        run: impl FnOnce(&mut [f32], &StencilFill<'_, S>),
     ) -> Result<Self, BufferError> {
         let fp = sampler.footprint();
         let Some(plan) = plan_for(fp, max_phases) else {
@@ -287,33 +354,15 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
         let cells = side * side;
         let ranges = (phases + 1) * (phases + 1) * cells;
         let (weights, spans) = buffer[..len].split_at_mut(ranges);
-        for (k, stencil) in weights.chunks_exact_mut(cells).enumerate() {
-            let (pa, pb) = (k % (phases + 1), k / (phases + 1));
-            let phase = [pa as f32 / phases as f32, pb as f32 / phases as f32];
-            let mut sum = 0.0f32;
-            for (my, row) in stencil.chunks_exact_mut(side).enumerate() {
-                let qy = (my as i64 - reach) as f32 + 0.5 - phase[1];
-                for (mx, w) in row.iter_mut().enumerate() {
-                    let q = [(mx as i64 - reach) as f32 + 0.5 - phase[0], qy];
-                    *w = if fp.contains(q) {
-                        sampler.weight(q)
-                    } else {
-                        0.0
-                    };
-                    sum += *w;
-                }
-            }
-            if fp.renormalise {
-                if sum > 0.0 {
-                    let inv = 1.0 / sum;
-                    stencil.iter_mut().for_each(|w| *w *= inv);
-                } else {
-                    // No pixel centre saw the footprint: the whole voxel goes to its own pixel.
-                    stencil.fill(0.0);
-                    stencil[reach as usize * side + reach as usize] = 1.0;
-                }
-            }
-        }
+        run(
+            weights,
+            &StencilFill {
+                sampler,
+                side,
+                phases,
+                reach,
+            },
+        );
         // Per phase cell and box row: the first and last pixel where one of the cell's four
         // corner stencils is non-zero (narrow footprints: the pixels a splat visits), or where
         // all four are (wide ones: the pixels it blends); first > last when there are none.

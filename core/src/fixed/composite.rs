@@ -43,7 +43,7 @@ pub fn over(front: [u32; 4], back: [u32; 4]) -> [u32; 4] {
 /// *over* the image back to front, *under* it front to back.
 ///
 /// Written without branches per pixel (the order and the fraction bits are settled per row, the
-/// rounding and saturation are arithmetic; see [`resolve_fast`] and [`over_fast`]), so the loop
+/// rounding and saturation are arithmetic; see `resolve_fast` and `over_fast`), so the loop
 /// vectorises: the same bits as [`resolve`] and [`over`] (a unit test checks them against each
 /// other).
 #[inline(never)]

@@ -26,7 +26,7 @@
 
 use super::load::Voxels;
 use super::prepare::Prepared;
-use super::run::stencil_len;
+use super::run::{build_stencils, stencil_len};
 use super::sampling::{mix, Estimate};
 use super::supersample::downsample;
 use crate::args::RenderArgs;
@@ -38,7 +38,6 @@ use footprint::render::{FloatPath, RenderBuffers, SheetRenderer, SheetRing};
 use footprint::shade::{Sample, OPACITY_TABLE_LEN};
 use footprint::source::{render_all_from, SheetSource};
 use footprint::splat::Splatter;
-use footprint::stencil::Stencils;
 use footprint::{Lookup, ViewTable};
 use std::time::Instant;
 
@@ -131,7 +130,7 @@ pub fn render_rows(
         let bands = match len {
             Some(len) => {
                 let mut buffer = vec![0.0f32; len];
-                let stencils = Stencils::build(&*table, args.phases, &mut buffer)?;
+                let stencils = build_stencils(&*table, args.phases, &mut buffer, threads)?;
                 split_rows(p, &stencils, volume, rows, threads)?
             }
             None => split_rows(p, &*table, volume, rows, threads)?,

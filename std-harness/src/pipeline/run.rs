@@ -95,7 +95,7 @@ pub fn render_frame(
                 let r = if let Some(len) = stencil_len(p, args) {
                     // Footprints up to 128 px across: the view table sampled once per phase.
                     let mut buffer = vec![0.0f32; len];
-                    let stencils = Stencils::build(&*table, args.phases, &mut buffer)?;
+                    let stencils = build_stencils(&*table, args.phases, &mut buffer, threads)?;
                     let tables = start.elapsed().as_secs_f64();
                     let path = FloatPath { sampler: &stencils };
                     let r = run_path(p, path, p.background.as_deref(), cache, threads)?;
@@ -159,6 +159,30 @@ pub fn render_frame(
             refine: None,
             visible,
         }
+    })
+}
+
+/// The float path's phase stencils of `sampler` (at most `phases` per pixel) in `buffer`,
+/// sampled on `threads` threads, whole stencils each: the same bits for any number.
+pub fn build_stencils<'a, S: footprint::Sampler + Sync + ?Sized>(
+    sampler: &'a S,
+    phases: usize,
+    buffer: &'a mut [f32],
+    threads: usize,
+) -> Result<Stencils<'a, S>, footprint::splat::BufferError> {
+    Stencils::build_split(sampler, phases, buffer, |weights, fill| {
+        let cells = fill.cells();
+        let count = weights.len() / cells.max(1);
+        let per = count.div_ceil(threads.clamp(1, count.max(1))).max(1);
+        std::thread::scope(|scope| {
+            for (t, chunk) in weights.chunks_mut(per * cells).enumerate() {
+                scope.spawn(move || {
+                    for (i, stencil) in chunk.chunks_exact_mut(cells).enumerate() {
+                        fill.fill(t * per + i, stencil);
+                    }
+                });
+            }
+        });
     })
 }
 
