@@ -5,7 +5,8 @@ use footprint::composite::RowSpan;
 use footprint::frame::{FrameSetup, Order};
 use footprint::geometry::FootprintOptions;
 use footprint::render::{
-    gradient, RenderBuffers, RenderError, RenderStats, SheetRenderer, SheetRing, SheetWindow,
+    gradient, RenderBuffers, RenderError, RenderStats, ShadeCacheEntry, SheetRenderer, SheetRing,
+    SheetWindow, SHADE_CACHE_LEN,
 };
 use footprint::shade::{Phong, Shader, Shading, TransferFunction};
 use footprint::{GenericTable, Grid, Kernel, Lookup, View, ViewTable};
@@ -89,6 +90,22 @@ fn render(
     lut: &[[f32; 4]],
     bg: Option<&[[f32; 4]]>,
 ) -> Out {
+    render_cached(scene, view, size, shading, order, lut, bg, None)
+}
+
+/// [`render`], remembering shaded values in `cache` when given
+/// (`SheetRenderer::with_shade_cache`).
+#[allow(clippy::too_many_arguments)]
+fn render_cached(
+    scene: &Scene,
+    view: Mat3,
+    size: usize,
+    shading: Shading,
+    order: Order,
+    lut: &[[f32; 4]],
+    bg: Option<&[[f32; 4]]>,
+    cache: Option<&mut [ShadeCacheEntry]>,
+) -> Out {
     let kernel = Kernel::PAPER_GAUSSIAN;
     let grid = Grid::from_spacing(scene.spacing).unwrap();
     let frame = FrameSetup::new(
@@ -127,6 +144,9 @@ fn render(
         rows: &mut rows,
     };
     let mut r = SheetRenderer::new(&frame, &table, shader, order, buffers, bg).unwrap();
+    if let Some(c) = cache {
+        r = r.with_shade_cache(c);
+    }
     let mut storage = vec![0.0f32; 3 * frame.sheet_shape().0];
     let mut ring = SheetRing::new(&mut storage, &frame, order).unwrap();
     let mut tmp = vec![0.0f32; frame.sheet_shape().0];
@@ -549,4 +569,51 @@ fn pre_shaded_sheets_match_classified_sheets() {
         1e-6,
         "pre-shaded vs classified",
     );
+}
+
+/// Emission shading remembered per sample value (`SheetRenderer::with_shade_cache`) gives the
+/// same image bit for bit: on a volume of few distinct values (where it hits) and of many, with a
+/// full-size memo and with memos so small that every value collides; other shadings ignore it.
+#[test]
+fn the_shade_cache_changes_no_bit() {
+    let smooth = blob([13, 11, 9], [1.0, 1.2, 0.8]);
+    let mut few = blob([13, 11, 9], [1.0, 1.2, 0.8]);
+    few.data
+        .iter_mut()
+        .for_each(|v| *v = (*v * 16.0).round() / 16.0);
+    let lut = ramp(0.7);
+    let bits = |o: &Out| {
+        o.image
+            .iter()
+            .flat_map(|p| p.map(f32::to_bits))
+            .collect::<Vec<_>>()
+    };
+    for scene in [&smooth, &few] {
+        for shading in [Shading::Emission, Shading::Phong(Phong::default())] {
+            let plain = render(
+                scene,
+                oblique(3.0),
+                48,
+                shading,
+                Order::FrontToBack,
+                &lut,
+                None,
+            );
+            assert!(plain.stats.voxels_splatted > 100);
+            for len in [SHADE_CACHE_LEN, 3, 1] {
+                let mut cache = vec![ShadeCacheEntry::default(); len];
+                let cached = render_cached(
+                    scene,
+                    oblique(3.0),
+                    48,
+                    shading,
+                    Order::FrontToBack,
+                    &lut,
+                    None,
+                    Some(&mut cache),
+                );
+                assert_eq!(bits(&plain), bits(&cached), "{shading:?}, {len} entries");
+            }
+        }
+    }
 }

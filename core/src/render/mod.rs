@@ -21,18 +21,22 @@
 //! [`crate::fixed`]). One build holds both, so they can be compared on the same frame.
 
 mod band;
+mod error;
 mod perspective;
 mod precision;
 mod refined;
 mod scaled;
+mod shade_cache;
 mod sheets;
 pub mod slabs;
 mod visible;
 
+pub use error::RenderError;
 pub use perspective::PerspectivePath;
 pub use precision::{FixedPath, FloatPath, Precision};
 pub use refined::{key_spacings, rate_index, spacing_key, RefineTables, RefinedGrid, SPACING_KEYS};
 pub use scaled::{sheet_map, splat_scaled, ScaledFootprint};
+pub use shade_cache::{ShadeCacheEntry, SHADE_CACHE_LEN};
 pub use sheets::{gradient, SheetRing, SheetWindow};
 pub use slabs::{SlabBuffers, SlabError, SlabRenderer, SlabSetup, SlabVoxel};
 pub use visible::{classify_sheet, VisibleSheet, VisibleVoxel};
@@ -42,130 +46,7 @@ use crate::frame::{FrameSetup, Order};
 use crate::shade::{Lighting, OpacityTable, Sample, Shader};
 use crate::splat::{BufferError, ImageMut, Splatter};
 use band::{check_band, start_image, BandReach};
-use core::fmt;
-
-/// Why a render step was refused.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[non_exhaustive]
-pub enum RenderError {
-    /// A caller buffer has the wrong size.
-    Buffer(BufferError),
-    /// A sheet holds the wrong number of samples.
-    SheetLength {
-        /// Samples expected (`dims[a] × dims[b]`).
-        expected: usize,
-        /// Samples given.
-        got: usize,
-    },
-    /// A sheet index beyond the volume.
-    SheetIndex {
-        /// Index given.
-        index: usize,
-        /// Number of sheets.
-        count: usize,
-    },
-    /// More sheets pushed into a [`SheetRing`] than the volume has.
-    TooManySheets,
-    /// [`SheetRing::finish`] before every sheet of the frame was pushed.
-    MissingSheets {
-        /// Sheets pushed.
-        delivered: usize,
-        /// Sheets the frame has.
-        expected: usize,
-    },
-    /// A band of rows that is not inside the image.
-    Band {
-        /// First row asked for.
-        start: usize,
-        /// One past the last row asked for.
-        end: usize,
-        /// Image height, rows.
-        height: usize,
-    },
-    /// A transfer function that cannot classify.
-    TransferFunction(crate::shade::TransferFunctionError),
-    /// A perspective frame given to a precision that splats with one footprint per view
-    /// ([`FloatPath`], [`FixedPath`]): use [`PerspectivePath`].
-    Projection,
-    /// A voxel's own footprint (perspective) could not be built.
-    Geometry(crate::geometry::GeometryError),
-    /// A voxel given to a [`SlabRenderer`] overlaps a slab already composited (voxels must come
-    /// in the order of the slab they reach first).
-    SlabOrder {
-        /// The voxel's first slab.
-        first: usize,
-        /// Its last slab.
-        last: usize,
-        /// Slabs composited so far.
-        composited: usize,
-    },
-    /// A voxel above the channel bound a [`FixedPath`] was promised
-    /// ([`FixedPath::with_value_bound`]).
-    ValueAboveBound {
-        /// The channel value (Q24).
-        value: u32,
-        /// The bound.
-        bound: u32,
-    },
-}
-
-impl fmt::Display for RenderError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Self::Buffer(e) => e.fmt(f),
-            Self::SheetLength { expected, got } => {
-                write!(f, "sheet has {got} samples, expected {expected}")
-            }
-            Self::SheetIndex { index, count } => write!(f, "sheet {index} is outside 0..{count}"),
-            Self::TooManySheets => f.write_str("more sheets than the volume has"),
-            Self::MissingSheets {
-                delivered,
-                expected,
-            } => write!(
-                f,
-                "the frame ended after {delivered} of its {expected} sheets were delivered"
-            ),
-            Self::Band { start, end, height } => {
-                write!(
-                    f,
-                    "band of rows {start}..{end} is not inside an image {height} rows high"
-                )
-            }
-            Self::TransferFunction(e) => e.fmt(f),
-            Self::Projection => f.write_str(
-                "a perspective frame needs per-voxel footprints (PerspectivePath); this path has one footprint per view",
-            ),
-            Self::Geometry(e) => write!(f, "a voxel's footprint: {e}"),
-            Self::SlabOrder {
-                first,
-                last,
-                composited,
-            } => write!(
-                f,
-                "a voxel overlapping slabs {first}..={last} came after {composited} slabs were \
-                 composited: feed voxels in the order of the slab they reach first"
-            ),
-            Self::ValueAboveBound { value, bound } => write!(
-                f,
-                "a voxel channel of {value} (Q24) is above the bound {bound} the fixed path was given"
-            ),
-        }
-    }
-}
-
-impl core::error::Error for RenderError {}
-
-impl From<crate::shade::TransferFunctionError> for RenderError {
-    fn from(e: crate::shade::TransferFunctionError) -> Self {
-        RenderError::TransferFunction(e)
-    }
-}
-
-impl From<BufferError> for RenderError {
-    fn from(e: BufferError) -> Self {
-        RenderError::Buffer(e)
-    }
-}
+use shade_cache::ShadeCache;
 
 /// The caller-owned buffers of a render, each [`FrameSetup::image_len`] long except `rows`
 /// (one per image row). `A` and `P` are the [`Precision`]'s accumulator and image pixels:
@@ -210,6 +91,7 @@ pub struct SheetRenderer<'a, P: Precision> {
     shader: Shader<'a>,
     lighting: Lighting,
     opacity: Option<OpacityTable<'a>>,
+    cache: Option<ShadeCache<'a>>,
     order: Order,
     /// First image row of the band and its number of rows.
     band: (usize, usize),
@@ -297,6 +179,7 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
             shader,
             lighting: Lighting::new(frame),
             opacity: None,
+            cache: None,
             order,
             band: (rows.start, band_rows),
             buffers,
@@ -314,6 +197,15 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
     pub fn with_opacity_table(mut self, buffer: &'a mut [f32]) -> Result<Self, RenderError> {
         self.opacity = Some(OpacityTable::build(&self.lighting, buffer)?);
         Ok(self)
+    }
+
+    /// Remembers emission shading per sample value in `buffer` (see [`SHADE_CACHE_LEN`] and the
+    /// `shade_cache` module): the same image, shaded once per distinct value instead of once per
+    /// voxel. Ignored for other shadings. Call it after [`SheetRenderer::with_opacity_table`]
+    /// (the memo holds values shaded with the frame's opacity correction).
+    pub fn with_shade_cache(mut self, buffer: &'a mut [ShadeCacheEntry]) -> Self {
+        self.cache = ShadeCache::new(&self.shader, buffer);
+        self
     }
 
     /// The frame being rendered.
@@ -349,9 +241,12 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
             window.lower.map(<[T]>::len),
             window.upper.map(<[T]>::len),
         ];
-        let (path, opacity) = (&self.path, self.opacity);
+        let (path, opacity, cache) = (&self.path, self.opacity, &mut self.cache);
         let shade = |u: usize, v: usize| {
             let sample = window.current[v * na + u];
+            if let (Some(c), None) = (cache.as_mut(), sample.colour()) {
+                return path.value(c.shade(&shader, &lighting, opacity.as_ref(), sample.to_f32()));
+            }
             path.value(shader.shade_coloured(
                 &lighting,
                 opacity.as_ref(),
@@ -432,15 +327,19 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
                     glam::Vec3::ZERO
                 }
             };
-            let value = self.path.value(shader.shade_coloured(
-                &lighting,
-                opacity.as_ref(),
-                vox.value,
-                visible.colours.get(k).copied(),
-                g,
-                f.grid_index(index, u, v),
-                f.dims,
-            ));
+            let colour = visible.colours.get(k).copied();
+            let value = self.path.value(match (&mut self.cache, colour) {
+                (Some(c), None) => c.shade(&shader, &lighting, opacity.as_ref(), vox.value),
+                _ => shader.shade_coloured(
+                    &lighting,
+                    opacity.as_ref(),
+                    vox.value,
+                    colour,
+                    g,
+                    f.grid_index(index, u, v),
+                    f.dims,
+                ),
+            });
             self.stats.voxels += 1;
             if P::is_transparent(&value) {
                 continue;

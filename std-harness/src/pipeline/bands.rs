@@ -7,7 +7,9 @@ use super::prepare::Prepared;
 use super::visible::VisibleLists;
 use crate::CliError;
 use footprint::composite::RowSpan;
-use footprint::render::{Precision, RenderBuffers, RenderStats, SheetRenderer};
+use footprint::render::{
+    Precision, RenderBuffers, RenderStats, ShadeCacheEntry, SheetRenderer, SHADE_CACHE_LEN,
+};
 use footprint::shade::OPACITY_TABLE_LEN;
 use std::time::Instant;
 
@@ -232,6 +234,7 @@ fn render_band<P: Precision>(
     let mut acc = crate::io::try_filled(n, P::ACC_ZERO, "a band's sheet accumulator")?;
     let mut spans = vec![RowSpan::EMPTY; rows.len()];
     let mut opacity = vec![0.0f32; OPACITY_TABLE_LEN];
+    let mut shades = vec![ShadeCacheEntry::default(); SHADE_CACHE_LEN];
     let buffers = RenderBuffers {
         accumulator: &mut acc,
         image,
@@ -239,7 +242,8 @@ fn render_band<P: Precision>(
     };
     let mut renderer =
         SheetRenderer::with_band(f, path, p.shader(), p.order, buffers, background, rows)?
-            .with_opacity_table(&mut opacity)?;
+            .with_opacity_table(&mut opacity)?
+            .with_shade_cache(&mut shades);
     let mut phases = Phases::default();
     for k in 0..f.sheet_count() {
         let s = f.sheet_at(p.order, k);

@@ -22,8 +22,8 @@ use crate::{with_table_size, CliError};
 use footprint::fixed::stencil::FixedStencils;
 use footprint::fixed::{self, FixedTable};
 use footprint::render::{
-    FixedPath, FloatPath, PerspectivePath, Precision, RenderBuffers, RenderStats, SheetRenderer,
-    SheetRing,
+    FixedPath, FloatPath, PerspectivePath, Precision, RenderBuffers, RenderStats, ShadeCacheEntry,
+    SheetRenderer, SheetRing, SHADE_CACHE_LEN,
 };
 use footprint::shade::{Sample, OPACITY_TABLE_LEN};
 use footprint::source::{render_from, SheetSource};
@@ -279,8 +279,10 @@ fn run_sheets<P: Precision>(
         rows: &mut rows,
     };
     let mut opacity = vec![0.0f32; OPACITY_TABLE_LEN];
+    let mut shades = vec![ShadeCacheEntry::default(); SHADE_CACHE_LEN];
     let mut renderer = SheetRenderer::with_path(f, path, p.shader(), p.order, buffers, background)?
-        .with_opacity_table(&mut opacity)?;
+        .with_opacity_table(&mut opacity)?
+        .with_shade_cache(&mut shades);
     let mut show = Progress {
         inner: sheets("render"),
         count: f.sheet_count(),
