@@ -75,7 +75,7 @@ fn stencils_cover_every_size_and_skip_only_zeros() {
         let st = Stencils::build(&table, DEFAULT_PHASES, &mut buffer).unwrap();
         let r = minor_semi_axis(&fp);
         let p = st.phases();
-        let wide = stencil::is_wide(&fp, DEFAULT_PHASES);
+        let wide = stencil::plan_for(&fp, DEFAULT_PHASES).unwrap().edged;
         let reach = if wide { PHASE_REACH } else { BLEND_REACH };
         assert!(
             p == DEFAULT_PHASES || p as f32 * r >= reach,

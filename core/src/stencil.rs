@@ -167,12 +167,6 @@ pub fn edged_phases_for(footprint: &Footprint, max_phases: usize) -> usize {
     }
 }
 
-/// Whether `footprint` is splatted with its edge read from the sampler ([`Plan::edged`]); true
-/// also when no stencils fit.
-pub fn is_wide(footprint: &Footprint, max_phases: usize) -> bool {
-    plan_for(footprint, max_phases).is_none_or(|p| p.edged)
-}
-
 /// Largest box side (pixels) stencils are built for (half-extent up to 63.5 px); wider
 /// footprints use the table walk, whose per-row cost they amortise.
 pub const MAX_STENCIL_SIDE: usize = 129;
@@ -364,8 +358,8 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
             },
         );
         // Per phase cell and box row: the first and last pixel where one of the cell's four
-        // corner stencils is non-zero (narrow footprints: the pixels a splat visits), or where
-        // all four are (wide ones: the pixels it blends); first > last when there are none.
+        // corner stencils is non-zero (blended footprints: the pixels a splat visits), or where
+        // all four are (edged ones: the pixels it blends); first > last when there are none.
         let wide = plan.edged;
         let weights = &*weights;
         let nonzero = |stencil: usize, my: usize| {

@@ -244,17 +244,22 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
         let (path, opacity, cache) = (&self.path, self.opacity, &mut self.cache);
         let shade = |u: usize, v: usize| {
             let sample = window.current[v * na + u];
-            if let (Some(c), None) = (cache.as_mut(), sample.colour()) {
-                return path.value(c.shade(&shader, &lighting, opacity.as_ref(), sample.to_f32()));
-            }
-            path.value(shader.shade_coloured(
-                &lighting,
-                opacity.as_ref(),
-                sample.to_f32(),
-                sample.colour(),
-                || gradient(f, &window, u, v),
-                f.grid_index(index, u, v),
-                f.dims,
+            let (value, colour) = (sample.to_f32(), sample.colour());
+            path.value(ShadeCache::shade(
+                cache.as_mut(),
+                value,
+                colour.is_some(),
+                || {
+                    shader.shade_coloured(
+                        &lighting,
+                        opacity.as_ref(),
+                        value,
+                        colour,
+                        || gradient(f, &window, u, v),
+                        f.grid_index(index, u, v),
+                        f.dims,
+                    )
+                },
             ))
         };
         Self::splat_sheet(
@@ -328,18 +333,23 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
                 }
             };
             let colour = visible.colours.get(k).copied();
-            let value = self.path.value(match (&mut self.cache, colour) {
-                (Some(c), None) => c.shade(&shader, &lighting, opacity.as_ref(), vox.value),
-                _ => shader.shade_coloured(
-                    &lighting,
-                    opacity.as_ref(),
-                    vox.value,
-                    colour,
-                    g,
-                    f.grid_index(index, u, v),
-                    f.dims,
-                ),
-            });
+            let cache = self.cache.as_mut();
+            let value = self.path.value(ShadeCache::shade(
+                cache,
+                vox.value,
+                colour.is_some(),
+                || {
+                    shader.shade_coloured(
+                        &lighting,
+                        opacity.as_ref(),
+                        vox.value,
+                        colour,
+                        g,
+                        f.grid_index(index, u, v),
+                        f.dims,
+                    )
+                },
+            ));
             self.stats.voxels += 1;
             if P::is_transparent(&value) {
                 continue;

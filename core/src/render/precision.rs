@@ -150,8 +150,9 @@ pub struct FixedPath<'a, const M: usize> {
     place: Placement,
     /// The caller's bound on voxel channel values ([`FixedPath::with_value_bound`]).
     value_bound: Option<u32>,
-    /// Whether the stencils may add without saturating (the bound keeps every sum in range).
-    unsaturated: bool,
+    /// That bound, when it lets the stencils add without saturating (it keeps every sum in
+    /// range); `None` otherwise.
+    unsaturated_below: Option<u32>,
 }
 
 impl<'a, const M: usize> FixedPath<'a, M> {
@@ -168,7 +169,7 @@ impl<'a, const M: usize> FixedPath<'a, M> {
             stencils: None,
             place: Placement::new(frame)?,
             value_bound: None,
-            unsaturated: false,
+            unsaturated_below: None,
         })
     }
 
@@ -185,15 +186,16 @@ impl<'a, const M: usize> FixedPath<'a, M> {
 
     /// Whether the stencils add without saturating (see [`FixedPath::with_value_bound`]).
     pub fn unsaturated(&self) -> bool {
-        self.unsaturated
+        self.unsaturated_below.is_some()
     }
 
     fn settle(&mut self) {
         let (a, b) = (self.place.along_a, self.place.along_b);
-        self.unsaturated = match (&self.stencils, self.value_bound) {
-            (Some(s), Some(bound)) => s.exact_below(a, b).is_some_and(|m| u64::from(bound) <= m),
-            _ => false,
-        };
+        self.unsaturated_below = self.value_bound.filter(|&bound| {
+            self.stencils
+                .and_then(|s| s.exact_below(a, b))
+                .is_some_and(|m| u64::from(bound) <= m)
+        });
     }
 
     /// Splats through `stencils` (built from this path's table: [`FixedStencils::build`])
@@ -236,16 +238,15 @@ impl<const M: usize> Precision for FixedPath<'_, M> {
     ) -> Result<SplatStats, RenderError> {
         let mut center = self.place.at(sheet, u, v);
         center[1] -= (row0 as i64) << fixed::POS_FRAC;
-        Ok(match &self.stencils {
-            Some(s) if self.unsaturated => {
-                let bound = self.value_bound.unwrap_or(0);
+        Ok(match (&self.stencils, self.unsaturated_below) {
+            (Some(s), Some(bound)) => {
                 if let Some(&c) = value.iter().find(|&&c| c > bound) {
                     return Err(RenderError::ValueAboveBound { value: c, bound });
                 }
                 s.splat_unsaturated(center, value, acc, touched)
             }
-            Some(s) => s.splat(center, value, acc, touched),
-            None => fixed::splat::splat(self.table, center, value, acc, touched),
+            (Some(s), None) => s.splat(center, value, acc, touched),
+            (None, _) => fixed::splat::splat(self.table, center, value, acc, touched),
         })
     }
 

@@ -8,7 +8,7 @@
 //! same, bit for bit, with or without it. Float data with many distinct values mostly misses,
 //! at the cost of a hash and a compare per voxel.
 
-use crate::shade::{Lighting, OpacityTable, Shader, Shading};
+use crate::shade::{Shader, Shading};
 
 /// Entries a shade cache buffer should hold (a power of two; 4096 × 24 bytes = 96 KiB).
 pub const SHADE_CACHE_LEN: usize = 4096;
@@ -43,32 +43,27 @@ impl<'a> ShadeCache<'a> {
         })
     }
 
-    /// The shaded RGBA of a voxel of `value` without a colour of its own: from the memo, or
-    /// shaded now (and remembered).
+    /// The shaded RGBA of a voxel of `value`: remembered when it has no colour of its own (its
+    /// shade then depends on the value alone), else, or on a miss, `shade()` (which must be the
+    /// shader's result for this voxel).
     #[inline]
     pub(super) fn shade(
-        &mut self,
-        shader: &Shader<'_>,
-        lighting: &Lighting,
-        opacity: Option<&OpacityTable<'_>>,
+        cache: Option<&mut Self>,
         value: f32,
+        coloured: bool,
+        shade: impl FnOnce() -> [f32; 4],
     ) -> [f32; 4] {
+        let Some(cache) = cache.filter(|_| !coloured) else {
+            return shade();
+        };
         let key = value.to_bits();
         // Fibonacci hashing: the top bits of key × ⌊2³²/φ⌋.
-        let slot = (key.wrapping_mul(0x9E37_79B9) >> 20) as usize & self.mask;
-        let e = &mut self.entries[slot];
+        let slot = (key.wrapping_mul(0x9E37_79B9) >> 20) as usize & cache.mask;
+        let e = &mut cache.entries[slot];
         if e.tag && e.key == key {
             return e.rgba;
         }
-        let rgba = shader.shade_coloured(
-            lighting,
-            opacity,
-            value,
-            None,
-            || glam::Vec3::ZERO,
-            [0; 3],
-            [1; 3],
-        );
+        let rgba = shade();
         *e = ShadeCacheEntry {
             key,
             tag: true,

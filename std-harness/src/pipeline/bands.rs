@@ -108,18 +108,18 @@ pub fn balanced_rows(
     if bands == 1 || f.camera().is_some() || lists.run_offsets.len() < 2 {
         return equal();
     }
-    let cols = f.grid_to_screen;
-    let (ya, yb) = (cols.col(f.in_sheet.0).y, cols.col(f.in_sheet.1).y);
-    let ys = cols.col(f.sheet_axis).y;
+    let y_of = |s: usize, u: u16, v: u16| {
+        let index = f.grid_index(s, usize::from(u), usize::from(v));
+        f64::from(f.affine_position(index.map(|i| i as f32)).y)
+    };
     let [hx, hy] = f.footprint.half_extent.map(f64::from);
     let per_voxel = VOXEL_COST_PX + (std::f64::consts::PI * hx * hy).max(1.0);
     // Work density per row, as differences (added at a run's first row, taken off past its last).
     let mut diff = vec![0.0f64; h + 1];
     for (s, w) in lists.run_offsets.windows(2).enumerate() {
         for run in &lists.runs[w[0]..w[1]] {
-            let c = f.origin.y + ys * s as f32 + yb * f32::from(run.v);
-            let (a, b) = (c + ya * f32::from(run.u0), c + ya * f32::from(run.u1));
-            let (lo, hi) = (f64::from(a.min(b)) - hy, f64::from(a.max(b)) + hy);
+            let (a, b) = (y_of(s, run.u0, run.v), y_of(s, run.u1, run.v));
+            let (lo, hi) = (a.min(b) - hy, a.max(b) + hy);
             if !(hi >= 0.0 && lo < h as f64) {
                 continue;
             }
