@@ -3,6 +3,7 @@
 //! object slicing when it suffices and image slicing when only slabs do.
 
 use footprint_harness::args::parse_args;
+use footprint_harness::args::QualityReferenceArg::Continuous;
 use footprint_harness::metrics::compare;
 use footprint_harness::pipeline::pilot::{choose_continuous, sample_pixels, PILOT_RAYS};
 use footprint_harness::pipeline::run::continuous_at;
@@ -61,10 +62,10 @@ fn actual_db(p: &Prepared, args: &footprint_harness::args::RenderArgs) -> f64 {
 #[test]
 fn the_choice_reaches_its_target_with_the_cheapest_slicing_that_does() {
     let (args, p) = heart(&[]);
-    let low = choose_continuous(&p, &args, 20.0).unwrap();
+    let low = choose_continuous(&p, &args, 20.0, Continuous).unwrap();
     assert_eq!(low.config.slab(), None, "20 dB: object slicing suffices");
     assert!(low.predicted_db >= 20.0);
-    let high = choose_continuous(&p, &args, 45.0).unwrap();
+    let high = choose_continuous(&p, &args, 45.0, Continuous).unwrap();
     assert!(high.config.slab().is_some(), "45 dB needs slabs");
     assert!(high.predicted_db >= 45.0, "{:?}", high.pilot);
     let pilot = high.pilot.as_ref().unwrap();
@@ -88,7 +89,7 @@ fn the_choice_reaches_its_target_with_the_cheapest_slicing_that_does() {
     }
     // --slicing image: only slab thicknesses are candidates.
     let (args, p) = heart(&["--slicing", "image"]);
-    let c = choose_continuous(&p, &args, 20.0).unwrap();
+    let c = choose_continuous(&p, &args, 20.0, Continuous).unwrap();
     assert!(c.config.slab().is_some());
 }
 
@@ -119,6 +120,6 @@ fn the_flags_are_checked() {
     );
     // A target that is not a PSNR.
     let (args, p) = heart(&[]);
-    assert!(choose_continuous(&p, &args, f64::NAN).is_err());
-    assert!(choose_continuous(&p, &args, -3.0).is_err());
+    assert!(choose_continuous(&p, &args, f64::NAN, Continuous).is_err());
+    assert!(choose_continuous(&p, &args, -3.0, Continuous).is_err());
 }

@@ -1,7 +1,8 @@
 //! Adaptive refinement (`--refine`, issue 15 part 2): the built-in scene's analytic field sampled
 //! at 16³ and refined comes ≥ 3 dB closer to the same field sampled at 128³ than unrefined; the
 //! threshold trades samples for accuracy; any thread count gives the same bytes; what refinement
-//! cannot do is refused with a reason.
+//! cannot do is refused with a reason; `--quality` chooses it against the finer sampling (issue
+//! 15 part 3).
 
 use footprint_harness::args::parse_args;
 use footprint_harness::metrics::compare;
@@ -130,17 +131,105 @@ fn what_refinement_cannot_do_is_refused() {
     assert!(e.contains("cannot be used with"), "{e}");
 }
 
+/// `verify` refuses `--refine` against the grid's own references (they render the grid as
+/// given) and measures it against the finer sampling (`--reference field`).
 #[test]
-fn verify_refuses_refinement() {
-    let code = footprint_harness::run(vec![
-        "footprint",
-        "verify",
+fn verify_measures_refinement_only_against_the_field() {
+    let run = |reference: &str| {
+        footprint_harness::run(vec![
+            "footprint",
+            "verify",
+            "--scene-size",
+            "16",
+            "--size",
+            "32x32",
+            "--refine",
+            "0.1",
+            "--reference",
+            reference,
+        ])
+    };
+    assert_ne!(run("sheets"), 0, "verify --refine must be refused");
+    assert_ne!(run("continuous"), 0, "verify --refine must be refused");
+    assert_eq!(
+        run("field"),
+        0,
+        "verify --refine --reference field measures it"
+    );
+}
+
+/// `--quality DB --quality-reference field` (issue 15 part 3): where the unrefined grid cannot
+/// reach DB against the finer sampling and refinement can, the pilot chooses `--refine 0`, and
+/// the whole image reaches DB; where refinement can add nothing (steps under 2 × MIN_STEP_PX)
+/// it is not tried; a volume file has no field reference.
+#[test]
+fn quality_chooses_refinement_against_the_field() {
+    use footprint_harness::args::QualityReferenceArg::Field;
+    use footprint_harness::pipeline::field::prepare_field;
+    use footprint_harness::pipeline::pilot::choose_continuous;
+    use footprint_harness::pipeline::render_continuous_ref;
+    use footprint_harness::reference::continuous::Reconstruction;
+    // 16³ at 256² zoomed 2×: steps of 19.7 px, as at 512² (measured: unrefined 26.0 dB against
+    // the 128³ field on the pilot, refined 30.6 dB; the target sits between them).
+    let common = [
         "--scene-size",
         "16",
         "--size",
-        "32x32",
-        "--refine",
-        "0.1",
-    ]);
-    assert_ne!(code, 0, "verify --refine must be refused");
+        "256x256",
+        "--zoom",
+        "2",
+        "--view",
+        "30,20,0",
+    ];
+    let args = parse_args(&common).unwrap();
+    let p = prepare(&args).unwrap();
+    let target = 28.0;
+    let c = choose_continuous(&p, &args, target, Field).unwrap();
+    let pilot = c.pilot.as_ref().unwrap();
+    assert!(c.config.refine, "chose {}", c.config.label());
+    assert!(
+        pilot.tried.iter().any(|(t, _)| !t.refine),
+        "unrefined tried first"
+    );
+    assert!(c.predicted_db >= target);
+    assert_eq!(pilot.field_size, Some(128));
+    let chosen = c.config.apply(&args);
+    let f = render_frame(&p, &chosen, chosen.accum, &mut FrameCache::default()).unwrap();
+    let (truth, _) =
+        render_continuous_ref(&prepare_field(&args).unwrap(), Reconstruction::Kernel).unwrap();
+    let got = compare(&f.image, &truth.image).1.psnr_db;
+    assert!(got >= target, "refined: {got:.2} dB against the field");
+    // Unzoomed at 256², steps of 9.9 px: refinement cannot split an interval, so it is not tried.
+    let args = parse_args(&[
+        "--scene-size",
+        "16",
+        "--size",
+        "256x256",
+        "--view",
+        "30,20,0",
+    ])
+    .unwrap();
+    let p = prepare(&args).unwrap();
+    let c = choose_continuous(&p, &args, 60.0, Field).unwrap();
+    assert!(c.pilot.unwrap().tried.iter().all(|(t, _)| !t.refine));
+    // The grid's own continuous integral is never measured against refinement.
+    let c = choose_continuous(
+        &p,
+        &args,
+        60.0,
+        footprint_harness::args::QualityReferenceArg::Continuous,
+    )
+    .unwrap();
+    assert!(c.pilot.unwrap().tried.iter().all(|(t, _)| !t.refine));
+    // A file holds nothing finer than its samples.
+    let file = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/heart_32x32x12_float32_le.nhdr"
+    );
+    let args = parse_args(&[file, "--size", "32x32"]).unwrap();
+    let e = prepare_field(&args).err().expect("refused").to_string();
+    assert!(e.contains("nothing finer"), "{e}");
+    let args = parse_args(&["--scene-size", "16", "--field-size", "16"]).unwrap();
+    let e = prepare_field(&args).err().expect("refused").to_string();
+    assert!(e.contains("must be finer"), "{e}");
 }

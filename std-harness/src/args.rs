@@ -72,6 +72,48 @@ pub enum QualityReferenceArg {
     /// The continuous volume-rendering integral (`verify`'s `--reference continuous`): the error
     /// a user sees, measured on a pilot of sampled rays; chooses the slicing and slab too.
     Continuous,
+    /// The built-in scene only: the continuous integral of its analytic field sampled
+    /// `--field-size` N³ over the same box (`verify`'s `--reference field`), the finer field a
+    /// coarse grid stands for; measured on a pilot like `continuous`, and chooses refinement
+    /// (`--refine 0`) too.
+    Field,
+}
+
+/// `verify --reference`: what the core's image is measured against.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ReferenceArg {
+    Sheets,
+    Continuous,
+    /// The built-in scene only: the continuous integral of its field sampled `--field-size` N³
+    /// (the finer field the grid stands for; the one reference `--refine` can approach).
+    Field,
+}
+
+impl ReferenceArg {
+    /// The name the command line and the JSON use.
+    pub fn name(self) -> &'static str {
+        match self {
+            ReferenceArg::Sheets => "sheets",
+            ReferenceArg::Continuous => "continuous",
+            ReferenceArg::Field => "field",
+        }
+    }
+}
+
+/// `--reconstruction`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ReconstructionArg {
+    Kernel,
+    Trilinear,
+}
+
+impl From<ReconstructionArg> for crate::reference::continuous::Reconstruction {
+    fn from(a: ReconstructionArg) -> Self {
+        match a {
+            ReconstructionArg::Kernel => Self::Kernel,
+            ReconstructionArg::Trilinear => Self::Trilinear,
+        }
+    }
 }
 
 impl SlicingArg {
@@ -306,6 +348,11 @@ pub struct RenderArgs {
     /// default; 16 and 128 are what the refinement chart compares).
     #[arg(long, value_name = "N", default_value_t = crate::scene::SIDE, value_parser = parse_scene_size)]
     pub scene_size: usize,
+    /// The built-in scene only: the finer sampling, N×N×N over the same box, whose continuous
+    /// integral `--quality-reference field` and `verify --reference field` measure against (it
+    /// must exceed --scene-size).
+    #[arg(long, value_name = "N", default_value_t = 128, value_parser = parse_scene_size)]
+    pub field_size: usize,
     /// Threads (bands of image rows) for the core's render; 0 = every core. The image is
     /// byte-identical for any number. A streamed volume renders on one thread.
     #[arg(long, default_value_t = 0)]
@@ -321,7 +368,10 @@ pub struct RenderArgs {
     /// resolution (the table's error predicted in milliseconds; a coarser level's measured on a
     /// pilot of rows, about one full-resolution frame), or `continuous`, the volume-rendering integral (the error a
     /// user sees; measured on a pilot of about 4096 sampled rays, which costs seconds, and may
-    /// choose image slicing; with --slicing image only slab thicknesses are considered).
+    /// choose image slicing; with --slicing image only slab thicknesses are considered), or
+    /// `field` (built-in scene only), the continuous integral of the same analytic field sampled
+    /// --field-size N³: measured like `continuous`, and the one reference that can choose
+    /// `--refine 0`.
     #[arg(long, value_enum, default_value_t = QualityReferenceArg::Sheets, requires = "quality")]
     pub quality_reference: QualityReferenceArg,
     /// Transfer function: a preset (grey, ct-bone-skin, density) or a file of `t r g b a` lines.

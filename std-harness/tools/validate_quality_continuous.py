@@ -1,12 +1,15 @@
 #!/usr/bin/env python3
-"""Validates `--quality DB --quality-reference continuous` against the full continuous reference.
+"""Validates `--quality DB --quality-reference continuous` (or `field`) against the full reference.
 
   validate_quality_continuous.py FOOTPRINT VOLUME... [--size 256x256] [--targets 40,50,60]
                                  [--views 0,0,0:30,20,0] [--shadings emission,phong]
+                                 [--reference continuous|field]
 
-For every volume, view, shading and target it runs
+A VOLUME `scene:N` is the built-in scene sampled N³ (`--scene-size N`); with `--reference field`
+(built-in scene only) the reference is the continuous integral of its field sampled 128³, and
+the pilot may choose refinement (`--refine 0`). For every volume, view, shading and target it runs
 
-  FOOTPRINT verify VOLUME --quality Q --quality-reference continuous --reference continuous
+  FOOTPRINT verify VOLUME --quality Q --quality-reference R --reference R
 
 which chooses a configuration on a pilot of sampled rays, renders it, and measures it against
 the continuous integral over the whole image. Then every candidate the pilot tried is verified
@@ -30,13 +33,22 @@ def flags(label):
     if parts[0] == "image":
         return ["--slicing", "image", "--slab", parts[1].split("=")[1]]
     method = "robust" if parts[2] == "view" else parts[2]
+    refine = ["--refine", parts[5].split("=")[1]] if len(parts) > 5 else []
     return ["--table", parts[0].split("=")[1], "--lookup", parts[1], "--method", method,
-            "--accum", parts[3]]
+            "--accum", parts[3]] + refine
 
 
-def verify(fp, volume, common, extra, tmp):
+def source(volume):
+    """The command-line arguments naming VOLUME (`scene:N`: the built-in scene at N³)."""
+    if volume.startswith("scene:"):
+        return ["--scene-size", volume.split(":")[1]]
+    return [volume]
+
+
+def verify(fp, volume, reference, common, extra, tmp):
     out = os.path.join(tmp, "v.json")
-    cmd = [fp, "verify", volume, "--reference", "continuous", "--json", out] + common + extra
+    cmd = ([fp, "verify"] + source(volume) + ["--reference", reference, "--json", out] + common
+           + extra)
     subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     with open(out) as f:
         return json.load(f)
@@ -57,6 +69,7 @@ def main():
     targets = [float(t) for t in option(args, "--targets", "40,50,60").split(",")]
     views = option(args, "--views", "0,0,0:30,20,0").split(":")
     shadings = option(args, "--shadings", "emission,phong").split(",")
+    reference = option(args, "--reference", "continuous")
     fp, volumes = args[0], args[1:]
     failed = False
     deviations = []
@@ -65,7 +78,7 @@ def main():
     print("|---|---|---|---|---|---|---|---|---|")
     with tempfile.TemporaryDirectory() as tmp:
         for volume in volumes:
-            name = os.path.basename(volume).split("_")[0]
+            name = volume if volume.startswith("scene:") else os.path.basename(volume).split("_")[0]
             for view in views:
                 for shading in shadings:
                     common = ["--size", size, "--view", view, "--shading", shading]
@@ -73,13 +86,13 @@ def main():
 
                     def measured(label):
                         if label not in actual:
-                            j = verify(fp, volume, common, flags(label), tmp)
+                            j = verify(fp, volume, reference, common, flags(label), tmp)
                             actual[label] = j["continuous"]["psnr_db"]
                         return actual[label]
 
                     for q in targets:
-                        j = verify(fp, volume, common, ["--quality", str(q),
-                                                        "--quality-reference", "continuous"], tmp)
+                        j = verify(fp, volume, reference, common,
+                                   ["--quality", str(q), "--quality-reference", reference], tmp)
                         quality = j["quality"]
                         chosen = quality["chosen"]
                         got = j["continuous"]["psnr_db"]

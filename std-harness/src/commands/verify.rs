@@ -4,12 +4,12 @@
 //! Colour space: the renderers' output, linear premultiplied RGBA in [0, 1], composited over the
 //! background (transparent black if none); the measures are [`crate::metrics`]'.
 
-use crate::args::{AccumArg, Lod, MethodArg, RenderArgs};
+use crate::args::{AccumArg, Lod, MethodArg, ReconstructionArg, ReferenceArg, RenderArgs};
 use crate::io::image::{check_style, encode_rgb_for, RGB_EXTENSIONS};
 use crate::io::json::Json;
 use crate::io::outputs::{self, Planned};
 use crate::metrics::compare;
-use crate::pipeline::{choose::apply_quality, quality::quality_json};
+use crate::pipeline::{choose::apply_quality, field::prepare_field, quality::quality_json};
 use crate::pipeline::{
     describe, prepare, render_continuous_ref, render_core, render_core_with, render_ref,
 };
@@ -23,7 +23,7 @@ pub struct VerifyArgs {
     #[command(flatten)]
     pub render: RenderArgs,
     /// Exit with code 1 if the PSNR is below this, dB: against the continuous integral with
-    /// `--reference continuous`; against full resolution (the f64 reference of level 0) when a
+    /// `--reference continuous` (of the finer sampling with `--reference field`); against full resolution (the f64 reference of level 0) when a
     /// coarser level was rendered; else the overall figure against the same sheets.
     #[arg(long)]
     pub min_psnr: Option<f64>,
@@ -35,37 +35,17 @@ pub struct VerifyArgs {
     /// shading and compositing with exact footprints: table and precision error only) or
     /// `continuous` (the emission–absorption integral of the field the voxels, kernel and
     /// transfer function define, ray-marched in f64 until converged; both figures are printed
-    /// and written, the continuous one under the JSON key `continuous`). `--min-psnr` applies
-    /// to the one chosen.
+    /// and written, the continuous one under the JSON key `continuous`), or `field` (the
+    /// built-in scene only: the same integral of its analytic field sampled --field-size N³ over
+    /// the same box, the finer field the grid stands for, under `continuous` with `field_size`;
+    /// the one reference `--refine` may be measured against). `--min-psnr` applies to the one
+    /// chosen.
     #[arg(long, value_enum, default_value_t = ReferenceArg::Sheets)]
     pub reference: ReferenceArg,
-    /// With `--reference continuous`: reconstruct the field with the kernel (Gaussian) or
+    /// With `--reference continuous` or `field`: reconstruct the field with the kernel (Gaussian) or
     /// trilinearly (as VTK's ray casters do).
     #[arg(long, value_enum, default_value_t = ReconstructionArg::Kernel)]
     pub reconstruction: ReconstructionArg,
-}
-
-/// `--reference`.
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ReferenceArg {
-    Sheets,
-    Continuous,
-}
-
-/// `--reconstruction`.
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ReconstructionArg {
-    Kernel,
-    Trilinear,
-}
-
-impl From<ReconstructionArg> for Reconstruction {
-    fn from(a: ReconstructionArg) -> Self {
-        match a {
-            ReconstructionArg::Kernel => Reconstruction::Kernel,
-            ReconstructionArg::Trilinear => Reconstruction::Trilinear,
-        }
-    }
 }
 
 pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
@@ -75,11 +55,12 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
             "verify compares a table method with the reference: choose robust, paper or direct",
         ));
     }
-    if r.refine.is_some() {
+    if r.refine.is_some() && args.reference != ReferenceArg::Field {
         return Err(CliError::input(
-            "verify's references render the grid as given, so they would measure --refine \
-             against the unrefined grid: chart refinement against a finer sampling with \
-             `footprint chart --refine-only` (the built-in scene)",
+            "verify's sheet and continuous references render the grid as given, so they would \
+             measure --refine against the unrefined grid: measure refinement against a finer \
+             sampling of the built-in scene with --reference field (or chart it with \
+             `footprint chart --refine-only`)",
         ));
     }
     let mut planned = Vec::new();
@@ -103,7 +84,7 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
     // The continuous reference integrates full resolution: `--lod auto` then renders level 0
     // (an explicit level is compared with it as asked, and refused by it).
     let full;
-    let r = if matches!(args.reference, ReferenceArg::Continuous) && r.lod == Lod::Auto {
+    let r = if args.reference != ReferenceArg::Sheets && r.lod == Lod::Auto {
         full = RenderArgs {
             lod: Lod::Level(0),
             ..r.clone()
@@ -121,6 +102,12 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         ReferenceArg::Sheets => None,
         ReferenceArg::Continuous => {
             let (c, secs) = render_continuous_ref(&p, args.reconstruction.into())?;
+            let (_, e) = compare(&core, &c.image);
+            Some((c, secs, e))
+        }
+        ReferenceArg::Field => {
+            let fine = prepare_field(r)?;
+            let (c, secs) = render_continuous_ref(&fine, args.reconstruction.into())?;
             let (_, e) = compare(&core, &c.image);
             Some((c, secs, e))
         }
@@ -171,6 +158,12 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
             p.level
         );
     }
+    if r.refine.is_some() {
+        crate::say!(
+            "(--refine: the sheet reference renders the grid as given, so `overall` above is what \
+             refinement changed; the field line below measures it against the finer sampling)"
+        );
+    }
     if r.slicing == crate::args::SlicingArg::Image {
         crate::say!(
             "(--slicing image: the sheet reference renders the paper's object-aligned sheets, so \
@@ -180,11 +173,16 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
     }
     if let Some((c, secs, e)) = &continuous {
         crate::say!(
-            "continuous {:>9.2} {:>9.2e} {:>9.2e}   (RGB, against the continuous integral, {} \
+            "{} {:>9.2} {:>9.2e} {:>9.2e}   (RGB, against the continuous integral{}, {} \
              reconstruction; step {:.4} world units after {} passes, last change {:.1} dB{}; {:.1} s)",
+            args.reference.name(),
             e.psnr_db,
             e.rmse,
             e.max_abs,
+            match args.reference {
+                ReferenceArg::Field => format!(" of the field sampled {}^3", r.field_size),
+                _ => String::new(),
+            },
             Reconstruction::from(args.reconstruction).name(),
             c.step,
             c.passes,
@@ -247,26 +245,23 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         if let Some(e) = &full_resolution {
             summary = summary.obj("full_resolution", e.json());
         }
-        summary = summary.str(
-            "reference",
-            match args.reference {
-                ReferenceArg::Sheets => "sheets",
-                ReferenceArg::Continuous => "continuous",
-            },
-        );
+        summary = summary.str("reference", args.reference.name());
         if let Some((c, secs, e)) = &continuous {
+            let e = match args.reference {
+                ReferenceArg::Field => e.json().num("field_size", r.field_size as f64),
+                _ => e.json(),
+            };
             summary = summary.obj(
                 "continuous",
-                e.json()
-                    .str(
-                        "reconstruction",
-                        Reconstruction::from(args.reconstruction).name(),
-                    )
-                    .num("step_world", c.step)
-                    .num("passes", c.passes as f64)
-                    .num("change_db", c.change_db)
-                    .bool("converged", c.converged)
-                    .num("seconds", *secs),
+                e.str(
+                    "reconstruction",
+                    Reconstruction::from(args.reconstruction).name(),
+                )
+                .num("step_world", c.step)
+                .num("passes", c.passes as f64)
+                .num("change_db", c.change_db)
+                .bool("converged", c.converged)
+                .num("seconds", *secs),
             );
         }
         let summary = summary

@@ -39,6 +39,7 @@ pub fn apply_quality(
     let Some(q) = args.quality else {
         return Ok((p, args.clone(), None));
     };
+
     let (p, choice) = match args.quality_reference {
         QualityReferenceArg::Sheets if args.slicing == SlicingArg::Image => {
             return Err(CliError::input(
@@ -48,14 +49,15 @@ pub fn apply_quality(
             ));
         }
         QualityReferenceArg::Sheets => choose_sheets(p, args, q)?,
-        QualityReferenceArg::Continuous => {
+        r @ (QualityReferenceArg::Continuous | QualityReferenceArg::Field) => {
             if let Lod::Level(n @ 1..) = args.lod {
                 return Err(CliError::input(format!(
-                    "--quality-reference continuous measures against the integral at full \
-                     resolution and chooses among full-resolution renders: drop --lod {n}"
+                    "--quality-reference {} measures against the integral at full resolution \
+                     and chooses among full-resolution renders: drop --lod {n}",
+                    quality::reference_name(r)
                 )));
             }
-            let c = super::pilot::choose_continuous(&p, args, q)?;
+            let c = super::pilot::choose_continuous(&p, args, q, r)?;
             (p, c)
         }
     };
@@ -123,6 +125,7 @@ fn choose_sheets(
         method: MethodArg::Robust,
         accum: crate::args::AccumArg::Float,
         slab_quarters: None,
+        refine: false,
     };
     let allowed = rmse(target);
     let t00 = table_rmse(&p0, &c0)?;

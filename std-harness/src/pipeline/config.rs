@@ -1,6 +1,6 @@
 //! One table configuration (size, lookup, method, accumulation), or image-aligned slabs of one
-//! thickness: what `footprint chart` sweeps and `--quality` chooses among (table configurations
-//! only), with the names the benches use.
+//! thickness, and whether the grid is refined (`--refine 0`): what `footprint chart` sweeps and
+//! `--quality` chooses among, with the names the benches use.
 
 use crate::args::{AccumArg, LookupArg, MethodArg, RenderArgs, SlicingArg};
 
@@ -20,6 +20,10 @@ pub struct Config {
     /// `Some(q)`: image-aligned slicing with slabs q/4 voxel spacings thick (the table fields
     /// then do not apply); `None`: the paper's object-aligned sheets.
     pub slab_quarters: Option<u16>,
+    /// Object slicing with the grid refined wherever samples differ (`--refine 0`, the
+    /// paper's adaptive re-sampling; float, robust method, orthographic only). Only the
+    /// continuous pilot ([`super::pilot`]) tries it.
+    pub refine: bool,
 }
 
 impl Config {
@@ -47,6 +51,7 @@ impl Config {
                             method,
                             accum,
                             slab_quarters: None,
+                            refine: false,
                         });
                     }
                 }
@@ -68,6 +73,7 @@ impl Config {
                 method: MethodArg::Direct,
                 accum: AccumArg::Float,
                 slab_quarters: Some((t * 4.0) as u16),
+                refine: false,
             })
             .collect()
     }
@@ -77,22 +83,37 @@ impl Config {
         self.slab_quarters.map(|q| f32::from(q) / 4.0)
     }
 
-    /// `n=65/bilinear/view/float/libm`, the bench naming; `image/slab=0.5/float/libm` for slabs.
+    /// `n=65/bilinear/view/float/libm`, the bench naming; `image/slab=0.5/float/libm` for slabs;
+    /// `n=65/bilinear/view/float/libm/refine=0` refined.
     pub fn label(&self) -> String {
         if let Some(t) = self.slab() {
             return format!("image/slab={t}/float/{}", footprint::math::BACKEND);
         }
         format!(
-            "n={}/{}/{}/{}/{}",
+            "n={}/{}/{}/{}/{}{}",
             self.table,
             lookup_name(self.lookup),
             method_name(self.method),
             accum_name(self.accum),
-            footprint::math::BACKEND
+            footprint::math::BACKEND,
+            if self.refine { "/refine=0" } else { "" }
         )
     }
 
-    /// `args` with this configuration's table, lookup, method and accumulation.
+    /// This object-slicing configuration refined (`--refine 0`): float accumulation through the
+    /// robust method's view table, as refinement needs, with the same table size and lookup.
+    pub fn refined(&self) -> Config {
+        Config {
+            method: MethodArg::Robust,
+            accum: AccumArg::Float,
+            slab_quarters: None,
+            refine: true,
+            ..*self
+        }
+    }
+
+    /// `args` with this configuration's table, lookup, method, accumulation and slicing, and
+    /// `--refine 0` if it refines (`args`' own `--refine` is kept otherwise).
     pub fn apply(&self, args: &RenderArgs) -> RenderArgs {
         let mut a = args.clone();
         a.footprint.table = self.table;
@@ -106,6 +127,10 @@ impl Config {
                 a.slab = t;
             }
             None => a.slicing = SlicingArg::Object,
+        }
+        if self.refine {
+            a.refine = Some(0.0);
+            a.refine_sheets = false;
         }
         a
     }

@@ -16,8 +16,10 @@
 //! - [`choose`]: `--quality`'s entry: the sheet model or the pilot, as `--quality-reference` says.
 //! - [`level_pilot`]: `--quality`'s level of detail, measured against full resolution on a pilot
 //!   of image rows.
-//! - [`pilot`]: `--quality DB --quality-reference continuous`, measured on a pilot of sampled
-//!   rays against the continuous integral.
+//! - [`pilot`]: `--quality DB --quality-reference continuous` (or `field`), measured on a pilot
+//!   of sampled rays against the continuous integral (of the grid, or of a finer sampling).
+//! - [`field`]: the built-in scene's field sampled finer, the reference refinement is chosen
+//!   against.
 //! - [`sampling`]: what the pilots share (a hash placing samples, an estimate's figures).
 //! - [`slabs`]: `--slicing image`, the core's image-aligned slabs over the visible voxels.
 //! - [`lod`]: `--lod`, levels of detail for minified volumes (coarser levels, built once or as they stream).
@@ -31,6 +33,7 @@
 pub mod bands;
 pub mod choose;
 pub mod config;
+pub mod field;
 pub mod level_pilot;
 pub mod load;
 pub mod lod;

@@ -16,10 +16,14 @@
 //!    converges (`reference::continuous`), about 1/S² of its cost.
 //! 2. **Candidates**, cheapest first: object slicing with the table configuration the sheet
 //!    model picks for DB, then the one it picks for DB + [`TABLE_HEADROOM_DB`] (so that the
-//!    table's share of the error is negligible) if it differs; then image slicing at each
-//!    thickness of `Config::SLABS` the frame accepts, thickest (fastest) first. With
-//!    `--slicing image` only the slabs are tried; a perspective frame or a non-Gaussian kernel
-//!    has no slabs.
+//!    table's share of the error is negligible) if it differs; then that table with the grid
+//!    refined (`--refine 0`, the paper's adaptive re-sampling, 1.3–2.4× an unrefined frame on
+//!    the README's refinement chart), where refinement can add samples
+//!    ([`super::refine::worth_trying`]: float, the robust method, orthographic, in memory, full
+//!    resolution, and grid steps projecting at least twice [`super::refine::MIN_STEP_PX`]);
+//!    then image slicing (3–13× an object frame) at each thickness of `Config::SLABS` the
+//!    frame accepts, thickest (fastest) first. With `--slicing image` only the slabs are tried;
+//!    a perspective frame or a non-Gaussian kernel has no slabs.
 //! 3. **Measure.** Each candidate renders the whole frame; its squared error (RGB mean) at the n
 //!    sampled pixels has mean m and standard deviation s. The estimate is 10·log₁₀(1/m) and the
 //!    decision uses the upper confidence bound of the image's MSE, m + [`Z`]·s/√n·√(1 − n/N)
@@ -93,8 +97,14 @@ pub fn estimate(
     Estimate::of(&errors, total, Z)
 }
 
-/// The candidates for `p` aiming at `target_db` (see the module docs), cheapest first.
-fn candidates(p: &Prepared, args: &RenderArgs, target_db: f64) -> Result<Vec<Config>, CliError> {
+/// The candidates for `p` aiming at `target_db` (see the module docs), cheapest first; the
+/// refined one only against the `field` reference.
+fn candidates(
+    p: &Prepared,
+    args: &RenderArgs,
+    target_db: f64,
+    reference: QualityReferenceArg,
+) -> Result<Vec<Config>, CliError> {
     let mut v: Vec<Config> = Vec::new();
     if args.slicing == SlicingArg::Object {
         for aim in [target_db, target_db + TABLE_HEADROOM_DB] {
@@ -102,6 +112,11 @@ fn candidates(p: &Prepared, args: &RenderArgs, target_db: f64) -> Result<Vec<Con
             if !v.contains(&c) {
                 v.push(c);
             }
+        }
+    }
+    if let (Some(last), QualityReferenceArg::Field) = (v.last().copied(), reference) {
+        if super::refine::worth_trying(p, &last.refined().apply(args)) {
+            v.push(last.refined());
         }
     }
     let mut slabs = Config::slabs(&p.frame, &p.kernel);
@@ -119,24 +134,32 @@ fn candidates(p: &Prepared, args: &RenderArgs, target_db: f64) -> Result<Vec<Con
     Ok(v)
 }
 
-/// The cheapest candidate measured to reach `target_db` against the continuous integral.
+/// The cheapest candidate measured to reach `target_db` against the continuous integral of
+/// `p`'s grid (`reference` continuous) or of the finer sampling of its field (`field`,
+/// [`super::field`]).
 pub fn choose_continuous(
     p: &Prepared,
     args: &RenderArgs,
     target_db: f64,
+    reference: QualityReferenceArg,
 ) -> Result<Choice, CliError> {
     quality::check_target(target_db)?;
-    let candidates = candidates(p, args, target_db)?;
+    let fine = match reference {
+        QualityReferenceArg::Field => Some(super::field::prepare_field(args)?),
+        _ => None,
+    };
+    let candidates = candidates(p, args, target_db, reference)?;
     let (w, h) = p.out_size();
     let (pixels, stride) = sample_pixels(w, h, PILOT_RAYS);
-    let (reference, reference_seconds) = continuous_at(p, &pixels)?;
+    let (reference_image, reference_seconds) = continuous_at(fine.as_ref().unwrap_or(p), &pixels)?;
+    drop(fine);
     let start = Instant::now();
     let mut cache = FrameCache::default();
     let mut tried: Vec<(Config, Estimate)> = Vec::new();
     let mut chosen = None;
     for c in candidates {
         let frame = render_frame(p, &c.apply(args), c.accum, &mut cache)?;
-        let e = estimate(&frame.image, w, &pixels, &reference.image, w * h);
+        let e = estimate(&frame.image, w, &pixels, &reference_image.image, w * h);
         tried.push((c, e));
         if e.bound_db >= target_db {
             chosen = Some(tried.len() - 1);
@@ -156,8 +179,9 @@ pub fn choose_continuous(
                  orthographic view)"
             };
             crate::say!(
-                "--quality {target_db:.1} dB (continuous): no candidate was measured to reach it; \
+                "--quality {target_db:.1} dB ({}): no candidate was measured to reach it; \
                  using the most accurate, {} ({:.1} dB on the pilot){slabs}",
+                quality::reference_name(reference),
                 tried[best].0.label(),
                 tried[best].1.bound_db
             );
@@ -174,16 +198,17 @@ pub fn choose_continuous(
         target_db,
         config,
         predicted_db: e.bound_db,
-        reference: QualityReferenceArg::Continuous,
+        reference,
         footprint_error: None,
         rejected,
         pilot: Some(Pilot {
             pixels: pixels.len(),
             stride,
-            converged: reference.converged,
+            converged: reference_image.converged,
             reference_seconds,
             render_seconds: start.elapsed().as_secs_f64(),
             tried,
+            field_size: (reference == QualityReferenceArg::Field).then_some(args.field_size),
         }),
         level: 0,
         level_pilot: None,

@@ -124,9 +124,13 @@ impl Choice {
         };
         let why = match (&self.pilot, self.footprint_error) {
             (Some(pilot), _) => format!(
-                "measured against the continuous integral on a pilot of {} sampled pixels (one \
-                 per {}x{} cell){}: estimate {:.1} dB, {:.1} dB at its bound; pilot reference \
-                 {:.2} s, candidate renders ({}) {:.2} s",
+                "measured against the continuous integral{} on a pilot of {} sampled pixels \
+                 (one per {}x{} cell){}: estimate {:.1} dB, {:.1} dB at its bound; pilot \
+                 reference {:.2} s, candidate renders ({}) {:.2} s",
+                match pilot.field_size {
+                    Some(n) => format!(" of the field sampled {n}^3"),
+                    None => String::new(),
+                },
                 pilot.pixels,
                 pilot.stride,
                 pilot.stride,
@@ -375,8 +379,8 @@ pub fn pick(p: &Prepared, target_db: f64) -> Result<(Choice, bool), CliError> {
     Ok((choice, false))
 }
 
-/// The JSON record of a `--quality` choice: `target_db`, `reference` (`sheets` or
-/// `continuous`), `predicted_db`, `level`, `chosen`; with sheets `footprint_error` and `k_db`
+/// The JSON record of a `--quality` choice: `target_db`, `reference` (`sheets`, `continuous`
+/// or `field`), `predicted_db`, `level`, `chosen`; with sheets `footprint_error` and `k_db`
 /// (the table's, at the level chosen) and, when levels were measured, `level_pilot`; with
 /// continuous `pilot` (`pixels`, `stride`, `converged`, seconds, and each candidate tried).
 pub fn quality_json(c: &Choice) -> Json {
@@ -434,13 +438,19 @@ pub struct Pilot {
     pub render_seconds: f64,
     /// Every candidate rendered, in order, with its estimate.
     pub tried: Vec<(Config, Estimate)>,
+    /// Against `--quality-reference field`: the side N of the finer sampling (N³).
+    pub field_size: Option<usize>,
 }
 
 /// The JSON record of a pilot: `pixels`, `stride`, `converged`, `reference_seconds`,
-/// `render_seconds`, and `tried`, each candidate's `config`, `estimate_db` and `bound_db`.
+/// `render_seconds`, `field_size` (against the field reference), and `tried`, each candidate's
+/// `config`, `estimate_db` and `bound_db`.
 fn pilot_json(p: &Pilot) -> Json {
-    Json::object()
-        .num("pixels", p.pixels as f64)
+    let j = match p.field_size {
+        Some(n) => Json::object().num("field_size", n as f64),
+        None => Json::object(),
+    };
+    j.num("pixels", p.pixels as f64)
         .num("stride", p.stride as f64)
         .bool("converged", p.converged)
         .num("reference_seconds", p.reference_seconds)

@@ -74,6 +74,20 @@ pub fn check(p: &Prepared, args: &RenderArgs, accum: AccumArg) -> Result<(), Cli
     Ok(())
 }
 
+/// Whether `--refine` with `args` can add samples to `p`'s grid: [`check`] passes, `p` is at full
+/// resolution, and an in-sheet grid step (or, with `--refine-sheets`, the sheet step) projects
+/// at least 2 × [`MIN_STEP_PX`] (otherwise every interval keeps factor 1 and the refined render
+/// is the unrefined one).
+pub fn worth_trying(p: &Prepared, args: &RenderArgs) -> bool {
+    if check(p, args, args.accum).is_err() || p.level != 0 {
+        return false;
+    }
+    (0..3).any(|axis| {
+        (axis != p.frame.sheet_axis || args.refine_sheets)
+            && p.frame.grid_to_screen.col(axis).length() >= 2.0 * MIN_STEP_PX
+    })
+}
+
 /// The refinement factors of `volume` for `p`'s transfer function, view and `threshold`; the
 /// sheet axis stays unrefined unless `sheets`.
 pub fn choose(
