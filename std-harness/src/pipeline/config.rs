@@ -21,8 +21,8 @@ pub struct Config {
     /// then do not apply); `None`: the paper's object-aligned sheets.
     pub slab_quarters: Option<u16>,
     /// Object slicing with the grid refined wherever samples differ (`--refine 0`, the
-    /// paper's adaptive re-sampling; float, robust method, orthographic only). Only the
-    /// continuous pilot ([`super::pilot`]) tries it.
+    /// paper's adaptive re-sampling; float, robust method, orthographic only). Only the pilot
+    /// against `--quality-reference field` ([`super::pilot`]) tries it.
     pub refine: bool,
 }
 

@@ -16,9 +16,10 @@
 //!    converges (`reference::continuous`), about 1/S² of its cost.
 //! 2. **Candidates**, cheapest first: object slicing with the table configuration the sheet
 //!    model picks for DB, then the one it picks for DB + [`TABLE_HEADROOM_DB`] (so that the
-//!    table's share of the error is negligible) if it differs; then that table with the grid
-//!    refined (`--refine 0`, the paper's adaptive re-sampling, 1.3–2.4× an unrefined frame on
-//!    the README's refinement chart), where refinement can add samples
+//!    table's share of the error is negligible) if it differs; then, against `field` only
+//!    ([`super::field`]: the grid's own field is what refinement moves away from), that table
+//!    with the grid refined (`--refine 0`, the paper's adaptive re-sampling, 1.3–2.4× an
+//!    unrefined frame on the README's refinement chart), where refinement can add samples
 //!    ([`super::refine::worth_trying`]: float, the robust method, orthographic, in memory, full
 //!    resolution, and grid steps projecting at least twice [`super::refine::MIN_STEP_PX`]);
 //!    then image slicing (3–13× an object frame) at each thickness of `Config::SLABS` the
