@@ -100,14 +100,14 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
     let (per, overall) = compare(&core, &reference);
     let continuous = match args.reference {
         ReferenceArg::Sheets => None,
-        ReferenceArg::Continuous => {
-            let (c, secs) = render_continuous_ref(&p, args.reconstruction.into())?;
-            let (_, e) = compare(&core, &c.image);
-            Some((c, secs, e))
-        }
-        ReferenceArg::Field => {
-            let fine = prepare_field(r)?;
-            let (c, secs) = render_continuous_ref(&fine, args.reconstruction.into())?;
+        reference => {
+            // `field`: the same integral, over the finer sampling of the built-in scene.
+            let fine = match reference {
+                ReferenceArg::Field => Some(prepare_field(r)?),
+                _ => None,
+            };
+            let over = fine.as_ref().unwrap_or(&p);
+            let (c, secs) = render_continuous_ref(over, args.reconstruction.into())?;
             let (_, e) = compare(&core, &c.image);
             Some((c, secs, e))
         }
