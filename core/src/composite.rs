@@ -54,14 +54,13 @@ pub fn over(front: [f32; 4], back: [f32; 4]) -> [f32; 4] {
 /// zero while colour stays positive — colour without coverage, which `over` would add as light.)
 #[inline]
 pub fn clamp_unit(c: [f32; 4]) -> [f32; 4] {
-    // max/min, not clamp: a NaN alpha becomes 0 (clamp would keep it NaN, and a NaN bound
-    // would make the colour clamps panic).
-    #[allow(clippy::manual_clamp)]
-    let a = c[3].max(0.0).min(1.0);
-    [
-        c[0].max(0.0).min(a),
-        c[1].max(0.0).min(a),
-        c[2].max(0.0).min(a),
-        a,
-    ]
+    // Comparisons, not clamp or max/min: a NaN alpha or colour becomes 0 (clamp would keep it
+    // NaN, and a NaN bound would make the colour clamps panic), and each select is one SSE
+    // max/min (`f32::max` adds a NaN fix-up the compiler cannot vectorise; the same values).
+    let (lo, hi) = (
+        |x: f32| if x > 0.0 { x } else { 0.0 },
+        |x: f32, m: f32| if x < m { x } else { m },
+    );
+    let a = hi(lo(c[3]), 1.0);
+    [hi(lo(c[0]), a), hi(lo(c[1]), a), hi(lo(c[2]), a), a]
 }

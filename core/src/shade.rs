@@ -98,6 +98,69 @@ impl TransferFunction<'_> {
         Ok(())
     }
 
+    /// `value`'s position along the entries (0 at `lo`, n − 1 at `hi`; unclamped): a
+    /// non-decreasing function of `value` (each rounded step is).
+    #[inline]
+    fn position(&self, value: f32) -> f32 {
+        (value - self.lo) / (self.hi - self.lo) * (self.lut.len() - 1) as f32
+    }
+
+    /// The largest value at or below which [`TransferFunction::lookup`] gives opacity exactly
+    /// 0: every entry before the first with opacity above 0 is transparent, and so is every
+    /// value whose position falls at or before the last of them (the blend of two zeros is
+    /// zero); −∞ when the first entry is not transparent (or the function does not
+    /// [`check`](TransferFunction::check)). Found by bisection over the ordered finite `f32`s
+    /// on the position [`lookup`](TransferFunction::lookup) computes, which never decreases with
+    /// the value, so the bound is exact, not an estimate: a classifier may skip values at or
+    /// below it with one comparison.
+    pub fn transparent_at_or_below(&self) -> f32 {
+        if self.check().is_err() {
+            return f32::NEG_INFINITY;
+        }
+        let Some(first) = self.lut.iter().position(|c| c[3] > 0.0) else {
+            // No entry is visible: every value is transparent.
+            return f32::INFINITY;
+        };
+        if first == 0 {
+            return f32::NEG_INFINITY;
+        }
+        let last_clear = (first - 1) as f32;
+        let clear = |v: f32| self.position(v) <= last_clear;
+        // Finite f32s in order, as i32 keys (negative values reversed).
+        let key = |v: f32| {
+            let b = i64::from(v.to_bits() as i32);
+            if b < 0 {
+                i64::from(i32::MIN) - b
+            } else {
+                b
+            }
+        };
+        let value = |k: i64| {
+            if k < 0 {
+                f32::from_bits((i64::from(i32::MIN) - k) as u32)
+            } else {
+                f32::from_bits(k as u32)
+            }
+        };
+        let (mut lo, mut hi) = (key(-f32::MAX), key(f32::MAX));
+        if !clear(value(lo)) {
+            return f32::NEG_INFINITY;
+        }
+        if clear(value(hi)) {
+            return f32::MAX;
+        }
+        // Invariant: clear at lo, not clear at hi.
+        while hi - lo > 1 {
+            let mid = lo + (hi - lo) / 2;
+            if clear(value(mid)) {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        value(lo)
+    }
+
     /// Straight RGBA for `value`; transparent for a non-finite value.
     #[inline]
     pub fn lookup(&self, value: f32) -> [f32; 4] {
@@ -105,7 +168,7 @@ impl TransferFunction<'_> {
             return [0.0; 4];
         }
         let n = self.lut.len();
-        let t = (value - self.lo) / (self.hi - self.lo) * (n - 1) as f32;
+        let t = self.position(value);
         if !t.is_finite() {
             return [0.0; 4];
         }
@@ -293,6 +356,21 @@ impl Shader<'_> {
         };
         let shade = |c: f32| ((c * light + spec).min(1.0)) * corrected;
         [shade(rgb[0]), shade(rgb[1]), shade(rgb[2]), corrected]
+    }
+
+    /// A value at or below which no voxel is [`visible`](Shader::visible), whatever its
+    /// gradient or position: the transfer function's
+    /// [`transparent_at_or_below`](TransferFunction::transparent_at_or_below) where the shading
+    /// takes opacity from it (emission, Phong, texture), −∞ for an iso-surface (whose opacity
+    /// depends on the distance to the iso-value instead). Computed by a bisection of about 64
+    /// lookups: call it once per sheet or frame, not per voxel.
+    pub fn transparent_at_or_below(&self) -> f32 {
+        match self.shading {
+            Shading::Emission | Shading::Phong(_) | Shading::Texture(_) => {
+                self.tf.transparent_at_or_below()
+            }
+            Shading::Iso { .. } => f32::NEG_INFINITY,
+        }
     }
 
     /// Whether a voxel of `value` can be seen at all (opacity above zero before the per-view

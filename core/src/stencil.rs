@@ -56,6 +56,8 @@ use crate::splat::{
     floor_i64, row_pixels, BufferError, ImageMut, Pixel, Sampler, SplatStats, Splatter,
 };
 
+mod small;
+
 /// Largest number of phases per pixel the harness uses ([`phases_for`] lowers it for
 /// footprints wider than [`NARROW_SIDE`]).
 pub const DEFAULT_PHASES: usize = 32;
@@ -444,10 +446,14 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
             return Ok(stats);
         }
         let p = self.phases;
+        // Per voxel, so written with a select and 32-bit conversions (t ∈ [0, P] for a finite
+        // centre; P is small): the values of max and `as usize`, bit for bit, without their NaN
+        // and range fix-ups.
+        let pf = p as u32 as f32;
         let phase = |c: f32, i: i64| {
-            let t = (c - i as f32) * p as f32;
-            let k = (t.max(0.0) as usize).min(p - 1);
-            (k, (t - k as f32).clamp(0.0, 1.0))
+            let t = (c - i as f32) * pf;
+            let k = ((if t > 0.0 { t } else { 0.0 }) as u32 as usize).min(p - 1);
+            (k, (t - k as u32 as f32).clamp(0.0, 1.0))
         };
         let ((ka, fx), (kb, fy)) = (phase(center[0], ix), phase(center[1], iy));
         let side = self.side;
@@ -471,6 +477,14 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
         let mut weights = [0.0f32; MAX_STENCIL_SIDE];
         let wide = self.wide;
         if !wide {
+            // A box up to 15 px wholly inside the image: rows of a fixed width, no clipping.
+            if x0 >= 0 && y0 >= 0 && x0 + b <= w && y0 + b <= h {
+                let (at, blend) = ((x0 as usize, y0 as usize), [w00, w10, w01, w11]);
+                let small = (corners, blend, spans, at);
+                if let Some(stats) = self.splat_small(small, value, data, stride, &mut touched) {
+                    return Ok(stats);
+                }
+            }
             // Blended: weight and deposit in one pass over the stored runs.
             for (my, span) in spans.iter().enumerate().take(my1).skip(my0) {
                 let (first, last) = run(span);

@@ -242,9 +242,14 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
             window.upper.map(<[T]>::len),
         ];
         let (path, opacity, cache) = (&self.path, self.opacity, &mut self.cache);
+        // Values the transfer function surely makes transparent skip shading (the same image).
+        let clear = shader.transparent_at_or_below();
         let shade = |u: usize, v: usize| {
             let sample = window.current[v * na + u];
             let (value, colour) = (sample.to_f32(), sample.colour());
+            if value <= clear {
+                return path.value([0.0; 4]);
+            }
             path.value(ShadeCache::shade(
                 cache.as_mut(),
                 value,

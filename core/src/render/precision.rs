@@ -113,13 +113,20 @@ impl<S: Splatter + ?Sized> Precision for FloatPath<'_, S> {
 /// The float paths' compositing: clamp the accumulated sheet to [0, 1], over or under the image,
 /// clear the accumulator.
 pub(super) fn float_composite_row(acc: &mut [[f32; 4]], image: &mut [[f32; 4]], order: Order) {
-    for (a, i) in acc.iter_mut().zip(image.iter_mut()) {
-        let s = clamp_unit(*a);
-        *a = [0.0; 4];
-        *i = match order {
-            Order::BackToFront => over(s, *i),
-            Order::FrontToBack => over(*i, s),
-        };
+    // The order settled per row, so each loop is straight-line per pixel.
+    match order {
+        Order::BackToFront => {
+            for (a, i) in acc.iter_mut().zip(image.iter_mut()) {
+                *i = over(clamp_unit(*a), *i);
+                *a = [0.0; 4];
+            }
+        }
+        Order::FrontToBack => {
+            for (a, i) in acc.iter_mut().zip(image.iter_mut()) {
+                *i = over(*i, clamp_unit(*a));
+                *a = [0.0; 4];
+            }
+        }
     }
 }
 

@@ -98,11 +98,17 @@ pub fn classify_sheet<T: Sample>(
         }
         .into());
     }
+    // Values the transfer function makes transparent whatever the gradient are skipped with one
+    // comparison (exact: the bound is where its lookup's opacity stops being 0).
+    let clear = shader.transparent_at_or_below();
     let mut n = 0;
     for v in 0..nb {
         for u in 0..na {
             let sample = window.current[v * na + u];
             let value = sample.to_f32();
+            if value <= clear {
+                continue;
+            }
             let mut g = glam::Vec3::ZERO;
             let seen = shader.visible(value, || {
                 g = gradient(frame, &window, u, v);
