@@ -37,6 +37,9 @@ pub struct VisibleSheet<'s> {
     pub colours: &'s [[f32; 3]],
 }
 
+/// Samples tested together for the transparent early-out in [`classify_sheet`].
+const CLEAR_GROUP: usize = 16;
+
 /// Writes the visible voxels of sheet `index` (with its neighbours in `window`, for gradients)
 /// into `voxels`, their gradients into `gradients` when `shader` needs them, and their colours
 /// into `colours` when the sample type carries colours ([`Sample::COLOURED`]; a sample without
@@ -102,39 +105,49 @@ pub fn classify_sheet<T: Sample>(
     // comparison (exact: the bound is where its lookup's opacity stops being 0).
     let clear = shader.transparent_at_or_below();
     let mut n = 0;
-    for v in 0..nb {
-        for u in 0..na {
-            let sample = window.current[v * na + u];
-            let value = sample.to_f32();
-            if value <= clear {
+    for (v, row) in window.current.chunks_exact(na.max(1)).enumerate().take(nb) {
+        // Groups of samples all at or below the bound are skipped with one test (a branch-free
+        // loop the compiler vectorises); in the rest each sample is tested on its own.
+        for (k, group) in row.chunks(CLEAR_GROUP).enumerate() {
+            if group
+                .iter()
+                .fold(true, |all, s| all & (s.to_f32() <= clear))
+            {
                 continue;
             }
-            let mut g = glam::Vec3::ZERO;
-            let seen = shader.visible(value, || {
-                g = gradient(frame, &window, u, v);
-                g
-            });
-            if !seen {
-                continue;
-            }
-            voxels[n] = VisibleVoxel {
-                u: u as u16,
-                v: v as u16,
-                value,
-            };
-            if needs_gradient {
-                // Emission never asks for the gradient; every other shading computed it above.
-                gradients[n] = g.to_array();
-            }
-            if coloured {
-                // A sample of a coloured type without a colour of its own takes the transfer
-                // function's, as the renderer would give it.
-                colours[n] = sample.colour().unwrap_or_else(|| {
-                    let c = shader.tf.lookup(value);
-                    [c[0], c[1], c[2]]
+            for (i, &sample) in group.iter().enumerate() {
+                let u = k * CLEAR_GROUP + i;
+                let value = sample.to_f32();
+                if value <= clear {
+                    continue;
+                }
+                let mut g = glam::Vec3::ZERO;
+                let seen = shader.visible(value, || {
+                    g = gradient(frame, &window, u, v);
+                    g
                 });
+                if !seen {
+                    continue;
+                }
+                voxels[n] = VisibleVoxel {
+                    u: u as u16,
+                    v: v as u16,
+                    value,
+                };
+                if needs_gradient {
+                    // Emission never asks for the gradient; every other shading computed it above.
+                    gradients[n] = g.to_array();
+                }
+                if coloured {
+                    // A sample of a coloured type without a colour of its own takes the transfer
+                    // function's, as the renderer would give it.
+                    colours[n] = sample.colour().unwrap_or_else(|| {
+                        let c = shader.tf.lookup(value);
+                        [c[0], c[1], c[2]]
+                    });
+                }
+                n += 1;
             }
-            n += 1;
         }
     }
     Ok(n)
