@@ -267,8 +267,7 @@ fn footprint_of_ten_thousand_pixels_is_right_on_screen() {
 
 #[test]
 fn cli_reports_bad_input_with_exit_code_2_and_writes_nothing() {
-    let dir = std::env::temp_dir().join(format!("fp-degenerate-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = footprint_suite::tmpdir("degenerate");
     let out = dir.join("x.pfm");
     let o = out.to_str().unwrap();
     let (tiff, missing) = (dir.join("x.tiff"), dir.join("missing.fpt"));
@@ -300,5 +299,4 @@ fn cli_reports_bad_input_with_exit_code_2_and_writes_nothing() {
         0
     );
     assert!(out.exists());
-    std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -385,7 +385,7 @@ fn bad_volumes_fail_cleanly() {
     .unwrap();
     for p in [
         empty.as_path(),
-        d.as_path(),
+        &*d,
         missing_data.as_path(),
         Path::new("/nonexistent/v.nhdr"),
     ] {

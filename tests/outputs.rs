@@ -3,9 +3,9 @@
 
 use footprint_harness::io::outputs::{self, Planned};
 use footprint_harness::pipeline::prepare::{outside_data_warnings, parse_shading};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-fn tmpdir(name: &str) -> PathBuf {
+fn tmpdir(name: &str) -> footprint_suite::TestDir {
     footprint_suite::tmpdir(&format!("out-{name}"))
 }
 

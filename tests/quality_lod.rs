@@ -51,7 +51,11 @@ fn pilot_rows_are_the_frames_rows_bit_for_bit() {
 
 /// A u8 volume of side `n` from `f` (position in [-1, 1]³ → [0, 1]), written raw; the file's
 /// path as given to `--dims n,n,n --type u8`.
-fn volume(name: &str, n: usize, f: impl Fn([f32; 3], [usize; 3]) -> f32) -> String {
+fn volume(
+    name: &str,
+    n: usize,
+    f: impl Fn([f32; 3], [usize; 3]) -> f32,
+) -> (footprint_suite::TestDir, String) {
     let mut v = Vec::with_capacity(n * n * n);
     for z in 0..n {
         for y in 0..n {
@@ -61,9 +65,11 @@ fn volume(name: &str, n: usize, f: impl Fn([f32; 3], [usize; 3]) -> f32) -> Stri
             }
         }
     }
-    let path = tmpdir(&format!("quality-lod-{name}")).join(name);
+    let dir = tmpdir(&format!("quality-lod-{name}"));
+    let path = dir.join(name);
     std::fs::write(&path, v).unwrap();
-    path.to_str().unwrap().to_string()
+    let path = path.to_str().unwrap().to_string();
+    (dir, path)
 }
 
 /// `--quality 40` on `raw` (side `n`) at `size`: the level chosen and the image's PSNR against
@@ -90,7 +96,7 @@ fn quality_40(raw: &str, n: usize, size: &str) -> (u32, f64) {
 #[test]
 fn quality_coarsens_a_smooth_volume_and_meets_its_target_at_full_resolution() {
     // A Gaussian blob and a soft shell, 96³ at 32×32: samples about 0.17 px apart.
-    let raw = volume("smooth.raw", 96, |p, _| {
+    let (_dir, raw) = volume("smooth.raw", 96, |p, _| {
         let r2 = p.iter().map(|c| c * c).sum::<f32>();
         (-r2 / (2.0 * 0.15 * 0.15)).exp() + 0.6 * (-((r2.sqrt() - 0.8).powi(2)) / 0.005).exp()
     });
@@ -106,7 +112,7 @@ fn quality_coarsens_a_smooth_volume_and_meets_its_target_at_full_resolution() {
 fn quality_meets_its_target_where_voxel_scale_detail_breaks_levels() {
     // Thin shells and a hashed speckle (the minification test's kind of volume), 96³ at 48×48:
     // one value and colour per block cannot stand in for the speckle.
-    let raw = volume("speckle.raw", 96, |p, [x, y, z]| {
+    let (_dir, raw) = volume("speckle.raw", 96, |p, [x, y, z]| {
         let r = (p[0] * p[0] + 0.8 * p[1] * p[1] + 1.2 * p[2] * p[2]).sqrt() * 48.0;
         let shell = [22.0f32, 31.0, 40.0]
             .iter()

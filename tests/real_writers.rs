@@ -187,8 +187,7 @@ fn every_real_writer_file_loads_and_renders_as_the_raw_original() {
     }
 
     let want = original(&dir);
-    let tmp = std::env::temp_dir().join(format!("fp-real-writers-{}", std::process::id()));
-    std::fs::create_dir_all(&tmp).unwrap();
+    let tmp = footprint_suite::tmpdir("real-writers");
     let mut references = std::collections::HashMap::new();
     for e in &entries {
         let path = dir.join(&e.file);
@@ -227,5 +226,4 @@ fn every_real_writer_file_loads_and_renders_as_the_raw_original() {
             .trim()
             .replace('\n', ", ")
     );
-    std::fs::remove_dir_all(&tmp).unwrap();
 }

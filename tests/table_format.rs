@@ -113,8 +113,7 @@ proptest! {
 /// building the table in memory; a table for another kernel is refused.
 #[test]
 fn tables_command_output_loads_in_splat() {
-    let dir = std::env::temp_dir().join(format!("fp-tables-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = footprint_suite::tmpdir("tables");
     let file = dir.join("g65.fpt");
     let code = footprint_harness::run([
         "footprint",
@@ -146,7 +145,6 @@ fn tables_command_output_loads_in_splat() {
         err.message.contains("65x65") && err.message.contains("33x33"),
         "{err}"
     );
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// `from_file_const` (the compile-time loader a firmware puts in flash) gives what `from_bytes`

@@ -180,11 +180,30 @@ pub fn try_render_with<P: footprint::render::Precision>(
     Ok(img)
 }
 
-/// An empty folder for one test, `fp-NAME-PID` in the system's temporary folder (emptied first if
-/// a killed run left it behind).
-pub fn tmpdir(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("fp-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+/// An empty folder for one test, `fp-NAME-…` in the system's temporary folder, removed with
+/// everything in it when the value is dropped (when the test ends, passed or failed).
+pub fn tmpdir(name: &str) -> TestDir {
+    TestDir(
+        tempfile::Builder::new()
+            .prefix(&format!("fp-{name}-"))
+            .tempdir()
+            .expect("a temporary folder for the test"),
+    )
+}
+
+/// A test's folder (see [`tmpdir`]): a [`Path`](std::path::Path) while it lives.
+pub struct TestDir(tempfile::TempDir);
+
+impl std::ops::Deref for TestDir {
+    type Target = std::path::Path;
+
+    fn deref(&self) -> &std::path::Path {
+        self.0.path()
+    }
+}
+
+impl AsRef<std::path::Path> for TestDir {
+    fn as_ref(&self) -> &std::path::Path {
+        self.0.path()
+    }
 }
