@@ -106,7 +106,9 @@ pub fn quantise(c: [f32; 4]) -> [u32; 4] {
         if !(x > 0.0) {
             0
         } else {
-            crate::math::floor(x.min(255.0) * ONE as f32 + 0.5) as u32
+            // y = x·2²⁴ + ½ lies in (½, 255·2²⁴ + ½], inside u32 and positive, where truncation
+            // is the floor: `as u32` rounds to nearest without a call to `floor` per channel.
+            (x.min(255.0) * ONE as f32 + 0.5) as u32
         }
     })
 }
@@ -127,4 +129,48 @@ pub fn checksum(image: &[[u32; 4]]) -> u32 {
         }
     }
     crc.finish()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{quantise, ONE};
+
+    /// `quantise`'s truncation is the floor it replaced, over the whole range and its edges.
+    #[test]
+    fn quantise_rounds_as_the_floor_did() {
+        let floor = |x: f32| -> u32 {
+            if !(x > 0.0) {
+                0
+            } else {
+                crate::math::floor(x.min(255.0) * ONE as f32 + 0.5) as u32
+            }
+        };
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut edges = vec![
+            0.0f32,
+            -0.0,
+            f32::MIN_POSITIVE,
+            1e-30,
+            0.5 / ONE as f32,
+            1.0,
+            254.999_98,
+            255.0,
+            256.0,
+            f32::MAX,
+            f32::INFINITY,
+            f32::NAN,
+            -1.0,
+        ];
+        for _ in 0..200_000 {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            // Values in (0, 256): a random mantissa and a random exponent from 2^-30 up.
+            let bits = (seed as u32 & 0x007f_ffff) | (((seed >> 32) as u32 % 38 + 97) << 23);
+            edges.push(f32::from_bits(bits));
+        }
+        for x in edges {
+            assert_eq!(quantise([x; 4]), [floor(x); 4], "{x:e}");
+        }
+    }
 }
