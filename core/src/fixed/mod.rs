@@ -135,14 +135,21 @@ pub fn checksum(image: &[[u32; 4]]) -> u32 {
 mod tests {
     use super::{quantise, ONE};
 
-    /// `quantise`'s truncation is the floor it replaced, over the whole range and its edges.
+    /// `quantise`'s truncation is the floor, over the whole range and its edges. (Above 2²³ the
+    /// f32 y = x·2²⁴ + ½ is a whole number, its own floor; below, the backend's `floor` is the
+    /// reference. micromath's `floor` goes through `i32`, so it cannot serve above 2³¹: there the
+    /// former `floor`-based `quantise` gave 2³¹ for every x ≥ 128 under that backend.)
     #[test]
     fn quantise_rounds_as_the_floor_did() {
         let floor = |x: f32| -> u32 {
             if !(x > 0.0) {
-                0
+                return 0;
+            }
+            let y = x.min(255.0) * ONE as f32 + 0.5;
+            if y < 8_388_608.0 {
+                crate::math::floor(y) as u32
             } else {
-                crate::math::floor(x.min(255.0) * ONE as f32 + 0.5) as u32
+                y as u64 as u32
             }
         };
         let mut seed = 0x2545_f491_4f6c_dd1du64;
