@@ -126,7 +126,8 @@ impl TransferFunction<'_> {
         }
         let last_clear = (first - 1) as f32;
         let clear = |v: f32| self.position(v) <= last_clear;
-        // Finite f32s in order, as i32 keys (negative values reversed).
+        // Finite f32s in order: their bits read as an i32, negative values reversed (held in
+        // an i64 so the bisection's differences cannot overflow).
         let key = |v: f32| {
             let b = i64::from(v.to_bits() as i32);
             if b < 0 {

@@ -446,14 +446,10 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
             return Ok(stats);
         }
         let p = self.phases;
-        // Per voxel, so written with a select and 32-bit conversions (t ∈ [0, P] for a finite
-        // centre; P is small): the values of max and `as usize`, bit for bit, without their NaN
-        // and range fix-ups.
-        let pf = p as u32 as f32;
         let phase = |c: f32, i: i64| {
-            let t = (c - i as f32) * pf;
-            let k = ((if t > 0.0 { t } else { 0.0 }) as u32 as usize).min(p - 1);
-            (k, (t - k as u32 as f32).clamp(0.0, 1.0))
+            let t = (c - i as f32) * p as f32;
+            let k = (t.max(0.0) as usize).min(p - 1);
+            (k, (t - k as f32).clamp(0.0, 1.0))
         };
         let ((ka, fx), (kb, fy)) = (phase(center[0], ix), phase(center[1], iy));
         let side = self.side;
