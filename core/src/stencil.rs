@@ -245,6 +245,8 @@ pub struct Stencils<'a, S: ?Sized> {
     side: usize,
     reach: i64,
     phases: usize,
+    /// The longest stored row run, pixels (0 when every run is empty).
+    run_width: usize,
 }
 
 /// Samples single stencils of a view's phase stencils for [`Stencils::build_split`].
@@ -363,6 +365,7 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
         // corner stencils is non-zero (blended footprints: the pixels a splat visits), or where
         // all four are (edged ones: the pixels it blends); first > last when there are none.
         let wide = plan.edged;
+        let mut run_width = 0;
         let weights = &*weights;
         let nonzero = |stencil: usize, my: usize| {
             nonzero_run(&weights[stencil * cells + my * side..][..side])
@@ -397,6 +400,9 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
                 // B ≤ 129: both fit 16 bits, and the pattern (exponent field ≤ 1) is never a NaN, so
                 // it survives being stored and read as an f32 unchanged.
                 *packed = f32::from_bits(first as u32 | (last as u32) << 16);
+                if first <= last {
+                    run_width = run_width.max(last - first + 1);
+                }
             }
         }
         Ok(Stencils {
@@ -407,6 +413,7 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
             side,
             reach,
             phases,
+            run_width,
         })
     }
 
@@ -473,7 +480,8 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
         let mut weights = [0.0f32; MAX_STENCIL_SIDE];
         let wide = self.wide;
         if !wide {
-            // A box up to 15 px wholly inside the image: rows of a fixed width, no clipping.
+            // A box wholly inside the image whose runs are at most 16 px: windows of a fixed
+            // width, no clipping.
             if x0 >= 0 && y0 >= 0 && x0 + b <= w && y0 + b <= h {
                 let (at, blend) = ((x0 as usize, y0 as usize), [w00, w10, w01, w11]);
                 let small = (corners, blend, spans, at);

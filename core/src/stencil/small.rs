@@ -1,5 +1,5 @@
-//! The small-box splat: [`Stencils::splat`] of a footprint up to 15 px across whose box lies
-//! wholly inside the image, with rows of a fixed width. Measured against the general loop
+//! The small-box splat: [`Stencils::splat`] of a blended footprint whose box lies wholly inside
+//! the image and whose row runs are at most 16 px, over windows of a fixed width. Measured against the general loop
 //! (`footprint bench --frames 8 --orbit 2 --threads 1`, 512×512, builds alternated): 18 % off a
 //! blobs frame (box side 7), 19 % off the walnut (11), about 20 % at sides 13 and 15 (the walnut at
 //! 640² and 760²); at side 19 (headsq, an anisotropic footprint) padding the rows cost 21 %, so
@@ -13,8 +13,8 @@ use crate::splat::{Pixel, SplatStats};
 type SmallBox<'s> = ([usize; 4], [f32; 4], &'s [f32], (usize, usize));
 
 impl<S: ?Sized> Stencils<'_, S> {
-    /// [`Stencils::splat_box`] for this view's box side if it is odd and at most 15 px (one
-    /// instance per side, each with a fixed trip count), else `None`.
+    /// [`Stencils::splat_window`] for the narrowest window W ≥ this view's longest row run if W
+    /// is at most 16 px (one instance per width, each with a fixed trip count), else `None`.
     #[inline(always)]
     pub(super) fn splat_small<P: Pixel>(
         &self,
@@ -24,28 +24,29 @@ impl<S: ?Sized> Stencils<'_, S> {
         stride: usize,
         touched: &mut impl FnMut(usize, usize, usize),
     ) -> Option<SplatStats> {
-        macro_rules! by_side {
-            ($($side:literal)*) => {
-                match self.side {
-                    $($side => self.splat_box::<$side, P>(
+        macro_rules! by_width {
+            ($($w:literal)*) => {
+                match self.run_width {
+                    $($w => self.splat_window::<$w, P>(
                         corners, blend, spans, at, value, data, stride, touched,
                     ),)*
                     _ => None,
                 }
             };
         }
-        by_side!(3 5 7 9 11 13 15)
+        by_width!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16)
     }
 
-    /// [`Stencils::splat`] of a narrow footprint whose box (side `B`) lies wholly inside the
-    /// image with its corner at pixel `at`: each row's weights are blended over the whole box
-    /// width (a fixed-length loop the compiler vectorises) and added across it. Outside a row's
-    /// stored run all four corner stencils are zero, so the weight there is +0 and the pixel is
-    /// unchanged: the same sums, statistics and touched runs as the general loop. `None` (nothing
-    /// added) if the stencils are not `B` wide.
+    /// [`Stencils::splat`] of a blended footprint whose box lies wholly inside the image with its
+    /// corner at pixel `at` and whose row runs are at most `W` px: each row's weights are blended
+    /// over a window of `W` pixels that holds the row's run (starting at the run, moved left to
+    /// stay inside the box; a fixed-length loop the compiler vectorises) and added across it.
+    /// Outside a row's stored run all four corner stencils are zero, so the weight there is +0
+    /// and the pixel is unchanged: the same sums, statistics and touched runs as the general loop.
+    /// `None` (nothing added) if a run is longer than `W` or `W` exceeds the box.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn splat_box<const B: usize, P: Pixel>(
+    fn splat_window<const W: usize, P: Pixel>(
         &self,
         corners: [usize; 4],
         [w00, w10, w01, w11]: [f32; 4],
@@ -56,35 +57,45 @@ impl<S: ?Sized> Stencils<'_, S> {
         stride: usize,
         touched: &mut impl FnMut(usize, usize, usize),
     ) -> Option<SplatStats> {
-        if self.side != B || spans.len() != B {
+        let side = self.side;
+        if W > side || self.run_width > W || spans.len() != side {
             return None;
         }
-        let grid = |s: usize| Some(self.data.get(s..s + B * B)?.as_chunks::<B>().0);
+        let cells = side * side;
+        let grid = |s: usize| self.data.get(s..s + cells);
         let (g00, g10, g01, g11) = (
             grid(corners[0])?,
             grid(corners[1])?,
             grid(corners[2])?,
             grid(corners[3])?,
         );
+        let window =
+            |g: &[f32], o: usize| -> [f32; W] { g[o..o + W].try_into().unwrap_or([0.0; W]) };
         let mut stats = SplatStats::default();
-        let rows = spans
-            .iter()
-            .zip(g00.iter().zip(g10))
-            .zip(g01.iter().zip(g11));
-        for (my, ((span, (a, b)), (c, d))) in rows.enumerate() {
+        for (my, span) in spans.iter().enumerate() {
             let bits = span.to_bits();
             let (first, last) = ((bits & 0xffff) as usize, (bits >> 16) as usize);
             if first > last {
                 continue;
             }
-            let mut wt = [0.0f32; B];
+            // last − first < run_width ≤ W, and start ≤ B − W: the window holds the run and
+            // lies inside the box row.
+            let start = first.min(side - W);
+            let o = my * side + start;
+            let (a, b, c, d) = (
+                window(g00, o),
+                window(g10, o),
+                window(g01, o),
+                window(g11, o),
+            );
+            let mut wt = [0.0f32; W];
             for (k, o) in wt.iter_mut().enumerate() {
                 *o = w00 * a[k] + w10 * b[k] + w01 * c[k] + w11 * d[k];
             }
             let y = y0 + my;
-            let start = y * stride + x0;
-            // The box is inside the image, so the row is inside the buffer ImageMut checked.
-            let px = &mut data[start..start + B];
+            let begin = y * stride + x0 + start;
+            // The box is inside the image, so the window is inside the buffer ImageMut checked.
+            let px = &mut data[begin..begin + W];
             let mut updated = 0u32;
             for (d, &w) in px.iter_mut().zip(&wt) {
                 d.add_weighted(value, w);
