@@ -108,8 +108,13 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
         splat: median(&phases[1..].iter().map(|p| p.splat).collect::<Vec<_>>()),
         composite: median(&phases[1..].iter().map(|p| p.composite).collect::<Vec<_>>()),
     };
+    let later_text = if later.is_empty() {
+        "no later frames (--frames 1)".to_string()
+    } else {
+        format!("frames 2..: median {med:.2} ms (min {min:.2}, max {max:.2})")
+    };
     crate::say!(
-        "{}: {} frames on {threads} thread(s): first {first:.2} ms; frames 2..: median {med:.2} ms (min {min:.2}, max {max:.2})",
+        "{}: {} frames on {threads} thread(s): first {first:.2} ms; {later_text}",
         p.name,
         args.frames
     );

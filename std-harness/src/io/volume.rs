@@ -128,16 +128,29 @@ impl Volume {
 
     /// Smallest and largest finite sample; (+∞, −∞) when no sample is finite.
     pub fn range(&self) -> (f32, f32) {
-        let mut lo = f32::INFINITY;
-        let mut hi = f32::NEG_INFINITY;
-        for n in 0..self.len() {
-            let v = self.value(n);
-            if v.is_finite() {
-                lo = lo.min(v);
-                hi = hi.max(v);
-            }
+        // One loop per sample type (the type settled once, not per sample).
+        fn over<T: Copy>(v: &[T], to: impl Fn(T) -> f32) -> (f32, f32) {
+            v.iter()
+                .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &x| {
+                    let v = to(x);
+                    if v.is_finite() {
+                        (lo.min(v), hi.max(v))
+                    } else {
+                        (lo, hi)
+                    }
+                })
         }
-        (lo, hi)
+        match &self.samples {
+            Samples::U8(v) => over(v, f32::from),
+            Samples::I8(v) => over(v, f32::from),
+            Samples::U16(v) => over(v, f32::from),
+            Samples::I16(v) => over(v, f32::from),
+            Samples::U32(v) => over(v, |x| x as f32),
+            Samples::I32(v) => over(v, |x| x as f32),
+            Samples::F32(v) => over(v, |x| x),
+            Samples::F64(v) => over(v, |x| x as f32),
+            Samples::Coloured(v) => over(v, |x| x.value),
+        }
     }
 
     /// Copies sheet `s` of `axis` (row-major over the other two axes, lower axis fastest) into `out`
@@ -284,4 +297,47 @@ pub fn check_spacing(spacing: [f32; 3]) -> Result<(), String> {
 /// Error with the file's name in front.
 pub fn at(path: &Path, what: impl std::fmt::Display) -> CliError {
     CliError::input(format!("{}: {what}", path.display()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Samples, Volume};
+
+    /// `range` gives, for every sample type, the smallest and largest finite value as f32, the
+    /// same as reading each sample through `value`.
+    #[test]
+    fn range_over_every_sample_type() {
+        let vol = |samples: Samples, n: usize| Volume::new([n, 1, 1], [1.0; 3], samples);
+        let cases = [
+            (vol(Samples::U8(vec![7, 3, 255, 9]), 4), (3.0, 255.0)),
+            (vol(Samples::I8(vec![-128, 5, 127]), 3), (-128.0, 127.0)),
+            (vol(Samples::U16(vec![500, 65535, 2]), 3), (2.0, 65535.0)),
+            (vol(Samples::I16(vec![-300, 12, 40]), 3), (-300.0, 40.0)),
+            (
+                vol(Samples::U32(vec![1 << 30, 6]), 2),
+                (6.0, (1u32 << 30) as f32),
+            ),
+            (vol(Samples::I32(vec![-9, 4, -2]), 3), (-9.0, 4.0)),
+            (
+                vol(Samples::F32(vec![f32::NAN, 0.5, f32::INFINITY, -2.5]), 4),
+                (-2.5, 0.5),
+            ),
+            (
+                vol(Samples::F64(vec![1e300, 3.0, f64::NEG_INFINITY, 1.5]), 4),
+                (1.5, 3.0),
+            ),
+            (
+                vol(Samples::F32(vec![f32::NAN, f32::INFINITY]), 2),
+                (f32::INFINITY, f32::NEG_INFINITY),
+            ),
+        ];
+        for (v, want) in cases {
+            assert_eq!(v.range(), want, "{:?}", v.samples);
+            let by_value = (0..v.len()).map(|n| v.value(n)).filter(|x| x.is_finite());
+            let folded = by_value.fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), x| {
+                (lo.min(x), hi.max(x))
+            });
+            assert_eq!(v.range(), folded);
+        }
+    }
 }
