@@ -8,7 +8,7 @@
 //! | `atan` | micromath | absolute 2.9e-3 rad, 0.162° (measured 2.8e-3) |
 //! | `erf` | Abramowitz & Stegun 7.1.26 on top of this `exp` | absolute 1.5e-7 + 3e-3 × p(t)e^(−x²) ≤ 3e-3, since p(t)e^(−x²) ≤ 1 (measured 5.7e-4 on ±6) |
 //! | `powf` | exp(y · ln x) with this backend's own `ln` (micromath's `ln` is 2× off near 1, its `powf` 0.24 off) and this `exp` | absolute 1e-2 for x ∈ (0, 1], y ∈ [0, 64] (measured 1.2e-3) |
-//! | `floor` | micromath | exact |
+//! | `floor` | micromath below 2²³ in magnitude; the value itself from there (every f32 is whole), and for ±∞ and NaN | exact |
 //!
 //! `sqrt` is refined because a 5 % error in an ellipse axis would move every footprint edge by
 //! 5 %; the other bounds are what micromath states. The table in `tests/math_backends.rs` measures
@@ -91,8 +91,14 @@ pub fn cos(x: f32) -> f32 {
 pub fn atan(x: f32) -> f32 {
     F32(x).atan().0
 }
+/// micromath's floor goes through `i32`, so it saturates at ±2³¹ (4·10⁹ came out as 2.1·10⁹) and
+/// turns NaN into 0: from 2²³ up every f32 is whole already, and ±∞ and NaN are their own floor,
+/// so those are returned as they are.
 #[inline]
 pub fn floor(x: f32) -> f32 {
+    if !(x.abs() < 8_388_608.0) {
+        return x;
+    }
     F32(x).floor().0
 }
 /// exp(y · ln x) with [`ln`] below and this backend's `exp`. (micromath's own `powf` and `ln` are

@@ -193,6 +193,53 @@ mod tests {
         assert!(pow_e <= f64::from(b.powf_unit_abs), "powf {pow_e:e}");
         assert_eq!(floor(-2.5), -3.0);
         assert_eq!(floor(2.5), 2.0);
+    }
+
+    /// `floor` is exact over the whole f32 range under either backend: against libm's f64 floor
+    /// on values spread over every binade (both signs), the integers near 2²³ and 2³¹ where a
+    /// conversion through `i32` would saturate, and ±∞ and NaN (their own floor).
+    #[test]
+    fn floor_is_exact_everywhere() {
+        let mut cases = std::vec![
+            0.0f32,
+            -0.0,
+            0.5,
+            -0.5,
+            1.0,
+            -1.0,
+            8_388_607.5,
+            -8_388_607.5,
+            8_388_608.0,
+            16_777_217.0,
+            2_147_483_520.0,
+            2_147_483_648.0,
+            -2_147_483_648.0,
+            4.0e9,
+            -4.0e9,
+            1.0e30,
+            -1.0e30,
+            f32::MAX,
+            f32::MIN,
+            f32::MIN_POSITIVE,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+        ];
+        let mut bits = 0x9e37_79b9u32;
+        for _ in 0..200_000 {
+            bits ^= bits << 13;
+            bits ^= bits >> 17;
+            bits ^= bits << 5;
+            let x = f32::from_bits(bits);
+            if x.is_finite() {
+                cases.push(x);
+            }
+        }
+        for x in cases {
+            let want = libm::floor(f64::from(x)) as f32;
+            let got = floor(x);
+            assert!(got == want, "floor({x:e}) = {got:e}, want {want:e}");
+        }
+        assert!(floor(f32::NAN).is_nan());
         assert_eq!(abs(-0.0f32).to_bits(), 0);
         assert!(sqrt(-1.0).is_nan());
         assert_eq!(sqrt(0.0), 0.0);
