@@ -145,13 +145,33 @@ pub fn classify(p: &Prepared, volume: &Volume, threads: usize) -> Result<Visible
             .map(|h| h.join().expect("a classification thread panicked"))
             .collect()
     });
-    let mut out = VisibleLists {
-        axis: f.sheet_axis,
-        offsets: vec![0],
-        ..Default::default()
+    let mut parts = parts.into_iter().collect::<Result<Vec<_>, _>>()?;
+    let mut out = if parts.len() == 1 {
+        // One part is the whole list: no copy.
+        parts.pop().expect("one part")
+    } else {
+        let total = |n: fn(&VisibleLists) -> usize| parts.iter().map(n).sum::<usize>();
+        let mut out = VisibleLists {
+            axis: f.sheet_axis,
+            offsets: vec![0],
+            voxels: Vec::with_capacity(total(|p| p.voxels.len())),
+            gradients: Vec::with_capacity(total(|p| p.gradients.len())),
+            colours: Vec::with_capacity(total(|p| p.colours.len())),
+            ..Default::default()
+        };
+        for part in parts {
+            out.append(part);
+        }
+        out
     };
-    for part in parts {
-        let part = part?;
+    (out.runs, out.run_offsets) = summarise(&out.offsets, &out.voxels);
+    Ok(out)
+}
+
+impl VisibleLists {
+    /// Appends the next sheets' lists (`part`, offsets relative to its first sheet).
+    fn append(&mut self, part: VisibleLists) {
+        let out = self;
         let base = out.voxels.len();
         out.offsets
             .extend(part.offsets[1..].iter().map(|&o| o + base));
@@ -159,8 +179,6 @@ pub fn classify(p: &Prepared, volume: &Volume, threads: usize) -> Result<Visible
         out.gradients.extend_from_slice(&part.gradients);
         out.colours.extend_from_slice(&part.colours);
     }
-    (out.runs, out.run_offsets) = summarise(&out.offsets, &out.voxels);
-    Ok(out)
 }
 
 /// Classifies sheets `range` of `p`'s axis (offsets relative to the range's first sheet): a
@@ -192,8 +210,11 @@ fn classify_sheets<T: Sample + Default>(
     let shader = p.shader();
     let needs_gradient = shader.shading.needs_gradient();
     let (len, axis, count) = (f.sheet_shape().0, f.sheet_axis, f.sheet_count());
-    let read = |s: usize| {
-        let mut buf = vec![T::default(); len];
+    // Sheet buffers are reused (a sheet of a 256² volume is 256 KiB: allocating each afresh
+    // costs a fresh mapping and its page faults, sheet after sheet).
+    let mut spare: Vec<Vec<T>> = Vec::new();
+    let read = |s: usize, spare: &mut Vec<Vec<T>>| {
+        let mut buf = spare.pop().unwrap_or_else(|| vec![T::default(); len]);
         fill(s, &mut buf);
         buf
     };
@@ -214,15 +235,15 @@ fn classify_sheets<T: Sample + Default>(
     let mut colours = vec![[0.0f32; 3]; if T::COLOURED { len } else { 0 }];
     // The window of neighbours slides along the range (read only when gradients need them).
     let mut lower: Option<Vec<T>> = None;
-    let mut current = range.clone().next().map(read);
+    let mut current = range.clone().next().map(|s| read(s, &mut spare));
     let mut upper: Option<Vec<T>> = None;
     for s in range.clone() {
         let cur = current.take().expect("the sheet was read");
         if needs_gradient {
             if s > 0 && lower.is_none() {
-                lower = Some(read(s - 1));
+                lower = Some(read(s - 1, &mut spare));
             }
-            upper = (s + 1 < count).then(|| read(s + 1));
+            upper = (s + 1 < count).then(|| read(s + 1, &mut spare));
         }
         let window = SheetWindow {
             lower: lower.as_deref(),
@@ -249,9 +270,14 @@ fn classify_sheets<T: Sample + Default>(
         if s + 1 < range.end {
             current = Some(match upper.take() {
                 Some(next) => next,
-                None => read(s + 1),
+                None => read(s + 1, &mut spare),
             });
-            lower = needs_gradient.then_some(cur);
+            let done = if needs_gradient {
+                lower.replace(cur)
+            } else {
+                Some(cur)
+            };
+            spare.extend(done);
         }
     }
     Ok(out)
