@@ -53,6 +53,130 @@ fn phase(c: f32, i: i64, p: usize) -> (usize, f32) {
     (k, (t - k as f32).clamp(0.0, 1.0))
 }
 
+/// Checks the splat of footprint (`s`, `a`, `deg`) ([`footprint`]) at every [`CENTRES`] against
+/// brute force, bit for bit; returns its box side and whether it is edged (`None` when no stencils
+/// apply).
+fn check_against_brute_force(
+    generic: &GenericTable<129>,
+    s: f32,
+    a: f32,
+    deg: f32,
+) -> Option<(usize, bool)> {
+    let fp = footprint(s, a, deg);
+    let table = ViewTable::<129>::build(&fp, generic, Lookup::Bilinear, Lookup::Bilinear);
+    let Some(len) = stencil::len_for(&fp, DEFAULT_PHASES) else {
+        // Only a long thin footprint may be left to the table walk.
+        let e = fp.half_extent[0].max(fp.half_extent[1]);
+        assert!(
+            e > 2.0 * minor_semi_axis(&fp),
+            "scale {s}, {a}:1 at {deg}°: no stencils"
+        );
+        return None;
+    };
+    let mut buffer = vec![0.0f32; len];
+    let st = Stencils::build(&table, DEFAULT_PHASES, &mut buffer).unwrap();
+    let r = minor_semi_axis(&fp);
+    let p = st.phases();
+    let wide = stencil::plan_for(&fp, DEFAULT_PHASES).unwrap().edged;
+    let reach = if wide { PHASE_REACH } else { BLEND_REACH };
+    assert!(
+        p == DEFAULT_PHASES || p as f32 * r >= reach,
+        "P = {p} at r = {r}"
+    );
+    println!(
+        "scale {s}, {a}:1 at {deg}°: half-extents {:?} px, minor semi-axis {r:.2} px, B = {}, P = {p}, {} KiB",
+        fp.half_extent,
+        st.side(),
+        len * 4 / 1024
+    );
+    assert!(st.side() <= MAX_STENCIL_SIDE);
+    let reach = (st.side() / 2) as i64;
+    // The stencil weight (before renormalisation) at box pixel (mx, my) for phase (a, b).
+    let raw = |pa: usize, pb: usize, mx: i64, my: i64| {
+        let q = [
+            (mx - reach) as f32 + 0.5 - pa as f32 / p as f32,
+            (my - reach) as f32 + 0.5 - pb as f32 / p as f32,
+        ];
+        if fp.contains(q) {
+            table.weight(q)
+        } else {
+            0.0
+        }
+    };
+    let sums: Vec<f32> = (0..(p + 1) * (p + 1))
+        .map(|k| {
+            let (pa, pb) = (k % (p + 1), k / (p + 1));
+            let b = st.side() as i64;
+            let mut sum = 0.0f32;
+            for my in 0..b {
+                for mx in 0..b {
+                    sum += raw(pa, pb, mx, my);
+                }
+            }
+            sum
+        })
+        .collect();
+    let stencil = |pa: usize, pb: usize, mx: i64, my: i64| {
+        let w = raw(pa, pb, mx, my);
+        if fp.renormalise {
+            w * (1.0 / sums[pb * (p + 1) + pa])
+        } else {
+            w
+        }
+    };
+    for c in CENTRES {
+        let mut got = vec![0.0f32; SIZE * SIZE];
+        let mut img = ImageMut::new(&mut got, SIZE, SIZE, SIZE).unwrap();
+        st.splat(c, &1.0f32, &mut img, |_, _, _| {}).unwrap();
+        // Brute force: the blend over the whole box.
+        let (ix, iy) = (c[0].floor() as i64, c[1].floor() as i64);
+        let ((ka, fx), (kb, fy)) = (phase(c[0], ix, p), phase(c[1], iy, p));
+        let (w00, w10, w01, w11) = (
+            (1.0 - fx) * (1.0 - fy),
+            fx * (1.0 - fy),
+            (1.0 - fx) * fy,
+            fx * fy,
+        );
+        let mut want = vec![0.0f32; SIZE * SIZE];
+        let b = st.side() as i64;
+        for my in 0..b {
+            for mx in 0..b {
+                let (x, y) = (ix - reach + mx, iy - reach + my);
+                if x < 0 || y < 0 || x >= SIZE as i64 || y >= SIZE as i64 {
+                    continue;
+                }
+                let corners = [
+                    stencil(ka, kb, mx, my),
+                    stencil(ka + 1, kb, mx, my),
+                    stencil(ka, kb + 1, mx, my),
+                    stencil(ka + 1, kb + 1, mx, my),
+                ];
+                let q = [x as f32 + 0.5 - c[0], y as f32 + 0.5 - c[1]];
+                // Wide: only pixel centres inside the support (the table walk's rows), and
+                // the sampler itself where a corner stencil is zero.
+                let inside = fp.row_span(q[1]).is_some_and(|(lo, hi)| {
+                    let (x0, x1) = ((c[0] + lo - 0.5).ceil(), (c[0] + hi - 0.5).floor());
+                    x as f32 >= x0 && x as f32 <= x1
+                });
+                want[y as usize * SIZE + x as usize] = if wide && !inside {
+                    0.0
+                } else if wide && corners.contains(&0.0) {
+                    table.weight(q)
+                } else {
+                    w00 * corners[0] + w10 * corners[1] + w01 * corners[2] + w11 * corners[3]
+                };
+            }
+        }
+        for (i, (g, w)) in got.iter().zip(&want).enumerate() {
+            assert!(
+                g.to_bits() == w.to_bits(),
+                "scale {s}, {a}:1 at {deg}°, centre {c:?}: pixel {i} is {g}, brute force {w}"
+            );
+        }
+    }
+    Some((st.side(), wide))
+}
+
 #[test]
 fn stencils_cover_every_size_and_skip_only_zeros() {
     let generic = GenericTable::<129>::build(Kernel::PAPER_GAUSSIAN);
@@ -60,120 +184,11 @@ fn stencils_cover_every_size_and_skip_only_zeros() {
     // Boxes wider than 16 px blended to the edge, and read at the edge.
     let mut kinds = [0, 0];
     for &(s, a, deg) in &SHAPES {
-        let fp = footprint(s, a, deg);
-        let table = ViewTable::<129>::build(&fp, &generic, Lookup::Bilinear, Lookup::Bilinear);
-        let Some(len) = stencil::len_for(&fp, DEFAULT_PHASES) else {
-            // Only a long thin footprint may be left to the table walk.
-            let e = fp.half_extent[0].max(fp.half_extent[1]);
-            assert!(
-                e > 2.0 * minor_semi_axis(&fp),
-                "scale {s}, {a}:1 at {deg}°: no stencils"
-            );
+        let Some((side, wide)) = check_against_brute_force(&generic, s, a, deg) else {
             continue;
         };
-        let mut buffer = vec![0.0f32; len];
-        let st = Stencils::build(&table, DEFAULT_PHASES, &mut buffer).unwrap();
-        let r = minor_semi_axis(&fp);
-        let p = st.phases();
-        let wide = stencil::plan_for(&fp, DEFAULT_PHASES).unwrap().edged;
-        let reach = if wide { PHASE_REACH } else { BLEND_REACH };
-        assert!(
-            p == DEFAULT_PHASES || p as f32 * r >= reach,
-            "P = {p} at r = {r}"
-        );
-        kinds[usize::from(wide)] += usize::from(st.side() > 16);
-        println!(
-            "scale {s}, {a}:1 at {deg}°: half-extents {:?} px, minor semi-axis {r:.2} px, B = {}, P = {p}, {} KiB",
-            fp.half_extent,
-            st.side(),
-            len * 4 / 1024
-        );
-        assert!(st.side() <= MAX_STENCIL_SIDE);
-        covered += usize::from(st.side() > 16);
-        let reach = (st.side() / 2) as i64;
-        // The stencil weight (before renormalisation) at box pixel (mx, my) for phase (a, b).
-        let raw = |pa: usize, pb: usize, mx: i64, my: i64| {
-            let q = [
-                (mx - reach) as f32 + 0.5 - pa as f32 / p as f32,
-                (my - reach) as f32 + 0.5 - pb as f32 / p as f32,
-            ];
-            if fp.contains(q) {
-                table.weight(q)
-            } else {
-                0.0
-            }
-        };
-        let sums: Vec<f32> = (0..(p + 1) * (p + 1))
-            .map(|k| {
-                let (pa, pb) = (k % (p + 1), k / (p + 1));
-                let b = st.side() as i64;
-                let mut sum = 0.0f32;
-                for my in 0..b {
-                    for mx in 0..b {
-                        sum += raw(pa, pb, mx, my);
-                    }
-                }
-                sum
-            })
-            .collect();
-        let stencil = |pa: usize, pb: usize, mx: i64, my: i64| {
-            let w = raw(pa, pb, mx, my);
-            if fp.renormalise {
-                w * (1.0 / sums[pb * (p + 1) + pa])
-            } else {
-                w
-            }
-        };
-        for c in CENTRES {
-            let mut got = vec![0.0f32; SIZE * SIZE];
-            let mut img = ImageMut::new(&mut got, SIZE, SIZE, SIZE).unwrap();
-            st.splat(c, &1.0f32, &mut img, |_, _, _| {}).unwrap();
-            // Brute force: the blend over the whole box.
-            let (ix, iy) = (c[0].floor() as i64, c[1].floor() as i64);
-            let ((ka, fx), (kb, fy)) = (phase(c[0], ix, p), phase(c[1], iy, p));
-            let (w00, w10, w01, w11) = (
-                (1.0 - fx) * (1.0 - fy),
-                fx * (1.0 - fy),
-                (1.0 - fx) * fy,
-                fx * fy,
-            );
-            let mut want = vec![0.0f32; SIZE * SIZE];
-            let b = st.side() as i64;
-            for my in 0..b {
-                for mx in 0..b {
-                    let (x, y) = (ix - reach + mx, iy - reach + my);
-                    if x < 0 || y < 0 || x >= SIZE as i64 || y >= SIZE as i64 {
-                        continue;
-                    }
-                    let corners = [
-                        stencil(ka, kb, mx, my),
-                        stencil(ka + 1, kb, mx, my),
-                        stencil(ka, kb + 1, mx, my),
-                        stencil(ka + 1, kb + 1, mx, my),
-                    ];
-                    let q = [x as f32 + 0.5 - c[0], y as f32 + 0.5 - c[1]];
-                    // Wide: only pixel centres inside the support (the table walk's rows), and
-                    // the sampler itself where a corner stencil is zero.
-                    let inside = fp.row_span(q[1]).is_some_and(|(lo, hi)| {
-                        let (x0, x1) = ((c[0] + lo - 0.5).ceil(), (c[0] + hi - 0.5).floor());
-                        x as f32 >= x0 && x as f32 <= x1
-                    });
-                    want[y as usize * SIZE + x as usize] = if wide && !inside {
-                        0.0
-                    } else if wide && corners.contains(&0.0) {
-                        table.weight(q)
-                    } else {
-                        w00 * corners[0] + w10 * corners[1] + w01 * corners[2] + w11 * corners[3]
-                    };
-                }
-            }
-            for (i, (g, w)) in got.iter().zip(&want).enumerate() {
-                assert!(
-                    g.to_bits() == w.to_bits(),
-                    "scale {s}, {a}:1 at {deg}°, centre {c:?}: pixel {i} is {g}, brute force {w}"
-                );
-            }
-        }
+        kinds[usize::from(wide)] += usize::from(side > 16);
+        covered += usize::from(side > 16);
     }
     assert!(
         covered >= 2,
@@ -183,6 +198,23 @@ fn stencils_cover_every_size_and_skip_only_zeros() {
         kinds[0] >= 1 && kinds[1] >= 1,
         "wide footprints blended to the edge and read at the edge: {kinds:?}"
     );
+}
+
+/// Round footprints from 0.5 to 5.2 px per voxel step: every window width of the small-box
+/// splat (row runs of 3 to 17 px, including the runs of 7 and 12 px it blends over one pixel more,
+/// and the runs from 16 px up it leaves to the general loop), against brute force.
+#[test]
+fn every_window_width_matches_brute_force() {
+    let generic = GenericTable::<129>::build(Kernel::PAPER_GAUSSIAN);
+    let mut sides = Vec::new();
+    for i in 0..40 {
+        let s = 0.5 + i as f32 * 0.12;
+        if let Some((side, _)) = check_against_brute_force(&generic, s, 1.0, 0.0) {
+            sides.push(side);
+        }
+    }
+    assert_eq!(sides.len(), 40);
+    assert!(sides.contains(&5) && sides.contains(&19), "{sides:?}");
 }
 
 #[test]

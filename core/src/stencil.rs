@@ -56,6 +56,7 @@ use crate::splat::{
     floor_i64, row_pixels, BufferError, ImageMut, Pixel, Sampler, SplatStats, Splatter,
 };
 
+mod row;
 mod small;
 
 /// Largest number of phases per pixel the harness uses ([`phases_for`] lowers it for
@@ -480,7 +481,7 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
         let mut weights = [0.0f32; MAX_STENCIL_SIDE];
         let wide = self.wide;
         if !wide {
-            // A box wholly inside the image whose runs are at most 16 px: windows of a fixed
+            // A box wholly inside the image whose runs are at most 15 px: windows of a fixed
             // width, no clipping.
             if x0 >= 0 && y0 >= 0 && x0 + b <= w && y0 + b <= h {
                 let (at, blend) = ((x0 as usize, y0 as usize), [w00, w10, w01, w11]);
@@ -512,11 +513,8 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
                 let start = y * stride + lo as usize;
                 // Clipped to the image, so the range is inside the buffer ImageMut checked.
                 let px = &mut data[start..start + n];
-                for (k, d) in px.iter_mut().enumerate() {
-                    let wt = w00 * r00[k] + w10 * r10[k] + w01 * r01[k] + w11 * r11[k];
-                    d.add_weighted(value, wt);
-                    stats.pixels_updated += u32::from(wt != 0.0);
-                }
+                let rows = (r00, r10, r01, r11);
+                stats.pixels_updated += row::blend_row([w00, w10, w01, w11], rows, value, px);
                 stats.pixels_visited += n as u32;
                 touched(y, lo as usize, hi as usize);
             }

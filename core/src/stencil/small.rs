@@ -1,12 +1,12 @@
 //! The small-box splat: [`Stencils::splat`] of a blended footprint whose box lies wholly inside
-//! the image and whose row runs are at most 16 px, over windows of a fixed width.
+//! the image and whose row runs are at most 15 px, over windows of a fixed width.
 //!
 //! Measured (`footprint bench --frames 8 --orbit 2 --threads 1`, 512×512, builds alternated):
 //! - Rows of the whole box's width, against the general loop: 18 % off a blobs frame (box side
 //!   7), 19 % off the walnut (11), about 20 % at sides 13 and 15 (the walnut at 640² and 760²); at
 //!   side 19 (headsq, half-extents 7.4 × 8.0 px) padding the rows to the box cost 21 %.
 //! - Windows as wide as the view's longest row run, against whole-box rows: blobs 65.6 → 59.3
-//!   ms (runs ≤ 5 px in a box of 7), walnut 40.6 → 37.4 ms, and the CT head, whose runs fit 16 px
+//!   ms (runs ≤ 5 px in a box of 7), walnut 40.6 → 37.4 ms, and the CT head, whose runs fit 15 px
 //!   in its box of 19, 47.3 → 36.0 ms against the general loop. Windows of 17–32 px were slower
 //!   than the general loop (headsq at 1024²: 151 → 188 ms), so longer runs take it.
 
@@ -17,9 +17,24 @@ use crate::splat::{Pixel, SplatStats};
 /// cell's row runs and the box's corner pixel.
 type SmallBox<'s> = ([usize; 4], [f32; 4], &'s [f32], (usize, usize));
 
+/// The window for row runs of at most `run` px in a box of `side`: `run` itself, one pixel wider
+/// at 7 and 12 (those two instances compile to slower code than the next width's), and 0 (no
+/// window: the general loop, [`super::row`]) from 16 px up, where that loop is faster. Measured by splatting
+/// 200 000 voxels on a lattice into a 512² image per footprint size (ns per voxel, window of the
+/// run's width against the next wider window and the general loop): run 7 67.8–73.4 against
+/// 61.5–65.3 at width 8; run 12 162–171 against 136 at 13 and 134–143 general; run 15 173–178
+/// against 199–202 general; run 16 267–273 against 213–218 general; run 17 general 217–222.
+fn window_for(run: usize, side: usize) -> usize {
+    match run {
+        7 | 12 if run < side => run + 1,
+        1..=15 => run,
+        _ => 0,
+    }
+}
+
 impl<S: ?Sized> Stencils<'_, S> {
-    /// [`Stencils::splat_window`] for the narrowest window W ≥ this view's longest row run if W
-    /// is at most 16 px (one instance per width, each with a fixed trip count), else `None`.
+    /// [`Stencils::splat_window`] for this view's longest row run if [`window_for`] gives it a
+    /// window (one instance per width, each with a fixed trip count), else `None`.
     #[inline(always)]
     pub(super) fn splat_small<P: Pixel>(
         &self,
@@ -29,9 +44,10 @@ impl<S: ?Sized> Stencils<'_, S> {
         stride: usize,
         touched: &mut impl FnMut(usize, usize, usize),
     ) -> Option<SplatStats> {
+        let width = window_for(self.run_width, self.side);
         macro_rules! by_width {
             ($($w:literal)*) => {
-                match self.run_width {
+                match width {
                     $($w => self.splat_window::<$w, P>(
                         corners, blend, spans, at, value, data, stride, touched,
                     ),)*
@@ -39,7 +55,7 @@ impl<S: ?Sized> Stencils<'_, S> {
                 }
             };
         }
-        by_width!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16)
+        by_width!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15)
     }
 
     /// [`Stencils::splat`] of a blended footprint whose box lies wholly inside the image with its
