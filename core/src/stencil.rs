@@ -56,8 +56,11 @@ use crate::splat::{
     floor_i64, row_pixels, BufferError, ImageMut, Pixel, Sampler, SplatStats, Splatter,
 };
 
+mod fill;
 mod row;
 mod small;
+
+pub use fill::StencilFill;
 
 /// Largest number of phases per pixel the harness uses ([`phases_for`] lowers it for
 /// footprints wider than [`NARROW_SIDE`]).
@@ -248,55 +251,8 @@ pub struct Stencils<'a, S: ?Sized> {
     phases: usize,
     /// The longest stored row run, pixels (0 when every run is empty).
     run_width: usize,
-}
-
-/// Samples single stencils of a view's phase stencils for [`Stencils::build_split`].
-#[derive(Debug)]
-pub struct StencilFill<'a, S: ?Sized> {
-    sampler: &'a S,
-    side: usize,
-    phases: usize,
-    reach: i64,
-}
-
-impl<S: Sampler + ?Sized> StencilFill<'_, S> {
-    /// Weights per stencil, B².
-    pub fn cells(&self) -> usize {
-        self.side * self.side
-    }
-
-    /// Fills stencil `k` (phase (k mod (P + 1), k div (P + 1)) on the (P + 1)² grid; `stencil`
-    /// holds [`StencilFill::cells`] weights): the sampler's weight (px⁻²) at each box pixel inside
-    /// the support, zero outside, divided by the sum for a renormalised footprint.
-    pub fn fill(&self, k: usize, stencil: &mut [f32]) {
-        let (sampler, side, phases, reach) = (self.sampler, self.side, self.phases, self.reach);
-        let fp = sampler.footprint();
-        let (pa, pb) = (k % (phases + 1), k / (phases + 1));
-        let phase = [pa as f32 / phases as f32, pb as f32 / phases as f32];
-        let mut sum = 0.0f32;
-        for (my, row) in stencil.chunks_exact_mut(side).enumerate() {
-            let qy = (my as i64 - reach) as f32 + 0.5 - phase[1];
-            for (mx, w) in row.iter_mut().enumerate() {
-                let q = [(mx as i64 - reach) as f32 + 0.5 - phase[0], qy];
-                *w = if fp.contains(q) {
-                    sampler.weight(q)
-                } else {
-                    0.0
-                };
-                sum += *w;
-            }
-        }
-        if fp.renormalise {
-            if sum > 0.0 {
-                let inv = 1.0 / sum;
-                stencil.iter_mut().for_each(|w| *w *= inv);
-            } else {
-                // No pixel centre saw the footprint: the whole voxel goes to its own pixel.
-                stencil.fill(0.0);
-                stencil[reach as usize * side + reach as usize] = 1.0;
-            }
-        }
-    }
+    /// log₂ P when P is a power of two (see [`Stencils::splat`]'s scaled centre).
+    phase_shift: Option<u32>,
 }
 
 impl<S: ?Sized> Clone for Stencils<'_, S> {
@@ -415,6 +371,7 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
             reach,
             phases,
             run_width,
+            phase_shift: phases.is_power_of_two().then(|| phases.trailing_zeros()),
         })
     }
 
@@ -446,20 +403,41 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
             return Err(BufferError::NonFiniteCenter);
         }
         let (w, h) = (image.width() as i64, image.height() as i64);
-        let (ix, iy) = (floor_i64(center[0]), floor_i64(center[1]));
+        let p = self.phases;
+        // With P = 2^s phases the centre scaled by P, T = c·P, is exact, and one floor j = ⌊T⌋
+        // gives both the pixel (j >> s) and the phase cell (j mod P), and the fraction T − j is
+        // exact too (|T| < 2²⁴). For a box inside the image (c ≥ 1, so c − ⌊c⌋ is exact) that is
+        // bit for bit the general formula below, (c − ⌊c⌋)·P split into its floor and fraction,
+        // with two float-integer conversions fewer per axis.
+        let scaled = self.phase_shift.and_then(|s| {
+            let t = center.map(|c| c * p as f32);
+            (t[0].abs() < 16_777_216.0 && t[1].abs() < 16_777_216.0)
+                .then(|| (s, t, t.map(floor_i64)))
+        });
+        let (ix, iy) = match scaled {
+            Some((s, _, j)) => (j[0] >> s, j[1] >> s),
+            None => (floor_i64(center[0]), floor_i64(center[1])),
+        };
         let (x0, y0) = (ix - self.reach, iy - self.reach);
         let b = self.side as i64;
         let mut stats = SplatStats::default();
         if x0 + b <= 0 || y0 + b <= 0 || x0 >= w || y0 >= h {
             return Ok(stats);
         }
-        let p = self.phases;
+        let inside = x0 >= 0 && y0 >= 0 && x0 + b <= w && y0 + b <= h;
         let phase = |c: f32, i: i64| {
             let t = (c - i as f32) * p as f32;
             let k = (t.max(0.0) as usize).min(p - 1);
             (k, (t - k as f32).clamp(0.0, 1.0))
         };
-        let ((ka, fx), (kb, fy)) = (phase(center[0], ix), phase(center[1], iy));
+        let ((ka, fx), (kb, fy)) = match scaled {
+            Some((_, t, j)) if inside => {
+                let cell =
+                    |t: f32, j: i64| ((j as usize) & (p - 1), (t - j as f32).clamp(0.0, 1.0));
+                (cell(t[0], j[0]), cell(t[1], j[1]))
+            }
+            _ => (phase(center[0], ix), phase(center[1], iy)),
+        };
         let side = self.side;
         let corners = corner_offsets(ka, kb, p, side * side);
         let (w00, w10, w01, w11) = (
@@ -483,7 +461,7 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
         if !wide {
             // A box wholly inside the image whose runs are at most 15 px: windows of a fixed
             // width, no clipping.
-            if x0 >= 0 && y0 >= 0 && x0 + b <= w && y0 + b <= h {
+            if inside {
                 let (at, blend) = ((x0 as usize, y0 as usize), [w00, w10, w01, w11]);
                 let small = (corners, blend, spans, at);
                 if let Some(stats) = self.splat_small(small, value, data, stride, &mut touched) {
