@@ -411,8 +411,8 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
         // with two float-integer conversions fewer per axis.
         let scaled = self.phase_shift.and_then(|s| {
             let t = center.map(|c| c * p as f32);
-            (t[0].abs() < 16_777_216.0 && t[1].abs() < 16_777_216.0)
-                .then(|| (s, t, t.map(floor_i64)))
+            (t[0].abs() < small::SMALL_FLOOR_MAX && t[1].abs() < small::SMALL_FLOOR_MAX)
+                .then(|| (s, t, t.map(small::small_floor)))
         });
         let (ix, iy) = match scaled {
             Some((s, _, j)) => (j[0] >> s, j[1] >> s),

@@ -13,6 +13,20 @@
 use super::Stencils;
 use crate::splat::{Pixel, SplatStats};
 
+/// Magnitudes below which [`small_floor`] is exact: 2²².
+pub(super) const SMALL_FLOOR_MAX: f32 = 4_194_304.0;
+
+/// ⌊x⌋ for |x| < [`SMALL_FLOOR_MAX`] without a float-to-integer conversion: adding 1.5·2²³ rounds
+/// x to a whole number (to nearest, the default rounding) held in the sum's low mantissa bits,
+/// read as an integer; one less where that rounded up.
+#[inline]
+pub(super) fn small_floor(x: f32) -> i64 {
+    const MAGIC: f32 = 12_582_912.0; // 1.5·2²³
+    let s = x + MAGIC;
+    let rounded = i64::from(s.to_bits() as i32 - MAGIC.to_bits() as i32);
+    rounded - i64::from(s - MAGIC > x)
+}
+
 /// Where a small box goes: the four corner stencils' offsets, their blend weights, the phase
 /// cell's row runs and the box's corner pixel.
 type SmallBox<'s> = ([usize; 4], [f32; 4], &'s [f32], (usize, usize));
@@ -127,5 +141,30 @@ impl<S: ?Sized> Stencils<'_, S> {
             touched(y, x0 + first, x0 + last);
         }
         Some(stats)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// `small_floor` is ⌊x⌋ over its whole range: every whole number and half-way point near the
+    /// edges, values just either side of whole numbers, and a million spread over the range.
+    #[test]
+    fn small_floor_is_floor() {
+        let max = super::SMALL_FLOOR_MAX;
+        let mut xs = std::vec![0.0f32, -0.0, 0.5, -0.5, 1.0, -1.0, max - 0.5, -max + 0.5];
+        for n in [-4_194_303i32, -1000, -2, -1, 0, 1, 2, 1000, 4_194_303] {
+            let v = n as f32;
+            xs.extend([v, v + 0.5, v.next_up(), v.next_down()]);
+        }
+        let mut bits = 0x2545_f491u32;
+        for _ in 0..1_000_000 {
+            bits ^= bits << 13;
+            bits ^= bits >> 17;
+            bits ^= bits << 5;
+            xs.push((bits as f32 / u32::MAX as f32 * 2.0 - 1.0) * max);
+        }
+        for x in xs.into_iter().filter(|x| x.abs() < max) {
+            assert_eq!(super::small_floor(x), x.floor() as i64, "{x}");
+        }
     }
 }
