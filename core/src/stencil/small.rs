@@ -33,11 +33,13 @@ type SmallBox<'s> = ([usize; 4], [f32; 4], &'s [f32], (usize, usize));
 
 /// The window for row runs of at most `run` px in a box of `side`: `run` itself, one pixel wider
 /// at 7 and 12 (those two instances compile to slower code than the next width's), and 0 (no
-/// window: the general loop, [`super::row`]) from 16 px up, where that loop is faster. Measured by splatting
-/// 200 000 voxels on a lattice into a 512² image per footprint size (ns per voxel, window of the
-/// run's width against the next wider window and the general loop): run 7 67.8–73.4 against
-/// 61.5–65.3 at width 8; run 12 162–171 against 136 at 13 and 134–143 general; run 15 173–178
-/// against 199–202 general; run 16 267–273 against 213–218 general; run 17 general 217–222.
+/// window: the general loop, [`super::row`]) from 16 px up, where that loop is faster.
+///
+/// Measured by splatting 200 000 voxels on a lattice into a 512² image per footprint size (ns
+/// per voxel, window of the run's width against the next wider window and the general loop):
+/// run 7 67.8–73.4 against 61.5–65.3 at width 8; run 12 162–171 against 136 at 13 and 134–143
+/// general; run 15 173–178 against 199–202 general; run 16 267–273 against 213–218 general; run
+/// 17 general 217–222.
 fn window_for(run: usize, side: usize) -> usize {
     match run {
         7 | 12 if run < side => run + 1,

@@ -59,9 +59,10 @@ pub const MARGIN_DB: f64 = 1.0;
 /// The charts re-drawn later the same day (after the window splat and the scaled-centre phases)
 /// put the classes in the same order except the first two: view-table float nearest 1.24 / 1.40
 /// against bilinear 1.43 / 1.42 (on the built-in scene nearest is 13–15 % faster at equal N;
-/// why is not measured), fixed 2.78–3.13, direct 5.46–9.86. These constants are kept until `--quality`'s validation is re-run with nearest
-/// first: the 45 `verify --quality` runs CI makes (every shared volume, three views, 30/40/50 dB)
-/// all met their targets with it, but its choices and their documentation would change.
+/// why is not measured), fixed 2.78–3.13, direct 5.46–9.86. These constants are kept until
+/// `--quality`'s validation is re-run with nearest first: the 45 `verify --quality` runs CI
+/// makes (every shared volume, three views, 30/40/50 dB) all met their targets with it, but its
+/// choices and their documentation would change.
 pub const RELATIVE_COST: [(LookupArg, MethodArg, AccumArg, f64); 8] = [
     (
         LookupArg::Bilinear,

@@ -82,6 +82,20 @@ impl VisibleLists {
     pub fn is_empty(&self) -> bool {
         self.voxels.is_empty()
     }
+
+    /// Appends the next sheets' lists (`part`, offsets relative to its first sheet).
+    fn append(&mut self, part: VisibleLists) {
+        let base = self.voxels.len();
+        self.offsets
+            .extend(part.offsets[1..].iter().map(|&o| o + base));
+        let base = self.runs.len();
+        self.run_offsets
+            .extend(part.run_offsets[1..].iter().map(|&o| o + base));
+        self.runs.extend_from_slice(&part.runs);
+        self.voxels.extend_from_slice(&part.voxels);
+        self.gradients.extend_from_slice(&part.gradients);
+        self.colours.extend_from_slice(&part.colours);
+    }
 }
 
 /// Per-volume state kept across frames of one volume, transfer function and shading: the visible
@@ -150,23 +164,6 @@ pub fn classify(p: &Prepared, volume: &Volume, threads: usize) -> Result<Visible
         out
     };
     Ok(out)
-}
-
-impl VisibleLists {
-    /// Appends the next sheets' lists (`part`, offsets relative to its first sheet).
-    fn append(&mut self, part: VisibleLists) {
-        let out = self;
-        let base = out.voxels.len();
-        out.offsets
-            .extend(part.offsets[1..].iter().map(|&o| o + base));
-        let base = out.runs.len();
-        out.run_offsets
-            .extend(part.run_offsets[1..].iter().map(|&o| o + base));
-        out.runs.extend_from_slice(&part.runs);
-        out.voxels.extend_from_slice(&part.voxels);
-        out.gradients.extend_from_slice(&part.gradients);
-        out.colours.extend_from_slice(&part.colours);
-    }
 }
 
 /// Classifies sheets `range` of `p`'s axis (offsets relative to the range's first sheet): a
