@@ -17,10 +17,11 @@
 # --opacity-unit-distance 1; VolPack's per-slice opacity equals it at unit spacing).
 #
 # Per volume and repetition, in this order: Footprint float 1 thread, float 2 threads, fixed 1
-# thread (each `footprint bench --frames N --orbit 2`: first_ms = fresh volume, median_ms =
-# re-render), VTK vtkFixedPointVolumeRayCastMapper 1 and 2 threads, VolPack pre-classified. The
+# thread, float with --subsample auto on 1 and 2 threads (each `footprint bench --frames N --orbit
+# 2`: first_ms = fresh volume, median_ms = re-render), VTK vtkFixedPointVolumeRayCastMapper 1 and 2 threads, VolPack pre-classified. The
 # medians over the repetitions go to docs/performance.md as ratios; the raw rows to
-# docs/perf/peers.csv. Then the scaling runs (Footprint only): frame time against image size
+# docs/perf/peers.csv. Once per volume, `footprint verify --reference continuous` with
+# --subsample 1 and auto measures what subsampling costs in accuracy (docs/perf/subsample.csv). Then the scaling runs (Footprint only): frame time against image size
 # (128^2 ... 2048^2, blobs) and against volume size (64^3 ... 512^3, synthetic blobs), charted in
 # docs/charts/perf-scaling.svg/.png with docs/perf/scaling.csv.
 set -euo pipefail
@@ -80,6 +81,8 @@ volumes=(
 
 csv=docs/perf/peers.csv
 echo "volume,rep,renderer,threads,accum,first_ms,median_ms" > "$csv"
+acsv=docs/perf/subsample.csv
+echo "volume,subsample,factor,psnr_f64_db,psnr_continuous_db" > "$acsv"
 for spec in "${volumes[@]}"; do
   IFS='|' read -r name dims spacing ramp <<<"$spec"
   read -r nx ny nz <<<"$dims"; read -r sx sy sz <<<"$spacing"; read -r lo hi <<<"$ramp"
@@ -106,6 +109,13 @@ PY
           --size 512x512 --view-matrix "$vm" --frames "$frames" --orbit 2)
   "$fp" render "$raw" --dims "$nx,$ny,$nz" --type u8 --spacing "$sx,$sy,$sz" --window "$lo,$hi" --tf grey \
     --size 512x512 --view-matrix "$vm" --out "$work/out/fp-$name.png" >/dev/null
+  # What --subsample auto costs in accuracy on this view: against the full-size f64 reference
+  # (the splatting itself) and against the continuous integral, beside the full-size render's.
+  for sub in 1 auto; do
+    "$fp" verify "$raw" --dims "$nx,$ny,$nz" --type u8 --spacing "$sx,$sy,$sz" --window "$lo,$hi" --tf grey \
+      --size 512x512 --view-matrix "$vm" --subsample "$sub" --reference continuous --json "$work/v.json" >/dev/null
+    "$py" -c "import json; j=json.load(open('$work/v.json')); print(f'$name,$sub,{int(j[\"subsample\"])},{j[\"overall\"][\"psnr_db\"]:.2f},{j[\"continuous\"][\"psnr_db\"]:.2f}')" >> "$acsv"
+  done
   "$work/vp_bench" "$raw" "$nx" "$ny" "$nz" "$sx" "$sy" "$sz" 512 512 30 20 "$lo" "$hi" 3 "$work/out/vp-$name" classified grey >/dev/null
   "$py" - "$work/out" "$name" "docs/images/peers-$name.png" <<'PY'
 import sys, numpy as np
@@ -118,10 +128,11 @@ print(f"{name}: mean RGB  footprint {fp.mean():.2f}  vtk {vt.mean():.2f}  volpac
 Image.fromarray(np.concatenate([fp, vt, vp], 1)).resize((768, 256)).save(dest)
 PY
   for rep in $(seq 1 "$reps"); do
-    for cfg in "1 float" "2 float" "1 fixed"; do
-      read -r th acc <<<"$cfg"
-      "$fp" bench "${common[@]}" --threads "$th" --accum "$acc" --json "$work/b.json" >/dev/null
-      "$py" -c "import json,sys; j=json.load(open('$work/b.json')); print(f'$name,$rep,footprint,$th,$acc,{j[\"first_ms\"]:.3f},{j[\"median_ms\"]:.3f}')" >> "$csv"
+    for cfg in "1 float 1" "2 float 1" "1 fixed 1" "1 float auto" "2 float auto"; do
+      read -r th acc sub <<<"$cfg"
+      "$fp" bench "${common[@]}" --threads "$th" --accum "$acc" --subsample "$sub" --json "$work/b.json" >/dev/null
+      label=$acc; [ "$sub" = auto ] && label=$acc-subsample
+      "$py" -c "import json,sys; j=json.load(open('$work/b.json')); print(f'$name,$rep,footprint,$th,$label,{j[\"first_ms\"]:.3f},{j[\"median_ms\"]:.3f}')" >> "$csv"
     done
     for th in 1 2; do
       vtk "$th"
@@ -167,5 +178,5 @@ PY
 done
 
 echo "== docs/performance.md"
-"$py" "$root/benches/peers_report.py" "$csv" "$scsv" docs/performance.md docs/charts/perf-scaling
+"$py" "$root/benches/peers_report.py" "$csv" "$scsv" docs/performance.md docs/charts/perf-scaling "$acsv"
 echo "wrote docs/performance.md, docs/perf/*.csv, docs/charts/perf-scaling.{svg,png}, docs/images/peers-*.png"

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Writes docs/performance.md and the scaling chart from the CSVs benches/peers.sh measured.
 
-usage: peers_report.py PEERS.csv SCALING.csv OUT.md CHART_STEM
+usage: peers_report.py PEERS.csv SCALING.csv OUT.md CHART_STEM [SUBSAMPLE.csv]
 Every ratio is of medians over the repetitions, all measured alternately in one session.
 """
 import csv
@@ -18,6 +18,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import matplotlib.ticker  # noqa: E402,F401
 
 peers_csv, scaling_csv, out_md, stem = sys.argv[1:5]
+sub_csv = sys.argv[5] if len(sys.argv) > 5 else None
 rows = list(csv.DictReader(open(peers_csv)))
 volumes = list(dict.fromkeys(r["volume"] for r in rows))
 
@@ -76,6 +77,36 @@ lines += [
 ]
 for v, a, b, c, d, e in ratios:
     lines.append(f"| {v} | {a:.2f}× | {b:.2f}× | {c:.1f}× | {d:.2f}× | {e:.2f}× |")
+
+if any(r["accum"] == "float-subsample" for r in rows):
+    acc = {}
+    if sub_csv:
+        for r in csv.DictReader(open(sub_csv)):
+            acc[(r["volume"], r["subsample"])] = r
+    lines += [
+        "",
+        "### With `--subsample auto` (image-space level of detail, off by default)",
+        "",
+        "The frame rendered at 1/s of the size and resampled with Catmull-Rom (README, \"Subsampling\"); "
+        "s keeps the footprints' shorter semi-axis ≥ 2 px (1 = unchanged). Same runs as above, float. "
+        "Accuracy from `footprint verify --reference continuous` on the same view: *f64* is against the "
+        "full-size f64 splatting reference (what subsampling changes), *continuous* against the "
+        "volume-rendering integral, each as full size → `auto`.",
+        "",
+        "| volume | s | fresh, 1 thread | re-render, 1 thread | re-render, 2 threads | VTK 1 thread ÷ fresh [≥ 5] | re-render ÷ VolPack [≤ 2] | 1 ÷ 2 threads | PSNR against f64 | PSNR against the integral |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for v in volumes:
+        f1 = med(v, "footprint", 1, "float-subsample", "first_ms")
+        r1 = med(v, "footprint", 1, "float-subsample", "median_ms")
+        r2 = med(v, "footprint", 2, "float-subsample", "median_ms")
+        t1 = med(v, "vtk", 1, "-", "median_ms")
+        vp = med(v, "volpack", 1, "-", "median_ms")
+        a, full = acc.get((v, "auto")), acc.get((v, "1"))
+        s_ = a["factor"] if a else "?"
+        f64s = f"{float(full['psnr_f64_db']):.1f} → {float(a['psnr_f64_db']):.1f} dB" if a and full else "–"
+        cont = f"{float(full['psnr_continuous_db']):.2f} → {float(a['psnr_continuous_db']):.2f} dB" if a and full else "–"
+        lines.append(f"| {v} | {s_} | {f1:.1f} ms | {r1:.1f} ms | {r2:.1f} ms | {t1 / f1:.2f}× | {r1 / vp:.1f}× | {r1 / r2:.2f}× | {f64s} | {cont} |")
 
 srows = list(csv.DictReader(open(scaling_csv)))
 fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))

@@ -5,8 +5,8 @@
 //!
 //! Prints and writes (`--json`): `first_ms`, `median_ms`, `min_ms`, `max_ms` (over frames 2…N;
 //! null when N = 1), `threads`, `phases_ms` (frame 1: `classify`, `tables`, `splat`,
-//! `composite`), `rerender_phases_ms` (the same, medians over frames 2…N), `frames_ms` (every
-//! frame), `frames`, `orbit_deg`, and the render summary's fields.
+//! `composite`, and `resample` for `--subsample`), `rerender_phases_ms` (the same, medians over
+//! frames 2…N), `frames_ms` (every frame), `frames`, `orbit_deg`, and the render summary's fields.
 
 use crate::args::RenderArgs;
 use crate::io::{self, json::Json};
@@ -45,6 +45,7 @@ fn phases_json(p: &Phases) -> Json {
         .num("tables", p.tables * 1e3)
         .num("splat", p.splat * 1e3)
         .num("composite", p.composite * 1e3)
+        .num("resample", p.resample * 1e3)
 }
 
 pub fn run(args: &BenchArgs) -> Result<(), CliError> {
@@ -81,13 +82,14 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
         }
         let f = render_frame(&p, &a, a.accum, &mut cache)?;
         crate::say!(
-            "frame {:>3}: {:8.2} ms (classify {:.2}, tables {:.2}, splat {:.2}, composite {:.2}); sheets along {}",
+            "frame {:>3}: {:8.2} ms (classify {:.2}, tables {:.2}, splat {:.2}, composite {:.2}, resample {:.2}); sheets along {}",
             k + 1,
             f.seconds * 1e3,
             f.phases.classify * 1e3,
             f.phases.tables * 1e3,
             f.phases.splat * 1e3,
             f.phases.composite * 1e3,
+            f.phases.resample * 1e3,
             ["i", "j", "k"][p.frame.sheet_axis]
         );
         times.push(f.seconds * 1e3);
@@ -107,6 +109,7 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
         tables: median(&phases[1..].iter().map(|p| p.tables).collect::<Vec<_>>()),
         splat: median(&phases[1..].iter().map(|p| p.splat).collect::<Vec<_>>()),
         composite: median(&phases[1..].iter().map(|p| p.composite).collect::<Vec<_>>()),
+        resample: median(&phases[1..].iter().map(|p| p.resample).collect::<Vec<_>>()),
     };
     let later_text = if later.is_empty() {
         "no later frames (--frames 1)".to_string()

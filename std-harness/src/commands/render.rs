@@ -56,9 +56,10 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
             p.name,
             args.size.0,
             args.size.1,
-            match p.supersample {
-                1 => String::new(),
-                k => format!(" (supersampled {k}x: voxels project closer than --min-radius)"),
+            match (p.supersample, p.subsample_factor(args)?) {
+                (1, 1) => String::new(),
+                (1, s) => format!(" (subsampled: rendered at 1/{s} and resampled)"),
+                (k, _) => format!(" (supersampled {k}x: voxels project closer than --min-radius)"),
             },
             secs,
             stats.sheets,

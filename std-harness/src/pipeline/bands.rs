@@ -25,6 +25,8 @@ pub struct Phases {
     pub splat: f64,
     /// Compositing sheets into the image.
     pub composite: f64,
+    /// Resampling a subsampled frame to the output size (`--subsample`; zero without it).
+    pub resample: f64,
 }
 
 /// One frame rendered by the core.

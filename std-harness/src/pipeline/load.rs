@@ -7,11 +7,14 @@ use crate::io::stream::{file_range, is_stdin, Layout};
 use crate::io::volume::{SampleType, Volume};
 use crate::{io, scene, CliError};
 use glam::{Mat3, Vec3};
+use std::sync::Arc;
 
 /// Where the voxels come from.
+#[derive(Clone)]
 pub enum Voxels {
-    /// Loaded whole.
-    Memory(Volume),
+    /// Loaded whole (shared: a prepared render's copies, such as a subsampled frame's, do not
+    /// copy the samples).
+    Memory(Arc<Volume>),
     /// Streamed from a seekable file.
     File(Layout),
     /// Streamed from standard input, z-slices in file order.
@@ -101,7 +104,7 @@ pub(crate) fn load_voxels(args: &RenderArgs) -> Result<Loaded, CliError> {
         };
         let (dims, grid, range) = (volume.dims, volume.grid_to_world(), Some(volume.range()));
         return Ok(Loaded {
-            voxels: Voxels::Memory(volume),
+            voxels: Voxels::Memory(Arc::new(volume)),
             name,
             dims,
             grid,

@@ -26,6 +26,9 @@
 //! - [`refine`]: `--refine`, the paper's adaptive re-sampling for magnified volumes
 //!   ([`refinement`]: what it refined, carried by a frame).
 //! - [`single`]: one voxel rendered on its own (`footprint splat`, the stability charts).
+//! - [`supersample`]: minified frames rendered larger and averaged; [`subsample`]: `--subsample`,
+//!   magnified frames rendered smaller and resampled (image-space level of detail).
+//! - [`describe`](mod@describe): the JSON fields every render and verify summary share.
 //!
 //! It reads the shared argument structs of [`crate::args`] and calls down into [`crate::io`],
 //! [`crate::reference`] and the core; it imports no command.
@@ -33,6 +36,7 @@
 pub mod bands;
 pub mod choose;
 pub mod config;
+pub mod describe;
 pub mod field;
 pub mod level_pilot;
 pub mod load;
@@ -46,10 +50,12 @@ pub mod run;
 pub mod sampling;
 pub mod single;
 pub mod slabs;
+pub mod subsample;
 pub mod supersample;
 pub mod visible;
 
-pub use prepare::{describe, prepare, Prepared};
+pub use describe::describe;
+pub use prepare::{prepare, Prepared};
 pub use run::{
     render_continuous_ref, render_core, render_core_with, render_frame, render_ref, CoreFrame,
 };

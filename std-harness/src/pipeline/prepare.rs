@@ -10,7 +10,6 @@
 use super::load::{load_background, load_voxels, Loaded, Voxels};
 use super::supersample;
 use crate::args::{Lod, RenderArgs};
-use crate::io::json::Json;
 use crate::io::volume::{SampleType, Volume};
 use crate::{tf, CliError};
 use footprint::frame::{FrameSetup, Order};
@@ -18,6 +17,7 @@ use footprint::geometry::FootprintOptions;
 use footprint::lod::{level_frame, level_kernel, LodError};
 use footprint::shade::{Phong, Shader, Shading, TransferFunction};
 use footprint::{Grid, Kernel, View};
+use std::sync::Arc;
 
 /// Parses `--shading`; iso-surfaces are `1.5 × min_spacing` thick (world units).
 pub fn parse_shading(s: &str, min_spacing: f32) -> Result<Shading, CliError> {
@@ -69,7 +69,9 @@ pub fn outside_data_warnings(
     out
 }
 
-/// A render, set up and ready to run: the volume, the frame, the shading.
+/// A render, set up and ready to run: the volume, the frame, the shading. A clone shares the
+/// volume in memory.
+#[derive(Clone)]
 pub struct Prepared {
     pub voxels: Voxels,
     pub name: String,
@@ -157,7 +159,7 @@ impl Prepared {
             _ => super::lod::coarsen_volume(fine, level, &*averaging)?,
         };
         Ok(Prepared {
-            voxels: Voxels::Memory(volume),
+            voxels: Voxels::Memory(Arc::new(volume)),
             name: self.name.clone(),
             kernel,
             grid: self.grid,
@@ -177,6 +179,50 @@ impl Prepared {
             options: self.options,
             supersample,
         })
+    }
+
+    /// The `--subsample` factor `args` asks for with this render (1: off; see
+    /// [`super::subsample::factor`], which refuses what cannot be honoured).
+    pub fn subsample_factor(&self, args: &RenderArgs) -> Result<usize, CliError> {
+        super::subsample::factor(
+            &self.frame,
+            &self.kernel,
+            self.options,
+            self.supersample,
+            self.level,
+            args,
+        )
+    }
+
+    /// This render (prepared at the output size) seen at 1/s of it, and `args` for that frame
+    /// (see [`super::subsample`]): the same volume (shared, not copied), transfer function and
+    /// shading; the frame set up again with the view scaled by 1/s at
+    /// [`super::subsample::low_size`]; no background (it is composited at the output size).
+    pub fn subsampled(
+        &self,
+        args: &RenderArgs,
+        s: usize,
+    ) -> Result<(Prepared, RenderArgs), CliError> {
+        let view = view_for(args, self.fine_dims, &self.grid)?;
+        let view = View::new(view.to_screen() * (1.0 / s as f32))
+            .map_err(|e| CliError::input(format!("--subsample {s}: view: {e}")))?;
+        let (w, h) = super::subsample::low_size(args.size, s);
+        let frame = FrameSetup::new(
+            self.fine_dims,
+            &self.grid,
+            &view,
+            &self.kernel,
+            self.options,
+            [w, h],
+        )?;
+        let mut low = self.clone();
+        low.frame = frame;
+        low.background = None;
+        low.background_out = None;
+        let mut at_low = args.clone();
+        at_low.subsample = crate::args::Supersample::Fixed(1);
+        at_low.size = (w, h);
+        Ok((low, at_low))
     }
 
     /// The output image's width and height, pixels: the frame's, divided by the supersampling.
@@ -484,7 +530,11 @@ pub fn prepare(args: &RenderArgs) -> Result<Prepared, CliError> {
                 hi: window[1],
             };
             let averaging = super::lod::averaging_for(&shading, tf);
-            Voxels::Memory(super::lod::coarsen_volume(&v, level, &*averaging)?)
+            Voxels::Memory(Arc::new(super::lod::coarsen_volume(
+                &v,
+                level,
+                &*averaging,
+            )?))
         }
         other => other,
     };
@@ -513,71 +563,4 @@ pub fn prepare(args: &RenderArgs) -> Result<Prepared, CliError> {
         options,
         supersample,
     })
-}
-
-/// The JSON fields every render and verify summary share.
-pub fn describe(p: &Prepared, args: &RenderArgs) -> Json {
-    let f = &p.frame;
-    Json::object()
-        .str("volume", &p.name)
-        .arr_usize("dims", &p.frame.dims)
-        .arr_f64("spacing", &p.frame.spacing.map(f64::from))
-        .arr_usize("size", &[args.size.0, args.size.1])
-        .str("kernel", &p.kernel.to_string())
-        .num("table", args.footprint.table as f64)
-        .str(
-            "lookup",
-            &format!("{:?}", args.footprint.lookup).to_lowercase(),
-        )
-        .str(
-            "method",
-            &format!("{:?}", args.footprint.method).to_lowercase(),
-        )
-        .str("order", &format!("{:?}", p.order).to_lowercase())
-        .str("accum", &format!("{:?}", args.accum).to_lowercase())
-        .bool("streamed", p.volume().is_none())
-        .str("shading", &args.shading)
-        .str("tf", &p.tf_name)
-        .arr_f64("window", &p.window.map(f64::from))
-        .str("sheet_axis", ["i", "j", "k"][f.sheet_axis])
-        .str("slicing", args.slicing.name())
-        .num(
-            "slab",
-            match args.slicing {
-                crate::args::SlicingArg::Image => f64::from(args.slab),
-                crate::args::SlicingArg::Object => f64::NAN,
-            },
-        )
-        .str(
-            "projection",
-            if f.camera().is_some() {
-                "perspective"
-            } else {
-                "orthographic"
-            },
-        )
-        .num("fovy_deg", args.perspective.map_or(f64::NAN, f64::from))
-        .num(
-            "eye_distance",
-            f.camera().map_or(f64::NAN, |c| f64::from(c.eye_distance)),
-        )
-        .arr_f64(
-            "footprint_half_extent_px",
-            &f.footprint
-                .half_extent
-                .map(|e| f64::from(e) / p.supersample as f64),
-        )
-        .num("supersample", p.supersample as f64)
-        .num("lod", f64::from(p.level))
-        .arr_usize("lod_dims", &p.frame.dims)
-        .str(
-            "background",
-            &match &args.background {
-                crate::args::Background::Black => "black".to_string(),
-                crate::args::Background::Transparent => "transparent".to_string(),
-                crate::args::Background::Image(path) => path.display().to_string(),
-            },
-        )
-        .str("gamma", &format!("{:?}", args.gamma).to_lowercase())
-        .num("depth", f64::from(args.depth))
 }

@@ -7,6 +7,7 @@ use super::bands::{run_bands, Phases};
 use super::load::Voxels;
 use super::lod::{with_level, DynSource};
 use super::prepare::Prepared;
+use super::subsample;
 use super::supersample::{downsample, to_output};
 use super::visible::FrameCache;
 use crate::args::{AccumArg, MethodArg, RenderArgs, SlicingArg};
@@ -60,6 +61,21 @@ pub fn render_frame(
     accum: AccumArg,
     cache: &mut FrameCache,
 ) -> Result<CoreFrame, CliError> {
+    let s = p.subsample_factor(args)?;
+    if s > 1 {
+        // Rendered at 1/s of the size and resampled (`super::subsample`); timed as one frame.
+        let start = Instant::now();
+        let (low, at_low) = p.subsampled(args, s)?;
+        let mut f = render_frame(&low, &at_low, accum, cache)?;
+        let resample = Instant::now();
+        f.image = subsample::magnify(&f.image, at_low.size, args.size, s, args.thread_count());
+        if let Some(bg) = &p.background {
+            subsample::under_background(&mut f.image, bg);
+        }
+        f.phases.resample = resample.elapsed().as_secs_f64();
+        f.seconds = start.elapsed().as_secs_f64();
+        return Ok(f);
+    }
     if let Some(threshold) = args.refine {
         return super::refine::render_refined(p, args, accum, threshold);
     }

@@ -1,0 +1,318 @@
+//! Image-space level of detail for magnified volumes (`--subsample`): render the frame at 1/s of
+//! the output size and resample it to that size.
+//!
+//! **Why it is close.** Compositing is per pixel, so a frame rendered with the view scaled by 1/s
+//! holds, at each of its pixel centres, exactly the value the full-size render has at that point
+//! of the screen (up to the tables' sampling): it samples the full-size image on a grid s pixels
+//! apart. What is lost is only what that grid cannot carry. Each sheet's image is a sum of
+//! footprints, smooth on the scale of their width, so when footprints stay a few pixels wide at
+//! the lower resolution a cubic interpolation recovers the full-size image closely; the products
+//! of compositing sharpen it somewhat. Splatting costs per covered pixel, so a footprint r pixels
+//! across at the output costs about (r/s)² at the lower resolution.
+//!
+//! **Auto.** `--subsample auto` takes the largest s ≤ [`MAX_FACTOR`] that keeps the footprint's
+//! shorter semi-axis (before any widening) at least [`AUTO_MIN_RADIUS_PX`] pixels (and at least
+//! `--min-radius`, so nothing is widened) at the lower resolution; only for Gaussian kernels and
+//! orthographic views, where that rule was measured (README, "Subsampling"); elsewhere 1.
+//!
+//! **Geometry.** The output is W × H with pixel x's centre at x + ½ and the volume's centre at
+//! (W/2, H/2) (the core's `frame` placement). The low frame is w × h = (⌈W/s⌉ + 2m) × (⌈H/s⌉ + 2m)
+//! with m = [`MARGIN`] (so every cubic tap of an output pixel lies inside it), the view scaled by
+//! 1/s and the volume's centre at (w/2, h/2). Output pixel x therefore sits at low-frame index
+//! t = (x + ½ − W/2)/s + w/2 − ½ (low pixel i at t = i), and likewise in y.
+//!
+//! **Resampling.** Separable Catmull-Rom (cubic convolution, a = −½: interpolating, exact for
+//! quadratics), rows first, then columns; every output pixel is computed the same way on any
+//! number of threads, so the image does not depend on `--threads`. The cubic overshoots at sharp
+//! edges: channels are clamped at 0 and opacity at 1. A background image is composited under the
+//! resampled frame at the output size (C + (1 − A)·background, what the core's sheet loop does).
+
+use crate::args::{RenderArgs, Supersample};
+use crate::CliError;
+use footprint::frame::FrameSetup;
+use footprint::geometry::FootprintOptions;
+use footprint::Kernel;
+
+/// The low frame's margin, pixels on each side: Catmull-Rom reads two pixels either side.
+pub const MARGIN: usize = 2;
+
+/// Largest factor (`--subsample` takes 1 … 8).
+pub const MAX_FACTOR: usize = 8;
+
+/// `auto`'s floor on the footprint's shorter semi-axis at the lower resolution, pixels. Measured
+/// (Gaussian 1.6 / 2.5, 512², view 30,20,0, against the full-size render): semi-axes of 2.1 px
+/// (the walnut at s = 2) and 1.9 px (the CT head at s = 4) resample to 59.7 and 56.6 dB.
+pub const AUTO_MIN_RADIUS_PX: f32 = 2.0;
+
+/// The factor `args` asks for with a render prepared at the output size (its `frame`, `kernel`,
+/// footprint `options`, `supersample` factor and level of detail `level`; `Prepared::subsample_factor`
+/// passes them): 1 (off) unless `--subsample` gives s ≥ 2 or `auto` finds one. An explicit s ≥ 2
+/// that cannot be honoured is refused: with a perspective view, `--refine`, `--quality`, a
+/// supersampled or coarser-level frame, or when the footprints would be narrower than
+/// `--min-radius` at 1/s of the size (they would be widened: a blurred image).
+pub fn factor(
+    frame: &FrameSetup,
+    kernel: &Kernel,
+    options: FootprintOptions,
+    supersample: usize,
+    level: u32,
+    args: &RenderArgs,
+) -> Result<usize, CliError> {
+    let explicit = match args.subsample {
+        Supersample::Fixed(1) => return Ok(1),
+        Supersample::Fixed(s) => Some(s),
+        Supersample::Auto => None,
+    };
+    let refuse = |why: &str| {
+        CliError::input(format!(
+            "--subsample {}: {why}",
+            explicit.map_or("auto".to_string(), |s| s.to_string())
+        ))
+    };
+    if args.quality.is_some() {
+        return Err(refuse(
+            "--quality chooses the method from measured errors at the output size; drop one",
+        ));
+    }
+    let blocked = if frame.camera().is_some() {
+        Some("orthographic views only (a perspective view's footprints vary per voxel)")
+    } else if args.refine.is_some() {
+        Some("--refine adds samples for magnified volumes; subsampling removes pixels: drop one")
+    } else if supersample > 1 {
+        Some("the frame is supersampled (--supersample, or voxels projecting closer than --min-radius)")
+    } else if level > 0 {
+        Some("the volume renders at a coarser level of detail (--lod); give --lod 0 or auto")
+    } else {
+        None
+    };
+    let min_radius = options.min_radius_px;
+    let natural = frame.footprint.natural_minor_px;
+    match (explicit, blocked) {
+        (Some(_), Some(why)) => Err(refuse(why)),
+        (None, Some(_)) => Ok(1),
+        (Some(s), None) => {
+            if natural / s as f32 >= min_radius {
+                Ok(s)
+            } else {
+                Err(refuse(&format!(
+                    "the footprints' shorter semi-axis is {natural:.2} px, {:.2} px at 1/{s} of \
+                     the size, below --min-radius {min_radius} px (they would be widened and the \
+                     image blurred); the largest factor here is {}",
+                    natural / s as f32,
+                    ((natural / min_radius).floor() as usize).max(1)
+                )))
+            }
+        }
+        (None, None) => {
+            if !matches!(kernel, Kernel::Gaussian { .. }) {
+                return Ok(1);
+            }
+            let floor = AUTO_MIN_RADIUS_PX.max(min_radius);
+            let s = (natural / floor).floor();
+            Ok(if s.is_finite() && s >= 2.0 {
+                (s as usize).min(MAX_FACTOR)
+            } else {
+                1
+            })
+        }
+    }
+}
+
+/// The low frame's size for an output `size` and factor `s`: ⌈n/s⌉ + 2·[`MARGIN`] per side.
+pub fn low_size(size: (usize, usize), s: usize) -> (usize, usize) {
+    (
+        size.0.div_ceil(s) + 2 * MARGIN,
+        size.1.div_ceil(s) + 2 * MARGIN,
+    )
+}
+
+/// A background (`background`, the output's size) composited under the resampled `image`:
+/// C + (1 − A)·background per channel, what the core's sheet loop does with a background.
+pub fn under_background(image: &mut [[f32; 4]], background: &[[f32; 4]]) {
+    for (c, b) in image.iter_mut().zip(background) {
+        let t = 1.0 - c[3];
+        for ch in 0..4 {
+            c[ch] += t * b[ch];
+        }
+    }
+}
+
+/// Catmull-Rom's weight at distance `d` (a = −½).
+pub fn catmull_rom(d: f32) -> f32 {
+    let d = d.abs();
+    if d < 1.0 {
+        (1.5 * d - 2.5) * d * d + 1.0
+    } else if d < 2.0 {
+        ((-0.5 * d + 2.5) * d - 4.0) * d + 2.0
+    } else {
+        0.0
+    }
+}
+
+/// For each of `out` output pixels along an axis, the first of its four low-frame taps and their
+/// weights (`low` low pixels along it, factor `s`; see the module docs for t).
+pub fn taps(out: usize, low: usize, s: usize) -> Vec<(usize, [f32; 4])> {
+    let (out_f, low_f, s_f) = (out as f64, low as f64, s as f64);
+    (0..out)
+        .map(|x| {
+            let t = (x as f64 + 0.5 - out_f / 2.0) / s_f + low_f / 2.0 - 0.5;
+            let i = t.floor();
+            let frac = (t - i) as f32;
+            let first = (i as isize - 1).clamp(0, low.saturating_sub(4) as isize) as usize;
+            let shift = (i as isize - 1) - first as isize;
+            // Weights of taps i − 1 … i + 2 (shifted onto the clamped window at the edges, which
+            // the margin keeps from happening for frames made by `low_size`).
+            let mut w = [0.0f32; 4];
+            for (k, wk) in [1.0 + frac, frac, 1.0 - frac, 2.0 - frac]
+                .iter()
+                .enumerate()
+            {
+                let at = (k as isize + shift).clamp(0, 3) as usize;
+                w[at] += catmull_rom(*wk);
+            }
+            (first, w)
+        })
+        .collect()
+}
+
+/// The `low` image (w × h, premultiplied RGBA) resampled to `out` with factor `s` on `threads`
+/// threads (the same values for any number): rows first, then columns; channels clamped at 0,
+/// opacity at 1.
+pub fn magnify(
+    image: &[[f32; 4]],
+    low: (usize, usize),
+    out: (usize, usize),
+    s: usize,
+    threads: usize,
+) -> Vec<[f32; 4]> {
+    let (lw, lh) = low;
+    let (w, h) = out;
+    assert!(
+        lw >= 4 && lh >= 4 && image.len() == lw * lh,
+        "a low frame of at least 4x4"
+    );
+    let xs = taps(w, lw, s);
+    let ys = taps(h, lh, s);
+    let threads = threads.max(1);
+    // Rows: every low row resampled to the output width.
+    let mut rows = vec![[0.0f32; 4]; lh * w];
+    let per = lh.div_ceil(threads).max(1);
+    std::thread::scope(|scope| {
+        for (c, chunk) in rows.chunks_mut(per * w).enumerate() {
+            let xs = &xs;
+            scope.spawn(move || {
+                for (r, row) in chunk.chunks_exact_mut(w).enumerate() {
+                    let src = &image[(c * per + r) * lw..][..lw];
+                    for (o, (first, wt)) in row.iter_mut().zip(xs) {
+                        let t = &src[*first..*first + 4];
+                        for ch in 0..4 {
+                            o[ch] = wt[0] * t[0][ch]
+                                + wt[1] * t[1][ch]
+                                + wt[2] * t[2][ch]
+                                + wt[3] * t[3][ch];
+                        }
+                    }
+                }
+            });
+        }
+    });
+    // Columns: each output row from four resampled rows.
+    let mut out_img = vec![[0.0f32; 4]; w * h];
+    let per = h.div_ceil(threads).max(1);
+    std::thread::scope(|scope| {
+        for (c, chunk) in out_img.chunks_mut(per * w).enumerate() {
+            let (ys, rows) = (&ys, &rows);
+            scope.spawn(move || {
+                for (r, row) in chunk.chunks_exact_mut(w).enumerate() {
+                    let (first, wt) = ys[c * per + r];
+                    let src = |k: usize| &rows[(first + k) * w..][..w];
+                    let (r0, r1, r2, r3) = (src(0), src(1), src(2), src(3));
+                    for (x, o) in row.iter_mut().enumerate() {
+                        for ch in 0..4 {
+                            let v = wt[0] * r0[x][ch]
+                                + wt[1] * r1[x][ch]
+                                + wt[2] * r2[x][ch]
+                                + wt[3] * r3[x][ch];
+                            o[ch] = if v > 0.0 { v } else { 0.0 };
+                        }
+                        if o[3] > 1.0 {
+                            o[3] = 1.0;
+                        }
+                    }
+                }
+            });
+        }
+    });
+    out_img
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The cubic reproduces a quadratic exactly, so resampling samples of q at the low frame's
+    /// pixel centres gives q at every output pixel centre (brute force over sizes and factors).
+    #[test]
+    fn magnify_reproduces_quadratics() {
+        for (out, s) in [((37, 23), 2), ((64, 64), 3), ((101, 7), 4), ((5, 9), 8)] {
+            let low = low_size(out, s);
+            // Screen position (output pixels) of low pixel (i, j)'s centre.
+            let screen = |i: usize, n_low: usize, n_out: usize| {
+                (i as f64 + 0.5 - n_low as f64 / 2.0) * s as f64 + n_out as f64 / 2.0
+            };
+            let q = |x: f64, y: f64| 0.2 + 0.003 * x - 0.002 * y + 1e-4 * x * y + 5e-5 * x * x;
+            let image: Vec<[f32; 4]> = (0..low.0 * low.1)
+                .map(|n| {
+                    let (x, y) = (
+                        screen(n % low.0, low.0, out.0),
+                        screen(n / low.0, low.1, out.1),
+                    );
+                    let v = q(x, y) as f32;
+                    [v, 0.5 * v, 0.25 * v, v]
+                })
+                .collect();
+            for threads in [1, 3] {
+                let up = magnify(&image, low, out, s, threads);
+                for (n, p) in up.iter().enumerate() {
+                    let (x, y) = ((n % out.0) as f64 + 0.5, (n / out.0) as f64 + 0.5);
+                    let want = q(x, y);
+                    assert!(
+                        (f64::from(p[0]) - want).abs() < 2e-5 * want.abs().max(1.0),
+                        "out {out:?} s {s} pixel ({x}, {y}): {} against {want}",
+                        p[0]
+                    );
+                    assert!((p[1] - 0.5 * p[0]).abs() < 1e-6, "channels resampled alike");
+                }
+            }
+        }
+    }
+
+    /// Weights sum to one and the taps stay inside frames made by `low_size`.
+    #[test]
+    fn taps_are_inside_and_sum_to_one() {
+        for n in 1..200usize {
+            for s in 2..=MAX_FACTOR {
+                let low = n.div_ceil(s) + 2 * MARGIN;
+                for (x, (first, w)) in taps(n, low, s).into_iter().enumerate() {
+                    assert!(first + 4 <= low, "n {n} s {s} x {x}");
+                    let t = (x as f64 + 0.5 - n as f64 / 2.0) / s as f64 + low as f64 / 2.0 - 0.5;
+                    assert_eq!(
+                        first as f64,
+                        t.floor() - 1.0,
+                        "n {n} s {s} x {x}: no clamping"
+                    );
+                    let sum: f32 = w.iter().sum();
+                    assert!((sum - 1.0).abs() < 1e-6, "n {n} s {s} x {x}: {sum}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn catmull_rom_interpolates() {
+        assert_eq!(catmull_rom(0.0), 1.0);
+        for d in [1.0, 2.0, -1.0, 2.5] {
+            assert_eq!(catmull_rom(d), 0.0);
+        }
+    }
+}
