@@ -29,6 +29,18 @@ def med(vol, renderer, threads, accum, key):
     return statistics.median(v) if v else float("nan")
 
 
+def footprint_times(vol, accum):
+    """Fresh (1 thread), re-render on 1 and on 2 threads, ms."""
+    return (med(vol, "footprint", 1, accum, "first_ms"), med(vol, "footprint", 1, accum, "median_ms"),
+            med(vol, "footprint", 2, accum, "median_ms"))
+
+
+def peer_times(vol):
+    """VTK on 1 and 2 threads and VolPack, median frame, ms."""
+    return (med(vol, "vtk", 1, "-", "median_ms"), med(vol, "vtk", 2, "-", "median_ms"),
+            med(vol, "volpack", 1, "-", "median_ms"))
+
+
 def cpu():
     try:
         for line in open("/proc/cpuinfo"):
@@ -59,13 +71,9 @@ lines = [
 ]
 ratios = []
 for v in volumes:
-    f1 = med(v, "footprint", 1, "float", "first_ms")
-    r1 = med(v, "footprint", 1, "float", "median_ms")
-    r2 = med(v, "footprint", 2, "float", "median_ms")
+    f1, r1, r2 = footprint_times(v, "float")
     x1 = med(v, "footprint", 1, "fixed", "median_ms")
-    t1 = med(v, "vtk", 1, "-", "median_ms")
-    t2 = med(v, "vtk", 2, "-", "median_ms")
-    vp = med(v, "volpack", 1, "-", "median_ms")
+    t1, t2, vp = peer_times(v)
     lines.append(f"| {v} | {f1:.1f} ms | {r1:.1f} ms | {r2:.1f} ms | {x1:.1f} ms | {t1:.1f} ms | {t2:.1f} ms | {vp:.2f} ms |")
     ratios.append((v, t1 / f1, r1 / r2, r1 / vp, x1 / r1, t1 / r1))
 lines += [
@@ -97,11 +105,8 @@ if any(r["accum"] == "float-subsample" for r in rows):
         "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for v in volumes:
-        f1 = med(v, "footprint", 1, "float-subsample", "first_ms")
-        r1 = med(v, "footprint", 1, "float-subsample", "median_ms")
-        r2 = med(v, "footprint", 2, "float-subsample", "median_ms")
-        t1 = med(v, "vtk", 1, "-", "median_ms")
-        vp = med(v, "volpack", 1, "-", "median_ms")
+        f1, r1, r2 = footprint_times(v, "float-subsample")
+        t1, _, vp = peer_times(v)
         a, full = acc.get((v, "auto")), acc.get((v, "1"))
         s_ = a["factor"] if a else "?"
         f64s = f"{float(full['psnr_f64_db']):.1f} → {float(a['psnr_f64_db']):.1f} dB" if a and full else "–"
