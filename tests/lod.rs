@@ -5,7 +5,7 @@
 use footprint_harness::args::parse_args;
 use footprint_harness::metrics::compare;
 use footprint_harness::pipeline::{prepare, render_core};
-use footprint_suite::tmpdir;
+use footprint_suite::{rgb_psnr, tmpdir};
 
 const HEADSQ: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -17,11 +17,6 @@ fn render(args: &[&str]) -> (Vec<[f32; 4]>, u32) {
     let p = prepare(&a).unwrap();
     let level = p.level;
     (render_core(&p, &a).unwrap().0, level)
-}
-
-fn psnr(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
-    let b: Vec<[f64; 4]> = b.iter().map(|p| p.map(f64::from)).collect();
-    compare(a, &b).1.psnr_db
 }
 
 #[test]
@@ -44,7 +39,7 @@ fn streamed_and_in_memory_levels_agree() {
             s.extend_from_slice(&common);
             let ((mem, lm), (streamed, ls)) = (render(&m), render(&s));
             assert_eq!((lm, ls), (lod.parse().unwrap(), lod.parse().unwrap()));
-            let db = psnr(&streamed, &mem);
+            let db = rgb_psnr(&streamed, &mem);
             assert!(db >= 120.0, "view {view}, lod {lod}: {db:.1} dB");
         }
     }
@@ -83,7 +78,7 @@ fn auto_coarsens_a_minified_volume_and_stays_close() {
     let (auto, la) = with("auto");
     assert_eq!(l0, 0);
     assert!(la >= 1, "auto stayed at level {la}");
-    let db = psnr(&auto, &full);
+    let db = rgb_psnr(&auto, &full);
     assert!(db >= 38.0, "auto (level {la}) against level 0: {db:.1} dB");
     std::fs::remove_dir_all(&d).unwrap();
 }
@@ -137,7 +132,7 @@ fn auto_is_the_default_and_holds_on_real_data() {
     full.extend_from_slice(&["--lod", "0"]);
     let (full, _) = render(&full);
     assert_eq!(la, 1);
-    let db = psnr(&auto, &full);
+    let db = rgb_psnr(&auto, &full);
     assert!(db >= 38.0, "auto (level {la}) against level 0: {db:.1} dB");
 }
 

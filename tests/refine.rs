@@ -8,16 +8,12 @@ use footprint_harness::args::parse_args;
 use footprint_harness::metrics::compare;
 use footprint_harness::pipeline::visible::FrameCache;
 use footprint_harness::pipeline::{prepare, render_frame, CoreFrame};
+use footprint_suite::rgb_psnr;
 
 fn frame(args: &[&str]) -> CoreFrame {
     let a = parse_args(args).unwrap();
     let p = prepare(&a).unwrap();
     render_frame(&p, &a, a.accum, &mut FrameCache::default()).unwrap()
-}
-
-fn psnr(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
-    let b: Vec<[f64; 4]> = b.iter().map(|p| p.map(f64::from)).collect();
-    compare(a, &b).1.psnr_db
 }
 
 fn refused(args: &[&str]) -> String {
@@ -50,7 +46,7 @@ fn refinement_approaches_the_fine_sampling() {
         };
         let fine = with(&["--scene-size", "128"]);
         let coarse = with(&["--scene-size", "16"]);
-        let base = psnr(&coarse.image, &fine.image);
+        let base = rgb_psnr(&coarse.image, &fine.image);
         let mut last = 0;
         for t in ["0.3", "0.1", "0.02", "0"] {
             let r = with(&["--scene-size", "16", "--refine", t]);
@@ -61,7 +57,7 @@ fn refinement_approaches_the_fine_sampling() {
             );
             last = info.samples;
             assert_eq!(info.coarse_samples, 16 * 16 * 16);
-            let db = psnr(&r.image, &fine.image);
+            let db = rgb_psnr(&r.image, &fine.image);
             assert!(
                 db > base + 1.0,
                 "{view} {shading}: --refine {t} {db:.2} vs {base:.2} dB"

@@ -5,9 +5,17 @@
 use footprint::Kernel;
 use footprint_harness::args::{FootprintArgs, LookupArg, MethodArg};
 use footprint_harness::io::image::GreyImage;
+use footprint_harness::metrics::compare;
 use footprint_harness::{args::SplatArgs, pipeline::single::splat_image};
 use glam::{DMat3, Mat3};
 use std::path::PathBuf;
+
+/// PSNR (dB, peak 1) of `a` against `b` over R, G and B together: the overall figure of the
+/// harness's `metrics::compare` (what `verify` reports), for two f32 images.
+pub fn rgb_psnr(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
+    let b: Vec<[f64; 4]> = b.iter().map(|p| p.map(f64::from)).collect();
+    compare(a, &b).1.psnr_db
+}
 
 /// Composite Simpson's rule for ∫ₐᵇ f, with `steps` (even) intervals.
 pub fn simpson(f: impl Fn(f64) -> f64, a: f64, b: f64, steps: usize) -> f64 {
