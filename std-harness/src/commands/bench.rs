@@ -104,12 +104,15 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
     let (min, max) = later
         .iter()
         .fold((f64::NAN, f64::NAN), |(lo, hi), &t| (lo.min(t), hi.max(t)));
+    // Each phase's median over frames 2…N.
+    let over_later =
+        |phase: fn(&Phases) -> f64| median(&phases[1..].iter().map(phase).collect::<Vec<_>>());
     let rerender = Phases {
-        classify: median(&phases[1..].iter().map(|p| p.classify).collect::<Vec<_>>()),
-        tables: median(&phases[1..].iter().map(|p| p.tables).collect::<Vec<_>>()),
-        splat: median(&phases[1..].iter().map(|p| p.splat).collect::<Vec<_>>()),
-        composite: median(&phases[1..].iter().map(|p| p.composite).collect::<Vec<_>>()),
-        resample: median(&phases[1..].iter().map(|p| p.resample).collect::<Vec<_>>()),
+        classify: over_later(|p| p.classify),
+        tables: over_later(|p| p.tables),
+        splat: over_later(|p| p.splat),
+        composite: over_later(|p| p.composite),
+        resample: over_later(|p| p.resample),
     };
     let later_text = if later.is_empty() {
         "no later frames (--frames 1)".to_string()
