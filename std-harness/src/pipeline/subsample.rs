@@ -45,11 +45,11 @@ pub const MAX_FACTOR: usize = 8;
 pub const AUTO_MIN_RADIUS_PX: f32 = 2.0;
 
 /// The factor `args` asks for with a render prepared at the output size (its `frame`, `kernel`,
-/// footprint `options`, `supersample` factor and level of detail `level`; `Prepared::subsample_factor`
-/// passes them): 1 (off) unless `--subsample` gives s ≥ 2 or `auto` finds one. An explicit s ≥ 2
-/// that cannot be honoured is refused: with a perspective view, `--refine`, `--quality`, a
-/// supersampled or coarser-level frame, or when the footprints would be narrower than
-/// `--min-radius` at 1/s of the size (they would be widened: a blurred image).
+/// footprint `options`, `supersample` factor and level of detail `level`, as
+/// `Prepared::subsample_factor` passes them): 1 (off) unless `--subsample` gives s ≥ 2 or `auto`
+/// finds one. An explicit s ≥ 2 that cannot be honoured is refused: with a perspective view,
+/// `--refine`, `--quality`, a supersampled or coarser-level frame, or when the footprints would be
+/// narrower than `--min-radius` at 1/s of the size (they would be widened: a blurred image).
 pub fn factor(
     frame: &FrameSetup,
     kernel: &Kernel,
@@ -79,7 +79,10 @@ pub fn factor(
     } else if args.refine.is_some() {
         Some("--refine adds samples for magnified volumes; subsampling removes pixels: drop one")
     } else if supersample > 1 {
-        Some("the frame is supersampled (--supersample, or voxels projecting closer than --min-radius)")
+        Some(
+            "the frame is supersampled (--supersample, or voxels projecting closer than \
+             --min-radius)",
+        )
     } else if level > 0 {
         Some("the volume renders at a coarser level of detail (--lod); give --lod 0 or auto")
     } else {
