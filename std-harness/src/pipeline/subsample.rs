@@ -31,6 +31,7 @@ use crate::args::{RenderArgs, Supersample};
 use crate::CliError;
 use footprint::frame::FrameSetup;
 use footprint::geometry::FootprintOptions;
+use footprint::refine::catmull_rom;
 use footprint::Kernel;
 
 /// The low frame's margin, pixels on each side: Catmull-Rom reads two pixels either side.
@@ -140,18 +141,6 @@ pub fn under_background(image: &mut [[f32; 4]], background: &[[f32; 4]]) {
     }
 }
 
-/// Catmull-Rom's weight at distance `d` (a = −½).
-pub fn catmull_rom(d: f32) -> f32 {
-    let d = d.abs();
-    if d < 1.0 {
-        (1.5 * d - 2.5) * d * d + 1.0
-    } else if d < 2.0 {
-        ((-0.5 * d + 2.5) * d - 4.0) * d + 2.0
-    } else {
-        0.0
-    }
-}
-
 /// For each of `out` output pixels along an axis, the first of its four low-frame taps and their
 /// weights (`low` low pixels along it, factor `s`; see the module docs for t).
 pub fn taps(out: usize, low: usize, s: usize) -> Vec<(usize, [f32; 4])> {
@@ -166,12 +155,9 @@ pub fn taps(out: usize, low: usize, s: usize) -> Vec<(usize, [f32; 4])> {
             // Weights of taps i − 1 … i + 2 (shifted onto the clamped window at the edges, which
             // the margin keeps from happening for frames made by `low_size`).
             let mut w = [0.0f32; 4];
-            for (k, wk) in [1.0 + frac, frac, 1.0 - frac, 2.0 - frac]
-                .iter()
-                .enumerate()
-            {
+            for (k, wk) in catmull_rom(frac).0.into_iter().enumerate() {
                 let at = (k as isize + shift).clamp(0, 3) as usize;
-                w[at] += catmull_rom(*wk);
+                w[at] += wk;
             }
             (first, w)
         })
@@ -180,7 +166,8 @@ pub fn taps(out: usize, low: usize, s: usize) -> Vec<(usize, [f32; 4])> {
 
 /// The `low` image (w × h, premultiplied RGBA) resampled to `out` with factor `s` on `threads`
 /// threads (the same values for any number): rows first, then columns; channels clamped at 0,
-/// opacity at 1.
+/// opacity at 1 and each colour at its opacity (a valid premultiplied colour, as the renderer's
+/// frames are).
 pub fn magnify(
     image: &[[f32; 4]],
     low: (usize, usize),
@@ -197,38 +184,36 @@ pub fn magnify(
     let xs = taps(w, lw, s);
     let ys = taps(h, lh, s);
     let threads = threads.max(1);
-    // Rows: every low row resampled to the output width.
-    let mut rows = vec![[0.0f32; 4]; lh * w];
-    let per = lh.div_ceil(threads).max(1);
-    std::thread::scope(|scope| {
-        for (c, chunk) in rows.chunks_mut(per * w).enumerate() {
-            let xs = &xs;
-            scope.spawn(move || {
-                for (r, row) in chunk.chunks_exact_mut(w).enumerate() {
-                    let src = &image[(c * per + r) * lw..][..lw];
-                    for (o, (first, wt)) in row.iter_mut().zip(xs) {
-                        let t = &src[*first..*first + 4];
-                        for ch in 0..4 {
-                            o[ch] = wt[0] * t[0][ch]
-                                + wt[1] * t[1][ch]
-                                + wt[2] * t[2][ch]
-                                + wt[3] * t[3][ch];
-                        }
-                    }
-                }
-            });
+    // Each thread makes its band of output rows from the low rows they need, each low row
+    // resampled to the output width once per thread into a ring of four (output rows need taps
+    // first..first + 4, and first never decreases down the image): no frame-sized intermediate.
+    let resample_row = |y: usize, row: &mut [[f32; 4]]| {
+        let src = &image[y * lw..][..lw];
+        for (o, (first, wt)) in row.iter_mut().zip(&xs) {
+            let t = &src[*first..*first + 4];
+            for ch in 0..4 {
+                o[ch] = wt[0] * t[0][ch] + wt[1] * t[1][ch] + wt[2] * t[2][ch] + wt[3] * t[3][ch];
+            }
         }
-    });
-    // Columns: each output row from four resampled rows.
+    };
     let mut out_img = vec![[0.0f32; 4]; w * h];
     let per = h.div_ceil(threads).max(1);
     std::thread::scope(|scope| {
         for (c, chunk) in out_img.chunks_mut(per * w).enumerate() {
-            let (ys, rows) = (&ys, &rows);
+            let (ys, resample_row) = (&ys, &resample_row);
             scope.spawn(move || {
+                // Slot k % 4 holds low row k once `held[k % 4] == Some(k)`.
+                let mut ring = vec![[0.0f32; 4]; 4 * w];
+                let mut held = [None::<usize>; 4];
                 for (r, row) in chunk.chunks_exact_mut(w).enumerate() {
                     let (first, wt) = ys[c * per + r];
-                    let src = |k: usize| &rows[(first + k) * w..][..w];
+                    for k in first..first + 4 {
+                        if held[k % 4] != Some(k) {
+                            resample_row(k, &mut ring[(k % 4) * w..][..w]);
+                            held[k % 4] = Some(k);
+                        }
+                    }
+                    let src = |k: usize| &ring[((first + k) % 4) * w..][..w];
                     let (r0, r1, r2, r3) = (src(0), src(1), src(2), src(3));
                     for (x, o) in row.iter_mut().enumerate() {
                         for ch in 0..4 {
@@ -240,6 +225,13 @@ pub fn magnify(
                         }
                         if o[3] > 1.0 {
                             o[3] = 1.0;
+                        }
+                        // Premultiplied: the cubic's overshoot at an edge must not leave a
+                        // colour above its opacity (the renderer's sheets never do).
+                        for ch in 0..3 {
+                            if o[ch] > o[3] {
+                                o[ch] = o[3];
+                            }
                         }
                     }
                 }
@@ -270,15 +262,17 @@ mod tests {
                         screen(n % low.0, low.0, out.0),
                         screen(n / low.0, low.1, out.1),
                     );
+                    // Colours below their opacity (q stays under 1.2 here), so the clamps to
+                    // it do not act.
                     let v = q(x, y) as f32;
-                    [v, 0.5 * v, 0.25 * v, v]
+                    [0.5 * v, 0.25 * v, 0.125 * v, 1.0]
                 })
                 .collect();
             for threads in [1, 3] {
                 let up = magnify(&image, low, out, s, threads);
                 for (n, p) in up.iter().enumerate() {
                     let (x, y) = ((n % out.0) as f64 + 0.5, (n / out.0) as f64 + 0.5);
-                    let want = q(x, y);
+                    let want = 0.5 * q(x, y);
                     assert!(
                         (f64::from(p[0]) - want).abs() < 2e-5 * want.abs().max(1.0),
                         "out {out:?} s {s} pixel ({x}, {y}): {} against {want}",
@@ -287,6 +281,30 @@ mod tests {
                     assert!((p[1] - 0.5 * p[0]).abs() < 1e-6, "channels resampled alike");
                 }
             }
+        }
+    }
+
+    /// At a sharp colour edge under even opacity the cubic overshoots (above the brighter side's
+    /// colour, which equals the opacity); the result stays a valid premultiplied colour.
+    #[test]
+    fn overshoot_leaves_colour_at_most_opacity() {
+        let (out, s) = ((40, 8), 4);
+        let low = low_size(out, s);
+        let image: Vec<[f32; 4]> = (0..low.0 * low.1)
+            .map(|n| {
+                let c = if n % low.0 < low.0 / 2 { 0.0 } else { 0.5 };
+                [c, c, c, 0.5]
+            })
+            .collect();
+        // Not vacuous: the cubic along a row, before any clamp, rises above 0.5 somewhere.
+        let row: Vec<f32> = taps(out.0, low.0, s)
+            .iter()
+            .map(|(first, w)| (0..4).map(|k| w[k] * image[first + k][0]).sum())
+            .collect();
+        assert!(row.iter().any(|&c| c > 0.5 + 1e-3), "{row:?}");
+        for p in magnify(&image, low, out, s, 1) {
+            assert!((p[3] - 0.5).abs() < 1e-6, "even opacity stays even: {p:?}");
+            assert!(p[..3].iter().all(|&c| (0.0..=p[3]).contains(&c)), "{p:?}");
         }
     }
 
@@ -308,14 +326,6 @@ mod tests {
                     assert!((sum - 1.0).abs() < 1e-6, "n {n} s {s} x {x}: {sum}");
                 }
             }
-        }
-    }
-
-    #[test]
-    fn catmull_rom_interpolates() {
-        assert_eq!(catmull_rom(0.0), 1.0);
-        for d in [1.0, 2.0, -1.0, 2.5] {
-            assert_eq!(catmull_rom(d), 0.0);
         }
     }
 }
