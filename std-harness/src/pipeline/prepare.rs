@@ -88,10 +88,11 @@ pub struct Prepared {
     pub window: [f32; 2],
     pub shading: Shading,
     pub tf_name: String,
-    /// The background at the frame's (internal) size.
-    pub background: Option<Vec<[f32; 4]>>,
-    /// The background at the output size, as loaded.
-    pub background_out: Option<Vec<[f32; 4]>>,
+    /// The background at the frame's (internal) size (shared with `background_out` when the
+    /// frame is not supersampled).
+    pub background: Option<Arc<[[f32; 4]]>>,
+    /// The background at the output size, as loaded (shared by clones and subsampled frames).
+    pub background_out: Option<Arc<[[f32; 4]]>>,
     pub order: Order,
     pub options: FootprintOptions,
     /// The frame is set up at `supersample` × the output size (see [`super::supersample`]).
@@ -114,10 +115,7 @@ impl Prepared {
         )?;
         self.frame = frame;
         self.supersample = k;
-        self.background = self
-            .background_out
-            .as_ref()
-            .map(|b| supersample::upsample(b, args.size, k));
+        self.background = at_frame(self.background_out.as_ref(), args.size, k);
         Ok(())
     }
 
@@ -170,10 +168,7 @@ impl Prepared {
             window: self.window,
             shading,
             tf_name: self.tf_name.clone(),
-            background: self
-                .background_out
-                .as_ref()
-                .map(|b| supersample::upsample(b, args.size, supersample)),
+            background: at_frame(self.background_out.as_ref(), args.size, supersample),
             background_out: self.background_out.clone(),
             order: self.order,
             options: self.options,
@@ -538,13 +533,12 @@ pub fn prepare(args: &RenderArgs) -> Result<Prepared, CliError> {
         }
         other => other,
     };
-    let background_out = args
+    let background_out: Option<Arc<[[f32; 4]]>> = args
         .background_file()
         .map(|p| load_background(p, args.size, args.gamma_curve()))
-        .transpose()?;
-    let background = background_out
-        .as_ref()
-        .map(|b| supersample::upsample(b, args.size, supersample));
+        .transpose()?
+        .map(Into::into);
+    let background = at_frame(background_out.as_ref(), args.size, supersample);
     Ok(Prepared {
         voxels,
         name,
@@ -562,5 +556,21 @@ pub fn prepare(args: &RenderArgs) -> Result<Prepared, CliError> {
         order,
         options,
         supersample,
+    })
+}
+
+/// A background loaded at the output `size` as the frame needs it: the same image when the frame
+/// is not supersampled (`k` = 1), else each pixel repeated k × k times.
+fn at_frame(
+    out: Option<&Arc<[[f32; 4]]>>,
+    size: (usize, usize),
+    k: usize,
+) -> Option<Arc<[[f32; 4]]>> {
+    out.map(|b| {
+        if k == 1 {
+            Arc::clone(b)
+        } else {
+            supersample::upsample(b, size, k).into()
+        }
     })
 }
