@@ -59,21 +59,34 @@ pub fn composite_row(acc: &mut [[i64; 4]], image: &mut [[u32; 4]], frac: u32, or
         }
         return;
     }
-    match order {
-        Order::BackToFront => {
-            for (a, px) in acc.iter_mut().zip(image.iter_mut()) {
-                *px = over_fast(resolve_fast(*a, frac), *px);
-                *a = [0; 4];
-            }
+    // Groups of pixels whose accumulators are all zero are skipped: a zero sheet pixel resolves
+    // to zero, and compositing zero over or under a pixel leaves it exactly as it is (see
+    // `over`), so the bits are the same; sparse sheets have long runs of them.
+    let mut a_groups = acc.chunks_mut(GROUP);
+    let mut i_groups = image.chunks_mut(GROUP);
+    while let (Some(a), Some(img)) = (a_groups.next(), i_groups.next()) {
+        if a.iter().all(|p| (p[0] | p[1] | p[2] | p[3]) == 0) {
+            continue;
         }
-        Order::FrontToBack => {
-            for (a, px) in acc.iter_mut().zip(image.iter_mut()) {
-                *px = over_fast(*px, resolve_fast(*a, frac));
-                *a = [0; 4];
+        match order {
+            Order::BackToFront => {
+                for (a, px) in a.iter_mut().zip(img.iter_mut()) {
+                    *px = over_fast(resolve_fast(*a, frac), *px);
+                    *a = [0; 4];
+                }
+            }
+            Order::FrontToBack => {
+                for (a, px) in a.iter_mut().zip(img.iter_mut()) {
+                    *px = over_fast(*px, resolve_fast(*a, frac));
+                    *a = [0; 4];
+                }
             }
         }
     }
 }
+
+/// Pixels per group in [`composite_row`]'s test for all-zero accumulators.
+const GROUP: usize = 8;
 
 /// Widest fraction [`resolve_fast`] serves: `i64::MAX` >> 32 = 2³¹ − 1 is still above [`ONE`]
 /// (the tables use at most [`super::MAX_ENTRY_FRAC`] = 28 bits).
@@ -119,19 +132,85 @@ pub fn over_row(front: &mut [[u32; 4]], back: &[[u32; 4]]) {
 
 #[cfg(test)]
 mod tests {
-    use super::{over, over_fast, resolve, resolve_fast, FAST_FRAC_MAX};
+    use super::{composite_row, over, over_fast, resolve, resolve_fast, FAST_FRAC_MAX, GROUP};
+    use crate::frame::Order;
+
+    /// A xorshift64 generator of test values from `seed` (non-zero).
+    fn xorshift(mut seed: u64) -> impl FnMut() -> u64 {
+        move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed
+        }
+    }
+
+    /// `composite_row`, which skips groups of zero accumulators, gives every pixel what
+    /// [`resolve`] and [`over`] give it, and clears the whole row: rows of every length up to a
+    /// few groups (a partial last group), zero and non-zero groups mixed, zero pixels inside
+    /// non-zero groups, both orders and several fraction widths.
+    #[test]
+    fn composite_row_matches_per_pixel_compositing() {
+        let mut next = xorshift(0x0123_4567_89ab_cdef);
+        let mut skipped = 0;
+        for len in 0..=3 * GROUP + 3 {
+            for frac in [0, 4, 20, 28, 33] {
+                for order in [Order::BackToFront, Order::FrontToBack] {
+                    let mut acc: std::vec::Vec<[i64; 4]> = (0..len)
+                        .map(|i| {
+                            let r = next();
+                            let a = ((r >> 8) % (1 << 40)) as i64;
+                            if (i / GROUP) % 3 == 1 {
+                                // Groups of zeros, where one pixel in eight has a single
+                                // non-zero channel (a group that must not be skipped).
+                                let mut p = [0; 4];
+                                if r.is_multiple_of(8) {
+                                    p[(r >> 4) as usize % 4] = a | 1;
+                                }
+                                p
+                            } else if r.is_multiple_of(4) {
+                                [0; 4]
+                            } else {
+                                [a / 3, a / 5, a / 2, a]
+                            }
+                        })
+                        .collect();
+                    let mut image: std::vec::Vec<[u32; 4]> = (0..len)
+                        .map(|_| {
+                            let a = (next() % (u64::from(super::ONE) + 1)) as u32;
+                            [a / 2, a / 3, a, a]
+                        })
+                        .collect();
+                    let want: std::vec::Vec<[u32; 4]> = acc
+                        .iter()
+                        .zip(&image)
+                        .map(|(a, px)| {
+                            let s = resolve(*a, frac);
+                            match order {
+                                Order::BackToFront => over(s, *px),
+                                Order::FrontToBack => over(*px, s),
+                            }
+                        })
+                        .collect();
+                    skipped += acc
+                        .chunks(GROUP)
+                        .filter(|g| g.iter().all(|p| *p == [0; 4]))
+                        .count();
+                    composite_row(&mut acc, &mut image, frac, order);
+                    assert_eq!(image, want, "len {len} frac {frac} {order:?}");
+                    assert!(acc.iter().all(|p| *p == [0; 4]), "cleared");
+                }
+            }
+        }
+        // Not vacuous: many groups were all zero.
+        assert!(skipped > 50, "{skipped}");
+    }
 
     /// The branch-free twins give the same bits, over random values and the edges (zero, one,
     /// the extremes of `i64` and `u32`, every fraction width the tables use and more).
     #[test]
     fn the_fast_forms_match_the_plain_ones() {
-        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            seed
-        };
+        let mut next = xorshift(0x9e37_79b9_7f4a_7c15);
         let edges = [
             0i64,
             1,
