@@ -7,8 +7,9 @@ use footprint_harness::pipeline::visible::FrameCache;
 use footprint_harness::pipeline::{prepare, render_frame};
 use footprint_suite::tmpdir;
 
-/// The core's image of the built-in scene with `extra` flags on `threads` threads, as bits.
-fn image(extra: &[&str], threads: usize) -> Vec<[u32; 4]> {
+/// The core's image of the built-in scene with `extra` flags on `threads` threads, as bits, and
+/// the frame's counts: voxels, voxels splatted, pixel updates, pixels composited.
+fn frame(extra: &[&str], threads: usize) -> (Vec<[u32; 4]>, [u64; 4]) {
     let t = threads.to_string();
     let mut a = vec!["--size", "97x61", "--threads", &t];
     a.extend_from_slice(extra);
@@ -16,7 +17,16 @@ fn image(extra: &[&str], threads: usize) -> Vec<[u32; 4]> {
     let p = prepare(&args).unwrap();
     let f = render_frame(&p, &args, args.accum, &mut FrameCache::default()).unwrap();
     assert_eq!(f.threads, threads, "bands used");
-    f.image.iter().map(|c| c.map(f32::to_bits)).collect()
+    let s = f.stats;
+    (
+        f.image.iter().map(|c| c.map(f32::to_bits)).collect(),
+        [
+            s.voxels,
+            s.voxels_splatted,
+            s.pixel_updates,
+            s.pixels_composited,
+        ],
+    )
 }
 
 #[test]
@@ -69,17 +79,30 @@ fn every_thread_count_gives_the_same_bits() {
         &["--view", "80,0,0", "--accum", "fixed", "--zoom", "3"],
     ];
     for case in cases {
-        let one = image(case, 1);
+        let (one, counts) = frame(case, 1);
         assert!(
             one.iter().any(|p| p[3] != 0),
             "{case:?}: the scene is visible"
         );
         for threads in [2, 3, 7] {
-            let many = image(case, threads);
+            let (many, many_counts) = frame(case, threads);
             let differ = one.iter().zip(&many).filter(|(a, b)| a != b).count();
             assert_eq!(
                 differ, 0,
                 "{case:?}: {threads} threads differ in {differ} pixels"
+            );
+            // The frame's counts too, but for voxels splatted, which counts a voxel once in
+            // each band it reaches.
+            let [v, s, u, c] = counts;
+            let [mv, ms, mu, mc] = many_counts;
+            assert_eq!(
+                (mv, mu, mc),
+                (v, u, c),
+                "{case:?}: {threads} threads: voxels, pixel updates, composites"
+            );
+            assert!(
+                ms >= s,
+                "{case:?}: {threads} threads: {ms} splats, {s} voxels"
             );
         }
     }

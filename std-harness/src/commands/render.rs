@@ -52,7 +52,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
             );
         }
         crate::say!(
-            "{}: {}x{}{} in {:.3} s; {} sheets along {}, {} voxels ({} splatted), {} pixel updates, {} composites",
+            "{}: {}x{}{} in {:.3} s; {} sheets along {}, {} voxels ({} splatted{}), {} pixel updates, {} composites",
             p.name,
             args.size.0,
             args.size.1,
@@ -66,6 +66,14 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
             ["i", "j", "k"][p.frame.sheet_axis],
             stats.voxels,
             stats.voxels_splatted,
+            if frame.threads > 1 {
+                format!(
+                    ", counted in each of the {} bands of rows a voxel reaches",
+                    frame.threads
+                )
+            } else {
+                String::new()
+            },
             stats.pixel_updates,
             stats.pixels_composited
         );
@@ -73,6 +81,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
             .num("seconds", secs)
             .num("voxels", stats.voxels as f64)
             .num("voxels_splatted", stats.voxels_splatted as f64)
+            .num("bands", frame.threads as f64)
             .num("pixel_updates", stats.pixel_updates as f64)
             .num("pixels_composited", stats.pixels_composited as f64);
         let j = match &frame.refine {

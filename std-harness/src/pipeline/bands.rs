@@ -65,8 +65,9 @@ pub fn equal_bands(height: usize, threads: usize) -> Vec<std::ops::Range<usize>>
 }
 
 /// Renders `lists` through `path` on `threads` bands. Returns the image, the counts summed over
-/// bands (`voxels_splatted` counts a voxel once per band it reached) and the slowest band's
-/// splat and composite seconds.
+/// bands (`voxels_splatted` counts a voxel once per band it reached; `voxels` is the lists'
+/// length, what one band over the whole image visits, for any number of bands) and the slowest
+/// band's splat and composite seconds.
 pub fn run_bands<P>(
     p: &Prepared,
     path: P,
@@ -80,13 +81,16 @@ where
     P::Acc: Send,
 {
     let ranges = balanced_rows(&p.frame, lists, threads);
-    on_bands(
+    let (image, mut stats, phases) = on_bands(
         p.frame.size,
         ranges,
         P::CLEAR,
         background,
         |rows, band, bg| render_band(p, path, bg, lists, band, rows),
-    )
+    )?;
+    // A band visits only the voxels that can reach it, so no band's count is the frame's.
+    stats.voxels = lists.len() as u64;
+    Ok((image, stats, phases))
 }
 
 /// A voxel's own work (shading, placement, row set-up), in pixel updates' worth: about 50 ns
@@ -162,8 +166,9 @@ pub fn balanced_rows(
 /// Cuts a `size` image of `clear` pixels into the bands of rows `ranges` (in order, tiling the
 /// image: [`equal_bands`] or [`balanced_rows`]) and runs `band(rows, band's pixels, band's
 /// background)` on each, on its own thread. Returns the image, the counts summed over bands
-/// (`sheets` and `voxels` are the last band's: every band visits every sheet and voxel) and the
-/// slowest band's splat and composite seconds.
+/// (`sheets` and `voxels` are the last band's: right where every band visits every sheet and
+/// voxel, as the slab renderer's do; [`run_bands`] sets `voxels` itself) and the slowest band's
+/// splat and composite seconds.
 pub fn on_bands<X, F>(
     size: [usize; 2],
     ranges: Vec<std::ops::Range<usize>>,
