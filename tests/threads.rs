@@ -130,44 +130,53 @@ fn cached_lists_render_what_a_full_scan_renders() {
     }
     std::fs::write(&raw, &bytes).unwrap();
     let r = raw.to_str().unwrap();
-    for accum in ["float", "fixed"] {
-        for shading in ["emission", "phong"] {
-            let common = [
-                "--dims",
-                "24,20,16",
-                "--type",
-                "u8",
-                "--window",
-                "40,255",
-                "--size",
-                "80x64",
-                "--view",
-                "30,20,0",
-                "--accum",
-                accum,
-                "--shading",
-                shading,
-            ];
-            let mut loaded = vec![r];
-            loaded.extend_from_slice(&common);
-            let mut streamed = vec!["--stream", r];
-            streamed.extend_from_slice(&common);
-            let render = |a: &[&str]| {
-                let args = parse_args(a).unwrap();
-                let p = prepare(&args).unwrap();
-                let f = render_frame(&p, &args, args.accum, &mut FrameCache::default()).unwrap();
-                (
-                    f.image
-                        .iter()
-                        .map(|c| c.map(f32::to_bits))
-                        .collect::<Vec<_>>(),
-                    f.visible,
-                )
-            };
-            let (a, visible) = render(&loaded);
-            let (b, none) = render(&streamed);
-            assert!(visible.is_some_and(|n| n > 0) && none.is_none());
-            assert!(a == b, "{accum} {shading}: lists and full scan differ");
+    // Sheets along z, and along x (read in blocks of sheets: 24 sheets, two blocks, split
+    // between threads).
+    for (view, axis) in [("30,20,0", 2), ("85,10,0", 0)] {
+        for accum in ["float", "fixed"] {
+            for shading in ["emission", "phong"] {
+                let common = [
+                    "--dims",
+                    "24,20,16",
+                    "--type",
+                    "u8",
+                    "--window",
+                    "40,255",
+                    "--size",
+                    "80x64",
+                    "--view",
+                    view,
+                    "--accum",
+                    accum,
+                    "--shading",
+                    shading,
+                ];
+                let mut loaded = vec![r];
+                loaded.extend_from_slice(&common);
+                let mut streamed = vec!["--stream", r];
+                streamed.extend_from_slice(&common);
+                let render = |a: &[&str]| {
+                    let args = parse_args(a).unwrap();
+                    let p = prepare(&args).unwrap();
+                    assert_eq!(p.frame.sheet_axis, axis, "view {view}");
+                    let f =
+                        render_frame(&p, &args, args.accum, &mut FrameCache::default()).unwrap();
+                    (
+                        f.image
+                            .iter()
+                            .map(|c| c.map(f32::to_bits))
+                            .collect::<Vec<_>>(),
+                        f.visible,
+                    )
+                };
+                let (a, visible) = render(&loaded);
+                let (b, none) = render(&streamed);
+                assert!(visible.is_some_and(|n| n > 0) && none.is_none());
+                assert!(
+                    a == b,
+                    "{view} {accum} {shading}: lists and full scan differ"
+                );
+            }
         }
     }
 }

@@ -159,6 +159,25 @@ impl Volume {
         self.sheet_as(axis, s, out, |x| x);
     }
 
+    /// Sheets `sheets` of `axis` into `out`, one after another, each as [`Volume::sheet_into`]
+    /// writes it: a block read together, which is what sheets along x need to be read fast (see
+    /// [`footprint::volume::copy_sheets`]).
+    pub fn sheets_into(&self, axis: usize, sheets: std::ops::Range<usize>, out: &mut [f32]) {
+        use footprint::volume::copy_sheets;
+        let (d, a, s) = (self.dims, axis, sheets);
+        match &self.samples {
+            Samples::U8(v) => copy_sheets(v, d, a, s, out, f32::from),
+            Samples::I8(v) => copy_sheets(v, d, a, s, out, f32::from),
+            Samples::U16(v) => copy_sheets(v, d, a, s, out, f32::from),
+            Samples::I16(v) => copy_sheets(v, d, a, s, out, f32::from),
+            Samples::U32(v) => copy_sheets(v, d, a, s, out, |x| x as f32),
+            Samples::I32(v) => copy_sheets(v, d, a, s, out, |x| x as f32),
+            Samples::F32(v) => copy_sheets(v, d, a, s, out, |x| x),
+            Samples::F64(v) => copy_sheets(v, d, a, s, out, |x| x as f32),
+            Samples::Coloured(v) => copy_sheets(v, d, a, s, out, |x| x.value),
+        }
+    }
+
     /// Sheet `s` of `axis` into `out`, each sample's value (as f32) through `to`.
     fn sheet_as<O>(&self, axis: usize, s: usize, out: &mut [O], to: impl Fn(f32) -> O) {
         use footprint::volume::copy_sheet;
