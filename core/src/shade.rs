@@ -341,7 +341,7 @@ impl Shader<'_> {
                 let ndl = math::abs(n.dot(lighting.light));
                 let ndh = math::abs(n.dot(lighting.half));
                 light = p.ambient + p.diffuse * ndl;
-                spec = p.specular * math::powf(ndh, p.shininess);
+                spec = p.specular * math::powi_or_powf(ndh, p.shininess);
             } else {
                 // No gradient (a homogeneous region): lit as if facing the light.
                 light = p.ambient + p.diffuse;
