@@ -152,14 +152,15 @@ pub fn copy_sheet<T: Copy, U>(
     }
 }
 
-/// [`copy_sheet`] of the `count` consecutive sheets `first..first + count` along `axis`, into the
-/// first `count × dims[a] × dims[b]` entries of `out`, sheet after sheet, each laid out as
+/// [`copy_sheet`] of the consecutive sheets `sheets` along `axis` (count = `sheets.len()`), into
+/// the first `count × dims[a] × dims[b]` entries of `out`, sheet after sheet, each laid out as
 /// [`copy_sheet`] lays it out (so the result is bit for bit `count` calls of it).
 ///
 /// It reads the `count` samples each in-sheet position has along `axis` together. That matters
 /// for `axis` 0, where those samples are adjacent in memory and one sheet's samples are `dims[0]`
 /// apart: one sheet at a time uses one sample of each cache line it loads, `count` sheets at a
-/// time use `count`. Panics if the sheets or `out` do not fit, as [`copy_sheet`] does.
+/// time use `count`. Panics, before writing anything, if `sheets` ends past `dims[axis]` or `out`
+/// is too short (callers check, as for [`copy_sheet`]).
 pub fn copy_sheets<T: Copy, U>(
     data: &[T],
     dims: [usize; 3],
@@ -172,6 +173,11 @@ pub fn copy_sheets<T: Copy, U>(
     let (na, nb) = (dims[a], dims[b]);
     let len = na * nb;
     let count = sheets.len();
+    assert!(
+        sheets.end <= dims[axis],
+        "sheets {sheets:?} past the {} along axis {axis}",
+        dims[axis]
+    );
     let stride = [1, dims[0], dims[0] * dims[1]];
     let out = &mut out[..count * len];
     if axis != 0 {
@@ -208,6 +214,15 @@ mod tests {
     /// A block of sheets is, bit for bit, the sheets one at a time: every axis, blocks at the
     /// start, middle and end, dimensions around the tile width (the largest volume is 17 × 33 × 4
     /// = 2244 samples).
+    /// Sheets past the volume's end along x are refused, not read from the next row.
+    #[test]
+    #[should_panic(expected = "past the 5 along axis 0")]
+    fn copy_sheets_refuses_sheets_past_the_end() {
+        let data = [0u8; 5 * 7 * 3];
+        let mut out = [0u8; 3 * 7 * 3];
+        copy_sheets(&data, [5, 7, 3], 0, 3..6, &mut out, |x| x);
+    }
+
     #[test]
     fn copy_sheets_is_copy_sheet_repeated() {
         for dims in [[5, 7, 3], [17, 33, 4], [40, 16, 2], [1, 1, 1]] {
