@@ -211,9 +211,6 @@ pub fn copy_sheets<T: Copy, U>(
 mod tests {
     use super::{copy_sheet, copy_sheets};
 
-    /// A block of sheets is, bit for bit, the sheets one at a time: every axis, blocks at the
-    /// start, middle and end, dimensions around the tile width (the largest volume is 17 × 33 × 4
-    /// = 2244 samples).
     /// Sheets past the volume's end along x are refused, not read from the next row.
     #[test]
     #[should_panic(expected = "past the 5 along axis 0")]
@@ -223,6 +220,9 @@ mod tests {
         copy_sheets(&data, [5, 7, 3], 0, 3..6, &mut out, |x| x);
     }
 
+    /// A block of sheets is, bit for bit, the sheets one at a time: every axis, blocks at the
+    /// start, middle and end, dimensions around the tile width (the largest volume is 17 × 33 × 4
+    /// = 2244 samples).
     #[test]
     fn copy_sheets_is_copy_sheet_repeated() {
         for dims in [[5, 7, 3], [17, 33, 4], [40, 16, 2], [1, 1, 1]] {
