@@ -156,42 +156,37 @@ impl Volume {
     /// Copies sheet `s` of `axis` (row-major over the other two axes, lower axis fastest) into `out`
     /// as f32.
     pub fn sheet_into(&self, axis: usize, s: usize, out: &mut [f32]) {
-        self.sheet_as(axis, s, out, |x| x);
+        self.sheets_as(axis, s..s + 1, out, |x| x);
     }
 
     /// Sheets `sheets` of `axis` into `out`, one after another, each as [`Volume::sheet_into`]
     /// writes it: a block read together, which is what sheets along x need to be read fast (see
     /// [`footprint::volume::copy_sheets`]).
     pub fn sheets_into(&self, axis: usize, sheets: std::ops::Range<usize>, out: &mut [f32]) {
+        self.sheets_as(axis, sheets, out, |x| x);
+    }
+
+    /// Sheets `sheets` of `axis` into `out`, one after another, each sample's value (as f32)
+    /// through `to`.
+    fn sheets_as<O>(
+        &self,
+        axis: usize,
+        sheets: std::ops::Range<usize>,
+        out: &mut [O],
+        to: impl Fn(f32) -> O,
+    ) {
         use footprint::volume::copy_sheets;
         let (d, a, s) = (self.dims, axis, sheets);
         match &self.samples {
-            Samples::U8(v) => copy_sheets(v, d, a, s, out, f32::from),
-            Samples::I8(v) => copy_sheets(v, d, a, s, out, f32::from),
-            Samples::U16(v) => copy_sheets(v, d, a, s, out, f32::from),
-            Samples::I16(v) => copy_sheets(v, d, a, s, out, f32::from),
-            Samples::U32(v) => copy_sheets(v, d, a, s, out, |x| x as f32),
-            Samples::I32(v) => copy_sheets(v, d, a, s, out, |x| x as f32),
-            Samples::F32(v) => copy_sheets(v, d, a, s, out, |x| x),
-            Samples::F64(v) => copy_sheets(v, d, a, s, out, |x| x as f32),
-            Samples::Coloured(v) => copy_sheets(v, d, a, s, out, |x| x.value),
-        }
-    }
-
-    /// Sheet `s` of `axis` into `out`, each sample's value (as f32) through `to`.
-    fn sheet_as<O>(&self, axis: usize, s: usize, out: &mut [O], to: impl Fn(f32) -> O) {
-        use footprint::volume::copy_sheet;
-        let (d, a) = (self.dims, axis);
-        match &self.samples {
-            Samples::U8(v) => copy_sheet(v, d, a, s, out, |x| to(f32::from(x))),
-            Samples::I8(v) => copy_sheet(v, d, a, s, out, |x| to(f32::from(x))),
-            Samples::U16(v) => copy_sheet(v, d, a, s, out, |x| to(f32::from(x))),
-            Samples::I16(v) => copy_sheet(v, d, a, s, out, |x| to(f32::from(x))),
-            Samples::U32(v) => copy_sheet(v, d, a, s, out, |x| to(x as f32)),
-            Samples::I32(v) => copy_sheet(v, d, a, s, out, |x| to(x as f32)),
-            Samples::F32(v) => copy_sheet(v, d, a, s, out, &to),
-            Samples::F64(v) => copy_sheet(v, d, a, s, out, |x| to(x as f32)),
-            Samples::Coloured(v) => copy_sheet(v, d, a, s, out, |x| to(x.value)),
+            Samples::U8(v) => copy_sheets(v, d, a, s, out, |x| to(f32::from(x))),
+            Samples::I8(v) => copy_sheets(v, d, a, s, out, |x| to(f32::from(x))),
+            Samples::U16(v) => copy_sheets(v, d, a, s, out, |x| to(f32::from(x))),
+            Samples::I16(v) => copy_sheets(v, d, a, s, out, |x| to(f32::from(x))),
+            Samples::U32(v) => copy_sheets(v, d, a, s, out, |x| to(x as f32)),
+            Samples::I32(v) => copy_sheets(v, d, a, s, out, |x| to(x as f32)),
+            Samples::F32(v) => copy_sheets(v, d, a, s, out, &to),
+            Samples::F64(v) => copy_sheets(v, d, a, s, out, |x| to(x as f32)),
+            Samples::Coloured(v) => copy_sheets(v, d, a, s, out, |x| to(x.value)),
         }
     }
 
@@ -205,7 +200,7 @@ impl Volume {
         use footprint::volume::copy_sheet;
         match &self.samples {
             Samples::Coloured(v) => copy_sheet(v, self.dims, axis, s, out, |x| x),
-            _ => self.sheet_as(axis, s, out, |value| Coloured {
+            _ => self.sheets_as(axis, s..s + 1, out, |value| Coloured {
                 value,
                 colour: None,
             }),
