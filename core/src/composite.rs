@@ -62,5 +62,8 @@ pub fn clamp_unit(c: [f32; 4]) -> [f32; 4] {
         |x: f32, m: f32| if x < m { x } else { m },
     );
     let a = hi(lo(c[3]), 1.0);
-    [hi(lo(c[0]), a), hi(lo(c[1]), a), hi(lo(c[2]), a), a]
+    // hi(lo(c[3]), a) is a itself (for c[3] in [0, 1] both are c[3]; above, 1; at or below zero
+    // or NaN, +0), so all four lanes take one formula, which the compiler does as one max and
+    // one min of 4 lanes.
+    c.map(|x| hi(lo(x), a))
 }
