@@ -549,3 +549,73 @@ fn unsaturated_stencil_adds_match_saturating_ones() {
         "{err}"
     );
 }
+
+/// A grey voxel (R = G = B) is splatted by the stencils with each colour product computed once:
+/// its red, green and alpha sums equal those of a voxel whose blue differs (which takes the
+/// per-channel loop), and its blue equals its red, for the saturating and the unsaturated adds,
+/// from narrow to edged footprints, at centres all over the phase grid and across the image edge.
+#[test]
+fn grey_voxels_splat_as_the_per_channel_loop() {
+    use footprint::fixed::stencil::{len_for, FixedStencils};
+    let generic = GenericTable::<65>::build(Kernel::PAPER_GAUSSIAN);
+    let size = 48;
+    let mut checked = 0;
+    for zoom in [0.3f32, 1.0, 2.5, 7.0] {
+        let f = frame([9, 8, 7], zoom, size);
+        let mut table = Box::new(FixedTable::<65>::zeroed());
+        table
+            .build_view(&f, &generic, Lookup::Bilinear, Lookup::Bilinear)
+            .unwrap();
+        for blended in [false, true] {
+            let p = if blended {
+                footprint::stencil::phases_for(&f.footprint, 32)
+            } else {
+                footprint::stencil::edged_phases_for(&f.footprint, 32)
+            };
+            let Some(len) = len_for(&table, p) else {
+                continue;
+            };
+            let mut buffer = vec![0i32; len];
+            let build = if blended {
+                FixedStencils::build_blended
+            } else {
+                FixedStencils::build
+            };
+            let Ok(st) = build(&table, p, &mut buffer) else {
+                continue;
+            };
+            let (c, a) = (ONE / 3 + 7, ONE / 2 + 11);
+            for unsaturated in [false, true] {
+                let mut grey = vec![[0i64; 4]; size * size];
+                let mut other = grey.clone();
+                for k in 0..97i64 {
+                    // Centres (Q24 px) over the image and past its edges, at every sort of phase.
+                    let at = |n: i64| (n * 1_234_567 + k * 7_654_321) % (60 << 24) - (6 << 24);
+                    let centre = [at(3 + k), at(5 + 2 * k)];
+                    for (acc, value) in [(&mut grey, [c, c, c, a]), (&mut other, [c, c, c + 1, a])]
+                    {
+                        let mut img = ImageMut::new(acc, size, size, size).unwrap();
+                        if unsaturated {
+                            st.splat_unsaturated(centre, &value, &mut img, |_, _, _| {});
+                        } else {
+                            st.splat(centre, &value, &mut img, |_, _, _| {});
+                        }
+                    }
+                }
+                assert!(
+                    grey.iter().any(|p| p[0] != 0),
+                    "zoom {zoom}: nothing splatted"
+                );
+                for (g, o) in grey.iter().zip(&other) {
+                    assert_eq!(
+                        [g[0], g[1], g[2], g[3]],
+                        [o[0], o[1], o[0], o[3]],
+                        "zoom {zoom}"
+                    );
+                }
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked >= 6, "{checked} configurations checked");
+}
