@@ -26,7 +26,7 @@ fn footprint(s: f32, a: f32, deg: f32) -> Footprint {
     Footprint::new(&Kernel::PAPER_GAUSSIAN, &g2s, FootprintOptions::default()).unwrap()
 }
 
-const SHAPES: [(f32, f32, f32); 8] = [
+const SHAPES: [(f32, f32, f32); 9] = [
     (0.5, 1.0, 0.0),
     (0.9, 1.0, 0.0),
     (1.6, 1.0, 0.0),
@@ -35,6 +35,7 @@ const SHAPES: [(f32, f32, f32); 8] = [
     (3.0, 4.0, 60.0),
     (8.0, 1.0, 0.0),
     (20.0, 1.5, 20.0),
+    (5.0, 4.0, 30.0), // long and thin: edged (side 59, P = 17)
 ];
 
 const CENTRES: [[f32; 2]; 5] = [

@@ -71,8 +71,17 @@ pub const DEFAULT_PHASES: usize = 32;
 /// it bounds).
 pub const PHASE_REACH: f32 = 128.0;
 
-/// Largest stencil storage, floats (2 MiB): beyond it a footprint is splatted by the table walk.
-pub const MAX_STENCIL_FLOATS: usize = 1 << 19;
+/// Largest stencil storage, floats (8 MiB): beyond it a footprint is splatted by the table walk.
+///
+/// A wide footprint is blended when its stencils at P·r ≥ [`BLEND_REACH`] fit, else edged, and an
+/// edged splat costs about twice a blended one (a support solve per row and sampler reads at
+/// the edge). At 2 MiB the long footprints of anisotropic grids were edged: the CT head
+/// (64×64×93, spacing 3.2 × 3.2 × 1.5) at 1024² seen from the side. Raised to 8 MiB (`footprint
+/// bench --frames 3 --orbit 2 --threads 1`, builds alternated; `verify` against the f64
+/// reference): views 80,20,0 / 90,0,0 / 60,70,0 went 291 → 161, 279 → 171 and 265 → 149 ms per
+/// frame and 98.10 → 98.26, 92.47 → 92.67 and 98.66 → 98.74 dB; fixed at 80,20,0 428 → 320 ms,
+/// 98.08 → 98.25 dB. Building those stencils takes 9 ms instead of 4 (one thread).
+pub const MAX_STENCIL_FLOATS: usize = 1 << 21;
 
 /// The shorter semi-axis of `footprint`'s support ellipse |A q| ≤ 1, px: 1 / σ_max(A), A =
 /// [`Footprint::to_unit`] (for a separable kernel's parallelogram, the half-width of its
