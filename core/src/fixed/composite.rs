@@ -68,18 +68,42 @@ pub fn composite_row(acc: &mut [[i64; 4]], image: &mut [[u32; 4]], frac: u32, or
         if a.iter().all(|p| (p[0] | p[1] | p[2] | p[3]) == 0) {
             continue;
         }
-        match order {
-            Order::BackToFront => {
-                for (a, px) in a.iter_mut().zip(img.iter_mut()) {
-                    *px = over_fast(resolve_fast(*a, frac), *px);
-                    *a = [0; 4];
-                }
+        // A group whose sheet and image pixels are all grey (R = G = B, as everywhere under a
+        // grey transfer function over a grey background) is composited with each colour
+        // computed once: the same bits.
+        if a.iter().all(|p| p[0] == p[1] && p[1] == p[2])
+            && img.iter().all(|p| p[0] == p[1] && p[1] == p[2])
+        {
+            composite_group::<true>(a, img, frac, order);
+        } else {
+            composite_group::<false>(a, img, frac, order);
+        }
+    }
+}
+
+/// [`composite_row`]'s work on one group of pixels, 1 ≤ `frac` ≤ [`FAST_FRAC_MAX`]. With `GREY`
+/// (every pixel of both grey) each pixel is composited from its red and alpha channels.
+#[inline(always)]
+fn composite_group<const GREY: bool>(
+    acc: &mut [[i64; 4]],
+    image: &mut [[u32; 4]],
+    frac: u32,
+    order: Order,
+) {
+    // Grey: the colour channels read from red, so each colour is computed once.
+    let sheet = |p: [i64; 4]| if GREY { [p[0], p[0], p[0], p[3]] } else { p };
+    let under = |p: [u32; 4]| if GREY { [p[0], p[0], p[0], p[3]] } else { p };
+    match order {
+        Order::BackToFront => {
+            for (a, px) in acc.iter_mut().zip(image.iter_mut()) {
+                *px = over_fast(resolve_fast(sheet(*a), frac), under(*px));
+                *a = [0; 4];
             }
-            Order::FrontToBack => {
-                for (a, px) in a.iter_mut().zip(img.iter_mut()) {
-                    *px = over_fast(*px, resolve_fast(*a, frac));
-                    *a = [0; 4];
-                }
+        }
+        Order::FrontToBack => {
+            for (a, px) in acc.iter_mut().zip(image.iter_mut()) {
+                *px = over_fast(under(*px), resolve_fast(sheet(*a), frac));
+                *a = [0; 4];
             }
         }
     }
@@ -204,6 +228,75 @@ mod tests {
         }
         // Not vacuous: many groups were all zero.
         assert!(skipped > 50, "{skipped}");
+    }
+
+    /// Groups of grey pixels (R = G = B in the sheet and the image), composited from one colour
+    /// channel, give what [`resolve`] and [`over`] give per pixel: colours below zero, inside
+    /// and above alpha, alpha above one and negative; grey groups next to groups where one
+    /// pixel's red, green or blue differs, in the sheet or in the image (each of which the grey
+    /// test must send to the per-channel loop); both orders, several fraction widths.
+    #[test]
+    fn grey_groups_match_per_pixel_compositing() {
+        let mut next = xorshift(0x5851_f42d_4c95_7f2d);
+        let mut grey_groups = 0;
+        for len in [GROUP, 7 * GROUP, 8 * GROUP + 6] {
+            for frac in [4, 20, 28] {
+                for order in [Order::BackToFront, Order::FrontToBack] {
+                    // Per group: 0 all grey; in one pixel, 1 the sheet's green differs, 2 its
+                    // blue, 3 its red, 4 the image's green, 5 its blue, 6 its red.
+                    let kind = |i: usize| (i / GROUP) % 7;
+                    let odd = |i: usize, k: usize| kind(i) == k && i % GROUP == 5;
+                    let mut acc: std::vec::Vec<[i64; 4]> = (0..len)
+                        .map(|i| {
+                            let r = next();
+                            let a = ((r >> 8) % (1 << 34)) as i64 - (1 << 30);
+                            let c = match r % 3 {
+                                0 => a / 3,
+                                1 => a * 2,
+                                _ => -a.abs() / 7,
+                            };
+                            let d = a / 2 + 12345;
+                            match i {
+                                _ if odd(i, 1) => [c, d, c, a],
+                                _ if odd(i, 2) => [c, c, d, a],
+                                _ if odd(i, 3) => [d, c, c, a],
+                                _ => [c, c, c, a],
+                            }
+                        })
+                        .collect();
+                    let mut image: std::vec::Vec<[u32; 4]> = (0..len)
+                        .map(|i| {
+                            let a = (next() % (u64::from(super::ONE) + 1)) as u32;
+                            let (c, d) = (a / 2, a / 3 + 7);
+                            match i {
+                                _ if odd(i, 4) => [c, d, c, a],
+                                _ if odd(i, 5) => [c, c, d, a],
+                                _ if odd(i, 6) => [d, c, c, a],
+                                _ => [c, c, c, a],
+                            }
+                        })
+                        .collect();
+                    grey_groups += (0..len.div_ceil(GROUP))
+                        .filter(|&g| kind(g * GROUP) == 0)
+                        .count();
+                    let want: std::vec::Vec<[u32; 4]> = acc
+                        .iter()
+                        .zip(&image)
+                        .map(|(a, px)| {
+                            let s = resolve(*a, frac);
+                            match order {
+                                Order::BackToFront => over(s, *px),
+                                Order::FrontToBack => over(*px, s),
+                            }
+                        })
+                        .collect();
+                    composite_row(&mut acc, &mut image, frac, order);
+                    assert_eq!(image, want, "len {len} frac {frac} {order:?}");
+                    assert!(acc.iter().all(|p| *p == [0; 4]), "cleared");
+                }
+            }
+        }
+        assert!(grey_groups >= 12, "{grey_groups}");
     }
 
     /// The branch-free twins give the same bits, over random values and the edges (zero, one,
