@@ -383,10 +383,17 @@ fn rates_needed(r: &Refinement, sheet: usize, (a, b): (usize, usize)) -> [bool; 
 /// Stencil floats for a footprint that `samples` samples share, if stencils pay: they cost
 /// (P + 1)² footprint reads per box pixel to build and save part of a table walk per pixel
 /// update (about a fifth of a read, measured on the refinement chart), so a spacing gets them when
-/// at least 8·(P + 1)² samples share it (and stencils apply).
+/// at least 8·(P + 1)² samples share it (and stencils apply, within [`REFINE_STENCIL_FLOATS`]).
 fn stencil_len(fp: &Footprint, samples: usize, phases: usize) -> Option<usize> {
     let p = stencil::phases_for(fp, phases);
     (phases > 0 && samples >= 8 * (p + 1) * (p + 1))
         .then(|| stencil::len_for(fp, phases))
         .flatten()
+        .filter(|&len| len <= REFINE_STENCIL_FLOATS)
 }
+
+/// Largest stencils (floats, 2 MiB) for one spacing of a refined render, which holds one set per
+/// spacing that pays for them: the core allows 8 MiB for a frame's single set
+/// ([`stencil::MAX_STENCIL_FLOATS`]), which over many spacings would hold 4× the memory; a
+/// spacing whose stencils are larger walks its table.
+const REFINE_STENCIL_FLOATS: usize = 1 << 19;
