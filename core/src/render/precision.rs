@@ -137,7 +137,7 @@ pub(super) fn float_over_row(front: &mut [[f32; 4]], back: &[[f32; 4]]) {
 }
 
 /// Screen position (pixels) of voxel (u, v) of sheet `sheet`.
-#[inline]
+#[inline(always)]
 fn float_position(f: &FrameSetup, sheet: usize, u: usize, v: usize) -> [f32; 2] {
     let cols = f.grid_to_screen;
     let (a, b) = f.in_sheet;
