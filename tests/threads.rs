@@ -181,6 +181,52 @@ fn cached_lists_render_what_a_full_scan_renders() {
     }
 }
 
+/// Frames that reuse a cache's kept buffers (the bands' accumulators, and an image given back,
+/// here one full of NaN) render what a fresh cache renders, bit for bit: float and fixed, both
+/// compositing orders, one and two threads.
+#[test]
+fn kept_buffers_render_what_fresh_ones_render() {
+    for accum in ["float", "fixed"] {
+        for order in ["back-to-front", "front-to-back"] {
+            for threads in ["1", "2"] {
+                let args = parse_args(&[
+                    "--scene-size",
+                    "24",
+                    "--size",
+                    "64x48",
+                    "--view",
+                    "30,20,0",
+                    "--accum",
+                    accum,
+                    "--order",
+                    order,
+                    "--threads",
+                    threads,
+                ])
+                .unwrap();
+                let p = prepare(&args).unwrap();
+                let bits = |f: footprint_harness::pipeline::CoreFrame| {
+                    f.image
+                        .iter()
+                        .map(|c| c.map(f32::to_bits))
+                        .collect::<Vec<_>>()
+                };
+                let fresh =
+                    bits(render_frame(&p, &args, args.accum, &mut FrameCache::default()).unwrap());
+                let mut cache = FrameCache::default();
+                for k in 0..3 {
+                    cache.recycle(vec![[f32::NAN; 4]; 64 * 48]);
+                    let again = bits(render_frame(&p, &args, args.accum, &mut cache).unwrap());
+                    assert!(
+                        again == fresh,
+                        "{accum} {order} {threads} threads, frame {k}"
+                    );
+                }
+            }
+        }
+    }
+}
+
 #[test]
 fn bench_writes_the_named_keys() {
     let d = tmpdir("bench");

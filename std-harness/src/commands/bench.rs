@@ -97,6 +97,8 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
         threads = f.threads;
         if k == 0 {
             first_image = Some(f.image);
+        } else {
+            cache.recycle(f.image);
         }
     }
     let later = &times[1..];

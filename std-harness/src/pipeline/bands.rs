@@ -4,6 +4,7 @@
 //! one-band render, so the image is byte-identical for any thread count, float or fixed.
 
 use super::prepare::Prepared;
+use super::spares::Spares;
 use super::visible::VisibleLists;
 use crate::CliError;
 use footprint::composite::RowSpan;
@@ -73,21 +74,22 @@ pub fn run_bands<P>(
     path: P,
     background: Option<&[P::Pixel]>,
     lists: &VisibleLists,
+    spares: &Spares,
     threads: usize,
 ) -> Result<(Vec<P::Pixel>, RenderStats, Phases), CliError>
 where
     P: Precision + Copy + Send + Sync,
-    P::Pixel: Send + Sync,
-    P::Acc: Send,
+    P::Pixel: Send + Sync + 'static,
+    P::Acc: Send + PartialEq + 'static,
 {
     let ranges = balanced_rows(&p.frame, lists, threads);
-    let (image, mut stats, phases) = on_bands(
-        p.frame.size,
-        ranges,
-        P::CLEAR,
-        background,
-        |rows, band, bg| render_band(p, path, bg, lists, band, rows),
-    )?;
+    let [w, h] = p.frame.size;
+    // Any image of the right size will do: each band's renderer starts its rows afresh.
+    let image = spares.take_image(w * h, P::CLEAR, "the image")?;
+    let (image, mut stats, phases) =
+        on_bands_into(image, p.frame.size, ranges, background, |rows, band, bg| {
+            render_band(p, path, bg, lists, spares, band, rows)
+        })?;
     // A band visits only the voxels that can reach it, so no band's count is the frame's.
     stats.voxels = lists.len() as u64;
     Ok((image, stats, phases))
@@ -185,10 +187,32 @@ where
         ) -> Result<(RenderStats, Phases), CliError>
         + Sync,
 {
+    let image = crate::io::try_filled(size[0] * size[1], clear, "the image")?;
+    on_bands_into(image, size, ranges, background, band)
+}
+
+/// [`on_bands`] over a caller's `image` of `size` pixels (whatever it holds: each band gets its
+/// rows as they are).
+pub fn on_bands_into<X, F>(
+    mut image: Vec<X>,
+    size: [usize; 2],
+    ranges: Vec<std::ops::Range<usize>>,
+    background: Option<&[X]>,
+    band: F,
+) -> Result<(Vec<X>, RenderStats, Phases), CliError>
+where
+    X: Copy + Send + Sync,
+    F: Fn(
+            std::ops::Range<usize>,
+            &mut [X],
+            Option<&[X]>,
+        ) -> Result<(RenderStats, Phases), CliError>
+        + Sync,
+{
     let [w, h] = size;
     debug_assert!(ranges.first().is_some_and(|r| r.start == 0));
     debug_assert!(ranges.last().is_some_and(|r| r.end == h));
-    let mut image = crate::io::try_filled(w * h, clear, "the image")?;
+    debug_assert_eq!(image.len(), w * h);
     let mut chunks: Vec<&mut [X]> = Vec::with_capacity(ranges.len());
     let mut rest: &mut [X] = &mut image;
     for rows in &ranges {
@@ -227,18 +251,23 @@ where
     Ok((image, stats, phases))
 }
 
-/// One band: every sheet in compositing order, splat then composite, timed.
+/// One band: every sheet in compositing order, splat then composite, timed. Its accumulator is
+/// taken from `spares` and given back clear.
 fn render_band<P: Precision>(
     p: &Prepared,
     path: P,
     background: Option<&[P::Pixel]>,
     lists: &VisibleLists,
+    spares: &Spares,
     image: &mut [P::Pixel],
     rows: std::ops::Range<usize>,
-) -> Result<(RenderStats, Phases), CliError> {
+) -> Result<(RenderStats, Phases), CliError>
+where
+    P::Acc: Send + PartialEq + 'static,
+{
     let f = &p.frame;
     let n = f.size[0] * rows.len();
-    let mut acc = crate::io::try_filled(n, P::ACC_ZERO, "a band's sheet accumulator")?;
+    let mut acc = spares.take(n, P::ACC_ZERO, "a band's sheet accumulator")?;
     let mut spans = vec![RowSpan::EMPTY; rows.len()];
     let mut opacity = vec![0.0f32; OPACITY_TABLE_LEN];
     let mut shades = vec![ShadeCacheEntry::default(); SHADE_CACHE_LEN];
@@ -261,7 +290,10 @@ fn render_band<P: Precision>(
         phases.splat += (t1 - t0).as_secs_f64();
         phases.composite += t1.elapsed().as_secs_f64();
     }
-    Ok((renderer.finish(), phases))
+    let stats = renderer.finish();
+    // Every sheet was composited, which cleared each row it touched.
+    spares.give(acc, P::ACC_ZERO);
+    Ok((stats, phases))
 }
 
 #[cfg(test)]

@@ -223,19 +223,19 @@ fn run_path<P>(
 ) -> Result<PathResult<P::Pixel>, CliError>
 where
     P: Precision + Copy + Send + Sync,
-    P::Pixel: Send + Sync,
-    P::Acc: Send,
+    P::Pixel: Send + Sync + 'static,
+    P::Acc: Send + PartialEq + 'static,
 {
     match &p.voxels {
         Voxels::Memory(volume) => {
             let t0 = Instant::now();
-            let (lists, fresh) = cache.lists(p, volume, threads)?;
+            let (lists, fresh, spares) = cache.lists_and_spares(p, volume, threads)?;
             let classify = if fresh {
                 t0.elapsed().as_secs_f64()
             } else {
                 0.0
             };
-            let (image, stats, phases) = run_bands(p, path, background, lists, threads)?;
+            let (image, stats, phases) = run_bands(p, path, background, lists, spares, threads)?;
             Ok((
                 image,
                 stats,

@@ -3,6 +3,7 @@
 //! along the same axis (the re-render path; see the core's `render::classify_sheet`).
 
 use super::prepare::Prepared;
+use super::spares::Spares;
 use crate::io::volume::Volume;
 use crate::CliError;
 use footprint::lod::Coloured;
@@ -99,11 +100,12 @@ impl VisibleLists {
 }
 
 /// Per-volume state kept across frames of one volume, transfer function and shading: the visible
-/// lists of each sheet axis met so far. A caller that changes the transfer function, window or
-/// shading must start a new cache.
+/// lists of each sheet axis met so far, and the bands' clear accumulators ([`Spares`]). A caller
+/// that changes the transfer function, window or shading must start a new cache.
 #[derive(Debug, Default)]
 pub struct FrameCache {
     lists: [Option<VisibleLists>; 3],
+    spares: Spares,
 }
 
 impl FrameCache {
@@ -115,12 +117,30 @@ impl FrameCache {
         volume: &Volume,
         threads: usize,
     ) -> Result<(&VisibleLists, bool), CliError> {
+        self.lists_and_spares(p, volume, threads)
+            .map(|(lists, fresh, _)| (lists, fresh))
+    }
+
+    /// Keeps a finished frame's `image` (float, of its frame's size) for a later frame to render
+    /// into instead of allocating one; an image of another size or type is never used.
+    pub fn recycle(&self, image: Vec<[f32; 4]>) {
+        self.spares.give_image(image);
+    }
+
+    /// [`FrameCache::lists`], and the accumulators kept from earlier frames.
+    pub fn lists_and_spares(
+        &mut self,
+        p: &Prepared,
+        volume: &Volume,
+        threads: usize,
+    ) -> Result<(&VisibleLists, bool, &Spares), CliError> {
         let axis = p.frame.sheet_axis;
         let fresh = self.lists[axis].is_none();
         if fresh {
             self.lists[axis] = Some(classify(p, volume, threads)?);
         }
-        Ok((self.lists[axis].as_ref().expect("just filled"), fresh))
+        let lists = self.lists[axis].as_ref().expect("just filled");
+        Ok((lists, fresh, &self.spares))
     }
 }
 
