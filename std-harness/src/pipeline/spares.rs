@@ -13,10 +13,10 @@ use std::any::Any;
 use std::sync::Mutex;
 
 /// Most accumulators kept (more threads than this allocate the rest afresh).
-const MAX_SPARES: usize = 16;
+pub const MAX_SPARES: usize = 16;
 
 /// Most images kept: a frame renders one.
-const MAX_IMAGES: usize = 2;
+pub const MAX_IMAGES: usize = 2;
 
 /// Buffers of any pixel type, each kept as its `Vec`: clear accumulators, and images whose
 /// pixels are left as they were (a frame's bands overwrite every pixel before reading one).
