@@ -3,6 +3,7 @@
 //! larger-than-the-image footprints, a thousand opaque sheets, typed range errors, and
 //! bit-identical output on every run and thread.
 
+use footprint::fixed::stencil::{len_for, FixedStencils};
 use footprint::fixed::{self, composite, FixedError, FixedTable, ONE};
 use footprint::frame::{FrameSetup, Order};
 use footprint::geometry::FootprintOptions;
@@ -348,7 +349,6 @@ fn resolved_sheet_pixels_are_valid_premultiplied_colours() {
 /// renormalised voxel's total deposit equals the walk's up to per-pixel rounding.
 #[test]
 fn integer_stencils_match_the_table_walk() {
-    use footprint::fixed::stencil::{len_for, FixedStencils};
     let generic = GenericTable::<65>::build(Kernel::PAPER_GAUSSIAN);
     let (mut checked, mut blended_checked) = (0, 0);
     for (zoom, shear) in [
@@ -468,18 +468,17 @@ fn integer_stencils_match_the_table_walk() {
     );
 }
 
-/// With a value bound (`FixedPath::with_value_bound`) the integer stencils add without
-/// saturating where the bound proves every pixel's sum stays inside `i64`: the image is the
-/// saturating path's, bit for bit, from minified to magnified footprints (narrow, blended and
-/// edged); a voxel above the bound is refused with a typed error, not splatted.
-#[test]
-fn unsaturated_stencil_adds_match_saturating_ones() {
-    use footprint::fixed::stencil::{len_for, FixedStencils};
-    use footprint::render::RenderError;
+/// For each zoom, the frame (`size` px) and its 65-node table, and for each of blended and edged
+/// the integer stencils built for it (skipped where they do not apply): `check(zoom, blended,
+/// frame, table, stencils)`.
+fn with_stencils(
+    zooms: &[f32],
+    size: usize,
+    mut check: impl FnMut(f32, bool, &FrameSetup, &FixedTable<65>, FixedStencils<'_, 65>),
+) {
     let generic = GenericTable::<65>::build(Kernel::PAPER_GAUSSIAN);
-    let mut unsaturated = 0;
-    for zoom in [0.3f32, 1.0, 2.5, 7.0, 14.0] {
-        let f = frame([9, 8, 7], zoom, 96);
+    for &zoom in zooms {
+        let f = frame([9, 8, 7], zoom, size);
         let mut table = Box::new(FixedTable::<65>::zeroed());
         table
             .build_view(&f, &generic, Lookup::Bilinear, Lookup::Bilinear)
@@ -499,28 +498,42 @@ fn unsaturated_stencil_adds_match_saturating_ones() {
             } else {
                 FixedStencils::build
             };
-            let Ok(st) = build(&table, p, &mut buffer) else {
-                continue;
-            };
-            let (_, na, nb) = f.sheet_shape();
-            let sheet = |s: usize| -> Vec<[f32; 4]> {
-                (0..na * nb)
-                    .map(|i| {
-                        let a = ((i * 37 + s * 11) % 17) as f32 / 16.0;
-                        [a * 0.9, a * 0.5, a * 0.2, a]
-                    })
-                    .collect()
-            };
-            let path = || FixedPath::new(&f, &*table).unwrap().with_stencils(st);
-            let bounded = path().with_value_bound(ONE);
-            unsaturated += usize::from(bounded.unsaturated());
-            assert_eq!(
-                render_with(&f, path(), Order::BackToFront, &sheet),
-                render_with(&f, bounded, Order::BackToFront, &sheet),
-                "zoom {zoom}, blended {blended}"
-            );
+            if let Ok(st) = build(&table, p, &mut buffer) {
+                check(zoom, blended, &f, &table, st);
+            }
         }
     }
+}
+
+/// With a value bound (`FixedPath::with_value_bound`) the integer stencils add without
+/// saturating where the bound proves every pixel's sum stays inside `i64`: the image is the
+/// saturating path's, bit for bit, from minified to magnified footprints (narrow, blended and
+/// edged); a voxel above the bound is refused with a typed error, not splatted.
+#[test]
+fn unsaturated_stencil_adds_match_saturating_ones() {
+    use footprint::render::RenderError;
+    let generic = GenericTable::<65>::build(Kernel::PAPER_GAUSSIAN);
+    let mut unsaturated = 0;
+    let zooms = [0.3f32, 1.0, 2.5, 7.0, 14.0];
+    with_stencils(&zooms, 96, |zoom, blended, f, table, st| {
+        let (_, na, nb) = f.sheet_shape();
+        let sheet = |s: usize| -> Vec<[f32; 4]> {
+            (0..na * nb)
+                .map(|i| {
+                    let a = ((i * 37 + s * 11) % 17) as f32 / 16.0;
+                    [a * 0.9, a * 0.5, a * 0.2, a]
+                })
+                .collect()
+        };
+        let path = || FixedPath::new(f, table).unwrap().with_stencils(st);
+        let bounded = path().with_value_bound(ONE);
+        unsaturated += usize::from(bounded.unsaturated());
+        assert_eq!(
+            render_with(f, path(), Order::BackToFront, &sheet),
+            render_with(f, bounded, Order::BackToFront, &sheet),
+            "zoom {zoom}, blended {blended}"
+        );
+    });
     assert!(
         unsaturated >= 6,
         "{unsaturated} configurations added unsaturated"
@@ -556,66 +569,39 @@ fn unsaturated_stencil_adds_match_saturating_ones() {
 /// from narrow to edged footprints, at centres all over the phase grid and across the image edge.
 #[test]
 fn grey_voxels_splat_as_the_per_channel_loop() {
-    use footprint::fixed::stencil::{len_for, FixedStencils};
-    let generic = GenericTable::<65>::build(Kernel::PAPER_GAUSSIAN);
     let size = 48;
     let mut checked = 0;
-    for zoom in [0.3f32, 1.0, 2.5, 7.0] {
-        let f = frame([9, 8, 7], zoom, size);
-        let mut table = Box::new(FixedTable::<65>::zeroed());
-        table
-            .build_view(&f, &generic, Lookup::Bilinear, Lookup::Bilinear)
-            .unwrap();
-        for blended in [false, true] {
-            let p = if blended {
-                footprint::stencil::phases_for(&f.footprint, 32)
-            } else {
-                footprint::stencil::edged_phases_for(&f.footprint, 32)
-            };
-            let Some(len) = len_for(&table, p) else {
-                continue;
-            };
-            let mut buffer = vec![0i32; len];
-            let build = if blended {
-                FixedStencils::build_blended
-            } else {
-                FixedStencils::build
-            };
-            let Ok(st) = build(&table, p, &mut buffer) else {
-                continue;
-            };
-            let (c, a) = (ONE / 3 + 7, ONE / 2 + 11);
-            for unsaturated in [false, true] {
-                let mut grey = vec![[0i64; 4]; size * size];
-                let mut other = grey.clone();
-                for k in 0..97i64 {
-                    // Centres (Q24 px) over the image and past its edges, at every sort of phase.
-                    let at = |n: i64| (n * 1_234_567 + k * 7_654_321) % (60 << 24) - (6 << 24);
-                    let centre = [at(3 + k), at(5 + 2 * k)];
-                    for (acc, value) in [(&mut grey, [c, c, c, a]), (&mut other, [c, c, c + 1, a])]
-                    {
-                        let mut img = ImageMut::new(acc, size, size, size).unwrap();
-                        if unsaturated {
-                            st.splat_unsaturated(centre, &value, &mut img, |_, _, _| {});
-                        } else {
-                            st.splat(centre, &value, &mut img, |_, _, _| {});
-                        }
+    with_stencils(&[0.3, 1.0, 2.5, 7.0], size, |zoom, _, _, _, st| {
+        let (c, a) = (ONE / 3 + 7, ONE / 2 + 11);
+        for unsaturated in [false, true] {
+            let mut grey = vec![[0i64; 4]; size * size];
+            let mut other = grey.clone();
+            for k in 0..97i64 {
+                // Centres (Q24 px) over the image and past its edges, at every sort of phase.
+                let at = |n: i64| (n * 1_234_567 + k * 7_654_321) % (60 << 24) - (6 << 24);
+                let centre = [at(3 + k), at(5 + 2 * k)];
+                for (acc, value) in [(&mut grey, [c, c, c, a]), (&mut other, [c, c, c + 1, a])] {
+                    let mut img = ImageMut::new(acc, size, size, size).unwrap();
+                    if unsaturated {
+                        st.splat_unsaturated(centre, &value, &mut img, |_, _, _| {});
+                    } else {
+                        st.splat(centre, &value, &mut img, |_, _, _| {});
                     }
                 }
-                assert!(
-                    grey.iter().any(|p| p[0] != 0),
-                    "zoom {zoom}: nothing splatted"
-                );
-                for (g, o) in grey.iter().zip(&other) {
-                    assert_eq!(
-                        [g[0], g[1], g[2], g[3]],
-                        [o[0], o[1], o[0], o[3]],
-                        "zoom {zoom}"
-                    );
-                }
-                checked += 1;
             }
+            assert!(
+                grey.iter().any(|p| p[0] != 0),
+                "zoom {zoom}: nothing splatted"
+            );
+            for (g, o) in grey.iter().zip(&other) {
+                assert_eq!(
+                    [g[0], g[1], g[2], g[3]],
+                    [o[0], o[1], o[0], o[3]],
+                    "zoom {zoom}"
+                );
+            }
+            checked += 1;
         }
-    }
+    });
     assert!(checked >= 6, "{checked} configurations checked");
 }

@@ -169,6 +169,26 @@ mod tests {
         }
     }
 
+    /// Runs `composite_row` on `acc` and `image` and checks that it gave every pixel what
+    /// [`resolve`] and [`over`] give it, and cleared the row.
+    fn check_row(acc: &mut [[i64; 4]], image: &mut [[u32; 4]], frac: u32, order: Order) {
+        let want: std::vec::Vec<[u32; 4]> = acc
+            .iter()
+            .zip(image.iter())
+            .map(|(a, px)| {
+                let s = resolve(*a, frac);
+                match order {
+                    Order::BackToFront => over(s, *px),
+                    Order::FrontToBack => over(*px, s),
+                }
+            })
+            .collect();
+        composite_row(acc, image, frac, order);
+        let len = acc.len();
+        assert_eq!(image, &want[..], "len {len} frac {frac} {order:?}");
+        assert!(acc.iter().all(|p| *p == [0; 4]), "cleared");
+    }
+
     /// `composite_row`, which skips groups of zero accumulators, gives every pixel what
     /// [`resolve`] and [`over`] give it, and clears the whole row: rows of every length up to a
     /// few groups (a partial last group), zero and non-zero groups mixed, zero pixels inside
@@ -205,24 +225,11 @@ mod tests {
                             [a / 2, a / 3, a, a]
                         })
                         .collect();
-                    let want: std::vec::Vec<[u32; 4]> = acc
-                        .iter()
-                        .zip(&image)
-                        .map(|(a, px)| {
-                            let s = resolve(*a, frac);
-                            match order {
-                                Order::BackToFront => over(s, *px),
-                                Order::FrontToBack => over(*px, s),
-                            }
-                        })
-                        .collect();
                     skipped += acc
                         .chunks(GROUP)
                         .filter(|g| g.iter().all(|p| *p == [0; 4]))
                         .count();
-                    composite_row(&mut acc, &mut image, frac, order);
-                    assert_eq!(image, want, "len {len} frac {frac} {order:?}");
-                    assert!(acc.iter().all(|p| *p == [0; 4]), "cleared");
+                    check_row(&mut acc, &mut image, frac, order);
                 }
             }
         }
@@ -279,20 +286,7 @@ mod tests {
                     grey_groups += (0..len.div_ceil(GROUP))
                         .filter(|&g| kind(g * GROUP) == 0)
                         .count();
-                    let want: std::vec::Vec<[u32; 4]> = acc
-                        .iter()
-                        .zip(&image)
-                        .map(|(a, px)| {
-                            let s = resolve(*a, frac);
-                            match order {
-                                Order::BackToFront => over(s, *px),
-                                Order::FrontToBack => over(*px, s),
-                            }
-                        })
-                        .collect();
-                    composite_row(&mut acc, &mut image, frac, order);
-                    assert_eq!(image, want, "len {len} frac {frac} {order:?}");
-                    assert!(acc.iter().all(|p| *p == [0; 4]), "cleared");
+                    check_row(&mut acc, &mut image, frac, order);
                 }
             }
         }

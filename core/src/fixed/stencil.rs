@@ -316,7 +316,10 @@ impl<'a, const M: usize> FixedStencils<'a, M> {
         acc: &mut ImageMut<'_, [i64; 4]>,
         touched: impl FnMut(usize, usize, usize),
     ) -> SplatStats {
-        self.splat_as::<false>(center, value, acc, touched)
+        match grey(value) {
+            true => self.splat_as::<false, true>(center, value, acc, touched),
+            false => self.splat_as::<false, false>(center, value, acc, touched),
+        }
     }
 
     /// [`FixedStencils::splat`] with wrapping adds, for a caller that has shown no pixel's sum
@@ -329,27 +332,16 @@ impl<'a, const M: usize> FixedStencils<'a, M> {
         acc: &mut ImageMut<'_, [i64; 4]>,
         touched: impl FnMut(usize, usize, usize),
     ) -> SplatStats {
-        self.splat_as::<true>(center, value, acc, touched)
-    }
-
-    /// [`FixedStencils::splat_grey_as`], its colour products computed once for a grey voxel
-    /// (R = G = B, as every voxel of a grey transfer function): 7–9 % off the fixed splat of the
-    /// walnut and the CT head (`footprint bench --accum fixed`, 512², builds alternated).
-    fn splat_as<const WRAP: bool>(
-        &self,
-        center: [i64; 2],
-        value: &[u32; 4],
-        acc: &mut ImageMut<'_, [i64; 4]>,
-        touched: impl FnMut(usize, usize, usize),
-    ) -> SplatStats {
-        if value[0] == value[1] && value[1] == value[2] {
-            self.splat_grey_as::<WRAP, true>(center, value, acc, touched)
-        } else {
-            self.splat_grey_as::<WRAP, false>(center, value, acc, touched)
+        match grey(value) {
+            true => self.splat_as::<true, true>(center, value, acc, touched),
+            false => self.splat_as::<true, false>(center, value, acc, touched),
         }
     }
 
-    fn splat_grey_as<const WRAP: bool, const GREY: bool>(
+    /// The splat, with wrapping adds if `WRAP`; `GREY` for a grey voxel ([`grey`]), whose colour
+    /// products it computes once per pixel: 7–9 % off the fixed splat of the walnut and the CT
+    /// head (`footprint bench --accum fixed`, 512², builds alternated).
+    fn splat_as<const WRAP: bool, const GREY: bool>(
         &self,
         center: [i64; 2],
         value: &[u32; 4],
@@ -463,6 +455,12 @@ impl<'a, const M: usize> FixedStencils<'a, M> {
         }
         stats
     }
+}
+
+/// Whether a voxel is grey (R = G = B, as every voxel of a grey transfer function).
+#[inline]
+fn grey(value: &[u32; 4]) -> bool {
+    value[0] == value[1] && value[1] == value[2]
 }
 
 #[cfg(test)]

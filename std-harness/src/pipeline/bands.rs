@@ -87,7 +87,7 @@ where
     // Any image of the right size will do: each band's renderer starts its rows afresh.
     let image = spares.take_image(w * h, P::CLEAR, "the image")?;
     let (image, mut stats, phases) =
-        on_bands_into(image, p.frame.size, ranges, background, |rows, band, bg| {
+        on_bands(image, p.frame.size, ranges, background, |rows, band, bg| {
             render_band(p, path, bg, lists, spares, band, rows)
         })?;
     // A band visits only the voxels that can reach it, so no band's count is the frame's.
@@ -165,35 +165,13 @@ pub fn balanced_rows(
     ranges
 }
 
-/// Cuts a `size` image of `clear` pixels into the bands of rows `ranges` (in order, tiling the
+/// Cuts `image`, of `size` pixels, into the bands of rows `ranges` (in order, tiling the
 /// image: [`equal_bands`] or [`balanced_rows`]) and runs `band(rows, band's pixels, band's
-/// background)` on each, on its own thread. Returns the image, the counts summed over bands
-/// (`sheets` and `voxels` are the last band's: right where every band visits every sheet and
-/// voxel, as the slab renderer's do; [`run_bands`] sets `voxels` itself) and the slowest band's
-/// splat and composite seconds.
+/// background)` on each, on its own thread; each band gets its rows as the image holds them.
+/// Returns the image, the counts summed over bands (`sheets` and `voxels` are the last band's:
+/// right where every band visits every sheet and voxel, as the slab renderer's do; [`run_bands`]
+/// sets `voxels` itself) and the slowest band's splat and composite seconds.
 pub fn on_bands<X, F>(
-    size: [usize; 2],
-    ranges: Vec<std::ops::Range<usize>>,
-    clear: X,
-    background: Option<&[X]>,
-    band: F,
-) -> Result<(Vec<X>, RenderStats, Phases), CliError>
-where
-    X: Copy + Send + Sync,
-    F: Fn(
-            std::ops::Range<usize>,
-            &mut [X],
-            Option<&[X]>,
-        ) -> Result<(RenderStats, Phases), CliError>
-        + Sync,
-{
-    let image = crate::io::try_filled(size[0] * size[1], clear, "the image")?;
-    on_bands_into(image, size, ranges, background, band)
-}
-
-/// [`on_bands`] over a caller's `image` of `size` pixels (whatever it holds: each band gets its
-/// rows as they are).
-pub fn on_bands_into<X, F>(
     mut image: Vec<X>,
     size: [usize; 2],
     ranges: Vec<std::ops::Range<usize>>,

@@ -294,9 +294,9 @@ pub fn render_refined(
         let tables = RefineTables { rates, splatters: &splatters };
         let table_secs = t0.elapsed().as_secs_f64();
         let (image, stats, phases) = on_bands(
+            crate::io::try_filled(f.size[0] * f.size[1], [0.0f32; 4], "the image")?,
             f.size,
             equal_bands(f.size[1], threads),
-            [0.0f32; 4],
             p.background.as_deref(),
             |rows, image, bg| {
                 let n = f.size[0] * rows.len();

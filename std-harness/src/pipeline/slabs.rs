@@ -77,10 +77,11 @@ pub fn render_slabs(
     let classify = classify_lists + t1.elapsed().as_secs_f64();
 
     let (setup, table, sv) = (&setup, &*table, &voxels);
+    let [w, h] = p.frame.size;
     let (image, mut stats, band_phases) = on_bands(
+        crate::io::try_filled(w * h, [0.0f32; 4], "the image")?,
         p.frame.size,
-        equal_bands(p.frame.size[1], threads),
-        [0.0f32; 4],
+        equal_bands(h, threads),
         p.background.as_deref(),
         |rows, band, bg| render_band(p, setup, table, sv, bg, band, rows),
     )?;
