@@ -2,7 +2,7 @@
 //! formats and the rounding). No floating point here (denied below and audited in CI).
 #![deny(clippy::float_arithmetic, clippy::disallowed_types)]
 
-use super::{FRAC, ONE};
+use super::{is_grey, FRAC, ONE};
 use crate::frame::Order;
 
 /// An accumulated sheet pixel (Q(24 + `frac`) per channel) rounded to Q24, alpha clamped to
@@ -71,9 +71,7 @@ pub fn composite_row(acc: &mut [[i64; 4]], image: &mut [[u32; 4]], frac: u32, or
         // A group whose sheet and image pixels are all grey (R = G = B, as everywhere under a
         // grey transfer function over a grey background) is composited with each colour
         // computed once: the same bits.
-        if a.iter().all(|p| p[0] == p[1] && p[1] == p[2])
-            && img.iter().all(|p| p[0] == p[1] && p[1] == p[2])
-        {
+        if a.iter().all(is_grey) && img.iter().all(is_grey) {
             composite_group::<true>(a, img, frac, order);
         } else {
             composite_group::<false>(a, img, frac, order);

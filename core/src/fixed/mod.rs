@@ -119,6 +119,13 @@ pub fn to_f32(c: [u32; 4]) -> [f32; 4] {
     c.map(|x| x as f32 / ONE as f32)
 }
 
+/// Whether an RGBA value is grey (R = G = B, as everywhere under a grey transfer function): the
+/// fixed path then computes each colour once for the three channels.
+#[inline]
+pub(crate) fn is_grey<T: PartialEq>(p: &[T; 4]) -> bool {
+    p[0] == p[1] && p[1] == p[2]
+}
+
 /// CRC-32 of an image's channels, each as 4 little-endian bytes, row by row: the checksum the
 /// firmware and the host print for the same scene.
 pub fn checksum(image: &[[u32; 4]]) -> u32 {

@@ -31,7 +31,7 @@
 //! the same count as the float stencils.
 #![deny(clippy::float_arithmetic, clippy::disallowed_types)]
 
-use super::{FixedTable, POS_FRAC};
+use super::{is_grey, FixedTable, POS_FRAC};
 use crate::splat::{BufferError, ImageMut, SplatStats};
 use crate::stencil::{
     cell_corners, corner_offsets, nonzero_run, MAX_STENCIL_FLOATS, MAX_STENCIL_SIDE, NARROW_SIDE,
@@ -316,7 +316,7 @@ impl<'a, const M: usize> FixedStencils<'a, M> {
         acc: &mut ImageMut<'_, [i64; 4]>,
         touched: impl FnMut(usize, usize, usize),
     ) -> SplatStats {
-        match grey(value) {
+        match is_grey(value) {
             true => self.splat_as::<false, true>(center, value, acc, touched),
             false => self.splat_as::<false, false>(center, value, acc, touched),
         }
@@ -332,13 +332,13 @@ impl<'a, const M: usize> FixedStencils<'a, M> {
         acc: &mut ImageMut<'_, [i64; 4]>,
         touched: impl FnMut(usize, usize, usize),
     ) -> SplatStats {
-        match grey(value) {
+        match is_grey(value) {
             true => self.splat_as::<true, true>(center, value, acc, touched),
             false => self.splat_as::<true, false>(center, value, acc, touched),
         }
     }
 
-    /// The splat, with wrapping adds if `WRAP`; `GREY` for a grey voxel ([`grey`]), whose colour
+    /// The splat, with wrapping adds if `WRAP`; `GREY` for a grey voxel ([`super::is_grey`]), whose colour
     /// products it computes once per pixel: 7–9 % off the fixed splat of the walnut and the CT
     /// head (`footprint bench --accum fixed`, 512², builds alternated).
     fn splat_as<const WRAP: bool, const GREY: bool>(
@@ -455,12 +455,6 @@ impl<'a, const M: usize> FixedStencils<'a, M> {
         }
         stats
     }
-}
-
-/// Whether a voxel is grey (R = G = B, as every voxel of a grey transfer function).
-#[inline]
-fn grey(value: &[u32; 4]) -> bool {
-    value[0] == value[1] && value[1] == value[2]
 }
 
 #[cfg(test)]

@@ -11,7 +11,7 @@
 //! - [`run`]: the core's render (float or fixed, view table or direct) and the f64 reference.
 //! - [`visible`]: visible-voxel lists, classified once and kept across frames ([`visible::FrameCache`]).
 //! - [`bands`]: a frame split into bands of rows, one per thread, byte-identical for any count.
-//! - [`spares`]: bands' sheet accumulators kept clear from one frame for the next.
+//! - [`spares`]: bands' sheet accumulators (kept clear) and frame images kept for the next frame.
 //! - [`config`]: one table configuration (size, lookup, method, accumulation).
 //! - [`quality`]: `--quality`, the cheapest configuration predicted to reach a PSNR.
 //! - [`choose`]: `--quality`'s entry: the sheet model or the pilot, as `--quality-reference` says.

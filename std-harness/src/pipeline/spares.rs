@@ -1,6 +1,6 @@
-//! Sheet accumulators and images kept from one frame for the next. A band's accumulator ends its frame
-//! clear: the renderer composites every sheet over the rows it touched and clears those rows,
-//! and touches no other pixel. So a later frame of the same size can take it as it is, without
+//! Sheet accumulators and images kept from one frame for the next. A band's accumulator ends
+//! its frame clear: the renderer composites every sheet over the rows it touched and clears those
+//! rows, and touches no other pixel. So a later frame of the same size can take it as it is, without
 //! allocating and filling megabytes per band (`try_filled`, `memset` and page faults were about
 //! 4 % of a blobs re-render in `perf record`). An accumulator is given back only after a band
 //! finished without error; one that met an error is dropped. A frame's image is kept apart from
