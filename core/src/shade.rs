@@ -13,178 +13,9 @@ use crate::math;
 use crate::splat::BufferError;
 use glam::Vec3;
 
-/// Value → straight RGBA lookup table over the window [lo, hi]; finite values outside clamp to the
-/// ends. Entries are linearly interpolated. `lut` may have any length ≥ 2.
-///
-/// Non-finite samples (NaN, ±∞) are *missing data*: they classify as transparent, so they cost
-/// nothing and never paint a pixel. (Clamping +∞ to the top of the window would show missing data
-/// as the densest material.)
-#[derive(Clone, Copy, Debug)]
-pub struct TransferFunction<'a> {
-    /// Straight RGBA entries, evenly spaced from `lo` to `hi`; each channel in [0, 1].
-    pub lut: &'a [[f32; 4]],
-    /// Value mapped to the first entry.
-    pub lo: f32,
-    /// Value mapped to the last entry (> lo).
-    pub hi: f32,
-}
+mod transfer;
 
-/// Why a transfer function cannot classify.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[non_exhaustive]
-pub enum TransferFunctionError {
-    /// The lookup table has fewer than two entries.
-    TooFewEntries {
-        /// Entries given.
-        len: usize,
-    },
-    /// The window is empty, reversed or not finite (`lo` must be below `hi`).
-    Window {
-        /// Value mapped to the first entry.
-        lo: f32,
-        /// Value mapped to the last entry.
-        hi: f32,
-    },
-    /// An entry has a channel outside [0, 1] or not finite.
-    Entry {
-        /// Index of the entry.
-        index: usize,
-    },
-}
-
-impl core::fmt::Display for TransferFunctionError {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        match *self {
-            Self::TooFewEntries { len } => write!(
-                f,
-                "transfer function has {len} entries; it needs at least 2"
-            ),
-            Self::Window { lo, hi } => write!(
-                f,
-                "transfer function window {lo}..{hi} is empty: the low end must be below the high end"
-            ),
-            Self::Entry { index } => write!(
-                f,
-                "transfer function entry {index} has a channel outside [0, 1]"
-            ),
-        }
-    }
-}
-
-impl core::error::Error for TransferFunctionError {}
-
-impl TransferFunction<'_> {
-    /// Checks that this transfer function can classify: at least two entries, a finite window
-    /// with `lo < hi`, every channel in [0, 1].
-    pub fn check(&self) -> Result<(), TransferFunctionError> {
-        if self.lut.len() < 2 {
-            return Err(TransferFunctionError::TooFewEntries {
-                len: self.lut.len(),
-            });
-        }
-        if !(self.lo.is_finite() && self.hi.is_finite() && self.hi > self.lo) {
-            return Err(TransferFunctionError::Window {
-                lo: self.lo,
-                hi: self.hi,
-            });
-        }
-        if let Some(index) = self
-            .lut
-            .iter()
-            .position(|c| !c.iter().all(|v| (0.0..=1.0).contains(v)))
-        {
-            return Err(TransferFunctionError::Entry { index });
-        }
-        Ok(())
-    }
-
-    /// `value`'s position along the entries (0 at `lo`, n − 1 at `hi`; unclamped): a
-    /// non-decreasing function of `value` (each rounded step is).
-    #[inline]
-    fn position(&self, value: f32) -> f32 {
-        (value - self.lo) / (self.hi - self.lo) * (self.lut.len() - 1) as f32
-    }
-
-    /// The largest value at or below which [`TransferFunction::lookup`] gives opacity exactly
-    /// 0: every entry before the first with opacity above 0 is transparent, and so is every
-    /// value whose position falls at or before the last of them (the blend of two zeros is
-    /// zero); −∞ when the first entry is not transparent (or the function does not
-    /// [`check`](TransferFunction::check)). Found by bisection over the ordered finite `f32`s
-    /// on the position [`lookup`](TransferFunction::lookup) computes, which never decreases with
-    /// the value, so the bound is exact, not an estimate: a classifier may skip values at or
-    /// below it with one comparison.
-    pub fn transparent_at_or_below(&self) -> f32 {
-        if self.check().is_err() {
-            return f32::NEG_INFINITY;
-        }
-        let Some(first) = self.lut.iter().position(|c| c[3] > 0.0) else {
-            // No entry is visible: every value is transparent.
-            return f32::INFINITY;
-        };
-        if first == 0 {
-            return f32::NEG_INFINITY;
-        }
-        let last_clear = (first - 1) as f32;
-        let clear = |v: f32| self.position(v) <= last_clear;
-        // Finite f32s in order: their bits read as an i32, negative values reversed (held in
-        // an i64 so the bisection's differences cannot overflow).
-        let key = |v: f32| {
-            let b = i64::from(v.to_bits() as i32);
-            if b < 0 {
-                i64::from(i32::MIN) - b
-            } else {
-                b
-            }
-        };
-        let value = |k: i64| {
-            if k < 0 {
-                f32::from_bits((i64::from(i32::MIN) - k) as u32)
-            } else {
-                f32::from_bits(k as u32)
-            }
-        };
-        let (mut lo, mut hi) = (key(-f32::MAX), key(f32::MAX));
-        if !clear(value(lo)) {
-            return f32::NEG_INFINITY;
-        }
-        if clear(value(hi)) {
-            return f32::MAX;
-        }
-        // Invariant: clear at lo, not clear at hi.
-        while hi - lo > 1 {
-            let mid = lo + (hi - lo) / 2;
-            if clear(value(mid)) {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        value(lo)
-    }
-
-    /// Straight RGBA for `value`; transparent for a non-finite value.
-    #[inline]
-    pub fn lookup(&self, value: f32) -> [f32; 4] {
-        if !value.is_finite() {
-            return [0.0; 4];
-        }
-        let n = self.lut.len();
-        let t = self.position(value);
-        if !t.is_finite() {
-            return [0.0; 4];
-        }
-        let t = t.clamp(0.0, (n - 1) as f32);
-        let i = (t as usize).min(n - 2);
-        let f = t - i as f32;
-        let (a, b) = (self.lut[i], self.lut[i + 1]);
-        [
-            a[0] + f * (b[0] - a[0]),
-            a[1] + f * (b[1] - a[1]),
-            a[2] + f * (b[2] - a[2]),
-            a[3] + f * (b[3] - a[3]),
-        ]
-    }
-}
+pub use transfer::{TransferFunction, TransferFunctionError, RAMP_MIN_OPACITY};
 
 /// Phong lighting coefficients (a head-light at the viewer).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -357,6 +188,20 @@ impl Shader<'_> {
         };
         let shade = |c: f32| ((c * light + spec).min(1.0)) * corrected;
         [shade(rgb[0]), shade(rgb[1]), shade(rgb[2]), corrected]
+    }
+
+    /// The values a voxel is [`visible`](Shader::visible) at, whatever its gradient or position,
+    /// when they are exactly one interval: the transfer function's
+    /// [`visible_interval`](TransferFunction::visible_interval) where the shading takes opacity
+    /// from it (emission, Phong, texture), `None` for an iso-surface. A bisection of about 96
+    /// lookups: call it once per sheet or frame, not per voxel.
+    pub fn visible_interval(&self) -> Option<(f32, f32)> {
+        match self.shading {
+            Shading::Emission | Shading::Phong(_) | Shading::Texture(_) => {
+                self.tf.visible_interval()
+            }
+            Shading::Iso { .. } => None,
+        }
     }
 
     /// A value at or below which no voxel is [`visible`](Shader::visible), whatever its

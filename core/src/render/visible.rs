@@ -45,8 +45,9 @@ const CLEAR_GROUP: usize = 16;
 /// into `colours` when the sample type carries colours ([`Sample::COLOURED`]; a sample without
 /// one gets the transfer function's), in render order; returns how many. `voxels` (and
 /// `gradients` and `colours`, when needed) must hold a whole sheet's worth in the worst case
-/// (`dims[a] × dims[b]`); sheets wider than 65 536 voxels along an axis are refused. A sample type without colours leaves
-/// `colours` alone (it may then be empty).
+/// (`dims[a] × dims[b]`); sheets wider than 65 536 voxels along an axis are refused; entries
+/// past the count returned may be overwritten. A sample type without colours leaves `colours`
+/// alone (it may then be empty).
 pub fn classify_sheet<T: Sample>(
     frame: &FrameSetup,
     shader: &Shader<'_>,
@@ -104,6 +105,8 @@ pub fn classify_sheet<T: Sample>(
     // Values the transfer function makes transparent whatever the gradient are skipped with one
     // comparison (exact: the bound is where its lookup's opacity stops being 0).
     let clear = shader.transparent_at_or_below();
+    // Where visibility is one interval of values, two comparisons replace the lookup.
+    let interval = shader.visible_interval();
     let mut n = 0;
     for (v, row) in window.current.chunks_exact(na.max(1)).enumerate().take(nb) {
         // Groups of samples all at or below the bound are skipped with one test (a branch-free
@@ -115,6 +118,20 @@ pub fn classify_sheet<T: Sample>(
             {
                 continue;
             }
+            if let (Some((low, high)), false, false) = (interval, needs_gradient, coloured) {
+                // Visible exactly where low ≤ value ≤ high: each sample written, and counted
+                // if it is (no branch per sample; the slot is overwritten otherwise).
+                for (i, &sample) in group.iter().enumerate() {
+                    let value = sample.to_f32();
+                    voxels[n] = VisibleVoxel {
+                        u: (k * CLEAR_GROUP + i) as u16,
+                        v: v as u16,
+                        value,
+                    };
+                    n += usize::from(low <= value && value <= high);
+                }
+                continue;
+            }
             for (i, &sample) in group.iter().enumerate() {
                 let u = k * CLEAR_GROUP + i;
                 let value = sample.to_f32();
@@ -122,10 +139,19 @@ pub fn classify_sheet<T: Sample>(
                     continue;
                 }
                 let mut g = glam::Vec3::ZERO;
-                let seen = shader.visible(value, || {
-                    g = gradient(frame, &window, u, v);
-                    g
-                });
+                let seen = match interval {
+                    Some((low, high)) => {
+                        let seen = low <= value && value <= high;
+                        if seen && needs_gradient {
+                            g = gradient(frame, &window, u, v);
+                        }
+                        seen
+                    }
+                    None => shader.visible(value, || {
+                        g = gradient(frame, &window, u, v);
+                        g
+                    }),
+                };
                 if !seen {
                     continue;
                 }
