@@ -434,6 +434,16 @@ fn integer_stencils_match_the_table_walk() {
                     .flat_map(|(a, b)| (0..4).map(move |c| (a[c] - b[c]).abs() as f64))
                     .fold(0.0, f64::max);
                 let what = format!("zoom {zoom} shear {shear} k {k}");
+                if !blended && stencils.side() > footprint::stencil::NARROW_SIDE {
+                    // Edged: no blend crosses the support's edge, so no pixel outside the walk's
+                    // support gets weight (a blend there would, from the corners inside it).
+                    for (i, (a, b)) in walk.iter().zip(&st).enumerate() {
+                        assert!(
+                            a[3] != 0 || b[3] == 0,
+                            "{what}: pixel {i} outside the support"
+                        );
+                    }
+                }
                 if node {
                     at_nodes = at_nodes.max(worst / peak);
                     // Exact up to rounding for P a power of two; otherwise a node a·2²⁴/P rounds
