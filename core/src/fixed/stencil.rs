@@ -429,9 +429,6 @@ impl<'a, const M: usize> FixedStencils<'a, M> {
                         + (1 << 15))
                         >> 16
                 };
-                if wt == 0 {
-                    continue;
-                }
                 let add = |a: &mut i64, p: i64| {
                     *a = if WRAP {
                         a.wrapping_add(p)
@@ -453,7 +450,7 @@ impl<'a, const M: usize> FixedStencils<'a, M> {
                         add(a, c * wt);
                     }
                 }
-                updated += 1;
+                updated += u32::from(wt != 0);
             }
             stats.pixels_visited += n as u32;
             stats.pixels_updated += updated;
