@@ -159,6 +159,10 @@ pub fn render_frame(
                 let tables = start.elapsed().as_secs_f64();
                 let bg: Option<Vec<[u32; 4]>> =
                     p.background.as_ref().map(|b| b.iter().map(|&c| fixed::quantise(c)).collect());
+                // A kept float image (a frame handed back) serves as this one's, its bits as
+                // they are: the renderer starts every pixel afresh.
+                let [w, h] = p.frame.size;
+                cache.reuse_image_as(w * h, |px: [f32; 4]| px.map(f32::to_bits));
                 let (img, stats, phases, visible) = run_path(p, path, bg.as_deref(), cache, threads)?;
                 (img.into_iter().map(fixed::to_f32).collect(), stats, Phases { tables, ..phases }, visible)
             }

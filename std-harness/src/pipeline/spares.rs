@@ -72,6 +72,24 @@ impl Spares {
             .map_or_else(|| try_filled(n, fill, what), Ok)
     }
 
+    /// Where no image of `T` and `n` pixels is kept but one of `U` is, makes it one of `T`, each
+    /// pixel through `convert` (in place where the two have the same size and alignment, as the
+    /// fixed path's `[u32; 4]` and the float `[f32; 4]` it is handed back as), for a later
+    /// [`Spares::take_image`]: the page faults of a fresh image cost more than the pass.
+    pub fn convert_image<U: Send + 'static, T: Copy + Send + 'static>(
+        &self,
+        n: usize,
+        convert: impl Fn(U) -> T,
+    ) {
+        if self.images.holds::<T>(n) {
+            return;
+        }
+        if let Some(image) = self.images.take::<U>(n) {
+            self.images
+                .give(image.into_iter().map(convert).collect::<Vec<T>>());
+        }
+    }
+
     /// Keeps a finished frame's `image` for a later [`Spares::take_image`] (past [`MAX_IMAGES`],
     /// the oldest kept is dropped).
     pub fn give_image<T: Send + 'static>(&self, image: Vec<T>) {
@@ -100,6 +118,13 @@ impl Shelf {
             .iter()
             .position(|b| b.downcast_ref::<Vec<T>>().is_some_and(|v| v.len() == n))?;
         kept.remove(at).downcast::<Vec<T>>().ok().map(|v| *v)
+    }
+
+    /// Whether a `Vec<T>` of length `n` is kept.
+    fn holds<T: 'static>(&self, n: usize) -> bool {
+        let kept = self.kept.lock().unwrap_or_else(|e| e.into_inner());
+        kept.iter()
+            .any(|b| b.downcast_ref::<Vec<T>>().is_some_and(|v| v.len() == n))
     }
 
     fn give<T: Send + 'static>(&self, v: Vec<T>) {
@@ -154,6 +179,33 @@ mod tests {
         assert_eq!(
             s.take_image(3, [0.0f32; 4], "test").unwrap(),
             vec![[0.0f32; 4]; 3]
+        );
+    }
+
+    /// A kept image of another type and the same length becomes one of the type asked for,
+    /// converted, in place where the layouts agree; one of the type asked for is left alone.
+    #[test]
+    fn an_image_of_another_type_is_converted() {
+        let s = Spares::default();
+        let bits = |p: [f32; 4]| p.map(f32::to_bits);
+        let image = vec![[0.5f32; 4]; 3];
+        let ptr = image.as_ptr() as usize;
+        s.give_image(image);
+        s.convert_image(4, bits);
+        s.convert_image(3, bits);
+        let got = s.take_image(3, [0u32; 4], "test").unwrap();
+        let half = [0.5f32.to_bits(); 4];
+        assert_eq!((got.as_ptr() as usize, got), (ptr, vec![half; 3]));
+        s.give_image(vec![[1u32; 4]; 3]);
+        s.give_image(vec![[0.5f32; 4]; 3]);
+        s.convert_image(3, bits);
+        assert_eq!(
+            s.take_image(3, [0u32; 4], "test").unwrap(),
+            vec![[1u32; 4]; 3]
+        );
+        assert_eq!(
+            s.take_image(3, [0.0f32; 4], "test").unwrap(),
+            vec![[0.5f32; 4]; 3]
         );
     }
 

@@ -127,6 +127,17 @@ impl FrameCache {
         self.spares.give_image(image);
     }
 
+    /// Lets a frame whose pixels are `T` render into a kept float image of `n` pixels, each
+    /// pixel through `convert` (see [`Spares::convert_image`]): the fixed path's frames are
+    /// handed back as float.
+    pub fn reuse_image_as<T: Copy + Send + 'static>(
+        &self,
+        n: usize,
+        convert: impl Fn([f32; 4]) -> T,
+    ) {
+        self.spares.convert_image(n, convert);
+    }
+
     /// [`FrameCache::lists`], and the accumulators kept from earlier frames.
     pub fn lists_and_spares(
         &mut self,
