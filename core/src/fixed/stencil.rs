@@ -309,6 +309,11 @@ impl<'a, const M: usize> FixedStencils<'a, M> {
     /// Spreads `value` (premultiplied RGBA, Q24) of a voxel projected to `center` (Q24 px,
     /// absolute) into `acc` (Q(24 + f), saturating adds), calling `touched(y, x0, x1)` for each
     /// row it updated: the blend of the four stencils around the centre's sub-pixel phase.
+    ///
+    /// Not inlined (nor is [`FixedStencils::splat_unsaturated`]): inlined, its eight instances
+    /// raised the firmware's frame (which never splats through stencils) from 1976 to 2456 bytes
+    /// of stack on Cortex-M3; the host called it out of line anyway.
+    #[inline(never)]
     pub fn splat(
         &self,
         center: [i64; 2],
@@ -327,6 +332,7 @@ impl<'a, const M: usize> FixedStencils<'a, M> {
     /// [`FixedStencils::splat`] with wrapping adds, for a caller that has shown no pixel's sum
     /// can leave the `i64` range ([`FixedStencils::exact_below`]): the same sums, and cheaper
     /// (an `i64` saturating add is a compare and select per channel).
+    #[inline(never)]
     pub fn splat_unsaturated(
         &self,
         center: [i64; 2],
