@@ -9,7 +9,7 @@
 use footprint::frame::FrameSetup;
 use footprint::geometry::FootprintOptions;
 use footprint::render::{classify_sheet, SheetWindow, VisibleVoxel};
-use footprint::shade::{Shader, Shading, TransferFunction, RAMP_MIN_OPACITY};
+use footprint::shade::{Phong, Shader, Shading, TransferFunction, RAMP_MIN_OPACITY};
 use footprint::{Grid, Kernel, View};
 use proptest::prelude::*;
 
@@ -59,6 +59,27 @@ proptest! {
                 prop_assert!(v > bound, "{v} is visible but at or below the bound {bound}");
             }
         }
+    }
+}
+
+/// The lighting the tests' Phong and iso-surface shaders use.
+const PHONG: Phong = Phong {
+    ambient: 0.2,
+    diffuse: 0.7,
+    specular: 0.1,
+    shininess: 10.0,
+};
+
+/// An iso-surface at `value` over `tf` (opacity from the distance to it, not from `tf`).
+fn iso_at(tf: TransferFunction<'_>, value: f32) -> Shader<'_> {
+    Shader {
+        tf,
+        shading: Shading::Iso {
+            value,
+            opacity: 1.0,
+            thickness: 1.0,
+            phong: PHONG,
+        },
     }
 }
 
@@ -142,20 +163,7 @@ fn no_interval_where_visibility_is_not_one() {
         lo: 0.0,
         hi: 2.0,
     };
-    let iso = Shader {
-        tf,
-        shading: Shading::Iso {
-            value: 1.0,
-            opacity: 1.0,
-            thickness: 1.0,
-            phong: footprint::shade::Phong {
-                ambient: 0.2,
-                diffuse: 0.7,
-                specular: 0.1,
-                shininess: 10.0,
-            },
-        },
-    };
+    let iso = iso_at(tf, 1.0);
     assert!(iso.visible_interval().is_none());
     let emission = Shader {
         tf,
@@ -183,16 +191,10 @@ fn the_classifier_keeps_what_the_lookup_keeps() {
     let (len, na, _) = frame.sheet_shape();
     let ramp = lut_with(3, &[0.25, 0.5, 1.0]);
     let bump = lut_with(3, &[0.25, 0.0, 1.0]);
-    let phong = footprint::shade::Phong {
-        ambient: 0.2,
-        diffuse: 0.7,
-        specular: 0.1,
-        shininess: 10.0,
-    };
     let mut seed = 7u32;
     for (lut, shading) in [
         (&ramp, Shading::Emission),
-        (&ramp, Shading::Phong(phong)),
+        (&ramp, Shading::Phong(PHONG)),
         (&bump, Shading::Emission),
     ] {
         let tf = TransferFunction {
@@ -298,20 +300,7 @@ fn the_ends_and_the_iso_surface() {
         shading: Shading::Emission,
     };
     assert_eq!(emission.transparent_at_or_below(), bound);
-    let iso = Shader {
-        tf,
-        shading: Shading::Iso {
-            value: -3.0,
-            opacity: 1.0,
-            thickness: 1.0,
-            phong: footprint::shade::Phong {
-                ambient: 0.2,
-                diffuse: 0.7,
-                specular: 0.1,
-                shininess: 10.0,
-            },
-        },
-    };
+    let iso = iso_at(tf, -3.0);
     assert_eq!(iso.transparent_at_or_below(), f32::NEG_INFINITY);
     // A value of -3 is on that iso-surface, below the function's bound, and visible.
     assert!(iso.visible(-3.0, || glam::Vec3::X));
