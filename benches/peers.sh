@@ -20,7 +20,9 @@
 # thread, float with --subsample auto on 1 and 2 threads (each `footprint bench --frames N --orbit
 # 2`: first_ms = fresh volume, median_ms = re-render), VTK vtkFixedPointVolumeRayCastMapper 1 and 2 threads, VolPack pre-classified. The
 # medians over the repetitions go to docs/performance.md as ratios; the raw rows to
-# docs/perf/peers.csv. Once per volume, `footprint verify --reference continuous` with
+# docs/perf/peers.csv. After VolPack in each repetition, benches/floor.rs times the scene's
+# unavoidable work at 512² (its pixel updates and composites, counted by `footprint render --json`,
+# in the simplest vectorised loops): docs/perf/floor.csv. Once per volume, `footprint verify --reference continuous` with
 # --subsample 1 and auto measures what subsampling costs in accuracy (docs/perf/subsample.csv). Then the scaling runs (Footprint only): frame time against image size
 # (128^2 ... 2048^2, blobs) and against volume size (64^3 ... 512^3, synthetic blobs), charted in
 # docs/charts/perf-scaling.svg/.png with docs/perf/scaling.csv.
@@ -52,6 +54,7 @@ fi
 py=$work/venv/bin/python
 gcc -O2 -o "$work/vp_bench" "$peers/vp_bench.c" -lvolpack -lm
 cargo build -q --release -p footprint-harness
+cargo bench -q --bench floor --no-run 2>/dev/null
 fp=$root/target/release/footprint
 
 echo "== volumes"
@@ -82,6 +85,8 @@ volumes=(
 csv=docs/perf/peers.csv
 echo "volume,rep,renderer,threads,accum,first_ms,median_ms" > "$csv"
 acsv=docs/perf/subsample.csv
+fcsv=docs/perf/floor.csv
+echo "volume,rep,pixel,pixel_updates,composites,voxels,sheets,box_px,accumulate_ms,composite_ms,floor_ms" > "$fcsv"
 echo "volume,subsample,factor,psnr_f64_db,psnr_continuous_db" > "$acsv"
 for spec in "${volumes[@]}"; do
   IFS='|' read -r name dims spacing ramp <<<"$spec"
@@ -108,7 +113,9 @@ PY
   common=("$raw" --dims "$nx,$ny,$nz" --type u8 --spacing "$sx,$sy,$sz" --window "$lo,$hi" --tf grey
           --size 512x512 --view-matrix "$vm" --frames "$frames" --orbit 2)
   "$fp" render "$raw" --dims "$nx,$ny,$nz" --type u8 --spacing "$sx,$sy,$sz" --window "$lo,$hi" --tf grey \
-    --size 512x512 --view-matrix "$vm" --out "$work/out/fp-$name.png" >/dev/null
+    --size 512x512 --view-matrix "$vm" --threads 1 --out "$work/out/fp-$name.png" --json "$work/out/fp-$name.json" >/dev/null
+  # The scene's unavoidable work at 512² (benches/floor.rs): pixel updates, composites, voxels, sheets.
+  counts=$("$py" -c "import json; j=json.load(open('$work/out/fp-$name.json')); print(*(int(j[k]) for k in ('pixel_updates', 'pixels_composited', 'voxels_splatted', 'sheets')))")
   # What --subsample auto costs in accuracy on this view: against the full-size f64 reference
   # (the splatting itself) and against the continuous integral, beside the full-size render's.
   for sub in 1 auto; do
@@ -140,6 +147,9 @@ PY
     done
     "$work/vp_bench" "$raw" "$nx" "$ny" "$nz" "$sx" "$sy" "$sz" 512 512 30 20 "$lo" "$hi" "$frames" "$work/out/vp-$name" classified grey >/dev/null
     "$py" -c "import json; j=json.load(open('$work/out/vp-$name.json'))['seconds']; print(f'$name,$rep,volpack,1,-,{(j[\"preprocess\"]+j[\"first_frame\"])*1e3:.3f},{j[\"frame\"][\"median\"]*1e3:.3f}')" >> "$csv"
+    # shellcheck disable=SC2086 # four counts
+    cargo bench -q --bench floor -- $counts "$frames" 2>/dev/null \
+      | sed -nE "s/^floor ([a-z]+): box ([0-9]+) px, accumulate ([0-9.]+) ms.*composite ([0-9.]+) ms.*floor ([0-9.]+) ms$/$name,$rep,\1,${counts// /,},\2,\3,\4,\5/p" >> "$fcsv"
   done
   echo "$name: $reps repetitions done"
 done
@@ -178,5 +188,5 @@ PY
 done
 
 echo "== docs/performance.md"
-"$py" "$root/benches/peers_report.py" "$csv" "$scsv" docs/performance.md docs/charts/perf-scaling "$acsv"
+"$py" "$root/benches/peers_report.py" "$csv" "$scsv" docs/performance.md docs/charts/perf-scaling "$acsv" "$fcsv"
 echo "wrote docs/performance.md, docs/perf/*.csv, docs/charts/perf-scaling.{svg,png}, docs/images/peers-*.png"

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Writes docs/performance.md and the scaling chart from the CSVs benches/peers.sh measured.
 
-usage: peers_report.py PEERS.csv SCALING.csv OUT.md CHART_STEM [SUBSAMPLE.csv]
+usage: peers_report.py PEERS.csv SCALING.csv OUT.md CHART_STEM [SUBSAMPLE.csv [FLOOR.csv]]
 Every ratio is of medians over the repetitions, all measured alternately in one session.
 """
 import csv
@@ -19,6 +19,7 @@ import matplotlib.ticker  # noqa: E402,F401
 
 peers_csv, scaling_csv, out_md, stem = sys.argv[1:5]
 sub_csv = sys.argv[5] if len(sys.argv) > 5 else None
+floor_csv = sys.argv[6] if len(sys.argv) > 6 else None
 rows = list(csv.DictReader(open(peers_csv)))
 volumes = list(dict.fromkeys(r["volume"] for r in rows))
 
@@ -112,6 +113,40 @@ if any(r["accum"] == "float-subsample" for r in rows):
         f64s = f"{float(full['psnr_f64_db']):.1f} → {float(a['psnr_f64_db']):.1f} dB" if a and full else "–"
         cont = f"{float(full['psnr_continuous_db']):.2f} → {float(a['psnr_continuous_db']):.2f} dB" if a and full else "–"
         lines.append(f"| {v} | {s_} | {f1:.1f} ms | {r1:.1f} ms | {r2:.1f} ms | {t1 / f1:.2f}× | {r1 / vp:.1f}× | {r1 / r2:.2f}× | {f64s} | {cont} |")
+
+frows = list(csv.DictReader(open(floor_csv))) if floor_csv else []
+if frows:
+    def floor_med(vol, pixel, key):
+        return statistics.median(float(r[key]) for r in frows if r["volume"] == vol and r["pixel"] == pixel)
+
+    lines += [
+        "",
+        "## The floor: what splatting at 512² cannot avoid",
+        "",
+        "A sheet-buffer splatter makes one *pixel update* per non-zero footprint weight of each visible "
+        "voxel and one *composite* per sheet pixel a footprint touched; both counts are fixed by the scene, "
+        "the kernel and the image size (`footprint render --json` on the same scene). `benches/floor.rs` "
+        "times that work alone in the simplest vectorised loops (one weight read from a row, no blend of "
+        "stencils, no per-voxel work; square footprints of the scene's mean width; one contiguous run "
+        "composited per sheet), once per repetition right after VolPack: *RGBA* with the renderer's "
+        "four-channel f32 pixel, *LA* with a two-channel one, the cheapest a grey scene could use. Any "
+        "frame of this pipeline at this size costs at least the floor, so a re-render within 2× of VolPack "
+        "needs floor ÷ VolPack ≤ 2, and 5× VTK needs VTK ÷ floor ≥ 5. Data: `docs/perf/floor.csv`.",
+        "",
+        "| volume | voxels splatted | pixel updates | composites | floor RGBA | floor LA | VolPack | floor RGBA ÷ VolPack [≤ 2 to meet it] | floor LA ÷ VolPack | VTK 1 thread ÷ floor RGBA [≥ 5 to meet it] | Footprint re-render ÷ floor RGBA |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for v in volumes:
+        if not any(r["volume"] == v for r in frows):
+            continue
+        r0 = next(r for r in frows if r["volume"] == v)
+        fr, fl = floor_med(v, "rgba", "floor_ms"), floor_med(v, "la", "floor_ms")
+        _, r1, _ = footprint_times(v, "float")
+        t1, _, vp = peer_times(v)
+        lines.append(
+            f"| {v} | {int(r0['voxels']):,} | {int(r0['pixel_updates']):,} | {int(r0['composites']):,} | "
+            f"{fr:.1f} ms | {fl:.1f} ms | {vp:.2f} ms | {fr / vp:.1f}× | {fl / vp:.1f}× | {t1 / fr:.2f}× | "
+            f"{r1 / fr:.2f}× |")
 
 srows = list(csv.DictReader(open(scaling_csv)))
 fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
