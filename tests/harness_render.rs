@@ -50,6 +50,8 @@ fn default_scene_renders_to_a_picture() {
         "\"voxels\"",
         "\"voxels_splatted\"",
         "\"pixel_updates\"",
+        "\"pixels_composited\"",
+        "\"sheets\"",
         "\"seconds\"",
         "\"kernel\"",
     ] {

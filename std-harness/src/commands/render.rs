@@ -79,6 +79,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         );
         let j = describe(&p, args)
             .num("seconds", secs)
+            .num("sheets", stats.sheets as f64)
             .num("voxels", stats.voxels as f64)
             .num("voxels_splatted", stats.voxels_splatted as f64)
             .num("bands", frame.threads as f64)
