@@ -85,9 +85,9 @@ volumes=(
 csv=docs/perf/peers.csv
 echo "volume,rep,renderer,threads,accum,first_ms,median_ms" > "$csv"
 acsv=docs/perf/subsample.csv
+echo "volume,subsample,factor,psnr_f64_db,psnr_continuous_db" > "$acsv"
 fcsv=docs/perf/floor.csv
 echo "volume,rep,pixel,pixel_updates,composites,voxels,sheets,box_px,accumulate_ms,composite_ms,floor_ms" > "$fcsv"
-echo "volume,subsample,factor,psnr_f64_db,psnr_continuous_db" > "$acsv"
 for spec in "${volumes[@]}"; do
   IFS='|' read -r name dims spacing ramp <<<"$spec"
   read -r nx ny nz <<<"$dims"; read -r sx sy sz <<<"$spacing"; read -r lo hi <<<"$ramp"

@@ -137,9 +137,9 @@ if frows:
         "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for v in volumes:
-        if not any(r["volume"] == v for r in frows):
+        r0 = next((r for r in frows if r["volume"] == v), None)
+        if r0 is None:
             continue
-        r0 = next(r for r in frows if r["volume"] == v)
         fr, fl = floor_med(v, "rgba", "floor_ms"), floor_med(v, "la", "floor_ms")
         _, r1, _ = footprint_times(v, "float")
         t1, _, vp = peer_times(v)
