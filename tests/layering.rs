@@ -69,7 +69,7 @@ fn rank(node: &str) -> u32 {
         "pipeline" => 4,
         "args" | "metrics" => 3,
         "scene" | "tf" => 2,
-        "io" | "reference" | "dispatch" => 1,
+        "io" | "reference" | "dispatch" | "threads" => 1,
         other => panic!("module '{other}' has no layer: add it to tests/layering.rs"),
     }
 }

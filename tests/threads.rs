@@ -155,12 +155,11 @@ fn cached_lists_render_what_a_full_scan_renders() {
                 loaded.extend_from_slice(&common);
                 let mut streamed = vec!["--stream", r];
                 streamed.extend_from_slice(&common);
-                let render = |a: &[&str]| {
+                let render_with = |a: &[&str], cache: &mut FrameCache| {
                     let args = parse_args(a).unwrap();
                     let p = prepare(&args).unwrap();
                     assert_eq!(p.frame.sheet_axis, axis, "view {view}");
-                    let f =
-                        render_frame(&p, &args, args.accum, &mut FrameCache::default()).unwrap();
+                    let f = render_frame(&p, &args, args.accum, cache).unwrap();
                     (
                         f.image
                             .iter()
@@ -169,6 +168,7 @@ fn cached_lists_render_what_a_full_scan_renders() {
                         f.visible,
                     )
                 };
+                let render = |a: &[&str]| render_with(a, &mut FrameCache::default());
                 let (a, visible) = render(&loaded);
                 let (b, none) = render(&streamed);
                 assert!(visible.is_some_and(|n| n > 0) && none.is_none());
@@ -176,6 +176,21 @@ fn cached_lists_render_what_a_full_scan_renders() {
                     a == b,
                     "{view} {accum} {shading}: lists and full scan differ"
                 );
+                // A volume whose lists pass the budget (here 0 bytes) is classified by each band
+                // as it goes: the same bits and count, on one thread and on three.
+                for threads in ["1", "3"] {
+                    let mut a3 = loaded.clone();
+                    a3.extend_from_slice(&["--threads", threads]);
+                    let mut cache = FrameCache::with_list_budget(0);
+                    for frame in 0..2 {
+                        let (c, n) = render_with(&a3, &mut cache);
+                        assert!(
+                            c == a && n == visible,
+                            "{view} {accum} {shading}, {threads} thread(s), frame {frame}: \
+                             classified as it goes, differs from the kept lists ({n:?}, {visible:?})"
+                        );
+                    }
+                }
             }
         }
     }

@@ -121,11 +121,20 @@ pub struct Plan {
 }
 
 impl Plan {
-    /// Floats the stencils take: (P + 1)² · B² + P² · B.
+    /// Floats the stencils take: (P + 1)² · B² + P² · B; `usize::MAX` where that overflows
+    /// (P comes from the caller: such a plan never fits [`MAX_STENCIL_FLOATS`]).
     pub fn floats(&self) -> usize {
-        let (p, b) = (self.phases, self.side);
-        (p + 1) * (p + 1) * b * b + p * p * b
+        stencil_len(self.phases, self.side).unwrap_or(usize::MAX)
     }
+}
+
+/// (P + 1)² · B² + P² · B entries for P phases and box side B, or `None` where that overflows
+/// `usize` (both come from the caller: no size computed from them may wrap).
+pub fn stencil_len(phases: usize, side: usize) -> Option<usize> {
+    let p1 = phases.checked_add(1)?;
+    let corners = p1.checked_mul(p1)?.checked_mul(side)?.checked_mul(side)?;
+    let cells = phases.checked_mul(phases)?.checked_mul(side)?;
+    corners.checked_add(cells)
 }
 
 /// The stencils for `footprint` with at most `max_phases` (≥ 1) phases per pixel, if any fit in

@@ -12,7 +12,7 @@
 //!        └ pipeline   load → prepare → run (core, reference), configurations, --quality
 //!           └ args, metrics   shared argument structs; image comparisons
 //!              └ scene, tf   the built-in volume; transfer functions
-//!                 └ io, reference, dispatch   files and formats; the f64 reference; N → const N
+//!                 └ io, reference, dispatch, threads   files and formats; the f64 reference; N → const N; threads
 //! ```
 //!
 //! - [`cli`]: the entry point [`run`].
@@ -24,6 +24,7 @@
 //! - [`reference`](mod@reference): the f64, table-free footprint (exact line integrals) and renderer.
 //! - [`io`]: volume formats, streaming sources, images, tables, JSON (written atomically).
 //! - [`dispatch`]: runtime table size → const generic.
+//! - [`threads`]: scoped threads that run their work inline where none can be started.
 
 // `!(x > y)` sends NaN down the rejecting branch, on purpose (as in the core).
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -58,6 +59,7 @@ pub mod pipeline;
 pub mod reference;
 pub mod scene;
 pub mod tf;
+pub mod threads;
 
 pub use cli::run;
 

@@ -6,36 +6,42 @@
 //! any side render to the same image up to their sampling.
 
 use crate::io::volume::{Samples, Volume};
+use crate::CliError;
 
 /// Side of the default volume, voxels.
 pub const SIDE: usize = 64;
 
 /// Builds the default volume (f32 densities in [0, 1]).
 pub fn default_volume() -> Volume {
-    volume(SIDE)
+    volume(SIDE).expect("the 64³ scene (1 MiB) fits in memory")
 }
 
 /// The field sampled on an `n`³ grid (n ≥ 2) over the default volume's box, divided by the
-/// default grid's peak (so another grid's peak may differ slightly from 1).
-pub fn volume(n: usize) -> Volume {
-    let (data, spacing) = sample(n);
+/// default grid's peak (so another grid's peak may differ slightly from 1). An `n`³ grid takes
+/// 4n³ bytes: memory refusing them is an error (`--scene-size 512` needs 512 MiB), not an abort.
+pub fn volume(n: usize) -> Result<Volume, CliError> {
+    let (data, spacing) = sample(n)?;
     let peak = if n == SIDE {
         data.iter().copied().fold(0.0f32, f32::max)
     } else {
-        sample(SIDE).0.into_iter().fold(0.0f32, f32::max)
+        sample(SIDE)?.0.into_iter().fold(0.0f32, f32::max)
     };
     let data = data.into_iter().map(|v| v / peak).collect();
-    Volume::new([n; 3], [spacing; 3], Samples::F32(data))
+    Ok(Volume::new([n; 3], [spacing; 3], Samples::F32(data)))
 }
 
 /// The unnormalised field on an `n`³ grid, and the grid's spacing (world units).
-fn sample(n: usize) -> (Vec<f32>, f32) {
+fn sample(n: usize) -> Result<(Vec<f32>, f32), CliError> {
     let c = (n as f32 - 1.0) / 2.0;
     // Grid spans ±18 Bohr radii.
     let s = 18.0 / c;
     let (ca, sa) = (30f32.to_radians().cos(), 30f32.to_radians().sin());
     let (cb, sb) = (20f32.to_radians().cos(), 20f32.to_radians().sin());
-    let mut data = Vec::with_capacity(n * n * n);
+    let len = n
+        .checked_pow(3)
+        .ok_or_else(|| CliError::input(format!("--scene-size {n}: n³ samples overflow")))?;
+    let mut data =
+        crate::io::try_vec(len, &format!("the built-in scene at {n}³")).map_err(CliError::input)?;
     for k in 0..n {
         for j in 0..n {
             for i in 0..n {
@@ -52,5 +58,5 @@ fn sample(n: usize) -> (Vec<f32>, f32) {
             }
         }
     }
-    (data, (SIDE as f32 - 1.0) / (n as f32 - 1.0))
+    Ok((data, (SIDE as f32 - 1.0) / (n as f32 - 1.0)))
 }

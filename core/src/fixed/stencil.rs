@@ -85,7 +85,7 @@ pub fn side_for<const M: usize>(table: &FixedTable<M>) -> Option<usize> {
 /// phases [`crate::stencil::edged_phases_for`] picks for it.
 pub fn len_for<const M: usize>(table: &FixedTable<M>, phases: usize) -> Option<usize> {
     let side = side_for(table)?;
-    let len = (phases + 1) * (phases + 1) * side * side + phases * phases * side;
+    let len = crate::stencil::stencil_len(phases, side)?;
     (len <= MAX_STENCIL_FLOATS).then_some(len)
 }
 

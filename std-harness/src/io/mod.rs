@@ -59,6 +59,26 @@ pub fn try_vec<T>(n: usize, what: &str) -> Result<Vec<T>, String> {
     Ok(v)
 }
 
+/// Resizes `v` to `n` elements (new ones `value`), its growth failing as an error naming `what`
+/// (see [`try_vec`]) instead of an abort.
+pub fn try_resize<T: Clone>(
+    v: &mut Vec<T>,
+    n: usize,
+    value: T,
+    what: &str,
+) -> Result<(), CliError> {
+    if let Some(more) = n.checked_sub(v.len()) {
+        v.try_reserve_exact(more).map_err(|_| {
+            CliError::input(alloc_failed(
+                n.saturating_mul(std::mem::size_of::<T>()),
+                what,
+            ))
+        })?;
+    }
+    v.resize(n, value);
+    Ok(())
+}
+
 /// `n` copies of `value` in a vector whose allocation failing is an error naming `what` and the
 /// bytes it needed, not an abort (see [`try_vec`]).
 pub fn try_filled<T: Clone>(n: usize, value: T, what: &str) -> Result<Vec<T>, CliError> {

@@ -133,7 +133,12 @@ impl FileSource {
     }
 
     fn read_at(&mut self, pos: u64, len: usize) -> Result<(), CliError> {
-        self.bytes.resize(len, 0);
+        super::try_resize(
+            &mut self.bytes,
+            len,
+            0,
+            "the bytes read from the volume file",
+        )?;
         self.file
             .read_exact_at(&mut self.bytes, self.layout.offset + pos)
             .map_err(|e| {
@@ -152,7 +157,7 @@ impl FileSource {
         let (a, b) = footprint::geometry::in_sheet_axes(axis);
         let (na, nb) = (self.layout.dims[a], self.layout.dims[b]);
         let len = na * nb;
-        self.cache.resize(count * len, 0.0);
+        super::try_resize(&mut self.cache, count * len, 0.0, "the sheets read ahead")?;
         match axis {
             2 => {
                 // z-slices are contiguous: one read for the chunk.
@@ -164,7 +169,7 @@ impl FileSource {
             1 => {
                 // Sheet y = j holds row j of every z-slice: per slice, rows first..first+count are
                 // contiguous.
-                let mut row = vec![0.0f32; count * nx];
+                let mut row = super::try_filled(count * nx, 0.0f32, "rows of the volume")?;
                 for k in 0..nz {
                     self.read_at(((k * ny + first) * nx * size) as u64, count * nx * size)?;
                     decode_into(&self.bytes, ty, be, &mut row);
@@ -177,7 +182,7 @@ impl FileSource {
             _ => {
                 // Sheet x = i holds column i of every row: read each z-slice once per chunk and
                 // keep the chunk's columns.
-                let mut slice = vec![0.0f32; nx * ny];
+                let mut slice = super::try_filled(nx * ny, 0.0f32, "a z-slice of the volume")?;
                 for k in 0..nz {
                     self.read_at((k * nx * ny * size) as u64, nx * ny * size)?;
                     decode_into(&self.bytes, ty, be, &mut slice);
@@ -328,23 +333,42 @@ impl<R: Read> SheetSource for PipeSource<R> {
     }
 }
 
-/// Smallest and largest finite sample of a streamed file, read sequentially in bounded memory.
+/// Smallest and largest finite sample of a streamed file, read sequentially in chunks of at most
+/// [`RANGE_CHUNK_BYTES`] (however large a sheet is: a 32768² slice costs no more than a small one).
 pub fn file_range(layout: &Layout) -> Result<(f32, f32), CliError> {
-    let mut src = FileSource::open(layout.clone())?;
-    let [nx, ny, nz] = layout.dims;
-    let mut sheet = vec![0.0f32; nx * ny];
+    let src = FileSource::open(layout.clone())?;
+    let size = layout.ty.size();
+    let total = crate::io::volume::byte_len(layout.dims, layout.ty)
+        .map_err(|e| crate::io::volume::at(&layout.path, e))?;
+    let per = (RANGE_CHUNK_BYTES / size).max(1);
+    let mut bytes = super::try_filled(per * size, 0u8, "the range pass's chunk")?;
+    let mut values = super::try_filled(per, 0.0f32, "the range pass's chunk")?;
     let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
-    for k in 0..nz {
-        src.read_sheet(2, k, &mut sheet)?;
-        for &v in &sheet {
+    let mut done = 0usize;
+    while done < total {
+        let n = (total - done).min(per * size);
+        src.file
+            .read_exact_at(&mut bytes[..n], layout.offset + done as u64)
+            .map_err(|e| CliError::input(format!("{}: read failed: {e}", layout.path.display())))?;
+        decode_into(
+            &bytes[..n],
+            layout.ty,
+            layout.big_endian,
+            &mut values[..n / size],
+        );
+        for &v in &values[..n / size] {
             if v.is_finite() {
                 lo = lo.min(v);
                 hi = hi.max(v);
             }
         }
+        done += n;
     }
     Ok((lo, hi))
 }
+
+/// The most bytes [`file_range`] reads at a time (4 MiB).
+const RANGE_CHUNK_BYTES: usize = 4 << 20;
 
 /// Whether `path` means standard input.
 pub fn is_stdin(path: &Path) -> bool {

@@ -121,6 +121,18 @@ impl Volume {
         self.dims.iter().product()
     }
 
+    /// Bytes the samples take in memory.
+    pub fn bytes(&self) -> usize {
+        let per = match &self.samples {
+            Samples::U8(_) | Samples::I8(_) => 1,
+            Samples::U16(_) | Samples::I16(_) => 2,
+            Samples::U32(_) | Samples::I32(_) | Samples::F32(_) => 4,
+            Samples::F64(_) => 8,
+            Samples::Coloured(_) => std::mem::size_of::<Coloured>(),
+        };
+        self.len().saturating_mul(per)
+    }
+
     /// Whether the volume has no voxel (never true for a loaded volume).
     pub fn is_empty(&self) -> bool {
         self.len() == 0

@@ -5,13 +5,15 @@
 
 use super::prepare::Prepared;
 use super::spares::Spares;
-use super::visible::VisibleLists;
+use super::visible::{OnTheFly, SheetSupply, Visible, VisibleLists};
 use crate::CliError;
 use footprint::composite::RowSpan;
+use footprint::lod::Coloured;
 use footprint::render::{
     Precision, RenderBuffers, RenderStats, ShadeCacheEntry, SheetRenderer, SHADE_CACHE_LEN,
 };
 use footprint::shade::OPACITY_TABLE_LEN;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
 /// Seconds spent in each phase of a frame. With several threads, splat and composite are the
@@ -65,15 +67,16 @@ pub fn equal_bands(height: usize, threads: usize) -> Vec<std::ops::Range<usize>>
     (0..bands).map(|t| band_rows(height, bands, t)).collect()
 }
 
-/// Renders `lists` through `path` on `threads` bands. Returns the image, the counts summed over
-/// bands (`voxels_splatted` counts a voxel once per band it reached; `voxels` is the lists'
-/// length, what one band over the whole image visits, for any number of bands) and the slowest
+/// Renders the visible voxels (`visible`: kept lists, or classified by each band as it goes)
+/// through `path` on `threads` bands. Returns the image, the counts summed over bands
+/// (`voxels_splatted` counts a voxel once per band it reached; `voxels` is the visible voxels'
+/// number, what one band over the whole image visits, for any number of bands) and the slowest
 /// band's splat and composite seconds.
 pub fn run_bands<P>(
     p: &Prepared,
     path: P,
     background: Option<&[P::Pixel]>,
-    lists: &VisibleLists,
+    visible: Visible<'_>,
     spares: &Spares,
     threads: usize,
 ) -> Result<(Vec<P::Pixel>, RenderStats, Phases), CliError>
@@ -82,16 +85,33 @@ where
     P::Pixel: Send + Sync + 'static,
     P::Acc: Send + PartialEq + 'static,
 {
-    let ranges = balanced_rows(&p.frame, lists, threads);
     let [w, h] = p.frame.size;
+    let ranges = match visible {
+        Visible::Kept(lists) => balanced_rows(&p.frame, lists, threads),
+        Visible::OnTheFly(_) => equal_bands(h, threads),
+    };
     // Any image of the right size will do: each band's renderer starts its rows afresh.
     let image = spares.take_image(w * h, P::CLEAR, "the image")?;
+    let found = AtomicU64::new(0);
     let (image, mut stats, phases) =
         on_bands(image, p.frame.size, ranges, background, |rows, band, bg| {
-            render_band(p, path, bg, lists, spares, band, rows)
+            let r = match visible {
+                Visible::Kept(lists) => render_band(p, path, bg, &mut &*lists, spares, band, rows),
+                Visible::OnTheFly(v) if v.is_coloured() => {
+                    let mut lists = OnTheFly::<Coloured>::new(p, v)?;
+                    render_band(p, path, bg, &mut lists, spares, band, rows)
+                }
+                Visible::OnTheFly(v) => {
+                    let mut lists = OnTheFly::<f32>::new(p, v)?;
+                    render_band(p, path, bg, &mut lists, spares, band, rows)
+                }
+            }?;
+            found.fetch_max(r.2, Ordering::Relaxed);
+            Ok((r.0, r.1))
         })?;
-    // A band visits only the voxels that can reach it, so no band's count is the frame's.
-    stats.voxels = lists.len() as u64;
+    // A band visits only the voxels that can reach it, so no band's count is the frame's; every
+    // band is supplied every visible voxel.
+    stats.voxels = found.into_inner();
     Ok((image, stats, phases))
 }
 
@@ -206,12 +226,12 @@ where
             .map(|(t, chunk)| {
                 let rows = ranges[t].clone();
                 let bg = background.map(|b| &b[rows.start * w..rows.end * w]);
-                scope.spawn(move || band(rows, chunk, bg))
+                crate::threads::spawn(scope, move || band(rows, chunk, bg))
             })
             .collect();
         handles
             .into_iter()
-            .map(|h| h.join().expect("a render thread panicked"))
+            .map(crate::threads::Task::join)
             .collect()
     });
     let mut stats = RenderStats::default();
@@ -229,17 +249,17 @@ where
     Ok((image, stats, phases))
 }
 
-/// One band: every sheet in compositing order, splat then composite, timed. Its accumulator is
-/// taken from `spares` and given back clear.
+/// One band: every sheet in compositing order, splat then composite, timed, and the visible
+/// voxels `lists` supplied. Its accumulator is taken from `spares` and given back clear.
 fn render_band<P: Precision>(
     p: &Prepared,
     path: P,
     background: Option<&[P::Pixel]>,
-    lists: &VisibleLists,
+    lists: &mut impl SheetSupply,
     spares: &Spares,
     image: &mut [P::Pixel],
     rows: std::ops::Range<usize>,
-) -> Result<(RenderStats, Phases), CliError>
+) -> Result<(RenderStats, Phases, u64), CliError>
 where
     P::Acc: Send + PartialEq + 'static,
 {
@@ -262,7 +282,7 @@ where
     for k in 0..f.sheet_count() {
         let s = f.sheet_at(p.order, k);
         let t0 = Instant::now();
-        renderer.splat_visible_sheet(s, lists.sheet(s))?;
+        renderer.splat_visible_sheet(s, lists.sheet(s)?)?;
         let t1 = Instant::now();
         renderer.composite_sheet();
         phases.splat += (t1 - t0).as_secs_f64();
@@ -271,7 +291,7 @@ where
     let stats = renderer.finish();
     // Every sheet was composited, which cleared each row it touched.
     spares.give(acc, P::ACC_ZERO);
-    Ok((stats, phases))
+    Ok((stats, phases, lists.supplied()))
 }
 
 #[cfg(test)]

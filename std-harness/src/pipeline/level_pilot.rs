@@ -160,7 +160,7 @@ fn split_rows<S: Splatter + Sync + ?Sized>(
         let handles: Vec<_> = rows
             .chunks(per)
             .map(|part| {
-                scope.spawn(move || {
+                crate::threads::spawn(scope, move || {
                     if volume.is_coloured() {
                         bands_from(p, sampler, &mut ColouredMemorySource(volume), part)
                     } else {
@@ -171,7 +171,7 @@ fn split_rows<S: Splatter + Sync + ?Sized>(
             .collect();
         handles
             .into_iter()
-            .map(|h| h.join().expect("a pilot thread panicked"))
+            .map(crate::threads::Task::join)
             .collect()
     });
     let mut bands = Vec::with_capacity(rows.len());

@@ -95,7 +95,7 @@ pub(crate) fn load_voxels(args: &RenderArgs) -> Result<Loaded, CliError> {
                 path.display().to_string(),
             ),
             None => (
-                scene::volume(args.scene_size),
+                scene::volume(args.scene_size)?,
                 match args.scene_size {
                     scene::SIDE => "built-in electron-density scene".to_string(),
                     n => format!("built-in electron-density scene, {n}^3"),

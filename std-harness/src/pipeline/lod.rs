@@ -189,7 +189,7 @@ pub fn coarsen_volume(
             .chunks_mut(per * sheet)
             .enumerate()
             .map(|(t, run)| {
-                scope.spawn(move || {
+                crate::threads::spawn(scope, move || {
                     let mut fill = |s: &mut ColouredSource<'_>| {
                         for (i, slice) in run.chunks_mut(sheet).enumerate() {
                             s.read_sheet(2, t * per + i, slice)?;
@@ -207,7 +207,7 @@ pub fn coarsen_volume(
             .collect();
         handles
             .into_iter()
-            .map(|h| h.join().expect("a level-building thread panicked"))
+            .map(crate::threads::Task::join)
             .collect()
     });
     results.into_iter().collect::<Result<(), CliError>>()?;

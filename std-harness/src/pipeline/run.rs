@@ -196,7 +196,7 @@ pub fn build_stencils<'a, S: footprint::Sampler + Sync + ?Sized>(
         let per = count.div_ceil(threads.clamp(1, count.max(1))).max(1);
         std::thread::scope(|scope| {
             for (t, chunk) in weights.chunks_mut(per * cells).enumerate() {
-                scope.spawn(move || {
+                crate::threads::spawn(scope, move || {
                     for (i, stencil) in chunk.chunks_exact_mut(cells).enumerate() {
                         fill.fill(t * per + i, stencil);
                     }
@@ -233,19 +233,15 @@ where
     match &p.voxels {
         Voxels::Memory(volume) => {
             let t0 = Instant::now();
-            let (lists, fresh, spares) = cache.lists_and_spares(p, volume, threads)?;
+            let (visible, fresh, spares) = cache.visible_and_spares(p, volume, threads)?;
             let classify = if fresh {
                 t0.elapsed().as_secs_f64()
             } else {
                 0.0
             };
-            let (image, stats, phases) = run_bands(p, path, background, lists, spares, threads)?;
-            Ok((
-                image,
-                stats,
-                Phases { classify, ..phases },
-                Some(lists.len()),
-            ))
+            let (image, stats, phases) = run_bands(p, path, background, visible, spares, threads)?;
+            let count = stats.voxels as usize;
+            Ok((image, stats, Phases { classify, ..phases }, Some(count)))
         }
         _ => {
             let t0 = Instant::now();

@@ -66,7 +66,7 @@ pub fn render_slabs(
     let tables = start.elapsed().as_secs_f64();
 
     let t0 = Instant::now();
-    let (lists, fresh) = cache.lists(p, volume, threads)?;
+    let (lists, fresh) = cache.lists(p, volume, threads, "image slicing")?;
     let classify_lists = if fresh {
         t0.elapsed().as_secs_f64()
     } else {

@@ -201,7 +201,7 @@ pub fn magnify(
     std::thread::scope(|scope| {
         for (c, chunk) in out_img.chunks_mut(per * w).enumerate() {
             let (ys, resample_row) = (&ys, &resample_row);
-            scope.spawn(move || {
+            crate::threads::spawn(scope, move || {
                 // Slot k % 4 holds low row k once `held[k % 4] == Some(k)`.
                 let mut ring = vec![[0.0f32; 4]; 4 * w];
                 let mut held = [None::<usize>; 4];

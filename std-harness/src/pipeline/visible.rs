@@ -1,6 +1,14 @@
 //! Visible-voxel lists: each sheet's voxels that can be seen at all, classified once per volume,
 //! transfer function, shading and sheet axis, then reused by every later frame whose sheets run
 //! along the same axis (the re-render path; see the core's `render::classify_sheet`).
+//!
+//! **Memory.** The lists take [`VisibleLists::BYTES_PER_VOXEL`] bytes per visible voxel (8),
+//! plus 12 with gradients (Phong, iso-surfaces) and 12 with colours (a coloured level of detail),
+//! and are kept only while they fit [`list_budget`]: at most 1 GiB, or four bytes per byte of the
+//! volume where that is less, never under 256 MiB. A volume whose lists would pass it is not
+//! listed: each band classifies the sheets it renders as it goes ([`OnTheFly`]), which costs a
+//! sheet's worth of memory per band and a classification per band and frame, and renders the
+//! same bits (the same visible voxels, in the same order, through the same splat).
 
 use super::prepare::Prepared;
 use super::spares::Spares;
@@ -9,6 +17,7 @@ use crate::CliError;
 use footprint::lod::Coloured;
 use footprint::render::{classify_sheet, SheetWindow, VisibleSheet, VisibleVoxel};
 use footprint::shade::Sample;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// The visible voxels of every sheet along one axis, in sheet index order.
 #[derive(Clone, Debug, Default)]
@@ -74,6 +83,20 @@ impl VisibleLists {
         }
     }
 
+    /// Room for `n` more voxels (with gradients and colours as asked) and one more sheet, or
+    /// false where memory refuses it. Grows by doubling, as `Vec` does.
+    fn reserve(&mut self, n: usize, gradients: bool, colours: bool) -> bool {
+        fn grow<T>(v: &mut Vec<T>, n: usize) -> bool {
+            n <= v.capacity() - v.len() || v.try_reserve(n.max(v.len())).is_ok()
+        }
+        grow(&mut self.voxels, n)
+            && grow(&mut self.runs, n)
+            && (!gradients || grow(&mut self.gradients, n))
+            && (!colours || grow(&mut self.colours, n))
+            && grow(&mut self.offsets, 1)
+            && grow(&mut self.run_offsets, 1)
+    }
+
     /// Number of visible voxels.
     pub fn len(&self) -> usize {
         self.voxels.len()
@@ -82,6 +105,18 @@ impl VisibleLists {
     /// Whether no voxel is visible.
     pub fn is_empty(&self) -> bool {
         self.voxels.is_empty()
+    }
+
+    /// Bytes a visible voxel takes in the lists without gradients or colours (its place and
+    /// value; each takes 12 more).
+    pub const BYTES_PER_VOXEL: usize = std::mem::size_of::<VisibleVoxel>();
+
+    /// Bytes the lists hold (their voxels, gradients, colours and runs, as allocated).
+    pub fn bytes(&self) -> usize {
+        self.voxels.capacity() * std::mem::size_of::<VisibleVoxel>()
+            + (self.gradients.capacity() + self.colours.capacity()) * 12
+            + self.runs.capacity() * std::mem::size_of::<RowRun>()
+            + (self.offsets.capacity() + self.run_offsets.capacity()) * 8
     }
 
     /// Appends the next sheets' lists (`part`, offsets relative to its first sheet).
@@ -99,26 +134,73 @@ impl VisibleLists {
     }
 }
 
+/// Most bytes the visible lists of `volume` may hold: four per byte of the volume, at least
+/// 256 MiB and at most 1 GiB (see the module docs).
+pub fn list_budget(volume: &Volume) -> usize {
+    volume
+        .bytes()
+        .saturating_mul(4)
+        .clamp(MIN_LIST_BUDGET, MAX_LIST_BUDGET)
+}
+
+/// The lists' budget is never below this (256 MiB): a small volume keeps its lists.
+const MIN_LIST_BUDGET: usize = 256 << 20;
+/// Nor above this (1 GiB).
+const MAX_LIST_BUDGET: usize = 1 << 30;
+
+/// Where a frame finds each sheet's visible voxels.
+#[derive(Clone, Copy, Debug)]
+pub enum Visible<'a> {
+    /// The lists, classified once and kept.
+    Kept(&'a VisibleLists),
+    /// The volume, whose lists would pass [`list_budget`]: each band classifies as it goes.
+    OnTheFly(&'a Volume),
+}
+
 /// Per-volume state kept across frames of one volume, transfer function and shading: the visible
 /// lists of each sheet axis met so far, and the bands' clear accumulators ([`Spares`]). A caller
 /// that changes the transfer function, window or shading must start a new cache.
 #[derive(Debug, Default)]
 pub struct FrameCache {
     lists: [Option<VisibleLists>; 3],
+    /// Axes whose lists were found to pass the budget (not tried again).
+    over_budget: [bool; 3],
+    /// The lists' budget in bytes, where not [`list_budget`]'s.
+    budget: Option<usize>,
     spares: Spares,
 }
 
 impl FrameCache {
+    /// A cache whose lists may hold at most `bytes` (instead of [`list_budget`]'s): 0 has every
+    /// frame classify as it goes, as a volume too large for its lists does.
+    pub fn with_list_budget(bytes: usize) -> Self {
+        FrameCache {
+            budget: Some(bytes),
+            ..FrameCache::default()
+        }
+    }
+
     /// The lists for `p`'s sheet axis, classified now (on `threads` threads) if this cache has
-    /// none yet; and whether they were classified now.
-    pub fn lists(
-        &mut self,
+    /// none yet; and whether they were classified now. Lists that would pass [`list_budget`] are
+    /// refused, naming `what` needs them (a renderer that can classify as it goes takes
+    /// [`FrameCache::visible_and_spares`] instead).
+    pub fn lists<'a>(
+        &'a mut self,
         p: &Prepared,
-        volume: &Volume,
+        volume: &'a Volume,
         threads: usize,
-    ) -> Result<(&VisibleLists, bool), CliError> {
-        self.lists_and_spares(p, volume, threads)
-            .map(|(lists, fresh, _)| (lists, fresh))
+        what: &str,
+    ) -> Result<(&'a VisibleLists, bool), CliError> {
+        match self.visible_and_spares(p, volume, threads)? {
+            (Visible::Kept(lists), fresh, _) => Ok((lists, fresh)),
+            (Visible::OnTheFly(_), _, _) => Err(CliError::input(format!(
+                "{}: {what} keeps every visible voxel in memory, and this volume's take more \
+                 than {} MiB ({} bytes each): render a coarser level (--lod) or use --slicing object",
+                p.name,
+                list_budget(volume) >> 20,
+                VisibleLists::BYTES_PER_VOXEL
+            ))),
+        }
     }
 
     /// Keeps a finished frame's `image` (float, of its frame's size) for a later frame to render
@@ -138,63 +220,116 @@ impl FrameCache {
         self.spares.convert_image(n, convert);
     }
 
-    /// [`FrameCache::lists`], and the accumulators kept from earlier frames.
-    pub fn lists_and_spares(
-        &mut self,
+    /// Where `p`'s sheets find their visible voxels: the lists for its sheet axis (classified
+    /// now, on `threads` threads, if this cache has none yet), or, where they would pass
+    /// [`list_budget`], the volume itself ([`Visible::OnTheFly`]); whether anything was
+    /// classified now; and the accumulators kept from earlier frames.
+    pub fn visible_and_spares<'a>(
+        &'a mut self,
         p: &Prepared,
-        volume: &Volume,
+        volume: &'a Volume,
         threads: usize,
-    ) -> Result<(&VisibleLists, bool, &Spares), CliError> {
+    ) -> Result<(Visible<'a>, bool, &'a Spares), CliError> {
         let axis = p.frame.sheet_axis;
-        let fresh = self.lists[axis].is_none();
+        let fresh = self.lists[axis].is_none() && !self.over_budget[axis];
         if fresh {
-            self.lists[axis] = Some(classify(p, volume, threads)?);
+            let budget = self.budget.unwrap_or_else(|| list_budget(volume));
+            match classify(p, volume, threads, budget)? {
+                Some(lists) => self.lists[axis] = Some(lists),
+                None => self.over_budget[axis] = true,
+            }
         }
-        let lists = self.lists[axis].as_ref().expect("just filled");
-        Ok((lists, fresh, &self.spares))
+        let visible = match &self.lists[axis] {
+            Some(lists) => Visible::Kept(lists),
+            None => Visible::OnTheFly(volume),
+        };
+        Ok((visible, fresh, &self.spares))
     }
 }
 
 /// Classifies every sheet of `p`'s axis, contiguous ranges of sheets on `threads` threads, the
-/// results joined in sheet order (so the lists are the same for any thread count).
-pub fn classify(p: &Prepared, volume: &Volume, threads: usize) -> Result<VisibleLists, CliError> {
+/// results joined in sheet order (so the lists are the same for any thread count); `None` as
+/// soon as they would hold more than `budget` bytes (all threads together; the join then needs
+/// as much again, briefly), or memory refuses them.
+pub fn classify(
+    p: &Prepared,
+    volume: &Volume,
+    threads: usize,
+    budget: usize,
+) -> Result<Option<VisibleLists>, CliError> {
     let f = &p.frame;
     let count = f.sheet_count();
     let threads = threads.clamp(1, count.max(1));
     let per = count.div_ceil(threads);
-    let parts: Vec<Result<VisibleLists, CliError>> = std::thread::scope(|scope| {
+    let spent = AtomicUsize::new(0);
+    let budget = Budget {
+        spent: &spent,
+        limit: budget,
+    };
+    let parts: Vec<Result<Option<VisibleLists>, CliError>> = std::thread::scope(|scope| {
         let handles: Vec<_> = (0..threads)
             .map(|t| {
                 let range = (t * per).min(count)..((t + 1) * per).min(count);
-                scope.spawn(move || classify_range(p, volume, range))
+                crate::threads::spawn(scope, move || classify_range(p, volume, range, budget))
             })
             .collect();
         handles
             .into_iter()
-            .map(|h| h.join().expect("a classification thread panicked"))
+            .map(crate::threads::Task::join)
             .collect()
     });
-    let mut parts = parts.into_iter().collect::<Result<Vec<_>, _>>()?;
-    let out = if parts.len() == 1 {
-        // One part is the whole list: no copy.
-        parts.pop().expect("one part")
-    } else {
-        let total = |n: fn(&VisibleLists) -> usize| parts.iter().map(n).sum::<usize>();
-        let mut out = VisibleLists {
-            axis: f.sheet_axis,
-            offsets: vec![0],
-            run_offsets: vec![0],
-            runs: Vec::with_capacity(total(|p| p.runs.len())),
-            voxels: Vec::with_capacity(total(|p| p.voxels.len())),
-            gradients: Vec::with_capacity(total(|p| p.gradients.len())),
-            colours: Vec::with_capacity(total(|p| p.colours.len())),
-        };
-        for part in parts {
-            out.append(part);
-        }
-        out
+    let Some(mut parts) = parts.into_iter().collect::<Result<Option<Vec<_>>, _>>()? else {
+        return Ok(None);
     };
-    Ok(out)
+    if parts.len() == 1 {
+        // One part is the whole list: no copy.
+        return Ok(parts.pop());
+    }
+    let total = |n: fn(&VisibleLists) -> usize| parts.iter().map(n).sum::<usize>();
+    let mut out = VisibleLists {
+        axis: f.sheet_axis,
+        offsets: vec![0],
+        run_offsets: vec![0],
+        ..Default::default()
+    };
+    let reserved = out.runs.try_reserve_exact(total(|p| p.runs.len())).is_ok()
+        && out
+            .voxels
+            .try_reserve_exact(total(|p| p.voxels.len()))
+            .is_ok()
+        && out
+            .gradients
+            .try_reserve_exact(total(|p| p.gradients.len()))
+            .is_ok()
+        && out
+            .colours
+            .try_reserve_exact(total(|p| p.colours.len()))
+            .is_ok();
+    if !reserved {
+        return Ok(None);
+    }
+    for part in parts {
+        out.append(part);
+    }
+    Ok(Some(out))
+}
+
+/// The bytes the classification threads may add to their lists, all together.
+#[derive(Clone, Copy)]
+struct Budget<'a> {
+    spent: &'a AtomicUsize,
+    limit: usize,
+}
+
+impl Budget<'_> {
+    /// Takes `bytes` more; false (taking nothing) where that passes the limit.
+    fn take(&self, bytes: usize) -> bool {
+        self.spent
+            .fetch_update(Ordering::Relaxed, Ordering::Relaxed, |s| {
+                s.checked_add(bytes).filter(|&t| t <= self.limit)
+            })
+            .is_ok()
+    }
 }
 
 /// Classifies sheets `range` of `p`'s axis (offsets relative to the range's first sheet): a
@@ -203,10 +338,11 @@ fn classify_range(
     p: &Prepared,
     volume: &Volume,
     range: std::ops::Range<usize>,
-) -> Result<VisibleLists, CliError> {
+    budget: Budget<'_>,
+) -> Result<Option<VisibleLists>, CliError> {
     let axis = p.frame.sheet_axis;
     if volume.is_coloured() {
-        return classify_sheets(p, range, |s, buf: &mut [Coloured]| {
+        return classify_sheets(p, range, budget, |s, buf: &mut [Coloured]| {
             volume.coloured_sheet_into(axis, s, buf)
         });
     }
@@ -220,7 +356,7 @@ fn classify_range(
         // (more than 1024² samples) are read one at a time, as before, rather than held twice.
         let mut block = Vec::new();
         let mut held = 0..0;
-        classify_sheets(p, range, move |s, buf: &mut [f32]| {
+        classify_sheets(p, range, budget, move |s, buf: &mut [f32]| {
             if !held.contains(&s) {
                 held = s..(s + per_block).min(count);
                 block.resize(held.len() * len, 0.0);
@@ -229,7 +365,7 @@ fn classify_range(
             buf.copy_from_slice(&block[(s - held.start) * len..][..len]);
         })
     } else {
-        classify_sheets(p, range, |s, buf: &mut [f32]| {
+        classify_sheets(p, range, budget, |s, buf: &mut [f32]| {
             volume.sheet_into(axis, s, buf)
         })
     }
@@ -246,8 +382,9 @@ const MAX_SHEET_BLOCK: usize = 16;
 fn classify_sheets<T: Sample + Default>(
     p: &Prepared,
     range: std::ops::Range<usize>,
+    budget: Budget<'_>,
     mut fill: impl FnMut(usize, &mut [T]),
-) -> Result<VisibleLists, CliError> {
+) -> Result<Option<VisibleLists>, CliError> {
     let f = &p.frame;
     let shader = p.shader();
     let needs_gradient = shader.shading.needs_gradient();
@@ -302,6 +439,13 @@ fn classify_sheets<T: Sample + Default>(
             &mut gradients,
             &mut colours,
         )?;
+        // The sheet's voxels, gradients, colours, runs (at most one per voxel) and offsets.
+        let per = VisibleLists::BYTES_PER_VOXEL
+            + 12 * (usize::from(needs_gradient) + usize::from(T::COLOURED))
+            + std::mem::size_of::<RowRun>();
+        if !budget.take(n * per + 16) || !out.reserve(n, needs_gradient, T::COLOURED) {
+            return Ok(None);
+        }
         out.voxels.extend_from_slice(&voxels[..n]);
         sheet_runs(&voxels[..n], &mut out.runs);
         out.run_offsets.push(out.runs.len());
@@ -325,7 +469,154 @@ fn classify_sheets<T: Sample + Default>(
             spare.extend(done);
         }
     }
-    Ok(out)
+    Ok(Some(out))
+}
+
+/// What a band reads each sheet's visible voxels from: kept lists, or an [`OnTheFly`]
+/// classifier.
+pub trait SheetSupply {
+    /// Sheet `s`'s visible voxels (of the frame the supply was made for).
+    fn sheet(&mut self, s: usize) -> Result<VisibleSheet<'_>, CliError>;
+    /// Visible voxels supplied so far (over every sheet).
+    fn supplied(&self) -> u64;
+}
+
+impl SheetSupply for &VisibleLists {
+    fn sheet(&mut self, s: usize) -> Result<VisibleSheet<'_>, CliError> {
+        Ok(VisibleLists::sheet(self, s))
+    }
+    fn supplied(&self) -> u64 {
+        self.len() as u64
+    }
+}
+
+/// A sample type a volume in memory gives a sheet of.
+pub trait ReadSheet: Sample + Default + Clone {
+    /// Writes sheet `s` of `axis` of `volume` into `out`.
+    fn read(volume: &Volume, axis: usize, s: usize, out: &mut [Self]);
+}
+
+impl ReadSheet for f32 {
+    fn read(volume: &Volume, axis: usize, s: usize, out: &mut [f32]) {
+        volume.sheet_into(axis, s, out);
+    }
+}
+
+impl ReadSheet for Coloured {
+    fn read(volume: &Volume, axis: usize, s: usize, out: &mut [Coloured]) {
+        volume.coloured_sheet_into(axis, s, out);
+    }
+}
+
+/// Classifies each sheet when asked for it, from a volume in memory whose lists would pass the
+/// budget ([`Visible::OnTheFly`]): holds the sheet and its two neighbours (for gradients) and one
+/// sheet's worth of voxels, gradients and colours. The voxels are those
+/// [`classify`] would list, in the same order: the same core function over the same samples.
+pub struct OnTheFly<'a, T> {
+    p: &'a Prepared,
+    volume: &'a Volume,
+    /// Up to three sheets, each with its index.
+    held: Vec<(usize, Vec<T>)>,
+    voxels: Vec<VisibleVoxel>,
+    gradients: Vec<[f32; 3]>,
+    colours: Vec<[f32; 3]>,
+    supplied: u64,
+}
+
+impl<'a, T: ReadSheet> OnTheFly<'a, T> {
+    /// A classifier of `p`'s sheets of `volume` (its buffers allocated fallibly).
+    pub fn new(p: &'a Prepared, volume: &'a Volume) -> Result<Self, CliError> {
+        let len = p.frame.sheet_shape().0;
+        let needs_gradient = p.shader().shading.needs_gradient();
+        let what = "a sheet's visible voxels";
+        Ok(OnTheFly {
+            p,
+            volume,
+            held: Vec::with_capacity(3),
+            voxels: crate::io::try_filled(
+                len,
+                VisibleVoxel {
+                    u: 0,
+                    v: 0,
+                    value: 0.0,
+                },
+                what,
+            )?,
+            gradients: crate::io::try_filled(if needs_gradient { len } else { 0 }, [0.0; 3], what)?,
+            colours: crate::io::try_filled(if T::COLOURED { len } else { 0 }, [0.0; 3], what)?,
+            supplied: 0,
+        })
+    }
+
+    /// Makes sure sheet `s` is held (reusing the buffer of a sheet outside `keep`).
+    fn hold(&mut self, s: usize, keep: std::ops::RangeInclusive<usize>) -> Result<(), CliError> {
+        if self.held.iter().any(|(i, _)| *i == s) {
+            return Ok(());
+        }
+        let f = &self.p.frame;
+        let mut buf = match self.held.iter().position(|(i, _)| !keep.contains(i)) {
+            Some(k) => self.held.swap_remove(k).1,
+            None => {
+                crate::io::try_filled(f.sheet_shape().0, T::default(), "a sheet of the volume")?
+            }
+        };
+        T::read(self.volume, f.sheet_axis, s, &mut buf);
+        self.held.push((s, buf));
+        Ok(())
+    }
+}
+
+impl<T: ReadSheet> SheetSupply for OnTheFly<'_, T> {
+    fn sheet(&mut self, s: usize) -> Result<VisibleSheet<'_>, CliError> {
+        let f = &self.p.frame;
+        let shader = self.p.shader();
+        let needs_gradient = shader.shading.needs_gradient();
+        let count = f.sheet_count();
+        let (first, last) = if needs_gradient {
+            (s.saturating_sub(1), (s + 1).min(count - 1))
+        } else {
+            (s, s)
+        };
+        for i in first..=last {
+            self.hold(i, first..=last)?;
+        }
+        let find = |i: usize| {
+            self.held
+                .iter()
+                .find(|(j, _)| *j == i)
+                .map(|(_, b)| b.as_slice())
+        };
+        let window = SheetWindow {
+            lower: (needs_gradient && s > 0).then(|| find(s - 1)).flatten(),
+            current: find(s).expect("held above"),
+            upper: (needs_gradient && s + 1 < count)
+                .then(|| find(s + 1))
+                .flatten(),
+        };
+        let n = classify_sheet(
+            f,
+            &shader,
+            s,
+            window,
+            &mut self.voxels,
+            &mut self.gradients,
+            &mut self.colours,
+        )?;
+        self.supplied += n as u64;
+        Ok(VisibleSheet {
+            voxels: &self.voxels[..n],
+            gradients: if needs_gradient {
+                &self.gradients[..n]
+            } else {
+                &[]
+            },
+            colours: if T::COLOURED { &self.colours[..n] } else { &[] },
+        })
+    }
+
+    fn supplied(&self) -> u64 {
+        self.supplied
+    }
 }
 
 #[cfg(test)]

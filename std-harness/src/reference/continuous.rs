@@ -358,7 +358,7 @@ fn march(scene: &ContinuousScene<'_>, field: &Field, h: f64, rays: Rays<'_>) -> 
     let band = count.div_ceil(threads).max(1);
     std::thread::scope(|sc| {
         for (t, chunk) in image.chunks_mut(band).enumerate() {
-            sc.spawn(move || {
+            crate::threads::spawn(sc, move || {
                 let mut taps = field.taps();
                 for (i, px) in chunk.iter_mut().enumerate() {
                     let (x, y) = rays.pixel(f, t * band + i);

@@ -99,7 +99,7 @@ pub fn render_reference(
                 let window = &window;
                 let fp = &fp;
                 let lighting = &lighting;
-                scope.spawn(move || {
+                crate::threads::spawn(scope, move || {
                     let rows = t * band..(t * band + chunk.len() / w);
                     let first = rows.start * w;
                     for v in 0..nb {
