@@ -478,6 +478,22 @@ impl RenderArgs {
         }
     }
 
+    /// Records every file these flags name for reading (the volume, `--stream`, a `--tf` file,
+    /// a `--background` image, `--table-file`) as an input, which no output may replace
+    /// ([`crate::io::outputs`]).
+    pub fn note_inputs(&self) {
+        let named = [
+            self.volume.as_deref(),
+            self.stream.as_deref(),
+            self.tf.as_deref().map(std::path::Path::new),
+            self.background_file(),
+            self.footprint.table_file.as_deref(),
+        ];
+        for path in named.into_iter().flatten() {
+            crate::io::note_input_path(path);
+        }
+    }
+
     /// `--threads`, with 0 resolved to the number of cores.
     pub fn thread_count(&self) -> usize {
         match self.threads {

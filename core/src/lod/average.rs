@@ -141,7 +141,13 @@ impl<'a> Extinction<'a> {
         }
         let f = (target - a(lo)) / (a(hi) - a(lo));
         let t = (lo as f32 + f) / (lut.len() - 1) as f32;
-        self.tf.lo + t * (self.tf.hi - self.tf.lo)
+        let (a, b) = (self.tf.lo, self.tf.hi);
+        if b - a < f32::INFINITY {
+            a + t * (b - a)
+        } else {
+            // A window wider than f32 holds: no overflow (see `TransferFunction::position`).
+            a * (1.0 - t) + b * t
+        }
     }
 }
 

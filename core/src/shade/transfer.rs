@@ -87,10 +87,20 @@ impl TransferFunction<'_> {
     }
 
     /// `value`'s position along the entries (0 at `lo`, n − 1 at `hi`; unclamped): a
-    /// non-decreasing function of `value` (each rounded step is).
+    /// non-decreasing function of `value` (each rounded step is), never NaN for a finite value
+    /// and a checked window. A window wider than `f32` can hold (`hi − lo` overflows, as for data
+    /// spanning ±3.4·10³⁸) is measured in halves, which cannot overflow and round the same way
+    /// (halving is exact); a value so far outside the window that its position overflows is ±∞,
+    /// which [`lookup`](TransferFunction::lookup) clamps to the end entries like any other.
     #[inline]
     fn position(&self, value: f32) -> f32 {
-        (value - self.lo) / (self.hi - self.lo) * (self.lut.len() - 1) as f32
+        let scale = (self.lut.len() - 1) as f32;
+        let width = self.hi - self.lo;
+        if width < f32::INFINITY {
+            (value - self.lo) / width * scale
+        } else {
+            (value * 0.5 - self.lo * 0.5) / (self.hi * 0.5 - self.lo * 0.5) * scale
+        }
     }
 
     /// The largest value at or below which [`TransferFunction::lookup`] gives opacity exactly
@@ -124,14 +134,14 @@ impl TransferFunction<'_> {
     /// transparent). `None` otherwise, or when no value is visible or the function does not
     /// [`check`](TransferFunction::check).
     ///
-    /// Why it is exact: with p(v) the position the lookup computes (never decreasing in v) and F
-    /// the first visible entry, a value with finite p ≥ F blends two entries of opacity ≥
-    /// 2⁻²⁰, whose float blend a + f·(b − a) stays within a few 2⁻²⁴ of [a, b], so above 0; one
-    /// with p in (F − 1, F) has opacity f·α_F (0 plus the product), which never decreases with
-    /// v; below that, 0. So "p(v) = +∞, or p(v) finite and (p(v) ≥ F or opacity > 0)" goes from
-    /// false to true once, and "p(v) < +∞" from true to false once (a value so large that the
-    /// position overflows is transparent); `low` and `high` are where they change, found by
-    /// bisection on the lookup's own arithmetic (`tests/classify.rs` checks against the lookup).
+    /// Why it is exact: with p(v) the position the lookup computes (never decreasing in v, never
+    /// NaN, ±∞ clamped to the end entries) and F the first visible entry, a value with p ≥ F
+    /// blends two entries of opacity ≥ 2⁻²⁰ (or reads the last), whose float blend
+    /// a + f·(b − a) stays within a few 2⁻²⁴ of [a, b], so above 0; one with p in (F − 1, F)
+    /// has opacity f·α_F (0 plus the product), which never decreases with v; below that, 0. So
+    /// "p(v) ≥ F or opacity > 0" goes from false to true once, at `low`, found by bisection on
+    /// the lookup's own arithmetic, and holds up to `high` = the largest finite `f32`
+    /// (`tests/classify.rs` checks against the lookup).
     pub fn visible_interval(&self) -> Option<(f32, f32)> {
         self.check().ok()?;
         let first = self.lut.iter().position(|c| c[3] > 0.0)?;
@@ -142,17 +152,15 @@ impl TransferFunction<'_> {
             return None;
         }
         let from = first as f32;
-        let below = |v: f32| {
-            let t = self.position(v);
-            !(t == f32::INFINITY || (t.is_finite() && (t >= from || self.lookup(v)[3] > 0.0)))
-        };
+        let below = |v: f32| !(self.position(v) >= from || self.lookup(v)[3] > 0.0);
         let low = match last_finite(below) {
             None => -f32::MAX,
             Some(v) if v == f32::MAX => return None,
             Some(v) => next_finite_up(v),
         };
-        let high = last_finite(|v| self.position(v) < f32::INFINITY)?;
-        (low <= high).then_some((low, high))
+        // Every finite value above `low` is visible: positions past the last entry (overflowed
+        // ones included) clamp to it, and it is visible.
+        Some((low, f32::MAX))
     }
 
     /// Straight RGBA for `value`; transparent for a non-finite value.
@@ -162,11 +170,8 @@ impl TransferFunction<'_> {
             return [0.0; 4];
         }
         let n = self.lut.len();
-        let t = self.position(value);
-        if !t.is_finite() {
-            return [0.0; 4];
-        }
-        let t = t.clamp(0.0, (n - 1) as f32);
+        // Never NaN (see `position`); ±∞ clamps to the end entries.
+        let t = self.position(value).clamp(0.0, (n - 1) as f32);
         let i = (t as usize).min(n - 2);
         let f = t - i as f32;
         let (a, b) = (self.lut[i], self.lut[i + 1]);

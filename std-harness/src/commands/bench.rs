@@ -67,6 +67,7 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
             "--orbit must be a finite number of degrees",
         ));
     }
+    args.render.note_inputs();
     io::outputs::check_image_and_json(args.render.out.as_deref(), args.render.json.as_deref())?;
     if let Some(out) = &args.render.out {
         io::image::check_style(out, args.render.png_style())?;

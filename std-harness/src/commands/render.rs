@@ -27,6 +27,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
             extensions: &[],
         });
     }
+    args.note_inputs();
     outputs::check(&planned)?;
     check_style(&out, args.png_style())?;
     let (p, args, choice) = apply_quality(prepare(args)?, args)?;

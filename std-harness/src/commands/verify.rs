@@ -77,6 +77,7 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
             });
         }
     }
+    r.note_inputs();
     outputs::check(&planned)?;
     for path in [&r.out, &args.reference_out].into_iter().flatten() {
         check_style(path, r.png_style())?;

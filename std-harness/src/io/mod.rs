@@ -38,7 +38,46 @@ pub fn regular_file_len(path: &Path) -> Result<u64, CliError> {
             path.display()
         )));
     }
+    note_input(&meta);
     Ok(meta.len())
+}
+
+/// Every file this process has read or been told it will read, as (device, inode): no output
+/// may replace one ([`outputs`] checks before writing, and again before renaming into place).
+static INPUTS: std::sync::Mutex<Vec<(u64, u64)>> = std::sync::Mutex::new(Vec::new());
+
+/// Records the file `meta` describes as an input.
+fn note_input(meta: &std::fs::Metadata) {
+    use std::os::unix::fs::MetadataExt;
+    let id = (meta.dev(), meta.ino());
+    let mut inputs = INPUTS
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    if !inputs.contains(&id) {
+        inputs.push(id);
+    }
+}
+
+/// Records `path` as an input of this command, if it names an existing file (symbolic links
+/// followed): a command calls this for the files its arguments name, before checking its
+/// outputs, so that `--json VOLUME` is refused before any work.
+pub fn note_input_path(path: &std::path::Path) {
+    if let Ok(meta) = std::fs::metadata(path) {
+        if meta.is_file() {
+            note_input(&meta);
+        }
+    }
+}
+
+/// Whether `path` names (symbolic links followed, hard links alike) a file recorded as an input.
+pub fn is_input(path: &std::path::Path) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    std::fs::metadata(path).is_ok_and(|m| {
+        INPUTS
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .contains(&(m.dev(), m.ino()))
+    })
 }
 
 /// The one-line message for an allocation of `bytes` bytes for `what` that memory refused.
@@ -142,17 +181,36 @@ pub fn read_file(path: &Path) -> Result<Vec<u8>, CliError> {
     Ok(out)
 }
 
-/// Reads at most `limit` bytes from the start of a file (for headers of files that may be huge).
-pub fn read_prefix(path: &Path, limit: usize) -> Result<Vec<u8>, CliError> {
+/// The most bytes a text header (NRRD, MetaImage) may take when read ahead of its data for
+/// streaming (16 MiB): past it the header is refused, never cut.
+pub const MAX_HEADER_BYTES: usize = 16 << 20;
+
+/// Reads the start of a file up to the end of its text header, as `ended` tells from the bytes
+/// so far (checked after each 64 KiB read), or to the file's end: never a prefix that cuts the
+/// header (a long comment would drop the fields after it). A header still open after
+/// [`MAX_HEADER_BYTES`] is an error.
+pub fn read_header(path: &Path, ended: impl Fn(&[u8]) -> bool) -> Result<Vec<u8>, CliError> {
     use std::io::Read;
     regular_file_len(path)?;
-    let f = std::fs::File::open(path)
+    let mut f = std::fs::File::open(path)
         .map_err(|e| CliError::input(format!("{}: cannot read: {e}", path.display())))?;
     let mut out = Vec::new();
-    f.take(limit as u64)
-        .read_to_end(&mut out)
-        .map_err(|e| CliError::input(format!("{}: cannot read: {e}", path.display())))?;
-    Ok(out)
+    loop {
+        let got = (&mut f)
+            .take(1 << 16)
+            .read_to_end(&mut out)
+            .map_err(|e| CliError::input(format!("{}: cannot read: {e}", path.display())))?;
+        if got == 0 || ended(&out) {
+            return Ok(out);
+        }
+        if out.len() > MAX_HEADER_BYTES {
+            return Err(CliError::input(format!(
+                "{}: header not ended within {} MiB",
+                path.display(),
+                MAX_HEADER_BYTES >> 20
+            )));
+        }
+    }
 }
 
 /// A data file a header names, opened for reading exactly the bytes the header declares.
@@ -194,6 +252,9 @@ pub fn open_data(path: &Path) -> Result<DataFile, CliError> {
             "{}: a terminal, not a data file",
             path.display()
         )));
+    }
+    if ft.is_file() {
+        note_input(&meta);
     }
     Ok(DataFile {
         reader: std::io::BufReader::new(file),

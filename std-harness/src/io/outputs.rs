@@ -10,12 +10,24 @@
 //! files renamed before it then stay, and the error names the one that failed.
 //!
 //! **Devices and pipes.** An output naming an existing file that is neither a regular file nor a
-//! folder (`/dev/null`, `/dev/stdout`, a FIFO) is written in place, after every regular output is
-//! renamed into place: renaming a temporary over it would replace the device with a regular file
-//! (as root, `--json /dev/null` did exactly that to this machine's `/dev/null`).
+//! folder (`/dev/null`, `/dev/stdout`, a FIFO; symbolic links followed) is written in place,
+//! never replaced: renaming a temporary over it would replace the device with a regular file (as
+//! root, `--json /dev/null` did exactly that to this machine's `/dev/null`). It cannot be taken
+//! back, so it is written after every regular output is written to its temporary and before any
+//! is renamed into place: a device that fails (`/dev/full`, a closed pipe) leaves no output.
+//!
+//! **Inputs.** No output may name a file the command reads (`--json VOLUME`, an NRRD's detached
+//! data file, a `--tf` file; through symbolic or hard links alike): [`check`] refuses the inputs
+//! its command names, and [`write_all`] every file read since (`crate::io::is_input`).
+//!
+//! **Names.** The temporary is `.NAME.tmp-PID`; where that would pass a file name's 255 bytes,
+//! `NAME` is cut and a hash of the whole name added (`.PREFIX~HASH.tmp-PID`), so any name the
+//! file system takes can be written. A file-size limit (`ulimit -f`) makes the write fail with
+//! an error instead of killing the process ([`ignore_file_size_signal`]), so the temporary is
+//! removed as after any failed write.
 //!
 //! **After SIGKILL.** A kill between a temporary's creation and its rename leaves
-//! `.NAME.tmp-PID` beside the output (never a partial `NAME`). The next run that writes `NAME`
+//! the temporary beside the output (never a partial `NAME`). The next run that writes `NAME`
 //! removes such leftovers ([`clean_leftovers`]): those whose process no longer runs (on Linux,
 //! no `/proc/PID`), or, where that cannot be told, that are more than a day old.
 
@@ -56,16 +68,51 @@ fn folder(path: &Path) -> &Path {
     }
 }
 
+/// The longest file name most file systems take, bytes.
+const NAME_MAX: usize = 255;
+
+/// The part of a temporary's name before the PID: `.NAME.tmp-`, or, where a temporary with that
+/// prefix could pass [`NAME_MAX`], `.PREFIX~HASH.tmp-` with `NAME` cut on a character boundary
+/// and the FNV-1a hash of the whole name (see the module docs).
+fn temporary_prefix(name: &str) -> String {
+    // Room for the PID (at most 10 digits) after the prefix.
+    const PID: usize = 10;
+    let plain = format!(".{name}.tmp-");
+    if plain.len() + PID <= NAME_MAX {
+        return plain;
+    }
+    let hash = name.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+    });
+    let tail = format!("~{hash:016x}.tmp-");
+    let mut cut = NAME_MAX - PID - tail.len() - 1;
+    while !name.is_char_boundary(cut) {
+        cut -= 1;
+    }
+    format!(".{}{tail}", &name[..cut])
+}
+
 /// The temporary name `path` is written under before its rename.
 fn temporary(path: &Path) -> Result<PathBuf, CliError> {
     let name = path
         .file_name()
         .ok_or_else(|| CliError::input(format!("{}: not a file name", path.display())))?;
     Ok(folder(path).join(format!(
-        ".{}.tmp-{}",
-        name.to_string_lossy(),
+        "{}{}",
+        temporary_prefix(&name.to_string_lossy()),
         std::process::id()
     )))
+}
+
+/// Makes a write past the file-size limit (`ulimit -f`) fail with an error (EFBIG) instead of
+/// killing the process with SIGXFSZ, which would leave its temporary behind: called once, first
+/// thing, by the command line.
+pub fn ignore_file_size_signal() {
+    // SAFETY: setting a signal's disposition to SIG_IGN installs no handler and touches no
+    // memory of this process; SIGXFSZ is a valid signal number.
+    unsafe {
+        libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
+    }
 }
 
 /// Removes `.NAME.tmp-PID` files that a killed run left beside `path` (see the module docs);
@@ -74,7 +121,7 @@ pub fn clean_leftovers(path: &Path) -> usize {
     let Some(name) = path.file_name().map(|n| n.to_string_lossy().into_owned()) else {
         return 0;
     };
-    let prefix = format!(".{name}.tmp-");
+    let prefix = temporary_prefix(&name);
     let Ok(entries) = std::fs::read_dir(folder(path)) else {
         return 0;
     };
@@ -136,6 +183,12 @@ pub fn check(outputs: &[Planned<'_>]) -> Result<(), CliError> {
                 )));
             }
         }
+        if super::is_input(o.path) {
+            return Err(CliError::input(format!(
+                "{flag} {shown}: is an input of this command, which it would replace: \
+                 name another file"
+            )));
+        }
         let dir = folder(o.path);
         if is_special(o.path) {
             // Written in place: no folder probe (a temporary beside a device is never made).
@@ -174,8 +227,16 @@ fn same_file(a: &Path, b: &Path) -> bool {
     a == b || matches!((canon(a), canon(b)), (Some(x), Some(y)) if x == y)
 }
 
-/// Writes every `(path, bytes)` all-or-nothing (see the module docs).
+/// Writes every `(path, bytes)` all-or-nothing (see the module docs): regular files to their
+/// temporaries, then devices and pipes in place, then the temporaries renamed into place.
 pub fn write_all<B: AsRef<[u8]>>(files: &[(&Path, B)]) -> Result<(), CliError> {
+    if let Some((path, _)) = files.iter().find(|(p, _)| super::is_input(p)) {
+        return Err(CliError::input(format!(
+            "{}: is a file this command read, which it would replace: name another file \
+             (no output written)",
+            path.display()
+        )));
+    }
     let mut written: Vec<(PathBuf, &Path)> = Vec::with_capacity(files.len());
     let cleanup = |written: &[(PathBuf, &Path)]| {
         for (tmp, _) in written {
@@ -206,6 +267,19 @@ pub fn write_all<B: AsRef<[u8]>>(files: &[(&Path, B)]) -> Result<(), CliError> {
         }
         written.push((tmp, path));
     }
+    for (path, bytes) in files.iter().filter(|(p, _)| is_special(p)) {
+        let result = std::fs::OpenOptions::new()
+            .write(true)
+            .open(path)
+            .and_then(|mut f| f.write_all(bytes.as_ref()).and_then(|()| f.flush()));
+        if let Err(e) = result {
+            cleanup(&written);
+            return Err(CliError::input(format!(
+                "{}: cannot write: {e} (no file output written)",
+                path.display()
+            )));
+        }
+    }
     for (k, (tmp, path)) in written.iter().enumerate() {
         if let Err(e) = std::fs::rename(tmp, path) {
             cleanup(&written[k..]);
@@ -214,13 +288,6 @@ pub fn write_all<B: AsRef<[u8]>>(files: &[(&Path, B)]) -> Result<(), CliError> {
                 path.display()
             )));
         }
-    }
-    for (path, bytes) in files.iter().filter(|(p, _)| is_special(p)) {
-        std::fs::OpenOptions::new()
-            .write(true)
-            .open(path)
-            .and_then(|mut f| f.write_all(bytes.as_ref()))
-            .map_err(|e| CliError::input(format!("{}: cannot write: {e}", path.display())))?;
     }
     Ok(())
 }

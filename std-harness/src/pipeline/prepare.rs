@@ -254,8 +254,26 @@ impl Prepared {
 pub fn view_for(args: &RenderArgs, dims: [usize; 3], grid: &Grid) -> Result<View, CliError> {
     let view = match args.view_matrix {
         Some(m) => View::from_rows(m).map_err(|e| CliError::input(format!("--view-matrix: {e}"))),
-        None => View::from_vtk_camera(args.view, args.zoom, dims, grid, [args.size.0, args.size.1])
-            .map_err(|e| CliError::input(format!("--view/--zoom: {e}"))),
+        None => {
+            let size = [args.size.0, args.size.1];
+            View::from_vtk_camera(args.view, args.zoom, dims, grid, size).map_err(|e| {
+                // Blame the flags only where they are at fault: if the same camera fits a grid
+                // of unit spacing, the volume's own geometry (a spacing of 10³⁸, say, whose
+                // extent f32 cannot hold) is what cannot be viewed.
+                let unit = Grid::from_spacing([1.0; 3]);
+                if unit.is_ok_and(|u| {
+                    View::from_vtk_camera(args.view, args.zoom, dims, &u, size).is_ok()
+                }) {
+                    CliError::input(format!(
+                        "the volume's grid cannot be viewed ({e}): its spacing makes a world \
+                         extent too large or too small for f32 arithmetic; rescale the spacing \
+                         (--spacing for raw data)"
+                    ))
+                } else {
+                    CliError::input(format!("--view/--zoom: {e}"))
+                }
+            })
+        }
     }?;
     Ok(view)
 }

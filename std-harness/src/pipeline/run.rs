@@ -68,7 +68,7 @@ pub fn render_frame(
         let (low, at_low) = p.subsampled(args, s)?;
         let mut f = render_frame(&low, &at_low, accum, cache)?;
         let resample = Instant::now();
-        f.image = subsample::magnify(&f.image, at_low.size, args.size, s, args.thread_count());
+        f.image = subsample::magnify(&f.image, at_low.size, args.size, s, args.thread_count())?;
         if let Some(bg) = &p.background {
             subsample::under_background(&mut f.image, bg);
         }

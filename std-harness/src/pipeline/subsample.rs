@@ -174,7 +174,7 @@ pub fn magnify(
     out: (usize, usize),
     s: usize,
     threads: usize,
-) -> Vec<[f32; 4]> {
+) -> Result<Vec<[f32; 4]>, CliError> {
     let (lw, lh) = low;
     let (w, h) = out;
     assert!(
@@ -196,7 +196,7 @@ pub fn magnify(
             }
         }
     };
-    let mut out_img = vec![[0.0f32; 4]; w * h];
+    let mut out_img = crate::io::try_filled(w * h, [0.0f32; 4], "the resampled image")?;
     let per = h.div_ceil(threads).max(1);
     std::thread::scope(|scope| {
         for (c, chunk) in out_img.chunks_mut(per * w).enumerate() {
@@ -238,7 +238,7 @@ pub fn magnify(
             });
         }
     });
-    out_img
+    Ok(out_img)
 }
 
 #[cfg(test)]
@@ -269,7 +269,7 @@ mod tests {
                 })
                 .collect();
             for threads in [1, 3] {
-                let up = magnify(&image, low, out, s, threads);
+                let up = magnify(&image, low, out, s, threads).unwrap();
                 for (n, p) in up.iter().enumerate() {
                     let (x, y) = ((n % out.0) as f64 + 0.5, (n / out.0) as f64 + 0.5);
                     let want = 0.5 * q(x, y);
@@ -302,7 +302,7 @@ mod tests {
             .map(|(first, w)| (0..4).map(|k| w[k] * image[first + k][0]).sum())
             .collect();
         assert!(row.iter().any(|&c| c > 0.5 + 1e-3), "{row:?}");
-        for p in magnify(&image, low, out, s, 1) {
+        for p in magnify(&image, low, out, s, 1).unwrap() {
             assert!((p[3] - 0.5).abs() < 1e-6, "even opacity stays even: {p:?}");
             assert!(p[..3].iter().all(|&c| (0.0..=p[3]).contains(&c)), "{p:?}");
         }

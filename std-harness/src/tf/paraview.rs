@@ -337,11 +337,27 @@ fn locate(points: &[[f64; 4]], x: f64) -> (usize, f64) {
     }
     let (p, q) = (points[j - 1], points[j]);
     let t = if q[0] > p[0] {
-        ((x - p[0]) / (q[0] - p[0])).clamp(0.0, 1.0)
+        fraction(x, p[0], q[0]).clamp(0.0, 1.0)
     } else {
         1.0
     };
     (j, t)
+}
+
+/// (x − a) / (b − a) for a < b, measured in halves (exact) so that positions spanning more than
+/// f64 can hold (±10³⁰⁸) do not overflow to ∞ / ∞.
+fn fraction(x: f64, a: f64, b: f64) -> f64 {
+    (x * 0.5 - a * 0.5) / (b * 0.5 - a * 0.5)
+}
+
+/// The point a fraction `t` of the way from `a` to `b`, without overflow where b − a does.
+fn between(a: f64, b: f64, t: f64) -> f64 {
+    let span = b - a;
+    if span.is_finite() {
+        a + t * span
+    } else {
+        a * (1.0 - t) + b * t
+    }
 }
 
 /// Samples a preset's colours (`x r g b` quadruples) and opacities (`x a midpoint sharpness`)
@@ -378,7 +394,7 @@ fn sample(rgb: &[f64], alpha: Option<&[f64]>, space: &str) -> Result<Vec<[f32; 5
     };
     let opacity = |x: f64| -> f64 {
         let Some(o) = &ops else {
-            return ((x - x0) / (x1 - x0)).clamp(0.0, 1.0);
+            return fraction(x, x0, x1).clamp(0.0, 1.0);
         };
         let (j, t) = locate(o, x);
         if j == 0 || x >= o[o.len() - 1][0] {
@@ -403,7 +419,7 @@ fn sample(rgb: &[f64], alpha: Option<&[f64]>, space: &str) -> Result<Vec<[f32; 5
     (0..LUT_SIZE)
         .map(|i| {
             let t = i as f64 / (LUT_SIZE - 1) as f64;
-            let x = x0 + t * (x1 - x0);
+            let x = between(x0, x1, t);
             let c = colour(x)?;
             Ok([
                 t as f32,

@@ -60,8 +60,17 @@ pub fn unzlib(bytes: &[u8], expected: usize) -> Result<Vec<u8>, String> {
 
 /// Decodes an LZ4 *block* (no frame: what VTK's `vtkLZ4DataCompressor` writes, one per data
 /// block) into exactly `expected` bytes. The output buffer is the declared size, so a block that
-/// would decode to more is an error, not an allocation.
+/// would decode to more is an error, not an allocation; and a declared size the block cannot
+/// reach (LZ4 makes at most [`LZ4_MAX_RATIO`] bytes of each byte it reads) is an error before
+/// anything is allocated, so memory follows the data, not the header.
 pub fn unlz4(bytes: &[u8], expected: usize) -> Result<Vec<u8>, String> {
+    let reach = bytes.len().saturating_mul(LZ4_MAX_RATIO).saturating_add(16);
+    if expected > reach {
+        return Err(format!(
+            "LZ4 block of {} bytes cannot decode to the {expected} bytes declared",
+            bytes.len()
+        ));
+    }
     let mut out = crate::io::try_vec::<u8>(expected, "the decoded LZ4 data")?;
     out.resize(expected, 0);
     let n = lz4_flex::block::decompress_into(bytes, &mut out)
@@ -73,6 +82,10 @@ pub fn unlz4(bytes: &[u8], expected: usize) -> Result<Vec<u8>, String> {
     }
     Ok(out)
 }
+
+/// The most bytes an LZ4 block can decode to per byte it holds: a match's length grows by 255
+/// per extension byte (LZ4's block format), so no block expands by more.
+pub const LZ4_MAX_RATIO: usize = 255;
 
 /// A sink that keeps at most `limit` bytes and fails on the byte after: bounds what a decoder
 /// writing into it can make memory hold.

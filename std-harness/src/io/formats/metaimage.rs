@@ -1,7 +1,8 @@
 //! MetaImage (`.mhd` with a detached data file, `.mha` with `ElementDataFile = LOCAL`): `NDims = 3`,
 //! `DimSize`, `ElementType` (`MET_UCHAR` … `MET_DOUBLE`), `ElementSpacing` (or `ElementSize`),
 //! `ElementByteOrderMSB` / `BinaryDataByteOrderMSB`, `CompressedData` (zlib), `HeaderSize`,
-//! `TransformMatrix` (row i is grid axis i's direction).
+//! `TransformMatrix` (row i is grid axis i's direction). `ElementNumberOfChannels` other than 1
+//! (interleaved components) is refused.
 
 use super::{compress, numbers};
 use crate::io::volume::{at, byte_len, check_spacing, decode, SampleType, Volume, AXIS_ALIGNED};
@@ -91,6 +92,18 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
         o => return Err(format!("ElementType: '{o}' is not supported")),
     };
     byte_len(dims, ty)?;
+    // Several components per voxel lie interleaved in the data (RGB, a vector field): read as
+    // scalars they would render a wrong image, so they are refused, as VTI and legacy VTK
+    // refuse multi-component arrays.
+    if let Some(c) = get(&["ElementNumberOfChannels"]) {
+        if c != "1" {
+            return Err(format!(
+                "ElementNumberOfChannels = {}: only one component per voxel (a scalar volume) \
+                 is supported",
+                c.chars().take(20).collect::<String>()
+            ));
+        }
+    }
     let spacing = match get(&["ElementSpacing", "ElementSize"]) {
         Some(s) => {
             let v: Vec<f32> = numbers(s, 3, "ElementSpacing")?;
@@ -213,7 +226,12 @@ pub fn load(path: &Path) -> Result<Volume, CliError> {
 
 /// Where the samples of an uncompressed MetaImage are, and its grid, for streaming.
 pub fn raw_layout(path: &Path) -> Result<super::Streamable, CliError> {
-    let head = crate::io::read_prefix(path, 1 << 16)?;
+    // The header up to its ElementDataFile line, however long (read_header bounds it).
+    let head = crate::io::read_header(path, |b| {
+        b.windows(15)
+            .position(|w| w == b"ElementDataFile")
+            .is_some_and(|at| b[at..].contains(&b'\n'))
+    })?;
     let h = parse_header(&head).map_err(|e| at(path, e))?;
     if h.compressed {
         return Err(at(

@@ -246,8 +246,21 @@ pub fn parse_header(b: &[u8]) -> Result<Header, String> {
         }
         (spacing, d)
     } else if qform > 0 {
-        let [qb, qc, qd] = [0, 1, 2].map(|k| real(l.quatern, k) as f32);
-        let qa = (1.0 - (qb * qb + qc * qc + qd * qd)).max(0.0).sqrt();
+        // As nifti1_io's nifti_quatern_to_mat44 (in f64): a = √(1 − b² − c² − d²), except where
+        // that is below 10⁻⁷, when (b, c, d) is normalised and a = 0 (a 180° rotation), so a
+        // quaternion written a little past unit length still gives a rotation.
+        let [mut qb, mut qc, mut qd] = [0, 1, 2].map(|k| real(l.quatern, k));
+        let norm2 = qb * qb + qc * qc + qd * qd;
+        if !norm2.is_finite() {
+            return Err("qform quaternion (quatern_b, c, d) is not finite".into());
+        }
+        let qa = if 1.0 - norm2 < 1e-7 {
+            let k = 1.0 / norm2.sqrt();
+            (qb, qc, qd) = (qb * k, qc * k, qd * k);
+            0.0
+        } else {
+            (1.0 - norm2).sqrt()
+        };
         let qfac = if real(l.pixdim, 0) < 0.0 { -1.0 } else { 1.0 };
         let r = [
             [
@@ -266,7 +279,7 @@ pub fn parse_header(b: &[u8]) -> Result<Header, String> {
                 qa * qa + qd * qd - qc * qc - qb * qb,
             ],
         ];
-        let col = |c: usize, s: f32| [r[0][c] * s, r[1][c] * s, r[2][c] * s];
+        let col = |c: usize, s: f64| [0, 1, 2].map(|i| (r[i][c] * s) as f32);
         (pixdim, [col(0, 1.0), col(1, 1.0), col(2, qfac)])
     } else {
         (pixdim, AXIS_ALIGNED)

@@ -309,8 +309,10 @@ pub fn load(path: &Path) -> Result<Volume, CliError> {
 
 /// Where the samples of a raw-encoded NRRD are, and its grid, for streaming.
 pub fn raw_layout(path: &Path) -> Result<super::Streamable, CliError> {
-    // A header is small: read at most 64 KiB of it.
-    let head = crate::io::read_prefix(path, 1 << 16)?;
+    // The header up to its blank line, however long (read_header bounds it), never cut.
+    let head = crate::io::read_header(path, |b| {
+        b.windows(2).any(|w| w == b"\n\n") || b.windows(3).any(|w| w == b"\n\r\n")
+    })?;
     let h = parse_header(&head).map_err(|e| at(path, e))?;
     if h.encoding != Encoding::Raw || h.line_skip != 0 {
         return Err(at(path, "streaming needs raw encoding without line skip"));

@@ -234,7 +234,11 @@ pub fn parse_header_array<'a>(
     )?;
     let mut dims = [0usize; 3];
     for a in 0..3 {
-        let d = extent[2 * a + 1] - extent[2 * a] + 1;
+        // Checked: an extent near the ends of i64 must not wrap into a small volume.
+        let d = extent[2 * a + 1]
+            .checked_sub(extent[2 * a])
+            .and_then(|d| d.checked_add(1))
+            .ok_or_else(|| format!("WholeExtent: axis {a} spans more than 2^63 points"))?;
         dims[a] = usize::try_from(d)
             .ok()
             .filter(|&d| d > 0)
