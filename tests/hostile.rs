@@ -8,6 +8,9 @@
 //! otherwise this test binary run again as a child that calls `footprint_harness::run` — the one
 //! function `footprint`'s `main` calls — so `cargo test` alone runs the whole suite.
 //!
+//! Cases marked release-only (two renders of a 600³ volume, hundreds of millions of voxels) run
+//! only against `FOOTPRINT_BIN`; a debug child would not finish them in time.
+//!
 //! A custom harness (`harness = false`): `main` is either the suite or, with `FOOTPRINT_CHILD`
 //! set, the command line.
 
@@ -33,7 +36,15 @@ fn main() {
     std::fs::create_dir_all(&dir).unwrap();
     let cases = cases(&dir);
     let mut failed = 0;
+    let release = std::env::var_os("FOOTPRINT_BIN").is_some();
     for case in &cases {
+        if case.release_only && !release {
+            println!(
+                "skip  {}: runs against the release binary only (FOOTPRINT_BIN)",
+                case.name
+            );
+            continue;
+        }
         match run_case(case, &dir) {
             Ok(note) => println!("ok    {}: {note}", case.name),
             Err(why) => {
@@ -73,6 +84,49 @@ struct Case {
     gone: Vec<PathBuf>,
     /// Files written just before the run (name, bytes).
     before: Vec<(PathBuf, Vec<u8>)>,
+    /// Extra `ulimit` settings for this case (e.g. `-f 16`, or a lower `-v`), applied after the
+    /// 4 GiB address-space limit.
+    ulimit: &'static str,
+    /// A check of what the run left in the case folder (the image right, an input untouched),
+    /// run after the exit and outputs are checked.
+    check: Option<Check>,
+    /// Run only against the release binary (`FOOTPRINT_BIN`): the case renders hundreds of
+    /// millions of voxels, which a debug build does not do within the time limit.
+    release_only: bool,
+}
+
+type Check = Box<dyn Fn(&Path) -> Result<String, String>>;
+
+impl Case {
+    /// A case with no extra limit, check or file written before.
+    fn new(name: &'static str, args: Vec<String>, expect: Expect, gone: Vec<PathBuf>) -> Case {
+        Case {
+            name,
+            args,
+            stdin: None,
+            expect,
+            gone,
+            before: vec![],
+            ulimit: "",
+            check: None,
+            release_only: false,
+        }
+    }
+
+    fn checked(mut self, check: impl Fn(&Path) -> Result<String, String> + 'static) -> Case {
+        self.check = Some(Box::new(check));
+        self
+    }
+
+    fn ulimit(mut self, extra: &'static str) -> Case {
+        self.ulimit = extra;
+        self
+    }
+
+    fn release_only(mut self) -> Case {
+        self.release_only = true;
+        self
+    }
 }
 
 fn run_case(case: &Case, dir: &Path) -> Result<String, String> {
@@ -81,7 +135,14 @@ fn run_case(case: &Case, dir: &Path) -> Result<String, String> {
     }
     let mut cmd = Command::new("sh");
     cmd.arg("-c")
-        .arg(format!("ulimit -v {LIMIT_KIB} && exec \"$@\""))
+        .arg(if case.ulimit.is_empty() {
+            format!("ulimit -v {LIMIT_KIB} && exec \"$@\"")
+        } else {
+            format!(
+                "ulimit -v {LIMIT_KIB} && ulimit {} && exec \"$@\"",
+                case.ulimit
+            )
+        })
         .arg("sh");
     match std::env::var_os("FOOTPRINT_BIN") {
         Some(bin) => {
@@ -161,6 +222,10 @@ fn run_case(case: &Case, dir: &Path) -> Result<String, String> {
     if !leftovers.is_empty() {
         return Err(format!("temporaries left: {leftovers:?}"));
     }
+    let note = match &case.check {
+        Some(check) => format!("{note}; {}", check(dir)?),
+        None => note,
+    };
     Ok(format!("{:.2} s: {note}", elapsed.as_secs_f64()))
 }
 
@@ -180,6 +245,9 @@ fn refused(name: &'static str, a: &[&str], want: &'static str, dir: &Path) -> Ca
         expect: Expect::Refused(want),
         gone: vec![dir.join("out.png")],
         before: vec![],
+        ulimit: "",
+        check: None,
+        release_only: false,
     }
 }
 
@@ -240,6 +308,9 @@ fn cases(dir: &Path) -> Vec<Case> {
         expect: Expect::Refused("the stream ended after 1000 of its 4294967296 bytes"),
         gone: vec![dir.join("out.png")],
         before: vec![],
+        ulimit: "",
+        check: None,
+        release_only: false,
     });
 
     // XML nested 20 000 elements deep (140 KB).
@@ -278,6 +349,9 @@ fn cases(dir: &Path) -> Vec<Case> {
         expect: Expect::Renders,
         gone: vec![],
         before: vec![],
+        ulimit: "",
+        check: None,
+        release_only: false,
     });
 
     // A valid 8³ NIfTI followed by 3 GiB of zeros in the same gzip stream: the documented
@@ -290,6 +364,9 @@ fn cases(dir: &Path) -> Vec<Case> {
         expect: Expect::Renders,
         gone: vec![],
         before: vec![],
+        ulimit: "",
+        check: None,
+        release_only: false,
     });
 
     // A gzip NRRD declaring 8³ whose stream inflates to 3 GiB: cut off after 8³ + 1 bytes.
@@ -373,6 +450,9 @@ fn cases(dir: &Path) -> Vec<Case> {
         expect: Expect::CheckFails("non-finite value"),
         gone: vec![],
         before: vec![],
+        ulimit: "",
+        check: None,
+        release_only: false,
     });
     c.push(refused(
         "compare --max-diff NaN",
@@ -476,7 +556,11 @@ fn cases(dir: &Path) -> Vec<Case> {
         expect: Expect::Renders,
         gone: vec![stale.clone()],
         before: vec![(stale, b"half a PNG".to_vec())],
+        ulimit: "",
+        check: None,
+        release_only: false,
     });
+    c.extend(second_campaign(dir));
     c
 }
 
@@ -606,6 +690,512 @@ fn zlib_vti_bomb() -> Vec<u8> {
         "<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"0.1\" byte_order=\"LittleEndian\" header_type=\"UInt32\" compressor=\"vtkZLibDataCompressor\">\n<ImageData WholeExtent=\"0 7 0 7 0 7\" Spacing=\"1 1 1\">\n<Piece Extent=\"0 7 0 7 0 7\"><PointData Scalars=\"s\"><DataArray type=\"UInt8\" Name=\"s\" format=\"binary\">{}{}</DataArray></PointData></Piece></ImageData></VTKFile>\n",
         b64.encode(&head),
         b64.encode(&z)
+    )
+    .into_bytes()
+}
+
+/// The heart volume shipped with the tests (32×32×12 f32, detached raw data).
+const HEART: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/tests/data/heart_32x32x12_float32_le.nhdr"
+);
+const HEART_RAW: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/tests/data/heart_32x32x12_float32_le.raw"
+);
+
+/// A PNG the case left in `dir`: width, height, premultiplied RGBA.
+fn png(dir: &Path, name: &str) -> Result<(usize, usize, Vec<[f32; 4]>), String> {
+    let bytes = std::fs::read(dir.join(name)).map_err(|e| format!("{name}: {e}"))?;
+    footprint_harness::io::image::decode_png_rgba(&bytes, name).map_err(|e| e.to_string())
+}
+
+/// A check that `name` is an image with something on it (mean opacity at least 1 %).
+fn not_black(name: &'static str) -> impl Fn(&Path) -> Result<String, String> {
+    move |dir| {
+        let (_, _, px) = png(dir, name)?;
+        let mean = px.iter().map(|p| f64::from(p[3])).sum::<f64>() / px.len().max(1) as f64;
+        if mean >= 0.01 {
+            Ok(format!("{name}: mean opacity {mean:.3}"))
+        } else {
+            Err(format!("{name} is black (mean opacity {mean:.5})"))
+        }
+    }
+}
+
+/// A check that images `a` and `b` differ by at most `levels` of 255 in any channel.
+fn same_image(
+    a: &'static str,
+    b: &'static str,
+    levels: f32,
+) -> impl Fn(&Path) -> Result<String, String> {
+    move |dir| {
+        let ((wa, ha, pa), (wb, hb, pb)) = (png(dir, a)?, png(dir, b)?);
+        if (wa, ha) != (wb, hb) {
+            return Err(format!("{a} is {wa}x{ha}, {b} {wb}x{hb}"));
+        }
+        let worst = pa
+            .iter()
+            .zip(&pb)
+            .flat_map(|(p, q)| (0..4).map(move |c| (p[c] - q[c]).abs()))
+            .fold(0.0f32, f32::max);
+        if worst * 255.0 <= levels {
+            Ok(format!("{a} and {b} within {:.1} levels", worst * 255.0))
+        } else {
+            Err(format!("{a} and {b} differ by {:.1} levels", worst * 255.0))
+        }
+    }
+}
+
+/// A check that `path` still holds `bytes`.
+fn untouched(path: PathBuf, bytes: Vec<u8>) -> impl Fn(&Path) -> Result<String, String> {
+    move |_| match std::fs::read(&path) {
+        Ok(b) if b == bytes => Ok(format!("{} untouched", path.display())),
+        _ => Err(format!("{} was changed", path.display())),
+    }
+}
+
+/// A NIfTI-1 (`.nii`) of an 8³ u8 volume with an asymmetric bright block, oriented by a qform
+/// quaternion (b, c, d) written as given.
+fn nifti_quaternion(b: f32, c: f32, d: f32) -> Vec<u8> {
+    let mut h = nifti_header(352.0);
+    h[252..254].copy_from_slice(&1i16.to_le_bytes());
+    for (k, q) in [b, c, d].iter().enumerate() {
+        h[256 + 4 * k..260 + 4 * k].copy_from_slice(&q.to_le_bytes());
+    }
+    for k in 0..8 {
+        for j in 0..8 {
+            for i in 0..8 {
+                h.push(if i < 3 && j < 6 {
+                    250
+                } else {
+                    (i + j + k) as u8 * 4
+                });
+            }
+        }
+    }
+    h
+}
+
+/// The second hostile-input campaign (issue 43): each class's reproducers and the neighbours
+/// found beside them.
+fn second_campaign(dir: &Path) -> Vec<Case> {
+    let write = |name: &str, bytes: &[u8]| {
+        std::fs::write(dir.join(name), bytes).unwrap();
+        name.to_string()
+    };
+    let out = || vec![dir.join("out.png"), dir.join("out.json")];
+    let renders = |name, a: &[&str]| Case::new(name, args(a), Expect::Renders, vec![]);
+    let refused = |name, a: &[&str], want| Case::new(name, args(a), Expect::Refused(want), out());
+    let mut c = Vec::new();
+
+    // Sizes a user controls: checked, bounded, allocated fallibly.
+    c.push(refused(
+        "bench --frames 1e11",
+        &["bench", HEART, "--size", "8x8", "--frames", "100000000000"],
+        "at most 100000 frames",
+    ));
+    c.push(refused(
+        "bench --frames 2^64-1",
+        &[
+            "bench",
+            HEART,
+            "--size",
+            "8x8",
+            "--frames",
+            "18446744073709551615",
+        ],
+        "at most 100000 frames",
+    ));
+    for accum in ["float", "fixed"] {
+        c.push(renders(
+            "--phases 2^64-1 (stencils cannot hold it: the table walk serves)",
+            &[
+                "render",
+                HEART,
+                "--phases",
+                "18446744073709551615",
+                "--accum",
+                accum,
+                "--size",
+                "64x64",
+                "--out",
+                "phases.png",
+            ],
+        ));
+    }
+    c.push(
+        renders(
+            "--threads 2000 at 2048x2048 (threads the system refuses run on the caller's)",
+            &[
+                "render",
+                HEART,
+                "--threads",
+                "2000",
+                "--size",
+                "2048x2048",
+                "--out",
+                "threads.png",
+            ],
+        )
+        .checked(not_black("threads.png")),
+    );
+    c.push(
+        refused(
+            "--scene-size 512 under 384 MiB",
+            &[
+                "render",
+                "--scene-size",
+                "512",
+                "--size",
+                "64x64",
+                "--out",
+                "out.png",
+            ],
+            "cannot allocate",
+        )
+        .ulimit("-v 393216"),
+    );
+    // A 32768² slice (1 GiB, sparse) streamed without --window: the range pass reads chunks.
+    std::fs::File::create(dir.join("slice.raw"))
+        .unwrap()
+        .set_len(1 << 30)
+        .unwrap();
+    c.push(refused(
+        "--stream of a 32768x32768 slice without --window",
+        &[
+            "render",
+            "--stream",
+            "slice.raw",
+            "--dims",
+            "32768,32768,1",
+            "--type",
+            "u8",
+            "--out",
+            "out.png",
+        ],
+        "the data are constant",
+    ));
+    // 600³ u8 (216 MB) with Phong: the visible lists stay within their budget, past it the
+    // bands classify as they go.
+    let mut seed = 0x2545_f491_4f6c_dd1du64;
+    let big: Vec<u8> = (0..600 * 600 * 600)
+        .map(|_| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 56) as u8
+        })
+        .collect();
+    write("v600.raw", &big);
+    drop(big);
+    for (name, lod) in [
+        ("600³ u8, --shading phong --lod 0 under 4 GiB", "0"),
+        (
+            "600³ u8, --shading phong (default level) under 4 GiB",
+            "auto",
+        ),
+    ] {
+        c.push(
+            renders(
+                name,
+                &[
+                    "render",
+                    "v600.raw",
+                    "--dims",
+                    "600,600,600",
+                    "--type",
+                    "u8",
+                    "--shading",
+                    "phong",
+                    "--lod",
+                    lod,
+                    "--out",
+                    "v600.png",
+                ],
+            )
+            .checked(not_black("v600.png"))
+            .release_only(),
+        );
+    }
+
+    // Memory that follows the header: a VTI whose LZ4 block declares 1.7 GB from 16 bytes.
+    c.push(refused(
+        "VTI with an LZ4 block declaring 1.7 GB",
+        &[
+            "render",
+            &write("lz4.vti", &lz4_vti_bomb()),
+            "--out",
+            "out.png",
+        ],
+        "cannot decode",
+    ));
+
+    // Silently wrong images: windows and data whose range overflows f32.
+    c.push(
+        renders(
+            "--window=-3.4e38,3.4e38",
+            &[
+                "render",
+                HEART,
+                "--window=-3.4e38,3.4e38",
+                "--size",
+                "64x64",
+                "--out",
+                "w1.png",
+            ],
+        )
+        .checked(not_black("w1.png")),
+    );
+    c.push(
+        renders(
+            "--window 0,1e-45",
+            &[
+                "render", HEART, "--window", "0,1e-45", "--size", "64x64", "--out", "w2.png",
+            ],
+        )
+        .checked(not_black("w2.png")),
+    );
+    let wide: Vec<u8> = (0..16 * 16 * 16)
+        .flat_map(|n: i32| {
+            let (i, j, k) = (n % 16 - 8, n / 16 % 16 - 8, n / 256 - 8);
+            let v = if i * i + j * j + k * k < 25 {
+                3.4e38f32
+            } else {
+                -3.4e38
+            };
+            v.to_le_bytes()
+        })
+        .collect();
+    let wide = write("wide.raw", &wide);
+    c.push(
+        renders(
+            "f32 data spanning +-3.4e38, default window",
+            &[
+                "render", &wide, "--dims", "16,16,16", "--type", "f32", "--size", "64x64", "--out",
+                "w3.png",
+            ],
+        )
+        .checked(not_black("w3.png")),
+    );
+    let preset = write(
+        "wide.json",
+        br#"[{"Name": "wide", "ColorSpace": "RGB", "RGBPoints": [-1e308, 0, 0, 0, 1e308, 1, 1, 1], "Points": [-1e308, 0, 0.5, 0, 1e308, 1, 0.5, 0]}]"#,
+    );
+    c.push(
+        renders(
+            "ParaView points spanning +-1e308",
+            &[
+                "render", HEART, "--tf", &preset, "--size", "64x64", "--out", "w4.png",
+            ],
+        )
+        .checked(not_black("w4.png")),
+    );
+    let mut mha = b"ObjectType = Image\nNDims = 3\nDimSize = 4 4 4\nElementType = MET_UCHAR\nElementNumberOfChannels = 3\nElementDataFile = LOCAL\n".to_vec();
+    mha.extend([7u8; 192]);
+    c.push(refused(
+        "MetaImage with ElementNumberOfChannels = 3",
+        &["render", &write("rgb.mha", &mha), "--out", "out.png"],
+        "ElementNumberOfChannels",
+    ));
+    // An NRRD whose header holds a 100 KiB comment before its fields: streamed equals loaded.
+    let comment = format!("# {}\n", "x".repeat(100 << 10));
+    let long = format!(
+        "NRRD0004\n{comment}type: float\ndimension: 3\nsizes: 32 32 12\nendian: little\nencoding: raw\ndata file: {HEART_RAW}\n"
+    );
+    let long = write("long.nhdr", long.as_bytes());
+    c.push(renders(
+        "NRRD with a 100 KiB header comment, loaded",
+        &[
+            "render",
+            &long,
+            "--size",
+            "64x64",
+            "--out",
+            "long-loaded.png",
+        ],
+    ));
+    c.push(
+        renders(
+            "NRRD with a 100 KiB header comment, streamed",
+            &[
+                "render",
+                "--stream",
+                &long,
+                "--size",
+                "64x64",
+                "--out",
+                "long-streamed.png",
+            ],
+        )
+        .checked(same_image("long-loaded.png", "long-streamed.png", 0.0)),
+    );
+    // NIfTI qform: a quaternion written past unit length orients as nifti1_io's does. With
+    // a = 0, an unnormalised (b, c, d) of length l scales the rotation by l² (uniformly, so a
+    // view fitted to the volume would hide it): an explicit world-to-screen matrix shows it.
+    let third = (1.0f32 / 3.0).sqrt();
+    let unit = write("q-unit.nii", &nifti_quaternion(third, third, third));
+    let over = write("q-over.nii", &nifti_quaternion(0.6, 0.6, 0.6));
+    let view = [
+        "--size",
+        "64x64",
+        "--window",
+        "0,255",
+        "--view-matrix",
+        "3.5,0.9,0,-0.9,3.5,0.6,0.2,-0.6,3.6",
+    ];
+    let mut a = vec!["render", &unit, "--out", "q-unit.png"];
+    a.extend(view);
+    c.push(renders("NIfTI qform, unit quaternion", &a));
+    let mut a = vec!["render", &over, "--out", "q-over.png"];
+    a.extend(view);
+    c.push(
+        renders("NIfTI qform, quaternion of length 1.04 (normalised)", &a).checked(same_image(
+            "q-unit.png",
+            "q-over.png",
+            1.0,
+        )),
+    );
+    c.push(refused(
+        "VTI WholeExtent near the ends of i64",
+        &[
+            "render",
+            &write(
+                "extent.vti",
+                b"<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"0.1\" byte_order=\"LittleEndian\">\n<ImageData WholeExtent=\"-9223372036854775807 9223372036854775807 0 0 0 1\" Spacing=\"1 1 1\">\n<Piece Extent=\"0 1 0 0 0 1\"><PointData Scalars=\"s\"><DataArray type=\"UInt8\" Name=\"s\" format=\"ascii\">1 2 3 4</DataArray></PointData></Piece></ImageData></VTKFile>\n",
+            ),
+            "--out",
+            "out.png",
+        ],
+        "WholeExtent",
+    ));
+    // A spacing of 1e38 is the file's fault, not the flags'.
+    let nhdr = write(
+        "spacing.nhdr",
+        format!(
+            "NRRD0004\ntype: float\ndimension: 3\nsizes: 32 32 12\nspacings: 1e38 1 1\nendian: little\nencoding: raw\ndata file: {HEART_RAW}\n"
+        )
+        .as_bytes(),
+    );
+    c.push(refused(
+        "NRRD spacing 1e38",
+        &["render", &nhdr, "--out", "out.png"],
+        "spacing",
+    ));
+
+    // Outputs: devices and pipes first, no output naming an input, any name, any file limit.
+    c.push(refused(
+        "--json /dev/full",
+        &[
+            "render",
+            HEART,
+            "--size",
+            "32x32",
+            "--out",
+            "out.png",
+            "--json",
+            "/dev/full",
+        ],
+        "/dev/full",
+    ));
+    c.push(refused(
+        "--out, a symbolic link to /dev/full",
+        &[
+            "render", HEART, "--size", "32x32", "--out", "full.png", "--json", "out.json",
+        ],
+        "full.png",
+    ));
+    let _ = std::os::unix::fs::symlink("/dev/full", dir.join("full.png"));
+    // The shipped header names its data file beside it: both copied into the case folder.
+    let mine_header = std::fs::read(HEART).unwrap();
+    let mine = write("mine.nhdr", &mine_header);
+    std::fs::copy(HEART_RAW, dir.join("heart_32x32x12_float32_le.raw")).unwrap();
+    let raw = std::fs::read(HEART_RAW).unwrap();
+    c.push(
+        refused(
+            "--json naming the volume",
+            &[
+                "render", &mine, "--size", "32x32", "--out", "out.png", "--json", &mine,
+            ],
+            "is an input",
+        )
+        .checked(untouched(dir.join("mine.nhdr"), mine_header.clone())),
+    );
+    c.push(
+        refused(
+            "--json naming the volume's detached data file",
+            &[
+                "render",
+                &mine,
+                "--size",
+                "32x32",
+                "--out",
+                "out.png",
+                "--json",
+                "heart_32x32x12_float32_le.raw",
+            ],
+            "this command read",
+        )
+        .checked(untouched(dir.join("heart_32x32x12_float32_le.raw"), raw)),
+    );
+    let _ = std::os::unix::fs::symlink("mine.nhdr", dir.join("alias.json"));
+    c.push(
+        refused(
+            "--json naming the volume through a symbolic link",
+            &[
+                "render",
+                &mine,
+                "--size",
+                "32x32",
+                "--out",
+                "out.png",
+                "--json",
+                "alias.json",
+            ],
+            "is an input",
+        )
+        .checked(untouched(dir.join("mine.nhdr"), mine_header)),
+    );
+    let long_name: &'static str = Box::leak(format!("{}.png", "n".repeat(251)).into_boxed_str());
+    c.push(
+        renders(
+            "an output name of 255 bytes",
+            &["render", HEART, "--size", "32x32", "--out", long_name],
+        )
+        .checked(move |dir| {
+            std::fs::remove_file(dir.join(long_name))
+                .map(|()| "written".to_string())
+                .map_err(|e| format!("not written: {e}"))
+        }),
+    );
+    c.push(
+        refused(
+            "ulimit -f 16 (a write past the file-size limit)",
+            &["render", HEART, "--out", "out.png"],
+            "File too large",
+        )
+        .ulimit("-f 16"),
+    );
+    c
+}
+
+/// A VTI whose one LZ4 block (16 bytes) declares 1 728 000 000 bytes, as its 1200³ u8 extent
+/// needs.
+fn lz4_vti_bomb() -> Vec<u8> {
+    use base64::Engine as _;
+    let need = 1200u32 * 1200 * 1200;
+    let block = [
+        0x1fu8, 0, 1, 0, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0, 0, 0, 0,
+    ];
+    let mut head = Vec::new();
+    for v in [1u32, need, need, block.len() as u32] {
+        head.extend(v.to_le_bytes());
+    }
+    let b64 = base64::engine::general_purpose::STANDARD;
+    format!(
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"0.1\" byte_order=\"LittleEndian\" header_type=\"UInt32\" compressor=\"vtkLZ4DataCompressor\">\n<ImageData WholeExtent=\"0 1199 0 1199 0 1199\" Spacing=\"1 1 1\">\n<Piece Extent=\"0 1199 0 1199 0 1199\"><PointData Scalars=\"s\"><DataArray type=\"UInt8\" Name=\"s\" format=\"binary\">{}{}</DataArray></PointData></Piece></ImageData></VTKFile>\n",
+        b64.encode(&head),
+        b64.encode(block)
     )
     .into_bytes()
 }

@@ -150,3 +150,36 @@ put("render", "thin", bytes([5, 1, 2, 250, 127, 60, 96, 0, 64, 0, 200, 0, 180, 4
                            + [0, 0, 0, 0, 255, 255, 255, 255] + [255] * 10))
 put("render", "sinc", bytes([2, 2, 2, 127, 127, 127, 0, 0, 0, 0, 0, 0, 160, 60, 60, 255, 2, 3, 0, 2]
                            + [0, 0, 0, 0, 255, 255, 255, 255] + [255, 0] * 4))
+
+# compressors: pick byte (0 gzip, 1 zlib, 2 LZ4 block, 3 xz, 4 gzip stream, 5 zlib stream), the
+# declared size (u32 LE), then the compressed bytes.
+import lzma
+
+PLAIN = bytes((i * 37) % 251 for i in range(300)) + bytes(200)
+def declared(pick, size, body):
+    return bytes([pick]) + struct.pack("<I", size) + body
+
+put("compressors", "gzip", declared(0, len(PLAIN), gzip.compress(PLAIN)))
+put("compressors", "zlib", declared(1, len(PLAIN), zlib.compress(PLAIN)))
+# An LZ4 block: 15 literals, then a match of offset 1 repeating the last byte 100 times.
+LZ4 = bytes([0xF0 | 0x0F, 0]) + bytes(range(15)) + bytes([1, 0, 81]) + bytes([0x00])
+put("compressors", "lz4", declared(2, 15 + 100 + 0, LZ4))
+put("compressors", "xz", declared(3, len(PLAIN), lzma.compress(PLAIN, format=lzma.FORMAT_XZ, check=lzma.CHECK_CRC64)))
+put("compressors", "gzip-stream", declared(4, len(PLAIN), gzip.compress(PLAIN) + gzip.compress(b"")))
+put("compressors", "zlib-stream-short", declared(5, len(PLAIN) + 5, zlib.compress(PLAIN)))
+
+# transfer_function: entries - 2 (u8), lo and hi (f32 LE), 4 bytes per entry, then probe values.
+def tf(n, lo, hi, entries, probes):
+    return bytes([n - 2]) + struct.pack("<ff", lo, hi) + bytes(entries) + struct.pack(f"<{len(probes)}f", *probes)
+
+RAMP = [c for i in range(4) for c in (i * 85, i * 85, i * 85, i * 85)]
+put("transfer_function", "ramp", tf(4, 0.0, 1000.0, RAMP, [-1.0, 0.0, 10.0, 500.0, 999.0, 1e30]))
+put("transfer_function", "wide", tf(4, -3.4e38, 3.4e38, RAMP, [-3.4e38, 0.0, 1e38, 3.4e38]))
+put("transfer_function", "tiny", tf(4, 0.0, 1e-45, RAMP, [0.0, 1e-45, 1.0, -1.0]))
+put("transfer_function", "bump", tf(4, 100.0, 200.0, [0, 0, 0, 0, 255, 0, 0, 255, 0, 0, 0, 0, 0, 0, 0, 0], [100.0, 150.0, 199.0]))
+
+# stream_range: type (0 u8 … 7 f64, +8 big-endian), dims - 1 (three bytes, mod 8), offset, file.
+put("stream_range", "u8", bytes([0, 3, 2, 1, 0]) + bytes((7 * i) % 256 for i in range(4 * 3 * 2)))
+put("stream_range", "i16-offset", bytes([3, 1, 1, 1, 4]) + bytes(4) + I16[:16])
+put("stream_range", "f32-be-nan", bytes([6 + 8, 1, 0, 1, 0]) + struct.pack(">4f", 1.5, float("nan"), -2.0, float("inf")))
+put("stream_range", "f64-short", bytes([7, 7, 7, 7, 0]) + bytes(64))
