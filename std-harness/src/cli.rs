@@ -50,6 +50,7 @@ where
     T: Into<OsString> + Clone,
 {
     crate::io::outputs::ignore_file_size_signal();
+    crate::io::forget_inputs();
     let cli = match Cli::try_parse_from(args) {
         Ok(cli) => cli,
         Err(e) if !e.use_stderr() => {

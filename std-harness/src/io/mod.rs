@@ -42,20 +42,30 @@ pub fn regular_file_len(path: &Path) -> Result<u64, CliError> {
     Ok(meta.len())
 }
 
-/// Every file this process has read or been told it will read, as (device, inode): no output
-/// may replace one ([`outputs`] checks before writing, and again before renaming into place).
-static INPUTS: std::sync::Mutex<Vec<(u64, u64)>> = std::sync::Mutex::new(Vec::new());
+thread_local! {
+    /// Every file the command running on this thread has read or been told it will read, as
+    /// (device, inode): no output may replace one ([`outputs`] checks before writing, and again
+    /// before renaming into place). Per thread, and cleared as each command starts
+    /// ([`forget_inputs`]): a program that runs many commands (the tests, the Python package)
+    /// must not refuse an output because an earlier command read a file whose inode it reuses.
+    static INPUTS: std::cell::RefCell<Vec<(u64, u64)>> = const { std::cell::RefCell::new(Vec::new()) };
+}
+
+/// Starts a command afresh: no file counts as its input yet.
+pub fn forget_inputs() {
+    INPUTS.with(|i| i.borrow_mut().clear());
+}
 
 /// Records the file `meta` describes as an input.
 fn note_input(meta: &std::fs::Metadata) {
     use std::os::unix::fs::MetadataExt;
     let id = (meta.dev(), meta.ino());
-    let mut inputs = INPUTS
-        .lock()
-        .unwrap_or_else(std::sync::PoisonError::into_inner);
-    if !inputs.contains(&id) {
-        inputs.push(id);
-    }
+    INPUTS.with(|i| {
+        let mut inputs = i.borrow_mut();
+        if !inputs.contains(&id) {
+            inputs.push(id);
+        }
+    });
 }
 
 /// Records `path` as an input of this command, if it names an existing file (symbolic links
@@ -72,12 +82,7 @@ pub fn note_input_path(path: &std::path::Path) {
 /// Whether `path` names (symbolic links followed, hard links alike) a file recorded as an input.
 pub fn is_input(path: &std::path::Path) -> bool {
     use std::os::unix::fs::MetadataExt;
-    std::fs::metadata(path).is_ok_and(|m| {
-        INPUTS
-            .lock()
-            .unwrap_or_else(std::sync::PoisonError::into_inner)
-            .contains(&(m.dev(), m.ino()))
-    })
+    std::fs::metadata(path).is_ok_and(|m| INPUTS.with(|i| i.borrow().contains(&(m.dev(), m.ino()))))
 }
 
 /// The one-line message for an allocation of `bytes` bytes for `what` that memory refused.
