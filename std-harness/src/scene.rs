@@ -26,8 +26,8 @@ pub fn volume(n: usize) -> Result<Volume, CliError> {
     } else {
         sample(SIDE)?.0.into_iter().fold(0.0f32, f32::max)
     };
-    let data = data.into_iter().map(|v| v / peak).collect();
-    Ok(Volume::new([n; 3], [spacing; 3], Samples::F32(data)))
+    let data: Vec<f32> = data.into_iter().map(|v| v / peak).collect();
+    Ok(Volume::new([n; 3], [spacing; 3], Samples::F32(data.into())))
 }
 
 /// The unnormalised field on an `n`³ grid, and the grid's spacing (world units).

@@ -10,17 +10,82 @@ use std::path::Path;
 /// Sample storage, by type.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Samples {
-    U8(Vec<u8>),
-    I8(Vec<i8>),
-    U16(Vec<u16>),
-    I16(Vec<i16>),
-    U32(Vec<u32>),
-    I32(Vec<i32>),
-    F32(Vec<f32>),
-    F64(Vec<f64>),
+    U8(Data<u8>),
+    I8(Data<i8>),
+    U16(Data<u16>),
+    I16(Data<i16>),
+    U32(Data<u32>),
+    I32(Data<i32>),
+    F32(Data<f32>),
+    F64(Data<f64>),
     /// A coarser level of detail averaged by extinction: values with the straight colour of
     /// their block (the core's `lod::Coloured`); never read from a file.
-    Coloured(Vec<Coloured>),
+    Coloured(Data<Coloured>),
+}
+
+/// The samples of one type, x-fastest: owned (read from a file, computed), or shared with an
+/// owner outside the harness that keeps them alive and unchanged while the volume lives (a numpy
+/// array handed over by the Python package without a copy). Read as a slice either way.
+pub struct Data<T: 'static>(Store<T>);
+
+enum Store<T: 'static> {
+    Owned(Vec<T>),
+    Shared(std::sync::Arc<dyn AsRef<[T]> + Send + Sync>),
+}
+
+impl<T> Data<T> {
+    /// Samples another owner holds: `owner.as_ref()` must give the same slice for as long as
+    /// this (and every clone of it) lives.
+    pub fn shared(owner: std::sync::Arc<dyn AsRef<[T]> + Send + Sync>) -> Self {
+        Data(Store::Shared(owner))
+    }
+
+    /// Whether the samples are shared with an owner outside (not copied in).
+    pub fn is_shared(&self) -> bool {
+        matches!(self.0, Store::Shared(_))
+    }
+}
+
+impl<T> std::ops::Deref for Data<T> {
+    type Target = [T];
+    fn deref(&self) -> &[T] {
+        match &self.0 {
+            Store::Owned(v) => v,
+            Store::Shared(owner) => (**owner).as_ref(),
+        }
+    }
+}
+
+impl<T> From<Vec<T>> for Data<T> {
+    fn from(v: Vec<T>) -> Self {
+        Data(Store::Owned(v))
+    }
+}
+
+impl<T: Clone> Clone for Data<T> {
+    fn clone(&self) -> Self {
+        match &self.0 {
+            Store::Owned(v) => Data(Store::Owned(v.clone())),
+            Store::Shared(owner) => Data(Store::Shared(owner.clone())),
+        }
+    }
+}
+
+impl<T: PartialEq> PartialEq for Data<T> {
+    fn eq(&self, other: &Self) -> bool {
+        **self == **other
+    }
+}
+
+impl<T> std::fmt::Debug for Data<T> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} {} samples",
+            self.len(),
+            if self.is_shared() { "shared" } else { "owned" }
+        )
+    }
 }
 
 /// A sample type name as written on the command line and in NRRD headers.
@@ -221,10 +286,10 @@ impl Volume {
 }
 
 /// `n` values from `values` in a vector reserved fallibly (see [`crate::io::try_vec`]).
-fn collect_n<T>(n: usize, values: impl Iterator<Item = T>) -> Result<Vec<T>, String> {
+fn collect_n<T>(n: usize, values: impl Iterator<Item = T>) -> Result<Data<T>, String> {
     let mut v = crate::io::try_vec(n, "the samples")?;
     v.extend(values);
-    Ok(v)
+    Ok(v.into())
 }
 
 /// Decodes `bytes` (exactly `count × size` long) as samples of `ty`; memory refusing the samples
@@ -291,7 +356,7 @@ pub fn decode_ascii(text: &[u8], ty: SampleType, count: usize) -> Result<Samples
         SampleType::U32 => Samples::U32(collect_n(n, it.map(|&v| v as u32))?),
         SampleType::I32 => Samples::I32(collect_n(n, it.map(|&v| v as i32))?),
         SampleType::F32 => Samples::F32(collect_n(n, it.map(|&v| v as f32))?),
-        SampleType::F64 => Samples::F64(values),
+        SampleType::F64 => Samples::F64(values.into()),
     })
 }
 

@@ -216,7 +216,7 @@ pub fn coarsen_volume(
         dims,
         spacing: v.spacing.map(|s| s * scale),
         directions: v.directions,
-        samples: Samples::Coloured(out),
+        samples: Samples::Coloured(out.into()),
     })
 }
 

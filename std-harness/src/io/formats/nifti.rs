@@ -429,7 +429,7 @@ pub fn load(path: &Path) -> Result<Volume, CliError> {
         let mut scaled =
             crate::io::try_vec(v.len(), "the scaled samples").map_err(|e| at(&source, e))?;
         scaled.extend((0..v.len()).map(|n| v.value(n) * slope + inter));
-        samples = Samples::F32(scaled);
+        samples = Samples::F32(scaled.into());
     }
     Ok(Volume {
         dims: h.dims,
