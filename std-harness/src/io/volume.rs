@@ -400,25 +400,40 @@ mod tests {
     fn range_over_every_sample_type() {
         let vol = |samples: Samples, n: usize| Volume::new([n, 1, 1], [1.0; 3], samples);
         let cases = [
-            (vol(Samples::U8(vec![7, 3, 255, 9]), 4), (3.0, 255.0)),
-            (vol(Samples::I8(vec![-128, 5, 127]), 3), (-128.0, 127.0)),
-            (vol(Samples::U16(vec![500, 65535, 2]), 3), (2.0, 65535.0)),
-            (vol(Samples::I16(vec![-300, 12, 40]), 3), (-300.0, 40.0)),
+            (vol(Samples::U8(vec![7, 3, 255, 9].into()), 4), (3.0, 255.0)),
             (
-                vol(Samples::U32(vec![1 << 30, 6]), 2),
+                vol(Samples::I8(vec![-128, 5, 127].into()), 3),
+                (-128.0, 127.0),
+            ),
+            (
+                vol(Samples::U16(vec![500, 65535, 2].into()), 3),
+                (2.0, 65535.0),
+            ),
+            (
+                vol(Samples::I16(vec![-300, 12, 40].into()), 3),
+                (-300.0, 40.0),
+            ),
+            (
+                vol(Samples::U32(vec![1 << 30, 6].into()), 2),
                 (6.0, (1u32 << 30) as f32),
             ),
-            (vol(Samples::I32(vec![-9, 4, -2]), 3), (-9.0, 4.0)),
+            (vol(Samples::I32(vec![-9, 4, -2].into()), 3), (-9.0, 4.0)),
             (
-                vol(Samples::F32(vec![f32::NAN, 0.5, f32::INFINITY, -2.5]), 4),
+                vol(
+                    Samples::F32(vec![f32::NAN, 0.5, f32::INFINITY, -2.5].into()),
+                    4,
+                ),
                 (-2.5, 0.5),
             ),
             (
-                vol(Samples::F64(vec![1e300, 3.0, f64::NEG_INFINITY, 1.5]), 4),
+                vol(
+                    Samples::F64(vec![1e300, 3.0, f64::NEG_INFINITY, 1.5].into()),
+                    4,
+                ),
                 (1.5, 3.0),
             ),
             (
-                vol(Samples::F32(vec![f32::NAN, f32::INFINITY]), 2),
+                vol(Samples::F32(vec![f32::NAN, f32::INFINITY].into()), 2),
                 (f32::INFINITY, f32::NEG_INFINITY),
             ),
         ];

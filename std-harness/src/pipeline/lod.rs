@@ -228,7 +228,7 @@ mod tests {
     fn a_coarsened_volume_is_the_mean_of_its_blocks() {
         let dims = [4usize, 3, 2];
         let data: Vec<f32> = (0..24).map(|i| i as f32).collect();
-        let v = Volume::new(dims, [1.0, 2.0, 3.0], Samples::F32(data.clone()));
+        let v = Volume::new(dims, [1.0, 2.0, 3.0], Samples::F32(data.clone().into()));
         let c = coarsen_volume(&v, 1, &Linear).unwrap();
         assert_eq!(c.dims, [2, 2, 1]);
         assert_eq!(c.spacing, [2.0, 4.0, 6.0]);
@@ -248,7 +248,7 @@ mod tests {
         assert_eq!(s[3], want / 8.0);
         // Level 2 of the volume is level 1 of its level 1.
         let data: Vec<f32> = (0..8 * 6 * 4).map(|i| ((i * 37) % 11) as f32).collect();
-        let big = Volume::new([8, 6, 4], [1.0; 3], Samples::F32(data));
+        let big = Volume::new([8, 6, 4], [1.0; 3], Samples::F32(data.into()));
         let two = coarsen_volume(&big, 2, &Linear).unwrap();
         let one = coarsen_volume(&big, 1, &Linear).unwrap();
         assert_eq!(coarsen_volume(&one, 1, &Linear).unwrap(), two);
@@ -261,7 +261,7 @@ mod tests {
             Ok(())
         })
         .unwrap();
-        assert_eq!(one.samples, Samples::Coloured(sequential));
+        assert_eq!(one.samples, Samples::Coloured(sequential.into()));
         let c0 = coarsen_volume(&v, 0, &Linear).unwrap();
         assert_eq!(c0, v);
         assert!(coarsen_volume(&v, MAX_LEVEL + 1, &Linear).is_err());
