@@ -258,6 +258,13 @@ impl From<OrderArg> for Order {
 /// Every flag of `render` (and of `verify`, which takes them all).
 #[derive(Args, Debug, Clone)]
 pub struct RenderArgs {
+    /// A volume already in memory, rendered instead of VOLUME or the built-in scene (set by a
+    /// program, such as the Python package; not a flag).
+    #[arg(skip)]
+    pub memory: Option<crate::io::stream::InMemory>,
+    /// What `--stream -` reads instead of standard input (set by a program; not a flag).
+    #[arg(skip)]
+    pub stdin: Option<crate::io::stream::Pipe>,
     /// Volume: .nrrd/.nhdr, .vti, .vtk, .mhd/.mha, .nii/.nii.gz, a NIfTI or Analyze pair
     /// (.hdr + .img, either may be .gz), or headerless raw with --dims and --type. Omitted: the
     /// built-in electron-density scene.
@@ -362,7 +369,8 @@ pub struct RenderArgs {
     #[arg(long, value_name = "N", default_value_t = 128, value_parser = parse_scene_size)]
     pub field_size: usize,
     /// Threads (bands of image rows) for the core's render; 0 = every core. The image is
-    /// byte-identical for any number. A streamed volume renders on one thread.
+    /// byte-identical for any number. A streamed volume renders on one thread; more than 256
+    /// render on 256.
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
     /// Target PSNR, dB, against --quality-reference: choose the cheapest configuration expected
@@ -494,14 +502,20 @@ impl RenderArgs {
         }
     }
 
-    /// `--threads`, with 0 resolved to the number of cores.
+    /// `--threads`, with 0 resolved to the number of cores, and at most [`MAX_THREADS`].
     pub fn thread_count(&self) -> usize {
         match self.threads {
             0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
             n => n,
         }
+        .min(MAX_THREADS)
     }
 }
+
+/// The most threads a render starts (`--threads` above it renders on this many): every image is
+/// the same bits for any count, a thread more than the cores never helps, and each costs a
+/// stack, so `--threads 2000` must not exhaust the address space before the first voxel.
+pub const MAX_THREADS: usize = 256;
 
 /// `render`'s flags from a list of arguments (as on the command line after `render`), for
 /// programs that drive the harness (benches, charts).

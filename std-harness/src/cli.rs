@@ -3,6 +3,7 @@
 
 use crate::args::{RenderArgs, SplatArgs};
 use crate::commands;
+use crate::io::stream::InMemory;
 use clap::{Parser, Subcommand};
 use std::ffi::OsString;
 
@@ -69,16 +70,7 @@ where
             return 2;
         }
     };
-    let result = match cli.command {
-        Command::Render(a) => commands::render::run(&a),
-        Command::Splat(a) => commands::splat::run(&a),
-        Command::Verify(a) => commands::verify::run(&a),
-        Command::Tables(a) => commands::tables::run(&a),
-        Command::Compare(a) => commands::compare::run(&a),
-        Command::Chart(a) => commands::chart::run(&a),
-        Command::Bench(a) => commands::bench::run(&a),
-    };
-    match result {
+    match dispatch(cli.command) {
         Ok(()) => 0,
         Err(e) => {
             use std::io::Write as _;
@@ -86,4 +78,48 @@ where
             e.code
         }
     }
+}
+
+fn dispatch(command: Command) -> Result<(), crate::CliError> {
+    match command {
+        Command::Render(a) => commands::render::run(&a),
+        Command::Splat(a) => commands::splat::run(&a),
+        Command::Verify(a) => commands::verify::run(&a),
+        Command::Tables(a) => commands::tables::run(&a),
+        Command::Compare(a) => commands::compare::run(&a),
+        Command::Chart(a) => commands::chart::run(&a),
+        Command::Bench(a) => commands::bench::run(&a),
+    }
+}
+
+/// Runs the command line `args` (program name first) as [`run`] does, for a program that calls
+/// the harness (the Python package): `memory`, a volume it holds, is what `render`, `verify` or
+/// `bench` renders in place of VOLUME, and the error comes back instead of being printed
+/// (`--help` is an error here too). The process's signal dispositions are left as they are.
+pub fn run_with<I, T>(args: I, memory: Option<InMemory>) -> Result<(), crate::CliError>
+where
+    I: IntoIterator<Item = T>,
+    T: Into<OsString> + Clone,
+{
+    crate::io::forget_inputs();
+    let cli = Cli::try_parse_from(args).map_err(|e| {
+        let text = e.render().to_string();
+        let line = text.lines().next().unwrap_or("bad arguments").to_string();
+        crate::CliError::input(line.strip_prefix("error: ").unwrap_or(&line).to_string())
+    })?;
+    let mut command = cli.command;
+    if let Some(m) = memory {
+        let render = match &mut command {
+            Command::Render(a) => a,
+            Command::Verify(a) => &mut a.render,
+            Command::Bench(a) => &mut a.render,
+            _ => {
+                return Err(crate::CliError::input(
+                    "only render, verify and bench take a volume in memory",
+                ))
+            }
+        };
+        render.memory = Some(m);
+    }
+    dispatch(command)
 }

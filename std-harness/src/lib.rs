@@ -35,9 +35,15 @@
 macro_rules! say {
     ($($arg:tt)*) => {{
         use std::io::Write as _;
-        let _ = writeln!(std::io::stdout().lock(), $($arg)*);
+        if !$crate::QUIET.load(std::sync::atomic::Ordering::Relaxed) {
+            let _ = writeln!(std::io::stdout().lock(), $($arg)*);
+        }
     }};
 }
+
+/// When set, [`say!`] prints nothing: a program calling the commands (the Python package) takes
+/// their results from the values and files they return, not from standard output.
+pub static QUIET: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
 
 /// Prints a warning to standard error: `footprint: warning: …`, one line. The command goes on.
 #[macro_export]
@@ -61,7 +67,7 @@ pub mod scene;
 pub mod tf;
 pub mod threads;
 
-pub use cli::run;
+pub use cli::{run, run_with};
 
 use std::fmt;
 

@@ -370,6 +370,52 @@ pub fn file_range(layout: &Layout) -> Result<(f32, f32), CliError> {
 /// The most bytes [`file_range`] reads at a time (4 MiB).
 const RANGE_CHUNK_BYTES: usize = 4 << 20;
 
+/// What `--stream -` reads instead of standard input, for a program that feeds the renderer its
+/// own bytes (the Python package's iterables of slices): z-slices in file order, exactly as a
+/// pipe would deliver them. Taken once (a stream cannot be read twice).
+#[derive(Clone)]
+pub struct Pipe(std::sync::Arc<std::sync::Mutex<Option<Box<dyn Read + Send>>>>);
+
+impl Pipe {
+    /// A pipe reading from `reader`.
+    pub fn new(reader: impl Read + Send + 'static) -> Self {
+        Pipe(std::sync::Arc::new(std::sync::Mutex::new(Some(Box::new(
+            reader,
+        )))))
+    }
+
+    /// The reader, the first time; `None` once taken.
+    pub fn take(&self) -> Option<Box<dyn Read + Send>> {
+        self.0
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .take()
+    }
+}
+
+impl std::fmt::Debug for Pipe {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Pipe")
+    }
+}
+
+/// A volume a program already holds in memory (the Python package's arrays, shared without a
+/// copy: [`crate::io::volume::Data::shared`]), rendered instead of a file, with the name messages
+/// and summaries give it.
+#[derive(Clone)]
+pub struct InMemory {
+    /// The volume.
+    pub volume: std::sync::Arc<Volume>,
+    /// Its name in messages and the JSON's `volume`.
+    pub name: String,
+}
+
+impl std::fmt::Debug for InMemory {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "InMemory({}, {:?})", self.name, self.volume.dims)
+    }
+}
+
 /// Whether `path` means standard input.
 pub fn is_stdin(path: &Path) -> bool {
     path.as_os_str() == "-"

@@ -5,7 +5,8 @@
 
 use super::prepare::Prepared;
 use super::spares::Spares;
-use super::visible::{OnTheFly, SheetSupply, Visible, VisibleLists};
+use super::supply::{OnTheFly, SheetSupply};
+use super::visible::{Visible, VisibleLists};
 use crate::CliError;
 use footprint::composite::RowSpan;
 use footprint::lod::Coloured;

@@ -3,7 +3,7 @@
 
 use crate::args::RenderArgs;
 use crate::io::formats::{self, raw::RawOptions};
-use crate::io::stream::{file_range, is_stdin, Layout};
+use crate::io::stream::{file_range, is_stdin, Layout, Pipe};
 use crate::io::volume::{SampleType, Volume};
 use crate::{io, scene, CliError};
 use glam::{Mat3, Vec3};
@@ -17,11 +17,13 @@ pub enum Voxels {
     Memory(Arc<Volume>),
     /// Streamed from a seekable file.
     File(Layout),
-    /// Streamed from standard input, z-slices in file order.
+    /// Streamed from standard input (or the program's own [`Pipe`]), z-slices in file order.
     Stdin {
         dims: [usize; 3],
         ty: SampleType,
         big_endian: bool,
+        /// What to read instead of standard input (`RenderArgs::stdin`).
+        pipe: Option<Pipe>,
     },
 }
 
@@ -88,6 +90,22 @@ pub(crate) fn load_voxels(args: &RenderArgs) -> Result<Loaded, CliError> {
             "--scene-size samples the built-in scene: give no volume with it",
         ));
     }
+    if let Some(m) = &args.memory {
+        if args.volume.is_some() || args.stream.is_some() {
+            return Err(CliError::input(
+                "a volume in memory renders alone: give no VOLUME or --stream with it",
+            ));
+        }
+        let v = &m.volume;
+        let (dims, grid, range) = (v.dims, v.grid_to_world(), Some(v.range()));
+        return Ok(Loaded {
+            voxels: Voxels::Memory(Arc::clone(v)),
+            name: m.name.clone(),
+            dims,
+            grid,
+            range,
+        });
+    }
     let Some(stream) = &args.stream else {
         let (volume, name) = match &args.volume {
             Some(path) => (
@@ -130,6 +148,7 @@ pub(crate) fn load_voxels(args: &RenderArgs) -> Result<Loaded, CliError> {
             dims: o.dims,
             ty: o.ty,
             big_endian: o.big_endian,
+            pipe: args.stdin.clone(),
         };
         return Ok(Loaded {
             voxels,

@@ -54,6 +54,7 @@ pub mod slabs;
 pub mod spares;
 pub mod subsample;
 pub mod supersample;
+pub mod supply;
 pub mod visible;
 
 pub use describe::describe;

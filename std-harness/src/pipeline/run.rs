@@ -269,14 +269,23 @@ fn run_sheets<P: Precision>(
             dims,
             ty,
             big_endian,
+            pipe,
         } => {
-            let stdin = std::io::stdin().lock();
+            let (reader, name): (Box<dyn std::io::Read>, _) = match pipe {
+                Some(pipe) => (
+                    pipe.take().ok_or_else(|| {
+                        CliError::input("the stream was read already: a stream renders once")
+                    })? as Box<dyn std::io::Read>,
+                    "the stream",
+                ),
+                None => (Box::new(std::io::stdin().lock()), "standard input"),
+            };
             let mut src = PipeSource::new(
-                std::io::BufReader::with_capacity(1 << 20, stdin),
+                std::io::BufReader::with_capacity(1 << 20, reader),
                 *dims,
                 *ty,
                 *big_endian,
-                "standard input",
+                name,
             );
             src.prime()?;
             Some(src)
