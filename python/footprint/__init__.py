@@ -1,0 +1,279 @@
+"""Footprint from Python: Westover's footprint-evaluation splatting, numpy in, numpy out.
+
+Every function mirrors the ``footprint`` command line: its keyword arguments are the command's
+flags (``shading="phong"`` is ``--shading phong``, ``lod=0`` is ``--lod 0``, ``threads=4`` is
+``--threads 4``; underscores become hyphens, ``True`` gives a bare flag, tuples are joined with
+commas), and its errors carry the command's one-line messages.
+
+Conventions (as the command line's):
+
+* A volume is x-fastest in memory: a C-order array is indexed ``volume[z, y, x]`` (its last axis
+  is x), a Fortran-order array ``volume[x, y, z]``; both are read where they lie, without a copy.
+  Other layouts (a strided view) are copied once into C order.
+* ``spacing`` is (x, y, z) in world units per voxel; ``size`` is (width, height) in pixels;
+  ``view`` is VTK's camera, (azimuth, elevation, roll) in degrees.
+* Images are (height, width, 4) float32 premultiplied linear RGBA, top row first;
+  ``dtype=numpy.uint8`` gives 8-bit RGBA as the command line's PNG holds it (linear, alpha kept).
+* Sample types: uint8, int8, uint16, int16, uint32, int32, float32, float64.
+* Errors: ``ValueError`` for bad input, ``MemoryError`` where memory refuses, ``OSError`` for files.
+* Rendering releases the GIL: Python threads render at once.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from typing import Any, Iterable, Optional, Sequence, Tuple
+
+import numpy as np
+
+from . import _footprint
+
+__all__ = [
+    "render",
+    "render_stream",
+    "load",
+    "verify",
+    "bench",
+    "generic_table",
+    "save_table",
+    "time_table",
+    "SAMPLE_TYPES",
+]
+
+#: The sample types a volume may have.
+SAMPLE_TYPES = (
+    np.uint8,
+    np.int8,
+    np.uint16,
+    np.int16,
+    np.uint32,
+    np.int32,
+    np.float32,
+    np.float64,
+)
+
+
+def _flag_value(value: Any) -> str:
+    if isinstance(value, (tuple, list)):
+        return ",".join(_flag_value(v) for v in value)
+    if isinstance(value, float):
+        return repr(value)
+    return str(value)
+
+
+def _flags(**flags: Any) -> list:
+    """The command line's flags for keyword arguments (None and False are left out)."""
+    out = []
+    for key, value in flags.items():
+        if value is None or value is False:
+            continue
+        flag = "--" + key.replace("_", "-")
+        if value is True:
+            out.append(flag)
+        else:
+            out.extend([flag, _flag_value(value)])
+    return out
+
+
+def _size(size: Sequence[int]) -> str:
+    w, h = size
+    return f"{int(w)}x{int(h)}"
+
+
+def _common(size, view, tf, window, flags):
+    return _flags(
+        size=_size(size),
+        view=tuple(view),
+        tf=tf,
+        window=tuple(window) if window is not None else None,
+        **flags,
+    )
+
+
+def _volume_of(volume: Any, spacing):
+    """A numpy volume and its spacing from an array or a pyvista.ImageData."""
+    if hasattr(volume, "dimensions") and hasattr(volume, "point_data"):
+        # pyvista.ImageData (or vtkImageData wrapped by pyvista): its active point scalars, which
+        # VTK stores x-fastest, seen as an (x, y, z) Fortran-order array without a copy.
+        scalars = volume.active_scalars
+        if scalars is None:
+            raise ValueError("the ImageData has no active point scalars to render")
+        dims = tuple(int(d) for d in volume.dimensions)
+        array = np.asarray(scalars)
+        if array.ndim != 1:
+            raise ValueError("the ImageData's active scalars have several components: render one")
+        return array.reshape(dims, order="F"), tuple(float(s) for s in volume.spacing)
+    array = np.asarray(volume)
+    return array, spacing
+
+
+def _image(image: np.ndarray, dtype) -> np.ndarray:
+    if dtype is None or np.dtype(dtype) == np.float32:
+        return image
+    if np.dtype(dtype) == np.uint8:
+        return _footprint.to_rgba8(image)
+    raise ValueError(f"dtype {np.dtype(dtype)}: images are float32 or uint8")
+
+
+def render(
+    volume: Any,
+    spacing: Sequence[float] = (1, 1, 1),
+    size: Sequence[int] = (512, 512),
+    view: Sequence[float] = (0, 0, 0),
+    tf: str = "grey",
+    window: Optional[Sequence[float]] = None,
+    dtype: Any = np.float32,
+    **flags: Any,
+) -> np.ndarray:
+    """Renders a 3-D array (or a ``pyvista.ImageData``) as ``footprint render`` would.
+
+    Returns (height, width, 4) premultiplied linear RGBA, float32 (``dtype=numpy.uint8``: 8-bit).
+    ``window`` (lo, hi) maps values onto the transfer function; None takes the data's range.
+    Any other ``footprint render`` flag is a keyword (``shading="phong"``, ``threads=2``,
+    ``slicing="image"``, ``accum="fixed"``, ``lod=0``, ...).
+    """
+    array, spacing = _volume_of(volume, spacing)
+    args = _common(size, view, tf, window, flags)
+    image = _footprint.render_array(array, tuple(float(s) for s in spacing), args)
+    return _image(image, dtype)
+
+
+def render_stream(
+    sheets: Iterable[Any],
+    dims: Sequence[int],
+    spacing: Sequence[float] = (1, 1, 1),
+    dtype: Any = np.float32,
+    size: Sequence[int] = (512, 512),
+    view: Sequence[float] = (0, 0, 0),
+    tf: str = "grey",
+    window: Optional[Sequence[float]] = None,
+    image_dtype: Any = np.float32,
+    **flags: Any,
+) -> np.ndarray:
+    """Renders a volume delivered as z-slices, one 2-D (y, x) array per slice in file order, from
+    any iterable (a generator), as ``footprint render --stream -`` renders a pipe: only the
+    slices the renderer needs are held (three), so ``window`` must be given (a stream cannot be
+    read twice to find its range) and the view must look within 45 degrees of the z axis.
+    ``dims`` is (x, y, z), ``dtype`` the slices' sample type (each slice is converted to it).
+    """
+    if window is None:
+        raise ValueError("render_stream needs window=(lo, hi): a stream cannot be read twice")
+    nx, ny, nz = (int(d) for d in dims)
+    dtype = np.dtype(dtype)
+    if dtype not in [np.dtype(t) for t in SAMPLE_TYPES]:
+        raise ValueError(f"dtype {dtype} is not a supported sample type")
+
+    def slices():
+        count = 0
+        for sheet in sheets:
+            a = np.ascontiguousarray(sheet, dtype=dtype)
+            if a.shape != (ny, nx):
+                raise ValueError(f"slice {count} has shape {a.shape}, expected ({ny}, {nx})")
+            count += 1
+            yield a
+
+    args = _common(size, view, tf, window, flags)
+    image = _footprint.render_stream(
+        slices(), (nx, ny, nz), dtype.name, tuple(float(s) for s in spacing), args
+    )
+    return _image(image, image_dtype)
+
+
+def load(path: "os.PathLike[str] | str", **flags: Any) -> Tuple[np.ndarray, Tuple[float, float, float], dict]:
+    """Loads a volume file of any format ``footprint`` reads (NRRD, VTI, legacy VTK, MetaImage,
+    NIfTI; raw with ``dims=(x, y, z), type="u16"``). Returns (array, spacing, metadata): the
+    array C-ordered (z, y, x) in the file's sample type, spacing (x, y, z), and a dict with
+    ``dims``, ``type``, ``directions`` (each grid axis's world direction) and ``path``."""
+    return _footprint.load(os.fspath(path), _flags(**flags))
+
+
+def _json_command(command: str, volume: Any, spacing, flags: dict) -> dict:
+    with tempfile.TemporaryDirectory(prefix="footprint-") as d:
+        out = os.path.join(d, "out.json")
+        args = [command] + flags.pop("_args") + ["--json", out]
+        if isinstance(volume, (str, os.PathLike)):
+            _footprint.run_command([args[0], os.fspath(volume)] + args[1:], None, None)
+        else:
+            array, spacing = _volume_of(volume, spacing)
+            _footprint.run_command(args, array, tuple(float(s) for s in spacing))
+        with open(out) as f:
+            return json.load(f)
+
+
+def verify(
+    volume: Any = None,
+    spacing: Sequence[float] = (1, 1, 1),
+    size: Sequence[int] = (512, 512),
+    view: Sequence[float] = (0, 0, 0),
+    tf: str = "grey",
+    window: Optional[Sequence[float]] = None,
+    **flags: Any,
+) -> dict:
+    """``footprint verify``: the core's render against a reference (``reference="continuous"``
+    for the continuous integral). ``volume`` is an array, an ImageData, a file path, or None for
+    the built-in scene. Returns the JSON ``verify --json`` writes, as a dict."""
+    args = _common(size, view, tf, window, flags)
+    if volume is None:
+        return _json_command("verify", "", spacing, {"_args": args}) if False else _builtin("verify", args)
+    return _json_command("verify", volume, spacing, {"_args": args})
+
+
+def bench(
+    volume: Any = None,
+    spacing: Sequence[float] = (1, 1, 1),
+    size: Sequence[int] = (512, 512),
+    view: Sequence[float] = (0, 0, 0),
+    tf: str = "grey",
+    window: Optional[Sequence[float]] = None,
+    **flags: Any,
+) -> dict:
+    """``footprint bench``: ``frames`` frames (``orbit`` degrees apart), timed. Returns the JSON
+    ``bench --json`` writes (``first_ms``, ``median_ms``, ``phases_ms``, ...), as a dict."""
+    args = _common(size, view, tf, window, flags)
+    if volume is None:
+        return _builtin("bench", args)
+    return _json_command("bench", volume, spacing, {"_args": args})
+
+
+def _builtin(command: str, args: list) -> dict:
+    with tempfile.TemporaryDirectory(prefix="footprint-") as d:
+        out = os.path.join(d, "out.json")
+        _footprint.run_command([command] + args + ["--json", out], None, None)
+        with open(out) as f:
+            return json.load(f)
+
+
+def generic_table(kernel: str = "gaussian:spread=1.6,sigmas=2.5", size: int = 129) -> np.ndarray:
+    """The generic footprint table of ``kernel`` (a ``--kernel`` spec) at ``size`` x ``size``
+    nodes over [-1, 1]^2, normalised to unit integral: float32 (size, size)."""
+    return _footprint.generic_table(kernel, int(size))
+
+
+def save_table(
+    path: "os.PathLike[str] | str", kernel: str = "gaussian:spread=1.6,sigmas=2.5", size: int = 129
+) -> None:
+    """Writes the generic table as ``footprint tables`` does, for ``render(..., table=size,
+    table_file=path)``."""
+    _footprint.run_command(
+        ["tables", "--kernel", kernel, "--table", str(int(size)), "--out", os.fspath(path)], None, None
+    )
+
+
+def time_table(
+    volume: Any,
+    size: int,
+    kernel: str = "gaussian:spread=1.6,sigmas=2.5",
+    frames: int = 3,
+    reference: str = "continuous",
+    **flags: Any,
+) -> dict:
+    """One table size measured both ways: ``bench``'s median frame and ``verify``'s figure against
+    ``reference``, for charting time against accuracy. Returns ``{"table", "median_ms",
+    "psnr_db", "bench", "verify"}``."""
+    common = dict(flags, kernel=kernel, table=int(size))
+    b = bench(volume, frames=frames, **common)
+    v = verify(volume, reference=reference, **common)
+    figure = v.get(reference, v).get("psnr_db") if isinstance(v.get(reference), dict) else v.get("psnr_db")
+    return {"table": int(size), "median_ms": b.get("median_ms"), "psnr_db": figure, "bench": b, "verify": v}

@@ -1,0 +1,439 @@
+//! `footprint._footprint`, the extension module the Python package `footprint` wraps: numpy
+//! volumes rendered by the harness's pipeline without a copy, slices streamed from a Python
+//! iterable, files loaded, and the commands (`verify`, `bench`, `tables`) run on arrays.
+//!
+//! **Zero copy.** A C- or Fortran-contiguous array is handed to the harness as shared samples
+//! ([`Data::shared`]): a pointer and a length into the array's own buffer. That is sound because
+//! (1) the array is borrowed read-only through numpy's borrow checker for the whole call (a
+//! `PyReadonlyArray` held on this stack frame, so no Rust code writes it meanwhile), (2) the
+//! array object is kept alive by that borrow, and numpy cannot resize or free a buffer another
+//! reference holds, and (3) the volume holding the pointer is dropped before the call returns
+//! (checked: the call owns the only reference when it ends). Python code in another thread may
+//! still write the array while the GIL is released (as with any C extension that releases it):
+//! the documented rule is not to.
+
+// The one use of `unsafe`: reading a numpy array's buffer as a slice (see the module docs).
+#![deny(unsafe_op_in_unsafe_fn)]
+
+use footprint_harness::args::{parse_args, MethodArg, RenderArgs};
+use footprint_harness::io::stream::{InMemory, Pipe};
+use footprint_harness::io::volume::{check_spacing, Data, Samples, Volume};
+use footprint_harness::pipeline::choose::apply_quality;
+use footprint_harness::pipeline::visible::FrameCache;
+use footprint_harness::pipeline::{prepare, render_frame, render_ref};
+use footprint_harness::CliError;
+use numpy::{
+    Element, PyArray1, PyArray3, PyArrayDyn, PyArrayMethods, PyReadonlyArray3,
+    PyUntypedArrayMethods,
+};
+use pyo3::exceptions::{PyMemoryError, PyOSError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyIterator};
+use std::sync::Arc;
+
+/// The Python exception for a harness error: `MemoryError` where memory refused, `OSError` where
+/// a file could not be read or written, `ValueError` otherwise; the message is the harness's line.
+fn py_err(e: CliError) -> PyErr {
+    let m = e.message;
+    if m.contains("cannot allocate") || m.contains("out of memory") {
+        PyMemoryError::new_err(m)
+    } else if m.contains("cannot read:") || m.contains("cannot write:") {
+        PyOSError::new_err(m)
+    } else {
+        PyValueError::new_err(m)
+    }
+}
+
+/// A numpy array's buffer, read in place (see the module docs for why this is sound).
+struct Borrowed<T> {
+    ptr: *const T,
+    len: usize,
+}
+
+// SAFETY: the buffer is only read, and stays alive and unwritten by Rust while any `Borrowed`
+// exists (module docs); `T` is a plain number type.
+unsafe impl<T: Sync> Send for Borrowed<T> {}
+// SAFETY: as above: shared reads only.
+unsafe impl<T: Sync> Sync for Borrowed<T> {}
+
+impl<T> AsRef<[T]> for Borrowed<T> {
+    fn as_ref(&self) -> &[T] {
+        // SAFETY: `ptr` and `len` come from a contiguous array's `as_slice` on a read-only
+        // borrow that outlives every use of this value (module docs).
+        unsafe { std::slice::from_raw_parts(self.ptr, self.len) }
+    }
+}
+
+/// The harness's sample storage for a slice of `T`.
+trait SampleKind: Element + Copy + Sync + Send + 'static {
+    fn samples(data: Data<Self>) -> Samples;
+}
+
+macro_rules! kinds {
+    ($($t:ty => $v:ident),*) => {$(
+        impl SampleKind for $t {
+            fn samples(data: Data<Self>) -> Samples {
+                Samples::$v(data)
+            }
+        }
+    )*};
+}
+kinds!(u8 => U8, i8 => I8, u16 => U16, i16 => I16, u32 => U32, i32 => I32, f32 => F32, f64 => F64);
+
+/// Calls `f` with a volume over `array`'s samples (x fastest: a C-order array is (z, y, x), a
+/// Fortran-order one (x, y, z)), shared without a copy where the array is contiguous, copied into
+/// C order otherwise; whether it was shared comes with it.
+fn with_typed<T: SampleKind, R>(
+    array: &Bound<'_, PyArrayDyn<T>>,
+    spacing: [f32; 3],
+    f: impl FnOnce(Volume, bool) -> PyResult<R>,
+) -> PyResult<R> {
+    let ro = array.readonly();
+    let shape = ro.shape().to_vec();
+    if shape.len() != 3 {
+        return Err(PyValueError::new_err(format!(
+            "the volume has {} dimensions, expected 3",
+            shape.len()
+        )));
+    }
+    if shape.contains(&0) {
+        return Err(PyValueError::new_err(format!(
+            "the volume {shape:?} is empty"
+        )));
+    }
+    check_spacing(spacing).map_err(PyValueError::new_err)?;
+    let c_order = ro.is_c_contiguous();
+    let dims = if c_order || !ro.is_fortran_contiguous() {
+        [shape[2], shape[1], shape[0]]
+    } else {
+        [shape[0], shape[1], shape[2]]
+    };
+    let (data, shared) = match ro.as_slice() {
+        Ok(slice) => (
+            Data::shared(Arc::new(Borrowed {
+                ptr: slice.as_ptr(),
+                len: slice.len(),
+            })),
+            true,
+        ),
+        // Strided: one copy, in C order (the logical order of the view's iterator).
+        Err(_) => (
+            Data::from(ro.as_array().iter().copied().collect::<Vec<T>>()),
+            false,
+        ),
+    };
+    let volume = Volume::new(dims, spacing, T::samples(data));
+    // `ro` (the read-only borrow) lives until `f` returns, and `f` drops the volume.
+    let out = f(volume, shared);
+    drop(ro);
+    out
+}
+
+/// [`with_typed`] for whichever supported sample type `array` has.
+fn with_volume<R>(
+    array: &Bound<'_, PyAny>,
+    spacing: [f32; 3],
+    f: impl FnOnce(Volume, bool) -> PyResult<R>,
+) -> PyResult<R> {
+    macro_rules! try_type {
+        ($($t:ty),*) => {$(
+            if let Ok(a) = array.cast::<PyArrayDyn<$t>>() {
+                return with_typed(a, spacing, f);
+            }
+        )*};
+    }
+    try_type!(u8, i8, u16, i16, u32, i32, f32, f64);
+    let what = array
+        .getattr("dtype")
+        .map(|d| d.to_string())
+        .unwrap_or_else(|_| array.get_type().to_string());
+    Err(PyValueError::new_err(format!(
+        "a volume of {what} cannot be rendered: give a numpy array of uint8, int8, uint16, int16, \
+         uint32, int32, float32 or float64"
+    )))
+}
+
+fn spacing3(spacing: (f64, f64, f64)) -> [f32; 3] {
+    [spacing.0 as f32, spacing.1 as f32, spacing.2 as f32]
+}
+
+fn parse(flags: &[String]) -> PyResult<RenderArgs> {
+    let refs: Vec<&str> = flags.iter().map(String::as_str).collect();
+    parse_args(&refs).map_err(py_err)
+}
+
+/// A rendered image: premultiplied RGBA, row-major, top row first, and its (width, height).
+type Frame = (Vec<[f32; 4]>, (usize, usize));
+
+/// A loaded volume for Python: the array, its spacing (x, y, z) and its metadata.
+type Loaded<'py> = (Bound<'py, PyAny>, (f32, f32, f32), Bound<'py, PyDict>);
+
+/// The frame `args` describe, as `footprint render` renders it: premultiplied RGBA and its
+/// (width, height).
+fn frame(args: &RenderArgs) -> Result<Frame, CliError> {
+    let (p, args, _) = apply_quality(prepare(args)?, args)?;
+    let image = if args.footprint.method == MethodArg::Reference {
+        render_ref(&p)?
+            .0
+            .iter()
+            .map(|c| c.map(|x| x as f32))
+            .collect()
+    } else {
+        render_frame(&p, &args, args.accum, &mut FrameCache::default())?.image
+    };
+    Ok((image, args.size))
+}
+
+fn to_numpy<'py>(
+    py: Python<'py>,
+    image: Vec<[f32; 4]>,
+    (w, h): (usize, usize),
+) -> PyResult<Bound<'py, PyArray3<f32>>> {
+    let flat: Vec<f32> = image.into_iter().flatten().collect();
+    PyArray1::from_vec(py, flat).reshape([h, w, 4])
+}
+
+/// Renders `volume` (a 3-D numpy array) with `footprint render`'s `flags`, releasing the GIL.
+#[pyfunction]
+fn render_array<'py>(
+    py: Python<'py>,
+    volume: &Bound<'py, PyAny>,
+    spacing: (f64, f64, f64),
+    flags: Vec<String>,
+) -> PyResult<Bound<'py, PyArray3<f32>>> {
+    let mut args = parse(&flags)?;
+    let (image, size) = with_volume(volume, spacing3(spacing), |v, _| {
+        let v = Arc::new(v);
+        args.memory = Some(InMemory {
+            volume: Arc::clone(&v),
+            name: "array".into(),
+        });
+        let out = py.detach(|| frame(&args));
+        args.memory = None;
+        debug_assert_eq!(Arc::strong_count(&v), 1, "the volume outlives the call");
+        drop(v);
+        out.map_err(py_err)
+    })?;
+    to_numpy(py, image, size)
+}
+
+/// Whether an array's samples would be read in place (C- or Fortran-contiguous and of a
+/// supported type), for tests and for users who care.
+#[pyfunction]
+fn shares_memory(volume: &Bound<'_, PyAny>) -> PyResult<bool> {
+    with_volume(volume, [1.0; 3], |_, shared| Ok(shared))
+}
+
+/// Bytes pulled from a Python iterator of contiguous arrays, one z-slice each (the package
+/// checks their shape and type): what `--stream -` reads instead of standard input. The GIL is
+/// taken only to fetch the next slice.
+struct Slices {
+    iter: Py<PyIterator>,
+    buf: Vec<u8>,
+    at: usize,
+}
+
+impl std::io::Read for Slices {
+    fn read(&mut self, out: &mut [u8]) -> std::io::Result<usize> {
+        if self.at == self.buf.len() {
+            let next = Python::attach(|py| -> PyResult<Option<Vec<u8>>> {
+                let mut it = self.iter.bind(py).clone();
+                match it.next() {
+                    None => Ok(None),
+                    Some(item) => {
+                        let bytes = item?.call_method0("tobytes")?;
+                        Ok(Some(bytes.extract::<Vec<u8>>()?))
+                    }
+                }
+            });
+            match next {
+                Ok(Some(b)) => {
+                    self.buf = b;
+                    self.at = 0;
+                }
+                Ok(None) => return Ok(0),
+                Err(e) => return Err(std::io::Error::other(e.to_string())),
+            }
+        }
+        let n = out.len().min(self.buf.len() - self.at);
+        out[..n].copy_from_slice(&self.buf[self.at..self.at + n]);
+        self.at += n;
+        Ok(n)
+    }
+}
+
+/// Renders the z-slices `sheets` yields (contiguous arrays of `dtype`, (y, x) each, file order)
+/// as `footprint render --stream - --dims ...` renders a pipe, releasing the GIL between slices.
+#[pyfunction]
+fn render_stream<'py>(
+    py: Python<'py>,
+    sheets: &Bound<'py, PyAny>,
+    dims: (usize, usize, usize),
+    dtype: &str,
+    spacing: (f64, f64, f64),
+    flags: Vec<String>,
+) -> PyResult<Bound<'py, PyArray3<f32>>> {
+    let ty = match dtype {
+        "uint8" => "u8",
+        "int8" => "i8",
+        "uint16" => "u16",
+        "int16" => "i16",
+        "uint32" => "u32",
+        "int32" => "i32",
+        "float32" => "f32",
+        "float64" => "f64",
+        o => {
+            return Err(PyValueError::new_err(format!(
+                "dtype {o} is not a sample type"
+            )))
+        }
+    };
+    let endian = if cfg!(target_endian = "big") {
+        "big"
+    } else {
+        "little"
+    };
+    let mut all = vec![
+        "--stream".to_string(),
+        "-".into(),
+        "--dims".into(),
+        format!("{},{},{}", dims.0, dims.1, dims.2),
+        "--type".into(),
+        ty.into(),
+        "--endian".into(),
+        endian.into(),
+        "--spacing".into(),
+        format!("{},{},{}", spacing.0, spacing.1, spacing.2),
+    ];
+    all.extend(flags);
+    let mut args = parse(&all)?;
+    args.stdin = Some(Pipe::new(Slices {
+        iter: PyIterator::from_object(sheets)?.unbind(),
+        buf: Vec::new(),
+        at: 0,
+    }));
+    let (image, size) = py.detach(|| frame(&args)).map_err(py_err)?;
+    to_numpy(py, image, size)
+}
+
+/// Loads a volume file: (array (z, y, x) of its sample type, spacing (x, y, z), metadata).
+#[pyfunction]
+fn load<'py>(py: Python<'py>, path: &str, flags: Vec<String>) -> PyResult<Loaded<'py>> {
+    let mut all = vec![path.to_string()];
+    all.extend(flags);
+    let args = parse(&all)?;
+    let raw = footprint_harness::pipeline::load::raw_options(&args).map_err(py_err)?;
+    let volume = py
+        .detach(|| {
+            footprint_harness::io::formats::load_array(
+                std::path::Path::new(path),
+                raw.as_ref(),
+                args.array.as_deref(),
+            )
+        })
+        .map_err(py_err)?;
+    let [nx, ny, nz] = volume.dims;
+    fn arr<'py, T: Element + Copy>(
+        py: Python<'py>,
+        v: &[T],
+        s: [usize; 3],
+    ) -> PyResult<Bound<'py, PyAny>> {
+        Ok(PyArray1::from_slice(py, v).reshape(s)?.into_any())
+    }
+    let s = [nz, ny, nx];
+    let (array, ty) = match &volume.samples {
+        Samples::U8(v) => (arr(py, v, s)?, "uint8"),
+        Samples::I8(v) => (arr(py, v, s)?, "int8"),
+        Samples::U16(v) => (arr(py, v, s)?, "uint16"),
+        Samples::I16(v) => (arr(py, v, s)?, "int16"),
+        Samples::U32(v) => (arr(py, v, s)?, "uint32"),
+        Samples::I32(v) => (arr(py, v, s)?, "int32"),
+        Samples::F32(v) => (arr(py, v, s)?, "float32"),
+        Samples::F64(v) => (arr(py, v, s)?, "float64"),
+        Samples::Coloured(_) => {
+            return Err(PyValueError::new_err("a coloured level is not a file"))
+        }
+    };
+    let meta = PyDict::new(py);
+    meta.set_item("dims", (nx, ny, nz))?;
+    meta.set_item("type", ty)?;
+    meta.set_item("directions", volume.directions.to_vec())?;
+    meta.set_item("path", path)?;
+    let sp = volume.spacing;
+    Ok((array, (sp[0], sp[1], sp[2]), meta))
+}
+
+/// Runs a `footprint` command line (without the program name); `volume`, if given, is the array
+/// `render`, `verify` or `bench` renders in place of VOLUME. Nothing is printed; the GIL is
+/// released.
+#[pyfunction]
+#[pyo3(signature = (args, volume=None, spacing=None))]
+fn run_command(
+    py: Python<'_>,
+    args: Vec<String>,
+    volume: Option<&Bound<'_, PyAny>>,
+    spacing: Option<(f64, f64, f64)>,
+) -> PyResult<()> {
+    let argv: Vec<String> = std::iter::once("footprint".to_string())
+        .chain(args)
+        .collect();
+    let run = |memory: Option<InMemory>| {
+        py.detach(|| footprint_harness::run_with(argv.clone(), memory))
+            .map_err(py_err)
+    };
+    match volume {
+        None => run(None),
+        Some(v) => with_volume(v, spacing3(spacing.unwrap_or((1.0, 1.0, 1.0))), |v, _| {
+            run(Some(InMemory {
+                volume: Arc::new(v),
+                name: "array".into(),
+            }))
+        }),
+    }
+}
+
+/// The generic table of `kernel` (a `--kernel` spec) at `size`² nodes, as an array.
+#[pyfunction]
+fn generic_table<'py>(py: Python<'py>, kernel: &str, size: usize) -> PyResult<Bound<'py, PyAny>> {
+    let k = footprint::Kernel::parse(kernel)
+        .map_err(|e| PyValueError::new_err(format!("--kernel '{kernel}': {e}")))?;
+    let values: Vec<f32> = footprint_harness::with_table_size!(size, N => {
+        footprint::GenericTable::<N>::build(k).as_slice().to_vec()
+    })
+    .map_err(py_err)?;
+    Ok(PyArray1::from_vec(py, values)
+        .reshape([size, size])?
+        .into_any())
+}
+
+/// Premultiplied float RGBA as 8-bit RGBA (each channel clamped to [0, 1] and rounded), as the
+/// command line's PNG holds it.
+#[pyfunction]
+fn to_rgba8<'py>(
+    py: Python<'py>,
+    image: PyReadonlyArray3<'py, f32>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let shape = image.shape().to_vec();
+    let bytes: Vec<u8> = image
+        .as_array()
+        .iter()
+        .map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8)
+        .collect();
+    Ok(PyArray1::from_vec(py, bytes)
+        .reshape([shape[0], shape[1], shape[2]])?
+        .into_any())
+}
+
+#[pymodule]
+fn _footprint(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // Results come back as values and files: the commands print nothing to stdout here.
+    footprint_harness::QUIET.store(true, std::sync::atomic::Ordering::Relaxed);
+    m.add_function(wrap_pyfunction!(render_array, m)?)?;
+    m.add_function(wrap_pyfunction!(render_stream, m)?)?;
+    m.add_function(wrap_pyfunction!(shares_memory, m)?)?;
+    m.add_function(wrap_pyfunction!(load, m)?)?;
+    m.add_function(wrap_pyfunction!(run_command, m)?)?;
+    m.add_function(wrap_pyfunction!(generic_table, m)?)?;
+    m.add_function(wrap_pyfunction!(to_rgba8, m)?)?;
+    Ok(())
+}
