@@ -216,7 +216,7 @@ def verify(
     the built-in scene. Returns the JSON ``verify --json`` writes, as a dict."""
     args = _common(size, view, tf, window, flags)
     if volume is None:
-        return _json_command("verify", "", spacing, {"_args": args}) if False else _builtin("verify", args)
+        return _builtin("verify", args)
     return _json_command("verify", volume, spacing, {"_args": args})
 
 
@@ -257,23 +257,25 @@ def save_table(
     """Writes the generic table as ``footprint tables`` does, for ``render(..., table=size,
     table_file=path)``."""
     _footprint.run_command(
-        ["tables", "--kernel", kernel, "--table", str(int(size)), "--out", os.fspath(path)], None, None
+        ["tables", "--kernel", kernel, "--size", str(int(size)), "--out", os.fspath(path)], None, None
     )
 
 
 def time_table(
     volume: Any,
-    size: int,
+    table: int,
     kernel: str = "gaussian:spread=1.6,sigmas=2.5",
     frames: int = 3,
     reference: str = "continuous",
     **flags: Any,
 ) -> dict:
-    """One table size measured both ways: ``bench``'s median frame and ``verify``'s figure against
-    ``reference``, for charting time against accuracy. Returns ``{"table", "median_ms",
+    """One table size measured both ways, for charting time against accuracy: ``bench``'s
+    median frame (``frames`` frames) and ``verify``'s PSNR against ``reference`` (``"sheets"``,
+    the f64 sheet reference, or ``"continuous"``, the continuous integral). Other keywords are
+    render flags (``size``, ``view``, ``spacing``, ...). Returns ``{"table", "median_ms",
     "psnr_db", "bench", "verify"}``."""
-    common = dict(flags, kernel=kernel, table=int(size))
+    common = dict(flags, kernel=kernel, table=int(table))
     b = bench(volume, frames=frames, **common)
     v = verify(volume, reference=reference, **common)
-    figure = v.get(reference, v).get("psnr_db") if isinstance(v.get(reference), dict) else v.get("psnr_db")
-    return {"table": int(size), "median_ms": b.get("median_ms"), "psnr_db": figure, "bench": b, "verify": v}
+    figure = v["continuous"]["psnr_db"] if reference == "continuous" else v["overall"]["psnr_db"]
+    return {"table": int(table), "median_ms": b["median_ms"], "psnr_db": figure, "bench": b, "verify": v}

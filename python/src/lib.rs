@@ -203,6 +203,14 @@ fn render_array<'py>(
 ) -> PyResult<Bound<'py, PyArray3<f32>>> {
     let mut args = parse(&flags)?;
     let (image, size) = with_volume(volume, spacing3(spacing), |v, _| {
+        if args.window.is_none() {
+            // A constant volume (np.zeros) has no range to map: it renders as the transfer
+            // function's low end, where the command line asks for --window.
+            let (lo, hi) = v.range();
+            if lo == hi {
+                args.window = Some([lo, lo + lo.abs().max(1.0)]);
+            }
+        }
         let v = Arc::new(v);
         args.memory = Some(InMemory {
             volume: Arc::clone(&v),

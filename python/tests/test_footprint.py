@@ -1,0 +1,260 @@
+"""The Python package against the command line and its own promises: byte-identical renders, no
+copy of the input, streams equal to arrays, the right exceptions, the GIL released.
+
+The command line is `FOOTPRINT_BIN` (CI sets it to the release build), else the workspace's
+target/release/footprint; tests that need it fail without it rather than pass silently.
+"""
+
+import os
+import pathlib
+import subprocess
+import sys
+import textwrap
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import footprint
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+HEART = ROOT / "tests" / "data" / "heart_32x32x12_float32_le.nhdr"
+
+
+def cli():
+    path = os.environ.get("FOOTPRINT_BIN") or str(ROOT / "target" / "release" / "footprint")
+    assert os.path.exists(path), f"the footprint binary is not at {path}: build it or set FOOTPRINT_BIN"
+    return path
+
+
+def blob(shape=(24, 20, 28), dtype=np.uint16):
+    """A smooth asymmetric blob, C order (z, y, x)."""
+    z, y, x = np.mgrid[0 : shape[0], 0 : shape[1], 0 : shape[2]].astype(np.float64)
+    v = 3000 * np.exp(-((x - 11) ** 2 / 40 + (y - 9) ** 2 / 25 + (z - 13) ** 2 / 60))
+    v += 800 * (x > 20)
+    return v.astype(dtype)
+
+
+def read_pfm(path):
+    data = pathlib.Path(path).read_bytes()
+    head, rest = data.split(b"\n", 1)
+    assert head == b"PF"
+    size, rest = rest.split(b"\n", 1)
+    w, h = (int(t) for t in size.split())
+    scale, rest = rest.split(b"\n", 1)
+    assert float(scale) < 0, "little-endian PFM"
+    rgb = np.frombuffer(rest, dtype="<f4").reshape(h, w, 3)
+    return np.flipud(rgb)  # PFM rows run bottom to top
+
+
+def test_the_issue_one_liner():
+    out = subprocess.run(
+        [sys.executable, "-c", "import footprint, numpy as np; print(footprint.render(np.zeros((8, 8, 8), np.uint8)).shape)"],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    assert out.stdout.strip() == "(512, 512, 4)"
+
+
+@pytest.mark.parametrize(
+    "flags",
+    [
+        {},
+        {"shading": "phong", "view": (30, 20, 0)},
+        {"view": (75, -40, 20), "accum": "fixed", "threads": 3},
+        {"view": (30, 20, 0), "slicing": "image", "slab": 1},
+    ],
+)
+def test_render_is_byte_identical_to_the_command_line(tmp_path, flags):
+    v = blob()
+    raw = tmp_path / "v.raw"
+    v.astype("<u2").tofile(raw)
+    size = (96, 64)
+    py = footprint.render(v, spacing=(1, 1.5, 2), size=size, window=(0, 3500), **flags)
+    assert py.shape == (64, 96, 4) and py.dtype == np.float32
+    args = [cli(), "render", str(raw), "--dims", "28,20,24", "--type", "u16", "--spacing", "1,1.5,2"]
+    args += ["--size", "96x64", "--window", "0,3500", "--tf", "grey", "--out", str(tmp_path / "o.pfm")]
+    args += footprint._flags(**{k: v for k, v in flags.items()})
+    if "view" not in flags:
+        args += ["--view", "0,0,0"]
+    subprocess.run(args, check=True, capture_output=True)
+    want = read_pfm(tmp_path / "o.pfm")
+    assert want.shape == py[..., :3].shape
+    assert py[..., 3].max() > 0.1, "something is drawn"
+    # Bit for bit, as float32.
+    assert np.array_equal(py[..., :3].view(np.uint32), want.view(np.uint32))
+
+
+def test_fortran_order_is_the_same_volume():
+    v = blob()
+    a = footprint.render(v, size=(64, 64), view=(30, 20, 0), window=(0, 3500))
+    b = footprint.render(np.asfortranarray(v.T), size=(64, 64), view=(30, 20, 0), window=(0, 3500))
+    assert np.array_equal(a, b)
+    assert footprint._footprint.shares_memory(v) and footprint._footprint.shares_memory(np.asfortranarray(v.T))
+    # A strided view is copied (and still renders the same volume as its copy).
+    s = v[:, :, ::2]
+    assert not footprint._footprint.shares_memory(s)
+    assert np.array_equal(
+        footprint.render(s, size=(32, 32), window=(0, 3500)),
+        footprint.render(np.ascontiguousarray(s), size=(32, 32), window=(0, 3500)),
+    )
+
+
+def test_rendering_does_not_copy_the_volume():
+    """Peak memory of rendering a 512³ uint8 array (128 MiB): the array is read in place, so
+    the render adds only its own buffers (image, stencils, the visible voxels of a sparse
+    volume), far less than a copy (128 MiB, or 512 MiB as float32)."""
+    script = textwrap.dedent(
+        """
+        import resource, numpy as np, footprint
+        n = 512
+        v = np.zeros((n, n, n), np.uint8)
+        v[200:300, 180:330, 150:350] = 200          # a block: most of the volume is empty
+        v[...] += 0                                   # every page touched before measuring
+        base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+        im = footprint.render(v, size=(256, 256), view=(30, 20, 0), window=(0, 255), lod=0, supersample=1, threads=2)
+        peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+        assert im[..., 3].max() > 0.5
+        print(base // 1024, (peak - base) // 1024)
+        """
+    )
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True)
+    base_mib, extra_mib = (int(t) for t in out.stdout.split())
+    print(f"512^3 uint8: resident {base_mib} MiB before rendering, {extra_mib} MiB more at the peak")
+    assert base_mib >= 128
+    assert extra_mib < 64, f"rendering added {extra_mib} MiB: the volume (128 MiB) was copied?"
+
+
+def test_a_generator_streamed_equals_the_array_rendered():
+    v = blob()
+    taken = []
+
+    def slices():
+        for k in range(v.shape[0]):
+            taken.append(k)
+            yield v[k]
+
+    # A stream composites in file order (k = 0 first), as a pipe does: back to front where the
+    # view looks along -k (0,0,0 and 30,20,0), front to back from the other side (180,0,0).
+    for view, order in [((0, 0, 0), "back-to-front"), ((30, 20, 0), "back-to-front"), ((180, 0, 0), "front-to-back")]:
+        taken.clear()
+        s = footprint.render_stream(
+            slices(), (28, 20, 24), spacing=(1, 1.5, 2), dtype=np.uint16, size=(80, 64), view=view, window=(0, 3500)
+        )
+        a = footprint.render(v, spacing=(1, 1.5, 2), size=(80, 64), view=view, window=(0, 3500), order=order)
+        assert taken == list(range(24))
+        assert np.array_equal(s, a), view
+
+
+def test_a_stream_is_read_as_it_renders():
+    """Only the slices the renderer needs are held: a generator that ends early is an error
+    before the whole volume could have been gathered, and a side view is refused as a pipe's."""
+    v = blob()
+    with pytest.raises(ValueError, match="ended"):
+        footprint.render_stream(iter([v[0], v[1]]), (28, 20, 24), dtype=np.uint16, size=(32, 32), window=(0, 1))
+    with pytest.raises(ValueError, match="45"):
+        footprint.render_stream(iter(v), (28, 20, 24), dtype=np.uint16, size=(32, 32), view=(90, 0, 0), window=(0, 1))
+    with pytest.raises(ValueError, match="window"):
+        footprint.render_stream(iter(v), (28, 20, 24), dtype=np.uint16)
+
+
+def test_bad_input_raises_the_right_exception(tmp_path):
+    v = blob()
+    with pytest.raises(ValueError, match="3"):
+        footprint.render(np.zeros((4, 4)))
+    with pytest.raises(ValueError, match="complex64"):
+        footprint.render(np.zeros((4, 4, 4), np.complex64))
+    with pytest.raises(ValueError, match="--shading"):
+        footprint.render(v, shading="glossy")
+    with pytest.raises(ValueError, match="empty"):
+        footprint.render(np.zeros((0, 4, 4), np.uint8))
+    with pytest.raises(ValueError, match="spacing"):
+        footprint.render(v, spacing=(1, -1, 1))
+    with pytest.raises(ValueError, match="finite"):
+        footprint.render(np.full((4, 4, 4), np.nan, np.float32))
+    with pytest.raises(OSError):
+        footprint.load(tmp_path / "missing.nrrd")
+    with pytest.raises(ValueError):
+        footprint.load(tmp_path)  # a folder
+    # Memory refusing is a MemoryError, never a crash (a child under a 2 GiB address space).
+    script = "import resource, numpy as np, footprint\n" \
+        "resource.setrlimit(resource.RLIMIT_AS, (2 << 30, 2 << 30))\n" \
+        "try:\n    footprint.render(np.ones((4, 4, 4), np.uint8), size=(16384, 16384))\n" \
+        "except MemoryError as e:\n    print('MemoryError', e)\n"
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True)
+    assert out.returncode == 0 and out.stdout.startswith("MemoryError"), (out.stdout, out.stderr)
+
+
+def test_threads_release_the_gil():
+    v = blob((96, 96, 96), np.uint16)
+
+    def one():
+        footprint.render(v, size=(384, 384), view=(30, 20, 0), shading="phong", threads=1, window=(0, 3500))
+
+    one()
+    single = min(_timed(one) for _ in range(2))
+
+    def two():
+        ts = [threading.Thread(target=one) for _ in range(2)]
+        for t in ts:
+            t.start()
+        for t in ts:
+            t.join()
+
+    both = min(_timed(two) for _ in range(2))
+    print(f"one render {single:.3f} s, two at once {both:.3f} s")
+    assert both < 2 * single * 0.9, "two threads rendering at once take twice as long: the GIL is held"
+
+
+def _timed(f):
+    t = time.perf_counter()
+    f()
+    return time.perf_counter() - t
+
+
+def test_load_verify_bench_and_tables(tmp_path):
+    a, spacing, meta = footprint.load(HEART)
+    assert a.shape == (12, 32, 32) and a.dtype == np.float32 and spacing == (1.0, 1.0, 4.0)
+    assert meta["dims"] == (32, 32, 12) and meta["type"] == "float32"
+    # The loaded array renders as the file does.
+    assert np.array_equal(
+        footprint.render(a, spacing=spacing, size=(48, 48)),
+        footprint.render(footprint.load(HEART)[0], spacing=spacing, size=(48, 48)),
+    )
+    d = footprint.verify(a, spacing=spacing, size=(48, 48), reference="continuous")
+    assert {"overall", "continuous", "reference", "volume"} <= d.keys()
+    assert d["continuous"]["psnr_db"] > 20
+    f = footprint.verify(HEART, size=(48, 48))
+    assert f["overall"]["psnr_db"] > 40 and f["volume"] == str(HEART)
+    b = footprint.bench(a, spacing=spacing, size=(48, 48), frames=3, orbit=2)
+    assert {"first_ms", "median_ms", "min_ms", "max_ms", "threads", "phases_ms"} <= b.keys()
+    t = footprint.generic_table(size=33)
+    assert t.shape == (33, 33) and t.dtype == np.float32 and abs(t[16, 16] - t.max()) < 1e-6
+    footprint.save_table(tmp_path / "t.bin", size=33)
+    via_file = footprint.render(a, spacing=spacing, size=(48, 48), table=33, table_file=tmp_path / "t.bin")
+    assert np.array_equal(via_file, footprint.render(a, spacing=spacing, size=(48, 48), table=33))
+    row = footprint.time_table(a, 33, spacing=spacing, size=(48, 48), frames=2)
+    assert row["table"] == 33 and row["median_ms"] > 0 and row["psnr_db"] > 10
+
+
+def test_uint8_images_and_image_data():
+    v = blob()
+    f = footprint.render(v, size=(40, 40), window=(0, 3500))
+    b = footprint.render(v, size=(40, 40), window=(0, 3500), dtype=np.uint8)
+    assert b.dtype == np.uint8 and np.array_equal(b, np.round(np.clip(f, 0, 1) * 255).astype(np.uint8))
+
+    class ImageData:
+        """What the package reads of a pyvista.ImageData: x-fastest point scalars."""
+
+        def __init__(self, array, spacing):
+            self.dimensions = array.shape[::-1]
+            self.spacing = spacing
+            self.point_data = {"s": array.ravel()}
+            self.active_scalars = array.ravel()
+
+    assert np.array_equal(
+        footprint.render(ImageData(v, (1, 1.5, 2)), size=(40, 40), window=(0, 3500)),
+        footprint.render(v, spacing=(1, 1.5, 2), size=(40, 40), window=(0, 3500)),
+    )
