@@ -189,15 +189,21 @@ def load(path: "os.PathLike[str] | str", **flags: Any) -> Tuple[np.ndarray, Tupl
     return _footprint.load(os.fspath(path), _flags(**flags))
 
 
-def _json_command(command: str, volume: Any, spacing, flags: dict) -> dict:
+def _command_json(command: str, volume: Any, spacing, size, view, tf, window, flags: dict) -> dict:
+    """Runs ``footprint COMMAND`` on ``volume`` (an array, an ImageData, a file path, or None for
+    the built-in scene) with ``--json`` to a temporary file, and returns that JSON as a dict."""
+    args = _common(size, view, tf, window, flags)
     with tempfile.TemporaryDirectory(prefix="footprint-") as d:
         out = os.path.join(d, "out.json")
-        args = [command] + flags.pop("_args") + ["--json", out]
-        if isinstance(volume, (str, os.PathLike)):
-            _footprint.run_command([args[0], os.fspath(volume)] + args[1:], None, None)
+        if volume is None:
+            _footprint.run_command([command] + args + ["--json", out], None, None)
+        elif isinstance(volume, (str, os.PathLike)):
+            _footprint.run_command([command, os.fspath(volume)] + args + ["--json", out], None, None)
         else:
             array, spacing = _volume_of(volume, spacing)
-            _footprint.run_command(args, array, tuple(float(s) for s in spacing))
+            _footprint.run_command(
+                [command] + args + ["--json", out], array, tuple(float(s) for s in spacing)
+            )
         with open(out) as f:
             return json.load(f)
 
@@ -214,10 +220,7 @@ def verify(
     """``footprint verify``: the core's render against a reference (``reference="continuous"``
     for the continuous integral). ``volume`` is an array, an ImageData, a file path, or None for
     the built-in scene. Returns the JSON ``verify --json`` writes, as a dict."""
-    args = _common(size, view, tf, window, flags)
-    if volume is None:
-        return _builtin("verify", args)
-    return _json_command("verify", volume, spacing, {"_args": args})
+    return _command_json("verify", volume, spacing, size, view, tf, window, flags)
 
 
 def bench(
@@ -229,20 +232,10 @@ def bench(
     window: Optional[Sequence[float]] = None,
     **flags: Any,
 ) -> dict:
-    """``footprint bench``: ``frames`` frames (``orbit`` degrees apart), timed. Returns the JSON
-    ``bench --json`` writes (``first_ms``, ``median_ms``, ``phases_ms``, ...), as a dict."""
-    args = _common(size, view, tf, window, flags)
-    if volume is None:
-        return _builtin("bench", args)
-    return _json_command("bench", volume, spacing, {"_args": args})
-
-
-def _builtin(command: str, args: list) -> dict:
-    with tempfile.TemporaryDirectory(prefix="footprint-") as d:
-        out = os.path.join(d, "out.json")
-        _footprint.run_command([command] + args + ["--json", out], None, None)
-        with open(out) as f:
-            return json.load(f)
+    """``footprint bench``: ``frames`` frames (``orbit`` degrees apart), timed. ``volume`` as for
+    :func:`verify`. Returns the JSON ``bench --json`` writes (``first_ms``, ``median_ms``,
+    ``phases_ms``, ...), as a dict."""
+    return _command_json("bench", volume, spacing, size, view, tf, window, flags)
 
 
 def generic_table(kernel: str = "gaussian:spread=1.6,sigmas=2.5", size: int = 129) -> np.ndarray:
