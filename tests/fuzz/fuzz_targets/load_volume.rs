@@ -5,22 +5,11 @@
 //! end in a volume whose samples match its dimensions, or in a one-line error — never a panic,
 //! and never an allocation beyond what the input can fill (libFuzzer's malloc limit catches those).
 use footprint_harness::io::formats::{self, raw::RawOptions};
-use footprint_harness::io::volume::SampleType;
 use libfuzzer_sys::fuzz_target;
 use std::sync::OnceLock;
 
 const EXTENSIONS: [&str; 9] = [
     "nrrd", "nhdr", "vti", "vtk", "mhd", "mha", "nii", "nii.gz", "raw",
-];
-const TYPES: [SampleType; 8] = [
-    SampleType::U8,
-    SampleType::I8,
-    SampleType::U16,
-    SampleType::I16,
-    SampleType::U32,
-    SampleType::I32,
-    SampleType::F32,
-    SampleType::F64,
 ];
 
 fuzz_target!(|data: &[u8]| {
@@ -33,7 +22,7 @@ fuzz_target!(|data: &[u8]| {
     let raw = (ext == "raw" && rest.len() >= 4).then(|| {
         let o = RawOptions {
             dims: [0, 1, 2].map(|a| 1 + usize::from(rest[a] % 16)),
-            ty: TYPES[usize::from(rest[3] % 8)],
+            ty: footprint_fuzz::SAMPLE_TYPES[usize::from(rest[3] % 8)],
             big_endian: rest[3] & 8 != 0,
             spacing: [1.0, 1.0, 1.0],
         };

@@ -6,25 +6,13 @@
 //! too short for its layout is refused in one line.
 use footprint::source::SheetSource;
 use footprint_harness::io::stream::{decode_into, file_range, FileSource, Layout};
-use footprint_harness::io::volume::SampleType;
 use libfuzzer_sys::fuzz_target;
-
-const TYPES: [SampleType; 8] = [
-    SampleType::U8,
-    SampleType::I8,
-    SampleType::U16,
-    SampleType::I16,
-    SampleType::U32,
-    SampleType::I32,
-    SampleType::F32,
-    SampleType::F64,
-];
 
 fuzz_target!(|data: &[u8]| {
     let Some((head, body)) = data.split_first_chunk::<5>() else {
         return;
     };
-    let ty = TYPES[usize::from(head[0] % 8)];
+    let ty = footprint_fuzz::SAMPLE_TYPES[usize::from(head[0] % 8)];
     let big_endian = head[0] & 8 != 0;
     let dims = [1, 2, 3].map(|i| 1 + usize::from(head[i] % 8));
     let offset = u64::from(head[4] % 16);

@@ -8,23 +8,12 @@ use footprint_harness::io::stream::PipeSource;
 use footprint_harness::io::volume::SampleType;
 use libfuzzer_sys::fuzz_target;
 
-const TYPES: [SampleType; 8] = [
-    SampleType::U8,
-    SampleType::I8,
-    SampleType::U16,
-    SampleType::I16,
-    SampleType::U32,
-    SampleType::I32,
-    SampleType::F32,
-    SampleType::F64,
-];
-
 fuzz_target!(|data: &[u8]| {
     if data.len() < 4 {
         return;
     }
     let dims = [0, 1, 2].map(|a| 1 + usize::from(data[a] % 16));
-    let ty = TYPES[usize::from(data[3] % 8)];
+    let ty = footprint_fuzz::SAMPLE_TYPES[usize::from(data[3] % 8)];
     let big_endian = data[3] & 8 != 0;
     let stream = &data[4..];
     let mut src = PipeSource::new(std::io::Cursor::new(stream), dims, ty, big_endian, "stdin");

@@ -251,6 +251,21 @@ pub fn splat_one<P: Precision>(frame: &FrameSetup, path: &P, w: f32) -> Vec<P::A
     acc
 }
 
+/// Every sample type, for targets that pick one from a byte.
+pub const SAMPLE_TYPES: [footprint_harness::io::volume::SampleType; 8] = {
+    use footprint_harness::io::volume::SampleType;
+    [
+        SampleType::U8,
+        SampleType::I8,
+        SampleType::U16,
+        SampleType::I16,
+        SampleType::U32,
+        SampleType::I32,
+        SampleType::F32,
+        SampleType::F64,
+    ]
+};
+
 /// A folder of this process's own for files a target writes and loads back.
 pub fn scratch() -> PathBuf {
     let base = std::env::var_os("FUZZ_SCRATCH")
