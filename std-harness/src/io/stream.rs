@@ -334,7 +334,7 @@ impl<R: Read> SheetSource for PipeSource<R> {
 }
 
 /// Smallest and largest finite sample of a streamed file, read sequentially in chunks of at most
-/// [`RANGE_CHUNK_BYTES`] (however large a sheet is: a 32768² slice costs no more than a small one).
+/// 4 MiB (however large a sheet is: a 32768² slice costs no more than a small one).
 pub fn file_range(layout: &Layout) -> Result<(f32, f32), CliError> {
     let src = FileSource::open(layout.clone())?;
     let size = layout.ty.size();

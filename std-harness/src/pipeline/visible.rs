@@ -6,7 +6,7 @@
 //! plus 12 with gradients (Phong, iso-surfaces) and 12 with colours (a coloured level of detail),
 //! and are kept only while they fit [`list_budget`]: at most 1 GiB, or four bytes per byte of the
 //! volume where that is less, never under 256 MiB. A volume whose lists would pass it is not
-//! listed: each band classifies the sheets it renders as it goes ([`OnTheFly`]), which costs a
+//! listed: each band classifies the sheets it renders as it goes ([`super::supply::OnTheFly`]), which costs a
 //! sheet's worth of memory per band and a classification per band and frame, and renders the
 //! same bits (the same visible voxels, in the same order, through the same splat).
 
