@@ -1168,6 +1168,66 @@ fn second_campaign(dir: &Path) -> Vec<Case> {
                 .map_err(|e| format!("not written: {e}"))
         }),
     );
+    // The command line's own messages (issue 48): suggestions kept, negative numbers named,
+    // `compare` reads the colour PFM `render` writes and refuses two of a different kind.
+    c.push(refused(
+        "a misspelt subcommand",
+        &["rendr"],
+        "a similar subcommand exists: 'render'",
+    ));
+    c.push(refused(
+        "a misspelt flag",
+        &["render", "--sise", "8x8"],
+        "a similar argument exists: '--size'",
+    ));
+    c.push(refused(
+        "--threads -2",
+        &["render", "--threads", "-2", "--out", "out.png"],
+        "is not a whole number of threads >= 0",
+    ));
+    c.push(renders(
+        "render a colour PFM",
+        &["render", HEART, "--size", "24x16", "--out", "colour.pfm"],
+    ));
+    c.push(renders(
+        "compare reads render's colour PFM",
+        &["compare", "colour.pfm", "colour.pfm", "--max-diff", "0"],
+    ));
+    c.push(renders(
+        "a greyscale PFM",
+        &["splat", "--size", "24x16", "--out", "grey.pfm"],
+    ));
+    c.push(refused(
+        "compare a greyscale PFM with a colour one",
+        &["compare", "grey.pfm", "colour.pfm"],
+        "compare two of a kind",
+    ));
+    c.push(renders("bare footprint prints the help", &[]));
+    c.push(
+        renders(
+            "footprint info with --json",
+            &["info", HEART, "--json", "info.json"],
+        )
+        .checked(|dir| {
+            let j = std::fs::read_to_string(dir.join("info.json")).map_err(|e| e.to_string())?;
+            for key in [
+                "\"dims\"",
+                "\"type\": \"float32\"",
+                "\"percentiles\"",
+                "\"window\"",
+            ] {
+                if !j.contains(key) {
+                    return Err(format!("info.json lacks {key}"));
+                }
+            }
+            Ok("info.json has dims, type, percentiles, window".into())
+        }),
+    );
+    c.push(refused(
+        "footprint info without a volume",
+        &["info"],
+        "needs a VOLUME",
+    ));
     c.push(
         refused(
             "ulimit -f 16 (a write past the file-size limit)",

@@ -371,7 +371,7 @@ pub struct RenderArgs {
     /// Threads (bands of image rows) for the core's render; 0 = every core. The image is
     /// byte-identical for any number. A streamed volume renders on one thread; more than 256
     /// render on 256.
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, value_parser = parse_threads)]
     pub threads: usize,
     /// Target PSNR, dB, against --quality-reference: choose the cheapest configuration expected
     /// to reach it for this scene and view (overrides the table, lookup, method and
@@ -510,6 +510,13 @@ impl RenderArgs {
         }
         .min(MAX_THREADS)
     }
+}
+
+/// `--threads N`: a whole number ≥ 0, with a message that says so for `-2` or `two`.
+fn parse_threads(s: &str) -> Result<usize, String> {
+    s.trim()
+        .parse::<usize>()
+        .map_err(|_| format!("'{s}' is not a whole number of threads >= 0 (0 = every core)"))
 }
 
 /// The most threads a render starts (`--threads` above it renders on this many): every image is

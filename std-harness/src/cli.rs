@@ -9,7 +9,7 @@ use std::ffi::OsString;
 
 /// Footprint: Westover footprint-evaluation splatting.
 #[derive(Parser, Debug)]
-#[command(name = "footprint", version, about)]
+#[command(name = "footprint", version, about, arg_required_else_help = true)]
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,
@@ -30,13 +30,18 @@ pub enum Command {
     /// Precompute a generic footprint table and save it (the paper's preprocessor).
     #[command(allow_negative_numbers = true)]
     Tables(commands::tables::TablesArgs),
-    /// Compare two single-channel PFM images: max |A − B| relative to B's peak.
+    /// Compare two PFM images (greyscale, or colour as `render --out x.pfm` writes): max |A − B|
+    /// relative to B's peak.
     #[command(allow_negative_numbers = true)]
     Compare(commands::compare::CompareArgs),
     /// Sweep table size, lookup, method and accumulation on one scene: frame time against error
     /// (tradeoff.csv/.svg/.png with the Pareto frontier) and stability (stability.svg/.png).
     #[command(allow_negative_numbers = true)]
     Chart(commands::chart::ChartArgs),
+    /// What a volume file holds: dimensions, spacing, type, orientation, value range,
+    /// percentiles and the window `render` would use (--json writes them).
+    #[command(allow_negative_numbers = true)]
+    Info(commands::info::InfoArgs),
     /// Frame times of one volume loaded once: frame 1 fresh, later frames turned by --orbit and
     /// reusing cached state (first_ms, median_ms, phases_ms; --json).
     #[command(allow_negative_numbers = true)]
@@ -54,19 +59,22 @@ where
     crate::io::forget_inputs();
     let cli = match Cli::try_parse_from(args) {
         Ok(cli) => cli,
-        Err(e) if !e.use_stderr() => {
-            // --help and --version.
-            let _ = e.print();
+        Err(e)
+            if !e.use_stderr()
+                || e.kind() == clap::error::ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand =>
+        {
+            // --help, --version, and a bare `footprint`: the help, on stdout.
+            use clap::CommandFactory as _;
+            if e.use_stderr() {
+                crate::say!("{}", Cli::command().render_help());
+            } else {
+                let _ = e.print();
+            }
             return 0;
         }
         Err(e) => {
-            // One line, as every other error: clap's first line without its "error: " prefix
-            // (the usage and tips that follow are what --help prints).
-            let text = e.render().to_string();
-            let line = text.lines().next().unwrap_or("bad arguments");
-            let line = line.strip_prefix("error: ").unwrap_or(line);
             use std::io::Write as _;
-            let _ = writeln!(std::io::stderr().lock(), "footprint: {line} (see --help)");
+            let _ = writeln!(std::io::stderr().lock(), "footprint: {}", clap_line(&e));
             return 2;
         }
     };
@@ -89,6 +97,7 @@ fn dispatch(command: Command) -> Result<(), crate::CliError> {
         Command::Compare(a) => commands::compare::run(&a),
         Command::Chart(a) => commands::chart::run(&a),
         Command::Bench(a) => commands::bench::run(&a),
+        Command::Info(a) => commands::info::run(&a),
     }
 }
 
@@ -102,11 +111,7 @@ where
     T: Into<OsString> + Clone,
 {
     crate::io::forget_inputs();
-    let cli = Cli::try_parse_from(args).map_err(|e| {
-        let text = e.render().to_string();
-        let line = text.lines().next().unwrap_or("bad arguments").to_string();
-        crate::CliError::input(line.strip_prefix("error: ").unwrap_or(&line).to_string())
-    })?;
+    let cli = Cli::try_parse_from(args).map_err(|e| crate::CliError::input(clap_line(&e)))?;
     let mut command = cli.command;
     if let Some(m) = memory {
         let render = match &mut command {
@@ -122,4 +127,24 @@ where
         render.memory = Some(m);
     }
     dispatch(command)
+}
+
+/// A parse error as one line, as every other error: clap's first line without its "error: "
+/// prefix, with its suggestion kept where it has one ("tip: a similar argument exists: '--out'";
+/// the usage that follows is what --help prints).
+fn clap_line(e: &clap::Error) -> String {
+    let text = e.render().to_string();
+    let first = text.lines().next().unwrap_or("bad arguments");
+    let first = first.strip_prefix("error: ").unwrap_or(first);
+    let tips: Vec<&str> = text
+        .lines()
+        .map(str::trim)
+        .filter(|l| l.starts_with("tip:"))
+        .collect();
+    // "a similar argument exists" before clap's other tips.
+    let tip = tips.iter().find(|t| t.contains("similar")).or(tips.first());
+    match tip {
+        Some(tip) => format!("{first} ({tip}; see --help)"),
+        None => format!("{first} (see --help)"),
+    }
 }

@@ -1,6 +1,7 @@
-//! `footprint compare`: how far apart two single-channel PFM images are.
+//! `footprint compare`: how far apart two PFM images are, greyscale (`splat`'s) or colour
+//! (`render --out x.pfm`'s; every channel of every pixel compared).
 
-use crate::io::{self, image::decode_pfm};
+use crate::io::{self, image::decode_pfm_any};
 use crate::metrics::max_rel_diff;
 use crate::CliError;
 use clap::Args;
@@ -8,9 +9,9 @@ use std::path::PathBuf;
 
 #[derive(Args, Debug)]
 pub struct CompareArgs {
-    /// Image under test (PFM).
+    /// Image under test (PFM, greyscale or colour).
     pub a: PathBuf,
-    /// Reference image (PFM).
+    /// Reference image (PFM, of the same kind).
     pub b: PathBuf,
     /// Fail (exit 1) if max |A − B| / peak(B) exceeds this.
     #[arg(long)]
@@ -28,8 +29,18 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
             )));
         }
     }
-    let load = |p: &PathBuf| decode_pfm(&io::read_file(p)?, &p.display().to_string());
-    let (a, b) = (load(&args.a)?, load(&args.b)?);
+    let load = |p: &PathBuf| decode_pfm_any(&io::read_file(p)?, &p.display().to_string());
+    let ((a, ca), (b, cb)) = (load(&args.a)?, load(&args.b)?);
+    if ca != cb {
+        let kind = |c: usize| if c == 3 { "colour (RGB)" } else { "greyscale" };
+        return Err(CliError::input(format!(
+            "{} is a {} PFM, {} a {} one: compare two of a kind",
+            args.a.display(),
+            kind(ca),
+            args.b.display(),
+            kind(cb)
+        )));
+    }
     for (name, img) in [(&args.a, &a), (&args.b, &b)] {
         let bad = img.data.iter().filter(|v| !v.is_finite()).count();
         if bad > 0 {

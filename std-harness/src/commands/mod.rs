@@ -3,6 +3,7 @@
 pub mod bench;
 pub mod chart;
 pub mod compare;
+pub mod info;
 pub mod render;
 pub mod splat;
 pub mod tables;

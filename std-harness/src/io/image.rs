@@ -36,7 +36,19 @@ pub fn encode_pfm(img: &GreyImage) -> Vec<u8> {
 
 /// Decodes a single-channel PFM (either endianness).
 pub fn decode_pfm(bytes: &[u8], name: &str) -> Result<GreyImage, CliError> {
-    let bad = |what: &str| CliError::input(format!("{name}: not a greyscale PFM: {what}"));
+    decode_pfm_as(bytes, name, false).map(|(img, _)| img)
+}
+
+/// Decodes a greyscale (`Pf`) or colour (`PF`, what `render --out x.pfm` writes) PFM, either
+/// endianness: the values as a [`GreyImage`] whose rows hold each pixel's channels in turn
+/// (`width` is pixels × channels), and the number of channels (1 or 3).
+pub fn decode_pfm_any(bytes: &[u8], name: &str) -> Result<(GreyImage, usize), CliError> {
+    decode_pfm_as(bytes, name, true)
+}
+
+fn decode_pfm_as(bytes: &[u8], name: &str, colour: bool) -> Result<(GreyImage, usize), CliError> {
+    let kind = if colour { "PFM" } else { "greyscale PFM" };
+    let bad = |what: &str| CliError::input(format!("{name}: not a {kind}: {what}"));
     // Header: three whitespace-separated lines.
     let mut fields = Vec::new();
     let mut at = 0;
@@ -54,13 +66,20 @@ pub fn decode_pfm(bytes: &[u8], name: &str) -> Result<GreyImage, CliError> {
         fields.push(std::str::from_utf8(&bytes[start..at]).map_err(|_| bad("header is not text"))?);
     }
     at += 1; // the single whitespace byte after the scale
-    if fields[0] != "Pf" {
-        return Err(bad("magic is not Pf (colour PFM is not supported)"));
-    }
+    let channels = match fields[0] {
+        "Pf" => 1,
+        "PF" if colour => 3,
+        "PF" => return Err(bad("magic is not Pf (colour PFM is not supported)")),
+        _ if colour => return Err(bad("magic is neither Pf nor PF")),
+        _ => return Err(bad("magic is not Pf (colour PFM is not supported)")),
+    };
     let parse = |s: &str, what: &str| s.parse::<usize>().map_err(|_| bad(what));
-    let width = parse(fields[1], "bad width")?;
+    let pixels = parse(fields[1], "bad width")?;
     let height = parse(fields[2], "bad height")?;
     let scale: f32 = fields[3].parse().map_err(|_| bad("bad scale"))?;
+    let width = pixels
+        .checked_mul(channels)
+        .ok_or_else(|| bad("size overflows"))?;
     let n = width
         .checked_mul(height)
         .ok_or_else(|| bad("size overflows"))?;
@@ -70,7 +89,7 @@ pub fn decode_pfm(bytes: &[u8], name: &str) -> Result<GreyImage, CliError> {
         .ok_or_else(|| bad("size overflows"))?;
     if bytes.len() != need {
         return Err(bad(&format!(
-            "expected {need} bytes for {width}x{height}, got {}",
+            "expected {need} bytes for {pixels}x{height}, got {}",
             bytes.len()
         )));
     }
@@ -87,11 +106,14 @@ pub fn decode_pfm(bytes: &[u8], name: &str) -> Result<GreyImage, CliError> {
         let (r, c) = (i / width, i % width);
         data[(height - 1 - r) * width + c] = v;
     }
-    Ok(GreyImage {
-        width,
-        height,
-        data,
-    })
+    Ok((
+        GreyImage {
+            width,
+            height,
+            data,
+        },
+        channels,
+    ))
 }
 
 /// Encodes an 8-bit greyscale PNG, mapping [0, `white`] linearly to [0, 255] (clamped).
