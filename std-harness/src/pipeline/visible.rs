@@ -111,14 +111,6 @@ impl VisibleLists {
     /// value; each takes 12 more).
     pub const BYTES_PER_VOXEL: usize = std::mem::size_of::<VisibleVoxel>();
 
-    /// Bytes the lists hold (their voxels, gradients, colours and runs, as allocated).
-    pub fn bytes(&self) -> usize {
-        self.voxels.capacity() * std::mem::size_of::<VisibleVoxel>()
-            + (self.gradients.capacity() + self.colours.capacity()) * 12
-            + self.runs.capacity() * std::mem::size_of::<RowRun>()
-            + (self.offsets.capacity() + self.run_offsets.capacity()) * 8
-    }
-
     /// Appends the next sheets' lists (`part`, offsets relative to its first sheet).
     fn append(&mut self, part: VisibleLists) {
         let base = self.voxels.len();
@@ -191,16 +183,23 @@ impl FrameCache {
         threads: usize,
         what: &str,
     ) -> Result<(&'a VisibleLists, bool), CliError> {
+        let budget = self.budget_for(volume);
         match self.visible_and_spares(p, volume, threads)? {
             (Visible::Kept(lists), fresh, _) => Ok((lists, fresh)),
             (Visible::OnTheFly(_), _, _) => Err(CliError::input(format!(
                 "{}: {what} keeps every visible voxel in memory, and this volume's take more \
                  than {} MiB ({} bytes each): render a coarser level (--lod) or use --slicing object",
                 p.name,
-                list_budget(volume) >> 20,
+                budget >> 20,
                 VisibleLists::BYTES_PER_VOXEL
             ))),
         }
+    }
+
+    /// The lists' budget this cache applies to a volume: [`list_budget`]'s, or the one it was
+    /// made with.
+    fn budget_for(&self, volume: &Volume) -> usize {
+        self.budget.unwrap_or_else(|| list_budget(volume))
     }
 
     /// Keeps a finished frame's `image` (float, of its frame's size) for a later frame to render
@@ -233,8 +232,7 @@ impl FrameCache {
         let axis = p.frame.sheet_axis;
         let fresh = self.lists[axis].is_none() && !self.over_budget[axis];
         if fresh {
-            let budget = self.budget.unwrap_or_else(|| list_budget(volume));
-            match classify(p, volume, threads, budget)? {
+            match classify(p, volume, threads, self.budget_for(volume))? {
                 Some(lists) => self.lists[axis] = Some(lists),
                 None => self.over_budget[axis] = true,
             }
