@@ -4,7 +4,7 @@
 //! the accumulated weights times the lattice cell area S² should be 1 where the sheet is complete.
 //! The ripple (max |value − 1|) is measured for the core (each table size and lookup) and for the
 //! f64 reference (no tables), which is the kernel's own ripple: what no table can remove.
-//! `cargo test --test flat_field -- --nocapture` prints the table quoted in ARCHITECTURE.md.
+//! `cargo test --test suite flat_field:: -- --nocapture` prints the table quoted in ARCHITECTURE.md.
 
 use footprint::geometry::{Footprint, FootprintOptions};
 use footprint::splat::{splat, ImageMut};

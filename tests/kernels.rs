@@ -2,7 +2,7 @@
 //!
 //! The Gaussian's closed-form (erf) footprint is checked against Simpson integration of the 3D
 //! kernel along the chord; every kernel's generic table is checked against the exact footprint,
-//! and its error must fall as the table grows. `cargo test --test kernels -- --nocapture` prints
+//! and its error must fall as the table grows. `cargo test --test suite kernels:: -- --nocapture` prints
 //! the error table quoted in ARCHITECTURE.md.
 
 use footprint::{GenericTable, Kernel, Lookup};

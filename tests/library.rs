@@ -420,3 +420,118 @@ fn bad_transfer_functions_are_typed_errors() {
         RenderError::TransferFunction(TransferFunctionError::Entry { index: 1 })
     ));
 }
+
+#[allow(dead_code)] // its `main` is the example's.
+#[path = "../core/examples/in_memory.rs"]
+mod in_memory_example;
+
+/// `core/examples/in_memory.rs` (the front door, `footprint::prelude`) and `footprint render` on
+/// the same volume written as a raw file, with the flags its doc names and every other flag at
+/// its default (threads, levels, supersampling, table, phases): the same PNG bytes.
+#[test]
+fn the_in_memory_example_writes_the_cli_png_byte_for_byte() {
+    let dir = tempfile::tempdir().unwrap();
+    let [raw, lib, cli] = ["v.raw", "lib.png", "cli.png"].map(|f| dir.path().join(f));
+    let data = in_memory_example::volume();
+    let bytes: Vec<u8> = data.iter().flat_map(|v| v.to_le_bytes()).collect();
+    std::fs::write(&raw, bytes).unwrap();
+    in_memory_example::render_png(lib.to_str().unwrap()).unwrap();
+    let args = "render RAW --dims 64,64,48 --type u16 --spacing 1,1,1.5 --view 30,20,0 \
+                --tf ct-bone-skin --window 0,4000 --shading phong --size 256x256 --out OUT";
+    let args = args
+        .split_whitespace()
+        .map(|a| match a {
+            "RAW" => raw.to_str().unwrap(),
+            "OUT" => cli.to_str().unwrap(),
+            a => a,
+        })
+        .map(String::from);
+    assert_eq!(
+        footprint_harness::run(std::iter::once("footprint".into()).chain(args)),
+        0
+    );
+    let (a, b) = (std::fs::read(&lib).unwrap(), std::fs::read(&cli).unwrap());
+    assert!(
+        a == b,
+        "library and CLI PNGs differ ({} and {} bytes)",
+        a.len(),
+        b.len()
+    );
+    // And the picture is not empty: bone and skin both show.
+    assert!(a.len() > 4000);
+}
+
+/// A ring made for the other compositing order than the renderer's is refused (it would feed the
+/// sheets in the wrong order: a silently wrong image before); `for_renderer` takes the order from
+/// the renderer, so it is given once.
+#[test]
+fn a_ring_for_another_order_is_refused() {
+    use footprint::prelude::*;
+    let (dims, size) = ([8, 8, 8], [16, 16]);
+    let data = vec![100u8; 512];
+    let s = Settings {
+        window: [0.0, 255.0],
+        ..Settings::new(size, Preset::Grey.lut())
+    };
+    let frame = s.frame(dims).unwrap();
+    let generic = GenericTable::<17>::build(s.kernel);
+    let table = ViewTable::<17>::build(
+        &frame.footprint,
+        &generic,
+        Lookup::Bilinear,
+        Lookup::Bilinear,
+    );
+    let shader = Shader {
+        tf: TransferFunction {
+            lut: s.lut,
+            lo: 0.0,
+            hi: 255.0,
+        },
+        shading: Shading::Emission,
+    };
+    let (mut acc, mut image, mut rows) = (
+        vec![[0.0; 4]; 256],
+        vec![[0.0; 4]; 256],
+        vec![RowSpan::EMPTY; 16],
+    );
+    let buffers = RenderBuffers {
+        accumulator: &mut acc,
+        image: &mut image,
+        rows: &mut rows,
+    };
+    let mut r =
+        SheetRenderer::new(&frame, &table, shader, Order::FrontToBack, buffers, None).unwrap();
+    let mut vol = MemoryVolume::new(&data, dims).unwrap();
+    let mut storage = vec![0u8; 3 * frame.sheet_shape().0];
+    let mut ring = SheetRing::new(&mut storage, &frame, Order::BackToFront).unwrap();
+    let e = render_from(&mut r, &mut ring, &mut vol).unwrap_err();
+    assert!(matches!(e, RenderError::RingOrder { .. }), "{e:?}");
+    assert!(e.to_string().contains("for_renderer"), "{e}");
+    let mut ring = SheetRing::for_renderer(&mut storage, &r).unwrap();
+    render_from(&mut r, &mut ring, &mut vol).unwrap();
+    assert_eq!(r.finish().sheets, 8);
+}
+
+/// Every public error of the front door prints a message and is a `std::error::Error`.
+#[test]
+fn front_door_errors_display() {
+    use footprint::prelude::*;
+    let s = Settings::new([0, 16], Preset::Grey.lut());
+    let e: Error = s.lengths([8, 8, 8]).unwrap_err();
+    let _: &dyn std::error::Error = &e;
+    assert!(!e.to_string().is_empty());
+    let m = footprint::source::OrderMismatch {
+        source_axis: 2,
+        frame_axis: 0,
+    };
+    let e: Box<dyn std::error::Error> = Box::new(m);
+    assert!(e.to_string().contains("k (z)"), "{e}");
+    // Buffers too short are refused, not written past.
+    let s = Settings::new([16, 16], Preset::Grey.lut());
+    let n = s.lengths([8, 8, 8]).unwrap();
+    let (mut image, mut work) = (vec![[0.0; 4]; n.pixels], vec![0.0; n.work - 1]);
+    let (mut rows, mut sheets) = (vec![RowSpan::EMPTY; n.rows], vec![0u8; n.sheets]);
+    let generic = GenericTable::<17>::build(s.kernel);
+    let b = Buffers::new(&mut image, &mut work, &mut rows, &mut sheets);
+    assert!(render_volume(&[0u8; 512], [8, 8, 8], &s, &generic, b).is_err());
+}

@@ -145,7 +145,7 @@ fn robust_map_is_continuous_through_45_degrees() {
 
 /// The paper's θ method near 45°: with its 0.01° cheat it stays finite; without the cheat it
 /// fails (typed error or a large error) at 45°. Its error near 45° is measured and printed, not
-/// hidden: `cargo test --test rotation_45 -- --nocapture`.
+/// hidden: `cargo test --test suite rotation_45:: -- --nocapture`.
 #[test]
 fn paper_map_near_45_degrees_is_measured() {
     let mut far = 0.0f64;

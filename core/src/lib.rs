@@ -28,7 +28,8 @@
 //! - [`refine`]: the paper's adaptive re-sampling: refined axes, Catmull–Rom interpolation,
 //!   refinement factors (rendered by `render/refined.rs`).
 //! - [`volume`]: a volume already in memory (`&[T]`, x fastest) as a `SheetSource`.
-//! - [`output`]: the result as 8-bit sRGB RGBA or RGB565 pixels.
+//! - [`output`]: the result as 8-bit pixels (linear, sRGB, straight alpha) or RGB565.
+//! - [`quick`] and [`prelude`]: the front door, a volume in memory in one call.
 //!
 //! ## Conventions (kept everywhere)
 //! - world = G·(i, j, k), G the grid-to-world matrix (diagonal = spacing, world units such as mm);
@@ -37,33 +38,94 @@
 //! - a footprint weight is a density in px⁻² that integrates to one over the screen plane.
 //!
 //! ## Rendering a volume that is in memory
-//! A 16³ `u8` volume (x fastest) to 64×64 sRGB pixels, in caller-owned buffers (20 lines, then
-//! two checks):
+//! The front door ([`quick`], imported with [`prelude`]): a `&[T]` volume (x fastest), VTK's
+//! camera as `footprint render --view` takes it, a transfer-function [`Preset`](shade::Preset),
+//! into caller-owned buffers, the same image as the CLI bit for bit:
 //! ```
-//! use footprint::{composite::RowSpan, frame::*, render::*, shade::*, source::render_from};
-//! use footprint::{volume::MemoryVolume, FootprintOptions, GenericTable, Grid, Kernel, Lookup, View, ViewTable};
-//! let (dims, size) = ([16; 3], [64, 64]);
-//! let data: Vec<u8> = (0..16 * 16 * 16).map(|i: u32| ((i * 37) % 256) as u8).collect();
-//! let mut volume = MemoryVolume::new(&data, dims).unwrap();
-//! let grid = Grid::from_spacing([1.0, 1.0, 2.0]).unwrap();
-//! let view = View::from_angles([30.0, 20.0, 0.0], 1.0, dims, &grid, size).unwrap();
-//! let frame = FrameSetup::new(dims, &grid, &view, &Kernel::PAPER_GAUSSIAN, FootprintOptions::default(), size).unwrap();
-//! let generic = GenericTable::<33>::build(Kernel::PAPER_GAUSSIAN);
-//! let table = ViewTable::<33>::build(&frame.footprint, &generic, Lookup::Bilinear, Lookup::Bilinear);
-//! let lut = [[0.0; 4], [1.0, 0.9, 0.8, 0.2]];
-//! let shader = Shader { tf: TransferFunction { lut: &lut, lo: 0.0, hi: 255.0 }, shading: Shading::Emission };
-//! let (mut acc, mut image, mut rows) = (vec![[0.0; 4]; 64 * 64], vec![[0.0; 4]; 64 * 64], vec![RowSpan::EMPTY; 64]);
-//! let buffers = RenderBuffers { accumulator: &mut acc, image: &mut image, rows: &mut rows };
-//! let mut renderer = SheetRenderer::new(&frame, &table, shader, Order::BackToFront, buffers, None).unwrap();
-//! let mut sheets = vec![0u8; 3 * frame.sheet_shape().0];
-//! let mut ring = SheetRing::new(&mut sheets, &frame, Order::BackToFront).unwrap();
-//! render_from(&mut renderer, &mut ring, &mut volume).unwrap();
-//! let stats = renderer.finish();
-//! let pixels: Vec<[u8; 4]> = image.iter().map(|p| footprint::output::srgb8(*p)).collect();
+//! use footprint::prelude::*;
+//! let (dims, data) = ([16, 16, 16], (0..4096u32).map(|i| (i * 37 % 256) as u8).collect::<Vec<_>>());
+//! let mut s = Settings::new([64, 64], Preset::Density.lut());
+//! (s.spacing, s.view, s.window) = ([1.0, 1.0, 2.0], [30.0, 20.0, 0.0], [0.0, 255.0]);
+//! let n = s.lengths(dims)?;
+//! let (mut image, mut work) = (vec![[0.0; 4]; n.pixels], vec![0.0; n.work]);
+//! let (mut rows, mut sheets) = (vec![RowSpan::EMPTY; n.rows], vec![0u8; n.sheets]);
+//! let generic = GenericTable::<33>::build(s.kernel);
+//! let buffers = Buffers::new(&mut image, &mut work, &mut rows, &mut sheets);
+//! let stats = render_volume(&data, dims, &s, &generic, buffers)?;
+//! let pixels: Vec<[u8; 4]> = image.iter().map(|&p| linear8(p)).collect(); // or srgb8, straight8
 //! assert_eq!(stats.sheets, 16);
 //! assert!(pixels.iter().any(|p| p[3] > 0));
+//! # Ok::<(), footprint::Error>(())
 //! ```
-//! `core/examples/in_memory.rs` is the same as a program.
+//! `core/examples/in_memory.rs` is the same as a program that writes the CLI's PNG byte for byte.
+//!
+//! ## Streaming voxels from outside
+//! A [`SheetSource`](source::SheetSource) hands over one sheet at a time (row-major over the
+//! sheet's in-sheet axes, the lower axis fastest; see [`frame`]); the renderer keeps three in a
+//! [`SheetRing`](render::SheetRing). A source that can only deliver in one order (a sensor, a
+//! pipe) says so, and [`source::order_for`] picks the compositing order it implies:
+//! ```
+//! use footprint::{frame::*, render::*, shade::*, source::*, composite::RowSpan, prelude::Preset};
+//! use footprint::{FootprintOptions, GenericTable, Grid, Kernel, Lookup, View, ViewTable};
+//! /// Sheets of a ramp along z, in ascending order only.
+//! struct Sensor { next: usize }
+//! impl SheetSource for Sensor {
+//!     type Sample = u8;
+//!     type Error = RenderError;
+//!     fn read_sheet(&mut self, _axis: usize, k: usize, out: &mut [u8]) -> Result<(), RenderError> {
+//!         out.fill((k * 16) as u8);
+//!         self.next += 1;
+//!         Ok(())
+//!     }
+//!     fn sequential_axis(&self) -> Option<usize> { Some(2) }
+//! }
+//! let (dims, size) = ([16, 16, 16], [48, 48]);
+//! let grid = Grid::from_spacing([1.0; 3]).unwrap();
+//! let view = View::from_vtk_camera([0.0, 0.0, 0.0], 1.0, dims, &grid, size).unwrap();
+//! let frame = FrameSetup::new(dims, &grid, &view, &Kernel::PAPER_GAUSSIAN, FootprintOptions::default(), size).unwrap();
+//! let mut source = Sensor { next: 0 };
+//! let order = order_for(&source, &frame, Order::BackToFront).unwrap();
+//! let generic = GenericTable::<33>::build(Kernel::PAPER_GAUSSIAN);
+//! let table = ViewTable::<33>::build(&frame.footprint, &generic, Lookup::Bilinear, Lookup::Bilinear);
+//! let shader = Shader { tf: TransferFunction { lut: Preset::Grey.lut(), lo: 0.0, hi: 255.0 }, shading: Shading::Emission };
+//! let (mut acc, mut image, mut rows) = (vec![[0.0; 4]; 48 * 48], vec![[0.0; 4]; 48 * 48], vec![RowSpan::EMPTY; 48]);
+//! let buffers = RenderBuffers { accumulator: &mut acc, image: &mut image, rows: &mut rows };
+//! let mut renderer = SheetRenderer::new(&frame, &table, shader, order, buffers, None).unwrap();
+//! let mut sheets = vec![0u8; 3 * frame.sheet_shape().0];
+//! let mut ring = SheetRing::for_renderer(&mut sheets, &renderer).unwrap(); // the order given once
+//! render_from(&mut renderer, &mut ring, &mut source).unwrap();
+//! assert_eq!((renderer.finish().sheets, source.next), (16, 16));
+//! ```
+//!
+//! ## Fixed point
+//! The same frame with integer-only splatting and compositing (Q24 colour, [`fixed`]): build a
+//! [`FixedTable`](fixed::FixedTable) instead of the view table and render through a
+//! [`FixedPath`](render::FixedPath); the image is `[u32; 4]` per pixel,
+//! [`fixed::to_f32`] converts it exactly.
+//! ```
+//! use footprint::{fixed::{self, FixedTable}, frame::*, render::*, shade::*, source::*};
+//! use footprint::{composite::RowSpan, prelude::Preset, volume::MemoryVolume};
+//! use footprint::{FootprintOptions, GenericTable, Grid, Kernel, Lookup, View};
+//! let (dims, size) = ([16, 16, 16], [48, 48]);
+//! let data = vec![180u8; 16 * 16 * 16];
+//! let grid = Grid::from_spacing([1.0; 3]).unwrap();
+//! let view = View::from_vtk_camera([30.0, 20.0, 0.0], 1.0, dims, &grid, size).unwrap();
+//! let frame = FrameSetup::new(dims, &grid, &view, &Kernel::PAPER_GAUSSIAN, FootprintOptions::default(), size).unwrap();
+//! let generic = GenericTable::<33>::build(Kernel::PAPER_GAUSSIAN);
+//! let mut table = FixedTable::<33>::zeroed();
+//! table.build_view(&frame, &generic, Lookup::Bilinear, Lookup::Bilinear).unwrap();
+//! let shader = Shader { tf: TransferFunction { lut: Preset::Grey.lut(), lo: 0.0, hi: 255.0 }, shading: Shading::Emission };
+//! let (mut acc, mut image, mut rows) = (vec![[0i64; 4]; 48 * 48], vec![[0u32; 4]; 48 * 48], vec![RowSpan::EMPTY; 48]);
+//! let buffers = RenderBuffers { accumulator: &mut acc, image: &mut image, rows: &mut rows };
+//! let path = FixedPath::new(&frame, &table).unwrap();
+//! let mut renderer = SheetRenderer::with_path(&frame, path, shader, Order::BackToFront, buffers, None).unwrap();
+//! let mut sheets = vec![0u8; 3 * frame.sheet_shape().0];
+//! let mut ring = SheetRing::for_renderer(&mut sheets, &renderer).unwrap();
+//! render_from(&mut renderer, &mut ring, &mut MemoryVolume::new(&data, dims).unwrap()).unwrap();
+//! renderer.finish();
+//! let centre = fixed::to_f32(image[24 * 48 + 24]);
+//! assert!(centre[3] > 0.5 && centre[3] <= 1.0);
+//! ```
 //!
 //! ## One footprint
 //! ```
@@ -98,6 +160,8 @@ pub mod kernel;
 pub mod lod;
 pub mod math;
 pub mod output;
+pub mod prelude;
+pub mod quick;
 pub mod refine;
 pub mod render;
 pub mod shade;
@@ -137,6 +201,8 @@ pub enum Error {
     Fixed(fixed::FixedError),
     /// A slice that is not a volume of the dimensions given.
     Volume(volume::VolumeError),
+    /// A sequential source whose sheets run along another axis than the frame's.
+    Order(source::OrderMismatch),
 }
 
 impl fmt::Display for Error {
@@ -150,6 +216,7 @@ impl fmt::Display for Error {
             Error::Render(e) => e.fmt(f),
             Error::Fixed(e) => e.fmt(f),
             Error::Volume(e) => e.fmt(f),
+            Error::Order(e) => e.fmt(f),
         }
     }
 }
@@ -165,6 +232,7 @@ impl core::error::Error for Error {
             Error::Render(e) => Some(e),
             Error::Fixed(e) => Some(e),
             Error::Volume(e) => Some(e),
+            Error::Order(e) => Some(e),
         }
     }
 }
@@ -186,5 +254,6 @@ from_error!(
     Frame(frame::FrameError),
     Render(render::RenderError),
     Fixed(fixed::FixedError),
-    Volume(volume::VolumeError)
+    Volume(volume::VolumeError),
+    Order(source::OrderMismatch)
 );

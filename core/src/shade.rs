@@ -13,8 +13,10 @@ use crate::math;
 use crate::splat::BufferError;
 use glam::Vec3;
 
+pub mod presets;
 mod transfer;
 
+pub use presets::{Preset, LUT_SIZE};
 pub use transfer::{TransferFunction, TransferFunctionError, RAMP_MIN_OPACITY};
 
 /// Phong lighting coefficients (a head-light at the viewer).

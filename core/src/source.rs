@@ -61,6 +61,22 @@ pub struct OrderMismatch {
     pub frame_axis: usize,
 }
 
+impl core::fmt::Display for OrderMismatch {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        let name = |a: usize| ["i (x)", "j (y)", "k (z)"].get(a).copied().unwrap_or("?");
+        write!(
+            f,
+            "the source delivers sheets along axis {} in order, but this view splats sheets along \
+             axis {}: read the volume into memory (or from a seekable file), or choose a view whose \
+             sheet axis is the source's",
+            name(self.source_axis),
+            name(self.frame_axis)
+        )
+    }
+}
+
+impl core::error::Error for OrderMismatch {}
+
 /// The compositing order to use with `source` for `renderer`'s frame: `preferred` for a seekable
 /// source; for a sequential one, the order its ascending delivery implies, or an
 /// [`OrderMismatch`] if its axis is not the frame's sheet axis.
@@ -96,7 +112,9 @@ where
 
 /// [`render_from`] for several renderers of one frame and compositing order (the bands of an
 /// image, say, or a few bands sampled from it), every sheet read once and rendered by each in
-/// turn. The first renderer's frame sets the sheets; no renderer, nothing read.
+/// turn. The first renderer's frame sets the sheets; no renderer, nothing read. A ring made for
+/// another compositing order than a renderer's is refused ([`RenderError::RingOrder`]); make it
+/// with [`SheetRing::for_renderer`].
 pub fn render_all_from<P, Src>(
     renderers: &mut [SheetRenderer<'_, P>],
     ring: &mut SheetRing<'_, Src::Sample>,
@@ -109,6 +127,15 @@ where
     let Some(first) = renderers.first() else {
         return Ok(());
     };
+    // The order is the renderers' (given once, to them); a ring built for another one would feed
+    // the sheets back to front to a front-to-back renderer: refused, not a silently wrong image.
+    if let Some(r) = renderers.iter().find(|r| r.order() != ring.order()) {
+        return Err(RenderError::RingOrder {
+            ring: ring.order(),
+            renderer: r.order(),
+        }
+        .into());
+    }
     let (axis, count) = (first.frame().sheet_axis, first.frame().sheet_count());
     for step in 0..count {
         let s = ring.sheet_index(step);

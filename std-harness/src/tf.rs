@@ -7,38 +7,23 @@ pub mod paraview;
 use crate::CliError;
 use std::path::Path;
 
-/// Entries in the lookup tables the harness builds.
-pub const LUT_SIZE: usize = 256;
+/// Entries in the lookup tables the harness builds (the core's presets' size).
+pub use footprint::shade::LUT_SIZE;
 
-/// A named preset's control points.
+/// A named preset's control points (the core's [`footprint::shade::Preset`]s).
 pub fn preset(name: &str) -> Option<Vec<[f32; 5]>> {
-    Some(match name {
-        // Grey linear ramp: colour and opacity rise together.
-        "grey" => vec![[0.0, 0.0, 0.0, 0.0, 0.0], [1.0, 1.0, 1.0, 1.0, 1.0]],
-        // CT: air transparent, skin a faint tan veil, bone near-opaque ivory.
-        "ct-bone-skin" => vec![
-            [0.0, 0.0, 0.0, 0.0, 0.0],
-            [0.18, 0.0, 0.0, 0.0, 0.0],
-            [0.24, 0.9, 0.62, 0.5, 0.06],
-            [0.34, 0.9, 0.62, 0.5, 0.03],
-            [0.45, 0.9, 0.75, 0.6, 0.0],
-            [0.55, 0.95, 0.92, 0.85, 0.35],
-            [1.0, 1.0, 1.0, 0.95, 0.9],
-        ],
-        // Density, after the paper's ozone and orbital images: blue (low) → green → red (high).
-        "density" => vec![
-            [0.0, 0.0, 0.0, 1.0, 0.0],
-            [0.08, 0.1, 0.2, 1.0, 0.01],
-            [0.35, 0.1, 0.9, 0.3, 0.06],
-            [0.7, 1.0, 0.3, 0.1, 0.25],
-            [1.0, 1.0, 0.1, 0.05, 0.6],
-        ],
-        _ => return None,
-    })
+    footprint::shade::Preset::from_name(name).map(|p| p.points().to_vec())
 }
 
 /// Names of the presets.
-pub const PRESETS: [&str; 3] = ["grey", "ct-bone-skin", "density"];
+pub const PRESETS: [&str; 3] = {
+    use footprint::shade::Preset;
+    [
+        Preset::ALL[0].name(),
+        Preset::ALL[1].name(),
+        Preset::ALL[2].name(),
+    ]
+};
 
 /// Parses a control-point file: one `t r g b a` per line, `#` comments, t increasing in [0, 1].
 pub fn parse_points(text: &str, name: &str) -> Result<Vec<[f32; 5]>, CliError> {
@@ -112,26 +97,9 @@ pub fn load(spec: &str) -> Result<Vec<[f32; 5]>, CliError> {
 }
 
 /// Samples control points into a LUT of `LUT_SIZE` straight RGBA entries (linear between points,
-/// constant beyond the ends).
+/// constant beyond the ends): the core's [`footprint::shade::presets::sample_points`].
 pub fn lut(points: &[[f32; 5]]) -> Vec<[f32; 4]> {
-    (0..LUT_SIZE)
-        .map(|i| {
-            let t = i as f32 / (LUT_SIZE - 1) as f32;
-            let j = points
-                .iter()
-                .position(|p| p[0] >= t)
-                .unwrap_or(points.len() - 1);
-            let (p, q) = if j == 0 {
-                (points[0], points[0])
-            } else {
-                (points[j - 1], points[j])
-            };
-            let f = if q[0] > p[0] {
-                ((t - p[0]) / (q[0] - p[0])).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            [1, 2, 3, 4].map(|c| p[c] + f * (q[c] - p[c]))
-        })
-        .collect()
+    let mut out = vec![[0.0; 4]; LUT_SIZE];
+    footprint::shade::presets::sample_points(points, &mut out);
+    out
 }

@@ -10,7 +10,7 @@ venv=target/writers-venv
 "$venv/bin/pip" install -q --disable-pip-version-check vtk SimpleITK nibabel pynrrd numpy
 out=$(mktemp -d)
 "$venv/bin/python" tests/writers/make_fixtures.py "$out"
-FOOTPRINT_WRITER_FIXTURES="$out" cargo test -q --test real_writers -- --nocapture 2>&1 | grep -E "matched|test result|panicked|FAILED"
+FOOTPRINT_WRITER_FIXTURES="$out" cargo test -q --test suite real_writers:: -- --nocapture 2>&1 | grep -E "matched|test result|panicked|FAILED"
 rm -rf "$out"
 
 # VTK's camera: silhouettes of VTK's renders and Footprint's agree for the same --view.

@@ -27,7 +27,7 @@ pub type Mat2 = [[f32; 2]; 2];
 
 /// m · v.
 #[inline]
-pub fn mul2(m: &Mat2, v: [f32; 2]) -> [f32; 2] {
+pub(crate) fn mul2(m: &Mat2, v: [f32; 2]) -> [f32; 2] {
     [
         m[0][0] * v[0] + m[0][1] * v[1],
         m[1][0] * v[0] + m[1][1] * v[1],
@@ -285,7 +285,7 @@ pub fn covariance(n: &[[f32; 3]; 2]) -> Sym2 {
 }
 
 /// det(N Nᵀ) by Cauchy–Binet: the sum of the squares of N's three 2×2 minors. No cancellation.
-pub fn cauchy_binet_det(n: &[[f32; 3]; 2]) -> f32 {
+pub(crate) fn cauchy_binet_det(n: &[[f32; 3]; 2]) -> f32 {
     let minor = |a: usize, b: usize| n[0][a] * n[1][b] - n[0][b] * n[1][a];
     sq(minor(0, 1)) + sq(minor(0, 2)) + sq(minor(1, 2))
 }

@@ -462,7 +462,8 @@ mod ellipse;
 mod paper;
 mod perspective;
 
-pub use ellipse::{cauchy_binet_det, conic_of, covariance, mul2, Footprint, Mat2, Sym2};
+pub(crate) use ellipse::mul2;
+pub use ellipse::{conic_of, covariance, Footprint, Mat2, Sym2};
 pub use paper::{
     paper_decomposition, PaperDecomposition, PAPER_MAX_CHEAT_DEG, PAPER_ROUND_CONIC,
     PAPER_SINGULAR_COS2,

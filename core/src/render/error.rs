@@ -58,6 +58,14 @@ pub enum RenderError {
         /// Slabs composited so far.
         composited: usize,
     },
+    /// A [`SheetRing`](super::SheetRing) made for another compositing order than the renderer's
+    /// (make it with [`SheetRing::for_renderer`](super::SheetRing::for_renderer)).
+    RingOrder {
+        /// The ring's order.
+        ring: crate::frame::Order,
+        /// The renderer's.
+        renderer: crate::frame::Order,
+    },
     /// A voxel above the channel bound a [`FixedPath`](super::FixedPath) was promised
     /// ([`FixedPath::with_value_bound`](super::FixedPath::with_value_bound)).
     ValueAboveBound {
@@ -103,6 +111,11 @@ impl fmt::Display for RenderError {
                 f,
                 "a voxel overlapping slabs {first}..={last} came after {composited} slabs were \
                  composited: feed voxels in the order of the slab they reach first"
+            ),
+            Self::RingOrder { ring, renderer } => write!(
+                f,
+                "the sheet ring was made for {ring:?} but the renderer composites {renderer:?}: \
+                 make the ring with SheetRing::for_renderer"
             ),
             Self::ValueAboveBound { value, bound } => write!(
                 f,

@@ -77,6 +77,7 @@ pub struct SheetRing<'a, T> {
     pushed: usize,
     total: usize,
     ascending: bool,
+    order: Order,
 }
 
 impl<'a, T: Copy> SheetRing<'a, T> {
@@ -100,7 +101,22 @@ impl<'a, T: Copy> SheetRing<'a, T> {
             pushed: 0,
             total: frame.sheet_count(),
             ascending: frame.ascending_for(order),
+            order,
         })
+    }
+
+    /// A ring over `storage` for `renderer`'s frame and compositing order (the order given once,
+    /// to the renderer).
+    pub fn for_renderer<P: super::Precision>(
+        storage: &'a mut [T],
+        renderer: &super::SheetRenderer<'_, P>,
+    ) -> Result<Self, RenderError> {
+        Self::new(storage, renderer.frame(), renderer.order())
+    }
+
+    /// The compositing order the ring delivers sheets for.
+    pub fn order(&self) -> Order {
+        self.order
     }
 
     /// Fills the next sheet in sequence by calling `fill` with its slot (exactly one sheet long);
