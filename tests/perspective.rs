@@ -228,7 +228,12 @@ fn streamed_and_piped_renders_equal_loaded_renders() {
         args.extend_from_slice(&p);
         args.extend_from_slice(&["--out", piped_out.to_str().unwrap()]);
         let mut child = Command::new(std::env::current_exe().unwrap())
-            .args(["child", "--exact", "--nocapture", "--test-threads=1"])
+            .args([
+                "perspective::child",
+                "--exact",
+                "--nocapture",
+                "--test-threads=1",
+            ])
             .env("FOOTPRINT_CHILD", args.join(&SEP.to_string()))
             .stdin(Stdio::piped())
             .stdout(Stdio::null())

@@ -422,6 +422,8 @@ fn opaque_voxels_converge_too() {
         "30,20,0",
         "--window",
         "0,300",
+        "--tf",
+        "grey",
         "--threads",
         "2",
         // The continuous reference integrates full resolution.

@@ -18,6 +18,7 @@ mod layering;
 mod library;
 mod lod;
 mod minification;
+mod newcomer;
 mod outputs;
 mod paraview_presets;
 mod perspective;

@@ -20,6 +20,8 @@ while IFS='|' read -r name cmd; do
   "$fp" "$@" --out "$out/$name" >/dev/null
 done <<LIST
 default-scene.png|render
+headsq-default.png|render $data/headsq_64x64x93_int16_le.nhdr --view 180,-90,0 -s 256x256
+headsq-colorbar.png|render $data/headsq_64x64x93_int16_le.nhdr --shading phong --view 30,20,0 -s 256x256 --colorbar
 headsq-phong.png|render $data/headsq_64x64x93_int16_le.nhdr --tf ct-bone-skin --shading phong --view 180,-90,0
 headsq-iso.png|render $data/headsq_64x64x93_int16_le.nhdr --tf ct-bone-skin --shading iso:1900 --view -30,-80,180
 heart-texture.png|render $data/heart_32x32x12_float32_le.nhdr --tf density --shading texture --view 150,-20,180

@@ -122,7 +122,7 @@ def render(
     spacing: Sequence[float] = (1, 1, 1),
     size: Sequence[int] = (512, 512),
     view: Sequence[float] = (0, 0, 0),
-    tf: str = "grey",
+    tf: Optional[str] = None,
     window: Optional[Sequence[float]] = None,
     dtype: Any = np.float32,
     **flags: Any,
@@ -130,7 +130,9 @@ def render(
     """Renders a 3-D array (or a ``pyvista.ImageData``) as ``footprint render`` would.
 
     Returns (height, width, 4) premultiplied linear RGBA, float32 (``dtype=numpy.uint8``: 8-bit).
-    ``window`` (lo, hi) maps values onto the transfer function; None takes the data's range.
+    ``window`` (lo, hi) maps values onto the transfer function; None: the window ``render`` picks
+    from the data (Otsu threshold to the 99.5th percentile; ``footprint info`` prints it). ``tf``
+    None: ``ct-bone-skin``, as ``footprint render`` on a file.
     Any other ``footprint render`` flag is a keyword (``shading="phong"``, ``threads=2``,
     ``slicing="image"``, ``accum="fixed"``, ``lod=0``, ...).
     """
@@ -147,7 +149,7 @@ def render_stream(
     dtype: Any = np.float32,
     size: Sequence[int] = (512, 512),
     view: Sequence[float] = (0, 0, 0),
-    tf: str = "grey",
+    tf: Optional[str] = None,
     window: Optional[Sequence[float]] = None,
     image_dtype: Any = np.float32,
     **flags: Any,
@@ -213,7 +215,7 @@ def verify(
     spacing: Sequence[float] = (1, 1, 1),
     size: Sequence[int] = (512, 512),
     view: Sequence[float] = (0, 0, 0),
-    tf: str = "grey",
+    tf: Optional[str] = None,
     window: Optional[Sequence[float]] = None,
     **flags: Any,
 ) -> dict:
@@ -228,7 +230,7 @@ def bench(
     spacing: Sequence[float] = (1, 1, 1),
     size: Sequence[int] = (512, 512),
     view: Sequence[float] = (0, 0, 0),
-    tf: str = "grey",
+    tf: Optional[str] = None,
     window: Optional[Sequence[float]] = None,
     **flags: Any,
 ) -> dict:

@@ -75,7 +75,7 @@ def test_render_is_byte_identical_to_the_command_line(tmp_path, flags):
     py = footprint.render(v, spacing=(1, 1.5, 2), size=size, window=(0, 3500), **flags)
     assert py.shape == (64, 96, 4) and py.dtype == np.float32
     args = [cli(), "render", str(raw), "--dims", "28,20,24", "--type", "u16", "--spacing", "1,1.5,2"]
-    args += ["--size", "96x64", "--window", "0,3500", "--tf", "grey", "--out", str(tmp_path / "o.pfm")]
+    args += ["--size", "96x64", "--window", "0,3500", "--out", str(tmp_path / "o.pfm")]
     args += footprint._flags(**{k: v for k, v in flags.items()})
     if "view" not in flags:
         args += ["--view", "0,0,0"]

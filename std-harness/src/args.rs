@@ -170,7 +170,7 @@ pub struct FootprintArgs {
     #[arg(long, default_value = "gaussian:spread=1.6,sigmas=2.5")]
     pub kernel: String,
     /// Generic and view table size N (N×N). The default, 129, is on the Pareto frontier of
-    /// `footprint chart` for both charted scenes (README, "Speed against accuracy").
+    /// `footprint chart` for both charted scenes (docs/accuracy.md, "Speed against accuracy").
     #[arg(long, default_value_t = 129)]
     pub table: usize,
     /// Load the generic table from a file written by `footprint tables` (its N must equal --table).
@@ -274,11 +274,11 @@ pub struct RenderArgs {
     #[arg(long, value_name = "NAME")]
     pub array: Option<String>,
     /// Image size, WxH pixels.
-    #[arg(long, default_value = "512x512", value_parser = parse_size)]
+    #[arg(short, long, default_value = "512x512", value_parser = parse_size)]
     pub size: (usize, usize),
     /// VTK/ParaView camera AZ,EL,ROLL in degrees: from ParaView's default (on +z looking toward
     /// −z, +y up), Azimuth(AZ), Elevation(EL), Roll(ROLL); or a view-direction button of
-    /// ParaView's: +x, -x, +y, -y (+z up), +z, -z (+y up). See the README's "Camera".
+    /// ParaView's: +x, -x, +y, -y (+z up), +z, -z (+y up). See docs/cli.md, "Camera".
     #[arg(long, default_value = "0,0,0", value_parser = parse_view, allow_hyphen_values = true)]
     pub view: [f32; 3],
     /// Multiplies the zoom that fits the volume's bounding sphere into the image (VTK's
@@ -334,13 +334,13 @@ pub struct RenderArgs {
     /// cubic interpolation (the harness's `pipeline::subsample`); `auto` picks the largest s that
     /// keeps the footprints' shorter semi-axis at least 2 px at the lower resolution (Gaussian
     /// kernels, orthographic views only; otherwise 1). 1, the default, is off. Measured cost in
-    /// accuracy: README, "Subsampling".
+    /// accuracy: docs/modes.md, "Subsampling".
     #[arg(long, default_value = "1", value_parser = parse_supersample)]
     pub subsample: Supersample,
     /// Level of detail: a number N splats level N (each level averages 2x2x2 samples of the one
     /// above into one, the spacing doubled, carrying the block's colour; 0 = full resolution);
     /// `auto`, the default, the deepest level L with 4^L x (level 0's projected spacing) <= 3 px
-    /// (README, "Levels of detail"). Orthographic views only (`auto` keeps a perspective view, and
+    /// (docs/modes.md, "Levels of detail"). Orthographic views only (`auto` keeps a perspective view, and
     /// --refine, at level 0). The f64 reference `verify` compares with renders the same level
     /// (and, for a level >= 1, also level 0: `full res`); the continuous reference integrates
     /// full resolution (`auto` then means level 0). With --quality, `auto` means the level the
@@ -351,7 +351,7 @@ pub struct RenderArgs {
     /// whose neighbouring samples' classified colours (premultiplied RGBA, 0..1) differ by more
     /// than THRESHOLD get 2 or 4 steps of Catmull-Rom-interpolated samples, splatted with
     /// footprints for their local spacing (one-sided at region borders); steps stay ≥ 2 px apart
-    /// on screen. Float, object slicing, orthographic, the volume in memory. See the README's
+    /// on screen. Float, object slicing, orthographic, the volume in memory. See docs/modes.md,
     /// "Adaptive refinement".
     #[arg(long, value_name = "THRESHOLD", value_parser = parse_threshold, conflicts_with = "quality", allow_hyphen_values = true)]
     pub refine: Option<f32>,
@@ -391,10 +391,13 @@ pub struct RenderArgs {
     #[arg(long, value_enum, default_value_t = QualityReferenceArg::Sheets, requires = "quality")]
     pub quality_reference: QualityReferenceArg,
     /// Transfer function: a preset (grey, ct-bone-skin, density) or a file of `t r g b a` lines.
-    /// Default: density for the built-in scene, grey otherwise.
+    /// Default: density for the built-in scene, ct-bone-skin for a volume (transparent over the
+    /// window's first 18 %).
     #[arg(long)]
     pub tf: Option<String>,
-    /// Value window LO,HI mapped onto the transfer function (default: the data's range).
+    /// Value window LO,HI mapped onto the transfer function. Default for a volume: Otsu's
+    /// threshold between background and foreground to the 99.5th percentile, from at most 2^20
+    /// strided samples (`footprint info` prints it); the built-in scene: the data's range.
     #[arg(long, value_parser = parse_list::<2>, allow_hyphen_values = true)]
     pub window: Option<[f32; 2]>,
     /// Shading: emission, phong, iso:VALUE (Levoy iso-surface at VALUE, data units), texture.
@@ -441,7 +444,7 @@ pub struct RenderArgs {
     /// values unclamped, over black or the background image); other extensions are refused. `render`
     /// defaults to footprint.png; `verify` writes one only if asked. Every output is checked
     /// before rendering, and none is written unless all are.
-    #[arg(long)]
+    #[arg(short, long)]
     pub out: Option<PathBuf>,
 }
 
@@ -562,12 +565,12 @@ pub struct SplatArgs {
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub rotate_z: f32,
     /// Image size, WxH pixels.
-    #[arg(long, default_value = "256x256", value_parser = parse_size)]
+    #[arg(short, long, default_value = "256x256", value_parser = parse_size)]
     pub size: (usize, usize),
     /// Voxel position on screen, pixels (default: the image centre W/2,H/2).
     #[arg(long, value_parser = parse_list::<2>, allow_hyphen_values = true)]
     pub center: Option<[f32; 2]>,
     /// Output: .pfm (float32 weights) or .png (8-bit, normalised to the peak).
-    #[arg(long)]
+    #[arg(short, long)]
     pub out: PathBuf,
 }

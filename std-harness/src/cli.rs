@@ -1,7 +1,7 @@
 //! The command line's top: the subcommands and the dispatch to them. Nothing imports this module
 //! back; the argument structs commands share live in [`crate::args`].
 
-use crate::args::{RenderArgs, SplatArgs};
+use crate::args::SplatArgs;
 use crate::commands;
 use crate::io::stream::InMemory;
 use clap::{Parser, Subcommand};
@@ -18,8 +18,8 @@ pub struct Cli {
 #[derive(Subcommand, Debug)]
 pub enum Command {
     /// Render a volume (or, with no volume, the built-in scene) to a PNG.
-    #[command(allow_negative_numbers = true)]
-    Render(RenderArgs),
+    #[command(allow_negative_numbers = true, after_help = RENDER_EXAMPLES)]
+    Render(commands::render::RenderCommandArgs),
     /// Render one voxel (value 1) and write its raw footprint weights (px⁻²).
     #[command(allow_negative_numbers = true)]
     Splat(SplatArgs),
@@ -46,7 +46,21 @@ pub enum Command {
     /// reusing cached state (first_ms, median_ms, phases_ms; --json).
     #[command(allow_negative_numbers = true)]
     Bench(commands::bench::BenchArgs),
+    /// Print a shell completion script: `footprint completions bash > ~/.local/share/bash-completion/completions/footprint`
+    /// (zsh: into a folder on $fpath as `_footprint`; fish: ~/.config/fish/completions/footprint.fish).
+    Completions {
+        /// bash, zsh, fish, elvish or powershell.
+        shell: clap_complete::Shell,
+    },
 }
+
+const RENDER_EXAMPLES: &str = "Examples:
+  footprint render                                   the built-in scene to footprint.png
+  footprint info head.nrrd                           dims, spacing, range and the window render picks
+  footprint render head.nrrd --tf ct-bone-skin --shading phong -o head.png
+  footprint render head.nrrd -s 256x256 --view 30,20,0 --window 1200,2400 -o head.png
+  footprint render head.nrrd --orbit 36 --colorbar -o orbit.png   (an animated PNG)
+  footprint render head.nrrd -o head.pfm             linear float RGB, for footprint compare";
 
 /// Runs the command line `args` (program name first); returns the process exit code: 0 success,
 /// 1 a check failed, 2 bad input or I/O error. Errors are printed to stderr as one line.
@@ -98,7 +112,29 @@ fn dispatch(command: Command) -> Result<(), crate::CliError> {
         Command::Chart(a) => commands::chart::run(&a),
         Command::Bench(a) => commands::bench::run(&a),
         Command::Info(a) => commands::info::run(&a),
+        Command::Completions { shell } => {
+            let out = completion_script(&shell.to_string())?;
+            use std::io::Write as _;
+            std::io::stdout()
+                .lock()
+                .write_all(&out)
+                .map_err(|e| crate::CliError::input(format!("standard output: {e}")))
+        }
     }
+}
+
+/// The completion script of `footprint` for `shell` (bash, zsh, fish, elvish, powershell): what
+/// `footprint completions SHELL` prints.
+pub fn completion_script(shell: &str) -> Result<Vec<u8>, crate::CliError> {
+    use clap::CommandFactory as _;
+    let shell: clap_complete::Shell = shell.parse().map_err(|_| {
+        crate::CliError::input(format!(
+            "no completions for '{shell}': bash, zsh, fish, elvish or powershell"
+        ))
+    })?;
+    let mut out = Vec::new();
+    clap_complete::generate(shell, &mut Cli::command(), "footprint", &mut out);
+    Ok(out)
 }
 
 /// Runs the command line `args` (program name first) as [`run`] does, for a program that calls
@@ -115,7 +151,7 @@ where
     let mut command = cli.command;
     if let Some(m) = memory {
         let render = match &mut command {
-            Command::Render(a) => a,
+            Command::Render(a) => &mut a.render,
             Command::Verify(a) => &mut a.render,
             Command::Bench(a) => &mut a.render,
             _ => {

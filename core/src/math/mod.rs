@@ -253,7 +253,7 @@ mod tests {
                     .max((f64::from(powf(x, y)) - libm::pow(f64::from(x), f64::from(y))).abs());
             }
         }
-        // Printed with --nocapture; the README's backend table quotes these.
+        // Printed with --nocapture; docs/embedded.md's backend table quotes these.
         std::println!(
             "{BACKEND}: sqrt {sqrt_e:.2e} rel, exp {exp_e:.2e} rel, sin {sin_e:.2e}, cos {cos_e:.2e}, atan {atan_e:.2e}, erf {erf_e:.2e}, powf {pow_e:.2e}"
         );

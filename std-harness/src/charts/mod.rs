@@ -33,6 +33,7 @@
 //! built-in scene at `--scene-size`, unrefined and at each `--refine` threshold, its frame time
 //! and its PSNR against the same field sampled at `--refine-reference`.
 
+pub mod colorbar;
 pub mod lod;
 pub mod plot;
 pub mod popping;

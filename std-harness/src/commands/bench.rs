@@ -79,15 +79,7 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
     let mut first_image = None;
     let mut threads = 1;
     for k in 0..args.frames {
-        let mut a = base.clone();
-        let turn = args.orbit * k as f32;
-        a.view[0] += turn;
-        if let Some(m) = a.view_matrix {
-            // V · Ry(turn): the same turn of the volume about its vertical axis as --view's azimuth.
-            let v = glam::Mat3::from_cols_array(&m).transpose()
-                * glam::Mat3::from_rotation_y(turn.to_radians());
-            a.view_matrix = Some(v.transpose().to_cols_array());
-        }
+        let a = crate::pipeline::turned(&base, args.orbit * k as f32);
         if k > 0 {
             p.reframe(&a)?;
         }

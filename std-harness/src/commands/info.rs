@@ -6,6 +6,7 @@ use crate::io::json::Json;
 use crate::io::outputs::{self, Planned};
 use crate::io::volume::Samples;
 use crate::pipeline::load::raw_options;
+use crate::pipeline::window;
 use crate::CliError;
 use clap::Args;
 
@@ -15,9 +16,6 @@ pub struct InfoArgs {
     #[command(flatten)]
     pub render: RenderArgs,
 }
-
-/// Most samples the percentiles are taken from: an evenly strided sample of a larger volume.
-const PERCENTILE_SAMPLES: usize = 1 << 20;
 
 /// The percentiles printed, in percent.
 const PERCENTILES: [f64; 7] = [1.0, 5.0, 25.0, 50.0, 75.0, 95.0, 99.0];
@@ -50,25 +48,26 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
     };
     let n = v.len();
     let (lo, hi) = v.range();
-    // Every finite sample, or an evenly strided sample of them (the percentiles' source).
-    let step = n.div_ceil(PERCENTILE_SAMPLES).max(1);
-    let mut sample: Vec<f32> = (0..n)
-        .step_by(step)
-        .map(|i| v.value(i))
-        .filter(|x| x.is_finite())
-        .collect();
+    // Every finite sample, or an evenly strided sample of them (the percentiles' source, and
+    // the default window's, as render takes it).
+    let step = crate::io::volume::sample_stride(n);
+    let sample = v.strided_sample();
     let missing = (0..n).filter(|&i| !v.value(i).is_finite()).count();
-    sample.sort_by(f32::total_cmp);
     let at = |p: f64| {
-        sample
-            .get(((p / 100.0) * (sample.len().max(1) - 1) as f64).round() as usize)
-            .copied()
-            .unwrap_or(f32::NAN)
+        if sample.is_empty() {
+            f32::NAN
+        } else {
+            window::percentile(&sample, p)
+        }
     };
     let pcts: Vec<f64> = PERCENTILES.iter().map(|&p| f64::from(at(p))).collect();
-    let window = match r.window {
-        Some(w) => (w, "--window"),
-        None => ([lo, hi], "the data's range; --window LO,HI to change"),
+    let window = match (r.window, window::auto_window(&sample)) {
+        (Some(w), _) => (w, "--window".to_string()),
+        (None, Some(w)) => (w, format!("{}; --window LO,HI to change", window::RULE)),
+        (None, None) => (
+            [lo, hi],
+            "the data's range; --window LO,HI to change".into(),
+        ),
     };
     let [nx, ny, nz] = v.dims;
     let name = path.display();
@@ -129,6 +128,7 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
             .obj("percentiles", p)
             .num("percentile_stride", step as f64)
             .arr_f64("window", &window.0.map(f64::from))
+            .str("window_rule", &window.1)
             .finish();
         outputs::write_one(j, json.as_bytes())?;
     }

@@ -2,15 +2,35 @@
 //! PNG (see [`crate::pipeline::prepare`](mod@crate::pipeline::prepare) for the view conventions).
 
 use crate::args::{MethodArg, RenderArgs};
-use crate::io::image::{check_style, encode_rgb_for, RGB_EXTENSIONS};
+use crate::charts::colorbar;
+use crate::io::image::{check_style, encode_apng, encode_rgb_for, RGB_EXTENSIONS};
 use crate::io::outputs::{self, Planned};
 use crate::pipeline::visible::FrameCache;
 use crate::pipeline::{choose::apply_quality, quality::quality_json};
-use crate::pipeline::{describe, prepare, render_frame, render_ref};
+use crate::pipeline::{describe, prepare, render_frame, render_ref, turned, Prepared};
 use crate::CliError;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
 
-pub fn run(args: &RenderArgs) -> Result<(), CliError> {
+/// `footprint render`: the render flags every rendering command shares, and what only a picture
+/// for people needs.
+#[derive(clap::Args, Debug, Clone)]
+pub struct RenderCommandArgs {
+    #[command(flatten)]
+    pub render: RenderArgs,
+    /// An animated PNG (APNG) of N frames (2 to 360) turning the volume once around its vertical
+    /// axis, as ParaView's orbit does: frame k at --view's azimuth + 360·k/N degrees, a full turn
+    /// in about 4 s, looping. The volume is loaded and classified once. --out must be a .png.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(2..=360))]
+    pub orbit: Option<u16>,
+    /// Draw the transfer function's legend into the image (every frame of an --orbit): its
+    /// colours, its opacity as a white line, and the window's values, in a panel at the right.
+    #[arg(long)]
+    pub colorbar: bool,
+}
+
+pub fn run(command: &RenderCommandArgs) -> Result<(), CliError> {
+    let args = &command.render;
     let out = args
         .out
         .clone()
@@ -32,7 +52,10 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     check_style(&out, args.png_style())?;
     let (p, args, choice) = apply_quality(prepare(args)?, args)?;
     let args = &args;
-    let (rgb, summary) = if args.footprint.method == MethodArg::Reference {
+    if let Some(n) = command.orbit {
+        return orbit(p, args, &out, usize::from(n), command.colorbar);
+    }
+    let (mut rgb, summary) = if args.footprint.method == MethodArg::Reference {
         let (img, secs) = render_ref(&p)?;
         let rgb: Vec<[f32; 4]> = img.iter().map(|c| c.map(|x| x as f32)).collect();
         crate::say!("{}: f64 reference render in {:.3} s", p.name, secs);
@@ -96,6 +119,9 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         Some(c) => summary.obj("quality", quality_json(c)),
         None => summary,
     };
+    if command.colorbar {
+        colorbar::draw(&mut rgb, args.size, &p.lut, p.window)?;
+    }
     let image = encode_rgb_for(&out, &rgb, args.size.0, args.size.1, args.png_style())?;
     let summary = summary.str("out", &out.display().to_string()).finish();
     let mut files = vec![(out.as_path(), image.as_slice())];
@@ -104,5 +130,56 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     }
     outputs::write_all(&files)?;
     crate::say!("wrote {}", out.display());
+    Ok(())
+}
+
+/// `--orbit N`: N frames a 360/N-degree turn apart, reusing the loaded volume, its level and its
+/// visible-voxel lists, encoded into one animated PNG as they come.
+fn orbit(
+    mut p: Prepared,
+    args: &RenderArgs,
+    out: &Path,
+    n: usize,
+    bar: bool,
+) -> Result<(), CliError> {
+    if crate::io::outputs::extension(out).as_deref() != Some("png") {
+        return Err(CliError::input(format!(
+            "--orbit writes an animated PNG: {} is not a .png",
+            out.display()
+        )));
+    }
+    if args.footprint.method == MethodArg::Reference {
+        return Err(CliError::input(
+            "--orbit renders with the core: --method reference is one frame (render without --orbit)",
+        ));
+    }
+    let start = Instant::now();
+    let mut cache = FrameCache::default();
+    let delay = (4000 / n).clamp(20, 1000) as u16;
+    let image = encode_apng(args.size, args.png_style(), n, delay, |k| {
+        let a = turned(args, 360.0 * k as f32 / n as f32);
+        if k > 0 {
+            p.reframe(&a)?;
+        }
+        let mut f = render_frame(&p, &a, a.accum, &mut cache)?;
+        crate::say!("{}: frame {}/{n} in {:.3} s", p.name, k + 1, f.seconds);
+        if bar {
+            colorbar::draw(&mut f.image, args.size, &p.lut, p.window)?;
+        }
+        Ok(f.image)
+    })?;
+    let secs = start.elapsed().as_secs_f64();
+    let summary = describe(&p, args)
+        .num("frames", n as f64)
+        .num("frame_delay_ms", f64::from(delay))
+        .num("seconds", secs)
+        .str("out", &out.display().to_string())
+        .finish();
+    let mut files = vec![(out, image.as_slice())];
+    if let Some(j) = &args.json {
+        files.push((j.as_path(), summary.as_bytes()));
+    }
+    outputs::write_all(&files)?;
+    crate::say!("wrote {} ({n} frames, {secs:.2} s)", out.display());
     Ok(())
 }

@@ -235,6 +235,77 @@ pub fn encode_png(
     height: usize,
     style: PngStyle,
 ) -> Result<Vec<u8>, CliError> {
+    let bytes = png_samples(rgba, width, height, style)?;
+    let mut out = Vec::new();
+    let enc = png_encoder(&mut out, width, height, style);
+    let mut writer = enc.write_header().map_err(png_err)?;
+    writer.write_image_data(&bytes).map_err(png_err)?;
+    writer.finish().map_err(png_err)?;
+    Ok(out)
+}
+
+/// An animated PNG (APNG) of `count` frames in `style`, each shown `delay_ms` milliseconds and
+/// looping forever; `frame(k)` renders frame k (premultiplied RGBA as [`encode_png`] takes),
+/// which is encoded before the next is asked for, so memory holds one frame and the compressed
+/// file. Viewers without APNG show the first frame.
+pub fn encode_apng(
+    (width, height): (usize, usize),
+    style: PngStyle,
+    count: usize,
+    delay_ms: u16,
+    mut frame: impl FnMut(usize) -> Result<Vec<[f32; 4]>, CliError>,
+) -> Result<Vec<u8>, CliError> {
+    let mut out = Vec::new();
+    let mut enc = png_encoder(&mut out, width, height, style);
+    let frames = u32::try_from(count)
+        .map_err(|_| CliError::input(format!("{count} frames: too many for a PNG")))?;
+    enc.set_animated(frames, 0).map_err(png_err)?;
+    enc.set_frame_delay(delay_ms, 1000).map_err(png_err)?;
+    let mut writer = enc.write_header().map_err(png_err)?;
+    for k in 0..count {
+        let rgba = frame(k)?;
+        let bytes = png_samples(&rgba, width, height, style)?;
+        writer.write_image_data(&bytes).map_err(png_err)?;
+    }
+    writer.finish().map_err(png_err)?;
+    Ok(out)
+}
+
+fn png_err(e: png::EncodingError) -> CliError {
+    CliError::input(format!("PNG encoder: {e}"))
+}
+
+/// The PNG encoder for `style` (colour type, depth, the sRGB chunk) writing into `out`.
+fn png_encoder(
+    out: &mut Vec<u8>,
+    width: usize,
+    height: usize,
+    style: PngStyle,
+) -> png::Encoder<'static, &mut Vec<u8>> {
+    let mut enc = png::Encoder::new(out, width as u32, height as u32);
+    enc.set_color(if style.alpha {
+        png::ColorType::Rgba
+    } else {
+        png::ColorType::Rgb
+    });
+    enc.set_depth(if style.sixteen {
+        png::BitDepth::Sixteen
+    } else {
+        png::BitDepth::Eight
+    });
+    if style.gamma == Gamma::Srgb {
+        enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+    }
+    enc
+}
+
+/// The samples of one PNG image in `style` (see [`encode_png`]), row-major, big-endian at 16 bits.
+fn png_samples(
+    rgba: &[[f32; 4]],
+    width: usize,
+    height: usize,
+    style: PngStyle,
+) -> Result<Vec<u8>, CliError> {
     let channels = if style.alpha { 4 } else { 3 };
     let (top, bytes_per) = if style.sixteen {
         (65535.0, 2)
@@ -273,26 +344,7 @@ pub fn encode_png(
             put(a);
         }
     }
-    let mut out = Vec::new();
-    let mut enc = png::Encoder::new(&mut out, width as u32, height as u32);
-    enc.set_color(if style.alpha {
-        png::ColorType::Rgba
-    } else {
-        png::ColorType::Rgb
-    });
-    enc.set_depth(if style.sixteen {
-        png::BitDepth::Sixteen
-    } else {
-        png::BitDepth::Eight
-    });
-    if style.gamma == Gamma::Srgb {
-        enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
-    }
-    let err = |e: png::EncodingError| CliError::input(format!("PNG encoder: {e}"));
-    let mut writer = enc.write_header().map_err(err)?;
-    writer.write_image_data(&bytes).map_err(err)?;
-    writer.finish().map_err(err)?;
-    Ok(out)
+    Ok(bytes)
 }
 
 /// Encodes premultiplied RGBA (composited over black, i.e. the colour channels as they are) as an

@@ -336,6 +336,13 @@ impl<R: Read> SheetSource for PipeSource<R> {
 /// Smallest and largest finite sample of a streamed file, read sequentially in chunks of at most
 /// 4 MiB (however large a sheet is: a 32768² slice costs no more than a small one).
 pub fn file_range(layout: &Layout) -> Result<(f32, f32), CliError> {
+    file_summary(layout).map(|(range, _)| range)
+}
+
+/// [`file_range`] and, in the same pass, the finite values at every
+/// [`sample_stride`](crate::io::volume::sample_stride)th index, ascending: the same sample as
+/// [`Volume::strided_sample`](crate::io::volume::Volume::strided_sample) of the file loaded whole.
+pub fn file_summary(layout: &Layout) -> Result<((f32, f32), Vec<f32>), CliError> {
     let src = FileSource::open(layout.clone())?;
     let size = layout.ty.size();
     let total = crate::io::volume::byte_len(layout.dims, layout.ty)
@@ -345,6 +352,8 @@ pub fn file_range(layout: &Layout) -> Result<(f32, f32), CliError> {
     let mut values = super::try_filled(per, 0.0f32, "the range pass's chunk")?;
     let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
     let mut done = 0usize;
+    let step = crate::io::volume::sample_stride(total / size);
+    let mut sample = Vec::new();
     while done < total {
         let n = (total - done).min(per * size);
         src.file
@@ -356,15 +365,20 @@ pub fn file_range(layout: &Layout) -> Result<(f32, f32), CliError> {
             layout.big_endian,
             &mut values[..n / size],
         );
-        for &v in &values[..n / size] {
+        let first = done / size;
+        for (i, &v) in values[..n / size].iter().enumerate() {
             if v.is_finite() {
                 lo = lo.min(v);
                 hi = hi.max(v);
+                if (first + i).is_multiple_of(step) {
+                    sample.push(v);
+                }
             }
         }
         done += n;
     }
-    Ok((lo, hi))
+    sample.sort_by(f32::total_cmp);
+    Ok(((lo, hi), sample))
 }
 
 /// The most bytes [`file_range`] reads at a time (4 MiB).

@@ -203,6 +203,19 @@ impl Volume {
         self.len() == 0
     }
 
+    /// The finite samples at every [`sample_stride`]th index (0, s, 2s, …), ascending: at most
+    /// [`SAMPLE_LIMIT`] values, the same ones a streamed file's range pass takes.
+    pub fn strided_sample(&self) -> Vec<f32> {
+        let n = self.len();
+        let mut out: Vec<f32> = (0..n)
+            .step_by(sample_stride(n))
+            .map(|i| self.value(i))
+            .filter(|x| x.is_finite())
+            .collect();
+        out.sort_by(f32::total_cmp);
+        out
+    }
+
     /// Smallest and largest finite sample; (+∞, −∞) when no sample is finite.
     pub fn range(&self) -> (f32, f32) {
         // One loop per sample type (the type settled once, not per sample).
@@ -388,6 +401,15 @@ pub fn check_spacing(spacing: [f32; 3]) -> Result<(), String> {
 /// Error with the file's name in front.
 pub fn at(path: &Path, what: impl std::fmt::Display) -> CliError {
     CliError::input(format!("{}: {what}", path.display()))
+}
+
+/// Most values in a [`Volume::strided_sample`] (2²⁰): percentiles and the default window are taken
+/// from these.
+pub const SAMPLE_LIMIT: usize = 1 << 20;
+
+/// The stride of the evenly strided sample of `n` values: every `sample_stride(n)`th value.
+pub fn sample_stride(n: usize) -> usize {
+    n.div_ceil(SAMPLE_LIMIT).max(1)
 }
 
 #[cfg(test)]

@@ -17,7 +17,8 @@
 //! The same box and the same view give the same world-to-screen map, so the finer sampling's
 //! image lines up pixel for pixel with the coarse one (the refinement chart relies on the same).
 
-use super::prepare::{prepare, Prepared};
+use super::entry::prepare;
+use super::prepare::Prepared;
 use crate::args::{Lod, RenderArgs, SlicingArg};
 use crate::CliError;
 

@@ -6,7 +6,7 @@
 //! eight samples composited along a ray where a block holds structure (a thin shell beside empty
 //! space, voxel-scale noise). `--lod auto`'s rule on the projected spacing does not see that: it
 //! keeps the walnut's level 1 at 39.7 dB at 128×128, and gave 34.5 dB on voxel-scale speckle
-//! (README, "Levels of detail"). So `--quality` renders the candidates and compares them.
+//! (docs/modes.md, "Levels of detail"). So `--quality` renders the candidates and compares them.
 //!
 //! # The pilot
 //! 1. **Rows.** The output image's H rows are cut into R = min(H, [`PILOT_ROWS`]) strata of about
@@ -282,6 +282,29 @@ pub fn measure(
         tried,
     };
     Ok((pilot, accepted))
+}
+
+/// The least PSNR (dB, the pilot's lower bound, RGB against level 0) at which `--lod auto` keeps
+/// a coarser level.
+pub const AUTO_MIN_DB: f64 = 40.0;
+
+/// `--lod auto` for `p0` (prepared at level 0, `args` otherwise as given): the deepest level the
+/// geometric rule allows ([`super::lod::auto_level`]) whose pilot bound stays at or above
+/// [`AUTO_MIN_DB`] against level 0, the levels tried from 1 down and the first to fail ending the
+/// search; level 0 when none passes, for a stream, or in perspective. The geometric rule alone
+/// was fitted on grey ramps and kept the CT head's level 1 at 64² at 30.9 dB under a transfer
+/// function with sharp opacity steps (`ct-bone-skin`); the pilot sees what the data and the
+/// transfer function do to a level.
+pub fn validated_auto(p0: Prepared, args: &RenderArgs) -> Result<Prepared, CliError> {
+    // The level the geometric rule picks for `args` (`--lod auto`), as prepare would have.
+    let (_, _, deepest) =
+        super::prepare::setup_frame(args, p0.fine_dims, &p0.grid, &p0.kernel, p0.options)?;
+    if deepest == 0 || p0.volume().is_none() {
+        return Ok(p0);
+    }
+    let levels: Vec<u32> = (1..=deepest).collect();
+    let (_, mut accepted) = measure(&p0, args, &levels, |_, _, e| Ok(e.bound_db >= AUTO_MIN_DB))?;
+    Ok(accepted.pop().unwrap_or(p0))
 }
 
 #[cfg(test)]

@@ -3,7 +3,7 @@
 
 use crate::args::RenderArgs;
 use crate::io::formats::{self, raw::RawOptions};
-use crate::io::stream::{file_range, is_stdin, Layout, Pipe};
+use crate::io::stream::{file_summary, is_stdin, Layout, Pipe};
 use crate::io::volume::{SampleType, Volume};
 use crate::{io, scene, CliError};
 use glam::{Mat3, Vec3};
@@ -81,6 +81,9 @@ pub(crate) struct Loaded {
     pub(crate) grid: Mat3,
     /// The data's finite range, if it could be read without a second pass over a pipe.
     pub(crate) range: Option<(f32, f32)>,
+    /// A user's volume (not the built-in scene, not a pipe) with no `--window`: its strided
+    /// sample, for the default window (`super::window`).
+    pub(crate) sample: Option<Vec<f32>>,
 }
 
 pub(crate) fn load_voxels(args: &RenderArgs) -> Result<Loaded, CliError> {
@@ -98,7 +101,9 @@ pub(crate) fn load_voxels(args: &RenderArgs) -> Result<Loaded, CliError> {
         }
         let v = &m.volume;
         let (dims, grid, range) = (v.dims, v.grid_to_world(), Some(v.range()));
+        let sample = args.window.is_none().then(|| v.strided_sample());
         return Ok(Loaded {
+            sample,
             voxels: Voxels::Memory(Arc::clone(v)),
             name: m.name.clone(),
             dims,
@@ -121,7 +126,10 @@ pub(crate) fn load_voxels(args: &RenderArgs) -> Result<Loaded, CliError> {
             ),
         };
         let (dims, grid, range) = (volume.dims, volume.grid_to_world(), Some(volume.range()));
+        let sample =
+            (args.window.is_none() && args.volume.is_some()).then(|| volume.strided_sample());
         return Ok(Loaded {
+            sample,
             voxels: Voxels::Memory(Arc::new(volume)),
             name,
             dims,
@@ -156,6 +164,7 @@ pub(crate) fn load_voxels(args: &RenderArgs) -> Result<Loaded, CliError> {
             dims: o.dims,
             grid,
             range: None,
+            sample: None,
         });
     }
     let lower = name.to_ascii_lowercase();
@@ -190,12 +199,14 @@ pub(crate) fn load_voxels(args: &RenderArgs) -> Result<Loaded, CliError> {
     }
     let col = |c: usize| Vec3::from_array(directions[c]) * spacing[c];
     let grid = Mat3::from_cols(col(0), col(1), col(2));
-    let range = if args.window.is_none() {
-        Some(file_range(&layout)?)
+    let (range, sample) = if args.window.is_none() {
+        let (range, sample) = file_summary(&layout)?;
+        (Some(range), Some(sample))
     } else {
-        None
+        (None, None)
     };
     Ok(Loaded {
+        sample,
         dims: layout.dims,
         voxels: Voxels::File(layout),
         name,

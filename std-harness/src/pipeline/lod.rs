@@ -20,7 +20,7 @@
 //! at 1.16 px 36.5 dB. A bound on the spacing alone cannot keep the first and refuse the second
 //! and fourth; 4ᴸ·d ≤ 3 px does (2.6, 5.2, 2.3 and 9.3 px). The bound is empirical: fitted on
 //! these two volumes and checked on every volume in `../shared/data` at 64², 128² and 512²
-//! (README, "Levels of detail").
+//! (docs/modes.md, "Levels of detail").
 
 use crate::args::Lod;
 use crate::io::stream::{ColouredMemorySource, MemorySource};

@@ -38,6 +38,7 @@ pub mod bands;
 pub mod choose;
 pub mod config;
 pub mod describe;
+pub mod entry;
 pub mod field;
 pub mod level_pilot;
 pub mod load;
@@ -56,9 +57,25 @@ pub mod subsample;
 pub mod supersample;
 pub mod supply;
 pub mod visible;
+pub mod window;
 
 pub use describe::describe;
-pub use prepare::{prepare, Prepared};
+pub use entry::prepare;
+pub use prepare::Prepared;
 pub use run::{
     render_continuous_ref, render_core, render_core_with, render_frame, render_ref, CoreFrame,
 };
+
+/// `base` turned `degrees` of azimuth further about the volume's vertical axis: `--view`'s
+/// azimuth plus `degrees`, or a `--view-matrix` V as V · Ry(degrees) (the same turn). What
+/// `render --orbit` and `bench --orbit` step by.
+pub fn turned(base: &crate::args::RenderArgs, degrees: f32) -> crate::args::RenderArgs {
+    let mut a = base.clone();
+    a.view[0] += degrees;
+    if let Some(m) = a.view_matrix {
+        let v = glam::Mat3::from_cols_array(&m).transpose()
+            * glam::Mat3::from_rotation_y(degrees.to_radians());
+        a.view_matrix = Some(v.transpose().to_cols_array());
+    }
+    a
+}

@@ -5,7 +5,7 @@
 //! Against the sheet reference the error is the table's, and one footprint predicts it
 //! ([`super::quality`]). Against the integral, object slicing's error is dominated by compositing
 //! each kernel whole in one sheet, which depends on the data along every ray (27.9–77.9 dB over
-//! the shared volumes at 256×256, README "Image-aligned slicing"): no one-voxel model sees it.
+//! the shared volumes at 256×256, docs/accuracy.md, "Image-aligned slicing"): no one-voxel model sees it.
 //! So the choice is measured, on a **pilot**:
 //!
 //! 1. **Rays.** The output image is cut into S×S cells, S = ⌈√(W·H / [`PILOT_RAYS`])⌉, and one
@@ -19,7 +19,7 @@
 //!    table's share of the error is negligible) if it differs; then, against `field` only
 //!    ([`super::field`]: the grid's own field is what refinement moves away from), that table
 //!    with the grid refined (`--refine 0`, the paper's adaptive re-sampling, 1.3–2.4× an
-//!    unrefined frame on the README's refinement chart), where refinement can add samples
+//!    unrefined frame on docs/modes.md's refinement chart), where refinement can add samples
 //!    ([`super::refine::worth_trying`]: float, the robust method, orthographic, in memory, full
 //!    resolution, and grid steps projecting at least twice [`super::refine::MIN_STEP_PX`]);
 //!    then image slicing (3–13× an object frame) at each thickness of `Config::SLABS` the

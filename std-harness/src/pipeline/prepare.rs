@@ -10,7 +10,7 @@
 use super::load::{load_background, load_voxels, Loaded, Voxels};
 use super::supersample;
 use crate::args::{Lod, RenderArgs};
-use crate::io::volume::{SampleType, Volume};
+use crate::io::volume::Volume;
 use crate::{tf, CliError};
 use footprint::frame::{FrameSetup, Order};
 use footprint::geometry::FootprintOptions;
@@ -419,8 +419,9 @@ fn perspective_frame(
     Ok((frame, k))
 }
 
-/// Loads and sets up everything `args` describes.
-pub fn prepare(args: &RenderArgs) -> Result<Prepared, CliError> {
+/// Loads and sets up everything `args` describes, with `--lod` taken as it is (`auto`: the
+/// geometric rule of [`super::lod`]); [`super::entry::prepare`] validates that rule's level.
+pub fn prepare_as_asked(args: &RenderArgs) -> Result<Prepared, CliError> {
     let kernel = args.footprint.kernel()?;
     let Loaded {
         voxels,
@@ -428,6 +429,7 @@ pub fn prepare(args: &RenderArgs) -> Result<Prepared, CliError> {
         dims,
         grid,
         range,
+        sample,
     } = load_voxels(args)?;
     let grid = Grid::from_matrix(grid).map_err(|e| CliError::input(format!("{name}: {e}")))?;
     let mapping = args.footprint.mapping()?;
@@ -474,50 +476,18 @@ pub fn prepare(args: &RenderArgs) -> Result<Prepared, CliError> {
         _ => args.order.map_or(Order::BackToFront, Order::from),
     };
     let tf_name = args.tf.clone().unwrap_or_else(|| {
-        if args.volume.is_none() && args.stream.is_none() {
+        if args.volume.is_none() && args.stream.is_none() && args.memory.is_none() {
             "density"
         } else {
-            "grey"
+            // Transparent below the default window's first 18 %: see `super::window`.
+            "ct-bone-skin"
         }
         .into()
     });
     let lut = tf::lut(&tf::load(&tf_name)?);
     let window = match args.window {
         Some(w) => w,
-        None => {
-            let (lo, hi) = match (range, &voxels) {
-                (Some(r), _) => r,
-                (
-                    None,
-                    Voxels::Stdin {
-                        ty: SampleType::U8, ..
-                    },
-                ) => (0.0, 255.0),
-                (
-                    None,
-                    Voxels::Stdin {
-                        ty: SampleType::I8, ..
-                    },
-                ) => (-128.0, 127.0),
-                (None, _) => {
-                    return Err(CliError::input(
-                        "standard input cannot be read twice: give --window LO,HI",
-                    ))
-                }
-            };
-            if lo > hi {
-                // `range` of data without one finite sample.
-                return Err(CliError::input(format!(
-                    "{name}: no sample is finite (all NaN or infinite): nothing to render"
-                )));
-            }
-            if !(hi > lo) {
-                return Err(CliError::input(format!(
-                    "{name}: the data are constant ({lo}); give --window"
-                )));
-            }
-            [lo, hi]
-        }
+        None => super::window::default_window(&name, range, &voxels, sample.as_deref())?,
     };
     if !(window[1] > window[0]) {
         return Err(CliError::input(format!(

@@ -15,7 +15,7 @@
 //!
 //! `PSNR ≈ K − 20·log₁₀(e)`,
 //!
-//! K calibrated from `footprint chart` sweeps of every shared volume (README, "Choosing the
+//! K calibrated from `footprint chart` sweeps of every shared volume (docs/accuracy.md, "Choosing the
 //! configuration"): K is the smallest PSNR + 20·log₁₀(e) measured over all of them, less a margin,
 //! so the prediction errs low. Fixed-point accumulation adds < 10⁻⁵ of error (114–144 dB against
 //! float), so it shares the float prediction.

@@ -9,7 +9,7 @@
 //!    The sheet axis is refined only with `--refine-sheets`.
 //! 2. **How far.** A step never projects closer than [`MIN_STEP_PX`] pixels (the length of the
 //!    grid step on screen, depth included): smaller footprints cost more per pixel than they
-//!    gain (README, "Adaptive refinement": at 512², 16³ steps of 4.8 px gave +8.9 dB at 1.96×
+//!    gain (docs/modes.md, "Adaptive refinement": at 512², 16³ steps of 4.8 px gave +8.9 dB at 1.96×
 //!    the unrefined time, steps of 9.5 px +6.2 dB at 1.30×).
 //! 3. **Footprints**, built once per view, per spacing key the grid produces: a symmetric spacing's
 //!    exact footprint (a view table, with phase stencils where many samples share it); a border

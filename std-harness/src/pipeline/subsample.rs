@@ -13,7 +13,7 @@
 //! **Auto.** `--subsample auto` takes the largest s ≤ [`MAX_FACTOR`] that keeps the footprint's
 //! shorter semi-axis (before any widening) at least [`AUTO_MIN_RADIUS_PX`] pixels (and at least
 //! `--min-radius`, so nothing is widened) at the lower resolution; only for Gaussian kernels and
-//! orthographic views, where that rule was measured (README, "Subsampling"); elsewhere 1.
+//! orthographic views, where that rule was measured (docs/modes.md, "Subsampling"); elsewhere 1.
 //!
 //! **Geometry.** The output is W × H with pixel x's centre at x + ½ and the volume's centre at
 //! (W/2, H/2) (the core's `frame` placement). The low frame is w × h = (⌈W/s⌉ + 2m) × (⌈H/s⌉ + 2m)

@@ -1,0 +1,22 @@
+//! `prepare`, the pipeline's entry: load and set up everything the command line describes
+//! ([`super::prepare::prepare_as_asked`]), with `--lod auto` validated on a pilot where it can be
+//! ([`super::level_pilot::validated_auto`]).
+
+use super::level_pilot::validated_auto;
+use super::prepare::{prepare_as_asked, Prepared};
+use crate::args::{Lod, RenderArgs};
+use crate::CliError;
+
+/// Loads and sets up everything `args` describes. `--lod auto` on a volume in memory keeps a
+/// coarser level only where a pilot measures it close to level 0; a stream keeps the geometric
+/// rule alone (it cannot be read twice, and a file stream would be read once per level).
+pub fn prepare(args: &RenderArgs) -> Result<Prepared, CliError> {
+    if args.lod != Lod::Auto || args.quality.is_some() || args.stream.is_some() {
+        return prepare_as_asked(args);
+    }
+    let at_full = RenderArgs {
+        lod: Lod::Level(0),
+        ..args.clone()
+    };
+    validated_auto(prepare_as_asked(&at_full)?, args)
+}
