@@ -313,6 +313,33 @@ fn cases(dir: &Path) -> Vec<Case> {
         release_only: false,
     });
 
+    // An orbit of a pipe: every frame would read standard input again.
+    c.push(Case {
+        name: "render --orbit from standard input",
+        args: args(&[
+            "render",
+            "--stream",
+            "-",
+            "--dims",
+            "4,4,4",
+            "--type",
+            "u8",
+            "--window",
+            "0,255",
+            "--orbit",
+            "3",
+            "--out",
+            "orbit.png",
+        ]),
+        stdin: Some(vec![7; 64]),
+        expect: Expect::Refused("standard input can be read once"),
+        gone: vec![dir.join("orbit.png")],
+        before: vec![],
+        ulimit: "",
+        check: None,
+        release_only: false,
+    });
+
     // XML nested 20 000 elements deep (140 KB).
     let deep = format!(
         "<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\">{}{}</VTKFile>\n",

@@ -153,6 +153,16 @@ fn orbit(
             "--orbit renders with the core: --method reference is one frame (render without --orbit)",
         ));
     }
+    if args
+        .stream
+        .as_deref()
+        .is_some_and(crate::io::stream::is_stdin)
+    {
+        return Err(CliError::input(
+            "--orbit renders the volume once per frame, and standard input can be read once: \
+             give the volume as a file (VOLUME, or --stream FILE)",
+        ));
+    }
     let start = Instant::now();
     let mut cache = FrameCache::default();
     let delay = (4000 / n).clamp(20, 1000) as u16;
