@@ -310,3 +310,78 @@ fn files_stay_readable() {
     }
     assert!(long.is_empty(), "{}", long.join("\n"));
 }
+
+/// The core's layers, bottom up: a module imports only modules of lower layers (issue 41: no
+/// circle and no upward import in either crate). Within a folder module, files that name each
+/// other through `super::` form no circle either.
+fn core_rank(module: &str) -> u32 {
+    match module {
+        "math" | "composite" | "refine" => 0,
+        "kernel" | "output" => 1,
+        "geometry" => 2,
+        "table" => 3,
+        "splat" => 4,
+        "stencil" | "frame" => 5,
+        "shade" | "fixed" => 6,
+        "render" => 7,
+        "source" => 8,
+        "volume" | "lod" => 9,
+        "quick" => 10,
+        "prelude" => 11,
+        other => panic!("core module '{other}' has no layer: add it to tests/layering.rs"),
+    }
+}
+
+#[test]
+fn the_core_imports_downward_only_and_without_circles() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("core/src");
+    let mut files = Vec::new();
+    rs_files(&src, &mut files);
+    let mut upward = Vec::new();
+    // Sibling edges inside each folder module: (folder, file) -> files it names via `super::`.
+    let mut siblings: BTreeMap<(String, String), BTreeSet<String>> = BTreeMap::new();
+    for file in &files {
+        let rel: Vec<String> = file
+            .strip_prefix(&src)
+            .unwrap()
+            .iter()
+            .map(|p| p.to_string_lossy().trim_end_matches(".rs").to_string())
+            .collect();
+        if rel[0] == "lib" {
+            continue;
+        }
+        let code = code_of(&std::fs::read_to_string(file).unwrap());
+        let top = rel[0].clone();
+        for path in paths_after(&code, "crate::") {
+            let to = &path[0];
+            let module = to != &top && to.chars().next().is_some_and(|c| c.is_ascii_lowercase());
+            if module && core_rank(to) >= core_rank(&top) {
+                upward.push(format!("{} -> crate::{to}", rel.join("/")));
+            }
+        }
+        if rel.len() == 2 {
+            let folder = src.join(&rel[0]);
+            for path in paths_after(&code, "super::") {
+                if folder.join(format!("{}.rs", path[0])).exists() && path[0] != rel[1] {
+                    siblings
+                        .entry((rel[0].clone(), rel[1].clone()))
+                        .or_default()
+                        .insert(path[0].clone());
+                }
+            }
+        }
+    }
+    assert!(
+        upward.is_empty(),
+        "imports at or above their own layer: {upward:#?}"
+    );
+    for ((folder, file), names) in &siblings {
+        for other in names {
+            let back = siblings.get(&(folder.clone(), other.clone()));
+            assert!(
+                !back.is_some_and(|b| b.contains(file)),
+                "import circle in core/src/{folder}: {file}.rs <-> {other}.rs"
+            );
+        }
+    }
+}

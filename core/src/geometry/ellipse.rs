@@ -2,6 +2,7 @@
 //! (Cholesky) and separable (parallelogram) maps to unit coordinates, the minimum-radius widening,
 //! and the exact support per pixel row. Derivation in the [module docs](super).
 
+use super::mat2::{mul2, Mat2, Sym2};
 use super::paper::paper_decomposition;
 use super::{
     all_finite, in_sheet_axes, sheet_axis, well_conditioned, FootprintOptions, GeometryError,
@@ -10,29 +11,6 @@ use super::{
 use crate::kernel::{Kernel, Shape};
 use crate::math::{self, sq};
 use glam::Mat3;
-
-/// A symmetric 2×2 matrix [[xx, xy], [xy, yy]].
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Sym2 {
-    /// Entry (0, 0).
-    pub xx: f32,
-    /// Entries (0, 1) and (1, 0).
-    pub xy: f32,
-    /// Entry (1, 1).
-    pub yy: f32,
-}
-
-/// A 2×2 matrix in row-major order: `m[row][col]`.
-pub type Mat2 = [[f32; 2]; 2];
-
-/// m · v.
-#[inline]
-pub(crate) fn mul2(m: &Mat2, v: [f32; 2]) -> [f32; 2] {
-    [
-        m[0][0] * v[0] + m[0][1] * v[1],
-        m[1][0] * v[0] + m[1][1] * v[1],
-    ]
-}
 
 fn inverse2(m: &Mat2) -> (Mat2, f32) {
     let det = m[0][0] * m[1][1] - m[0][1] * m[1][0];

@@ -459,13 +459,17 @@ impl Default for FootprintOptions {
 }
 
 mod ellipse;
+mod mat2;
 mod paper;
 mod perspective;
+mod sampler;
 
-pub(crate) use ellipse::mul2;
-pub use ellipse::{conic_of, covariance, Footprint, Mat2, Sym2};
+pub use ellipse::{conic_of, covariance, Footprint};
+pub(crate) use mat2::mul2;
+pub use mat2::{Mat2, Sym2};
 pub use paper::{
     paper_decomposition, PaperDecomposition, PAPER_MAX_CHEAT_DEG, PAPER_ROUND_CONIC,
     PAPER_SINGULAR_COS2,
 };
 pub use perspective::{Perspective, Projected};
+pub use sampler::Sampler;

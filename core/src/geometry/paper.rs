@@ -1,7 +1,7 @@
 //! Westover's θ/Sx/Sy decomposition of the footprint conic, as the paper prints it (misprints
 //! corrected, see the [module docs](super)), kept so its failure near 45° can be measured.
 
-use super::ellipse::{Mat2, Sym2};
+use super::mat2::{Mat2, Sym2};
 use super::GeometryError;
 use crate::math::{self, sq};
 

@@ -155,9 +155,9 @@ impl<const M: usize> ViewTable<M> {
 
     /// Samples `sampler`'s weights at the nodes of its footprint's screen box (layout
     /// [`ViewLayout::ScreenBox`]), to be read with `sample` lookup: a table of any footprint a
-    /// [`Sampler`](crate::splat::Sampler) gives, such as a refined sample's scaled one
+    /// [`Sampler`](crate::geometry::Sampler) gives, such as a refined sample's scaled one
     /// ([`crate::render::ScaledFootprint`]), so that it splats through the row walk.
-    pub fn resample_into<S: crate::splat::Sampler + ?Sized>(
+    pub fn resample_into<S: crate::geometry::Sampler + ?Sized>(
         &mut self,
         sampler: &S,
         sample: Lookup,

@@ -354,12 +354,10 @@ pub fn encode_png_rgb(rgba: &[[f32; 4]], width: usize, height: usize) -> Result<
     encode_png(rgba, width, height, PngStyle::default())
 }
 
-/// Extensions a colour image output may have: `.png` (8-bit, [`encode_png_rgb`]) or `.pfm` (float,
-/// [`encode_pfm_rgb`]).
-pub const RGB_EXTENSIONS: [&str; 2] = ["png", "pfm"];
-
-/// Extensions a single-channel output may have ([`save_grey`]).
-pub const GREY_EXTENSIONS: [&str; 2] = ["pfm", "png"];
+/// Extensions a colour image output may have (`.png`, 8-bit, [`encode_png_rgb`]; `.pfm`, float,
+/// [`encode_pfm_rgb`]) and a single-channel one ([`save_grey`]); the lists live with the output
+/// checks ([`super::outputs`]).
+pub use super::outputs::{GREY_EXTENSIONS, RGB_EXTENSIONS};
 
 /// Encodes a colour PFM (`PF`, scale −1: little-endian float32 RGB, rows bottom to top): the
 /// premultiplied colour channels as they are (linear, not clamped), for measuring.

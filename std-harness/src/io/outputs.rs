@@ -35,6 +35,12 @@ use crate::CliError;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+/// Extensions a colour image output may have: `.png` (8-bit) or `.pfm` (float RGB).
+pub const RGB_EXTENSIONS: [&str; 2] = ["png", "pfm"];
+
+/// Extensions a single-channel output may have (`footprint splat`'s weights).
+pub const GREY_EXTENSIONS: [&str; 2] = ["pfm", "png"];
+
 /// One output a command will write: the flag that named it (for messages), its path and the
 /// extensions its kind may have (empty: any).
 #[derive(Clone, Copy, Debug)]
@@ -305,7 +311,7 @@ pub fn check_image_and_json(out: Option<&Path>, json: Option<&Path>) -> Result<(
         planned.push(Planned {
             flag: "--out",
             path,
-            extensions: &super::image::RGB_EXTENSIONS,
+            extensions: &RGB_EXTENSIONS,
         });
     }
     if let Some(path) = json {
