@@ -269,65 +269,130 @@ pub struct RenderArgs {
     /// (.hdr + .img, either may be .gz), or headerless raw with --dims and --type. Omitted: the
     /// built-in electron-density scene.
     pub volume: Option<PathBuf>,
-    /// VTK files (.vtk, .vti) with several point-data arrays: the one to render, by name (default:
-    /// the active scalars). A name the file lacks is an error that lists the file's arrays.
-    #[arg(long, value_name = "NAME")]
-    pub array: Option<String>,
     /// Image size, WxH pixels.
-    #[arg(short, long, default_value = "512x512", value_parser = parse_size)]
+    #[arg(help_heading = "Camera", short, long, default_value = "512x512", value_parser = parse_size)]
     pub size: (usize, usize),
     /// VTK/ParaView camera AZ,EL,ROLL in degrees: from ParaView's default (on +z looking toward
     /// −z, +y up), Azimuth(AZ), Elevation(EL), Roll(ROLL); or a view-direction button of
     /// ParaView's: +x, -x, +y, -y (+z up), +z, -z (+y up). See docs/cli.md, "Camera".
-    #[arg(long, default_value = "0,0,0", value_parser = parse_view, allow_hyphen_values = true)]
+    #[arg(help_heading = "Camera", long, default_value = "0,0,0", value_parser = parse_view, allow_hyphen_values = true)]
     pub view: [f32; 3],
     /// Multiplies the zoom that fits the volume's bounding sphere into the image (VTK's
     /// ResetCamera).
-    #[arg(long, default_value_t = 1.0, value_parser = parse_positive)]
+    #[arg(help_heading = "Camera", long, default_value_t = 1.0, value_parser = parse_positive)]
     pub zoom: f32,
     /// Explicit world-to-screen matrix, nine numbers row-major, pixels per world unit (overrides
     /// --view and --zoom). With --perspective only its rotation counts: it must be a rotation
     /// times one scale, and the scale is ignored (the field of view and --zoom set it).
-    #[arg(long, value_parser = parse_list::<9>, allow_hyphen_values = true)]
+    #[arg(help_heading = "Camera", long, value_parser = parse_list::<9>, allow_hyphen_values = true)]
     pub view_matrix: Option<[f32; 9]>,
     /// Perspective projection with this vertical field of view, degrees (0 < FOVY < 180): a
     /// pinhole on the view axis, the volume's centre at the image centre, focal length
     /// (H/2) / tan(FOVY/2) × --zoom pixels. Float accumulation only; every voxel gets its own
     /// footprint (the generic table is sampled directly, whatever --method says).
-    #[arg(long, value_name = "FOVY", value_parser = parse_fov)]
+    #[arg(help_heading = "Camera", long, value_name = "FOVY", value_parser = parse_fov)]
     pub perspective: Option<f32>,
     /// With --perspective: the eye's distance from the volume's centre, world units. Default
     /// VTK's ResetCamera: R / sin(FOVY/2), R half the diagonal of the voxel-centre box. An eye
     /// inside the volume (or within a kernel radius of it, or among its sheets) is refused.
-    #[arg(long, value_name = "D", value_parser = parse_positive, requires = "perspective")]
+    #[arg(help_heading = "Camera", long, value_name = "D", value_parser = parse_positive, requires = "perspective")]
     pub eye_distance: Option<f32>,
+    /// Transfer function: a preset (grey, ct-bone-skin, density) or a file of `t r g b a` lines.
+    /// Default: density for the built-in scene, ct-bone-skin for a volume (transparent over the
+    /// window's first 18 %).
+    #[arg(help_heading = "Picture", long)]
+    pub tf: Option<String>,
+    /// Value window LO,HI mapped onto the transfer function. Default for a volume: Otsu's
+    /// threshold between background and foreground to the 99.5th percentile, from at most 2^20
+    /// strided samples (`footprint info` prints it); the built-in scene: the data's range.
+    #[arg(help_heading = "Picture", long, value_parser = parse_list::<2>, allow_hyphen_values = true)]
+    pub window: Option<[f32; 2]>,
+    /// Shading: emission, phong, iso:VALUE (Levoy iso-surface at VALUE, data units), texture.
+    #[arg(help_heading = "Picture", long, default_value = "emission")]
+    pub shading: String,
+    /// What the volume is composited over: `black` (an RGB PNG), `transparent` (an RGBA PNG
+    /// with straight alpha, the render's coverage; PNG output only) or a PNG file of the output
+    /// size (read with --gamma's curve; a file named `black` or `transparent` needs a `./`).
+    #[arg(help_heading = "Picture", long, default_value = "black", value_parser = parse_background)]
+    pub background: Background,
+    /// PNG colour values: `linear` writes them as computed, with no curve (VTK and ParaView's
+    /// default, so presets show the colours they show there; PSNR is measured on these values);
+    /// `srgb` treats them as linear light and applies the sRGB curve. PNG output only.
+    #[arg(help_heading = "Picture", long, value_enum, default_value_t = GammaArg::Linear)]
+    pub gamma: GammaArg,
+    /// PNG bits per sample: 8 or 16. PNG output only.
+    #[arg(help_heading = "Picture", long, default_value = "8", value_parser = parse_depth)]
+    pub depth: u8,
+    /// Write a JSON summary here.
+    #[arg(help_heading = "Picture", long)]
+    pub json: Option<PathBuf>,
+    /// Output image: `.png` (RGB, the premultiplied colour over the background, clamped; RGBA
+    /// with --background transparent; see --gamma and --depth) or `.pfm` (float32 RGB, linear
+    /// values unclamped, over black or the background image); other extensions are refused. `render`
+    /// defaults to footprint.png; `verify` writes one only if asked. Every output is checked
+    /// before rendering, and none is written unless all are.
+    #[arg(help_heading = "Picture", short, long)]
+    pub out: Option<PathBuf>,
+    /// VTK files (.vtk, .vti) with several point-data arrays: the one to render, by name (default:
+    /// the active scalars). A name the file lacks is an error that lists the file's arrays.
+    #[arg(help_heading = "Input", long, value_name = "NAME")]
+    pub array: Option<String>,
+    /// The built-in scene only: its analytic field sampled N×N×N over the same box (64 by
+    /// default; 16 and 128 are what the refinement chart compares).
+    #[arg(help_heading = "Input", long, value_name = "N", default_value_t = crate::scene::SIDE, value_parser = parse_scene_size)]
+    pub scene_size: usize,
+    /// The built-in scene only: the finer sampling, N×N×N over the same box, whose continuous
+    /// integral `--quality-reference field` and `verify --reference field` measure against (it
+    /// must exceed --scene-size).
+    #[arg(help_heading = "Input", long, value_name = "N", default_value_t = 128, value_parser = parse_scene_size)]
+    pub field_size: usize,
+    /// Stream the volume a few sheets at a time instead of loading it: a raw file (with --dims and
+    /// --type), an NRRD with raw encoding or an uncompressed MetaImage; `-` reads raw z-slices from
+    /// standard input in file order (needs --dims and --type).
+    #[arg(help_heading = "Input", long)]
+    pub stream: Option<PathBuf>,
+    /// Raw volumes: dimensions X,Y,Z.
+    #[arg(help_heading = "Input", long, value_parser = parse_dims, allow_hyphen_values = true)]
+    pub dims: Option<[usize; 3]>,
+    /// Raw volumes: sample type (u8, i8, u16, i16, u32, i32, f32, f64).
+    #[arg(help_heading = "Input", long = "type")]
+    pub sample_type: Option<String>,
+    /// Raw volumes: byte order.
+    #[arg(help_heading = "Input", long, default_value = "little")]
+    pub endian: String,
+    /// Raw volumes: spacing X,Y,Z in world units.
+    #[arg(help_heading = "Input", long, default_value = "1,1,1", value_parser = parse_spacing, allow_hyphen_values = true)]
+    pub spacing: [f32; 3],
     /// Kernel, tables, lookup, method (`reference` renders with the f64 reference) and minimum
     /// footprint radius.
-    #[command(flatten)]
+    #[command(flatten, next_help_heading = "Method")]
     pub footprint: FootprintArgs,
     /// Accumulation: float, or fixed (integer splat, accumulator and compositing; bit-exact).
-    #[arg(long, value_enum, default_value_t = AccumArg::Float)]
+    #[arg(help_heading = "Method", long, value_enum, default_value_t = AccumArg::Float)]
     pub accum: AccumArg,
     /// Slicing: `object`, the paper's sheets along the grid axis most parallel to the image (the
     /// way to reproduce the paper; pops where that axis switches), or `image`, slabs parallel to
     /// the image plane (Mueller and Crawfis 1998; no popping). Image slicing needs a gaussian
     /// kernel, float accumulation, an orthographic view and the volume in memory.
-    #[arg(long, value_enum, default_value_t = SlicingArg::Object)]
+    #[arg(help_heading = "Method", long, value_enum, default_value_t = SlicingArg::Object)]
     pub slicing: SlicingArg,
     /// With --slicing image: slab thickness along the view ray, in voxel spacings (the smallest
     /// of the grid's three spacings).
-    #[arg(long, value_name = "T", default_value_t = 1.0, value_parser = parse_positive)]
+    #[arg(help_heading = "Method", long, value_name = "T", default_value_t = 1.0, value_parser = parse_positive)]
     pub slab: f32,
     /// View-table renders: sub-pixel phases per pixel (at most; wide footprints use fewer) of the
     /// phase stencils that splat footprints up to 128 px across: the view table (float, the
     /// core's `stencil` module) or the integer table (fixed, `fixed::stencil`) sampled once per
     /// phase; 0 walks the table per pixel instead.
-    #[arg(long, default_value_t = footprint::stencil::DEFAULT_PHASES)]
+    #[arg(help_heading = "Method", long, default_value_t = footprint::stencil::DEFAULT_PHASES)]
     pub phases: usize,
+    /// Compositing direction (default back-to-front; a pipe's views impose theirs).
+    #[arg(help_heading = "Method", long, value_enum)]
+    pub order: Option<OrderArg>,
     /// Supersampling: `auto` renders at k× the size and averages k×k blocks when voxels project
     /// too close for the smallest footprint (removes the brightness bias of minified renders; see
     /// the harness's `pipeline::supersample`); a number fixes k (1 = off).
-    #[arg(long, default_value = "auto", value_parser = parse_supersample)]
+    #[arg(help_heading = "Resolution", long, default_value = "auto", value_parser = parse_supersample)]
     pub supersample: Supersample,
     /// Image-space level of detail for magnified volumes: a number s ≥ 2 renders the frame at
     /// 1/s of the size (plus a 2-pixel margin) and resamples it to the size with Catmull-Rom
@@ -335,17 +400,18 @@ pub struct RenderArgs {
     /// keeps the footprints' shorter semi-axis at least 2 px at the lower resolution (Gaussian
     /// kernels, orthographic views only; otherwise 1). 1, the default, is off. Measured cost in
     /// accuracy: docs/modes.md, "Subsampling".
-    #[arg(long, default_value = "1", value_parser = parse_supersample)]
+    #[arg(help_heading = "Resolution", long, default_value = "1", value_parser = parse_supersample)]
     pub subsample: Supersample,
     /// Level of detail: a number N splats level N (each level averages 2x2x2 samples of the one
     /// above into one, the spacing doubled, carrying the block's colour; 0 = full resolution);
     /// `auto`, the default, the deepest level L with 4^L x (level 0's projected spacing) <= 3 px
-    /// (docs/modes.md, "Levels of detail"). Orthographic views only (`auto` keeps a perspective view, and
+    /// (docs/modes.md, "Levels of detail") that a pilot of image rows also measures within 40 dB
+    /// of level 0 (a volume in memory; a stream keeps the spacing rule alone). Orthographic views only (`auto` keeps a perspective view, and
     /// --refine, at level 0). The f64 reference `verify` compares with renders the same level
     /// (and, for a level >= 1, also level 0: `full res`); the continuous reference integrates
     /// full resolution (`auto` then means level 0). With --quality, `auto` means the level the
     /// quality pilot measures to hold the target against full resolution.
-    #[arg(long, default_value = "auto", value_parser = parse_lod)]
+    #[arg(help_heading = "Resolution", long, default_value = "auto", value_parser = parse_lod)]
     pub lod: Lod,
     /// The paper's adaptive re-sampling for magnified volumes: along each grid axis, intervals
     /// whose neighbouring samples' classified colours (premultiplied RGBA, 0..1) differ by more
@@ -353,32 +419,23 @@ pub struct RenderArgs {
     /// footprints for their local spacing (one-sided at region borders); steps stay ≥ 2 px apart
     /// on screen. Float, object slicing, orthographic, the volume in memory. See docs/modes.md,
     /// "Adaptive refinement".
-    #[arg(long, value_name = "THRESHOLD", value_parser = parse_threshold, conflicts_with = "quality", allow_hyphen_values = true)]
+    #[arg(help_heading = "Resolution", long, value_name = "THRESHOLD", value_parser = parse_threshold, conflicts_with = "quality", allow_hyphen_values = true)]
     pub refine: Option<f32>,
     /// With --refine: refine along the sheet axis too (more sheets; the paper's method in full).
     /// Off by default: on the refinement chart it bought 0.9 dB for 3.6x the time.
-    #[arg(long, requires = "refine")]
+    #[arg(help_heading = "Resolution", long, requires = "refine")]
     pub refine_sheets: bool,
-    /// The built-in scene only: its analytic field sampled N×N×N over the same box (64 by
-    /// default; 16 and 128 are what the refinement chart compares).
-    #[arg(long, value_name = "N", default_value_t = crate::scene::SIDE, value_parser = parse_scene_size)]
-    pub scene_size: usize,
-    /// The built-in scene only: the finer sampling, N×N×N over the same box, whose continuous
-    /// integral `--quality-reference field` and `verify --reference field` measure against (it
-    /// must exceed --scene-size).
-    #[arg(long, value_name = "N", default_value_t = 128, value_parser = parse_scene_size)]
-    pub field_size: usize,
     /// Threads (bands of image rows) for the core's render; 0 = every core. The image is
     /// byte-identical for any number. A streamed volume renders on one thread; more than 256
     /// render on 256.
-    #[arg(long, default_value_t = 0, value_parser = parse_threads)]
+    #[arg(help_heading = "Speed and quality", long, default_value_t = 0, value_parser = parse_threads)]
     pub threads: usize,
     /// Target PSNR, dB, against --quality-reference: choose the cheapest configuration expected
     /// to reach it for this scene and view (overrides the table, lookup, method and
     /// accumulation; with the continuous reference also the slab thickness). Against the sheet
     /// reference it aims at full resolution and also chooses the level of detail (`--lod auto`),
     /// measured on a pilot of image rows when the volume is minified.
-    #[arg(long, conflicts_with_all = ["table", "lookup", "method", "accum", "table_file", "slab"])]
+    #[arg(help_heading = "Speed and quality", long, conflicts_with_all = ["table", "lookup", "method", "accum", "table_file", "slab"])]
     pub quality: Option<f64>,
     /// What --quality aims at: `sheets`, the f64 renderer of the volume's sheets at full
     /// resolution (the table's error predicted in milliseconds; a coarser level's measured on a
@@ -388,64 +445,8 @@ pub struct RenderArgs {
     /// `field` (built-in scene only), the continuous integral of the same analytic field sampled
     /// --field-size N³: measured like `continuous`, and the one reference that can choose
     /// `--refine 0`.
-    #[arg(long, value_enum, default_value_t = QualityReferenceArg::Sheets, requires = "quality")]
+    #[arg(help_heading = "Speed and quality", long, value_enum, default_value_t = QualityReferenceArg::Sheets, requires = "quality")]
     pub quality_reference: QualityReferenceArg,
-    /// Transfer function: a preset (grey, ct-bone-skin, density) or a file of `t r g b a` lines.
-    /// Default: density for the built-in scene, ct-bone-skin for a volume (transparent over the
-    /// window's first 18 %).
-    #[arg(long)]
-    pub tf: Option<String>,
-    /// Value window LO,HI mapped onto the transfer function. Default for a volume: Otsu's
-    /// threshold between background and foreground to the 99.5th percentile, from at most 2^20
-    /// strided samples (`footprint info` prints it); the built-in scene: the data's range.
-    #[arg(long, value_parser = parse_list::<2>, allow_hyphen_values = true)]
-    pub window: Option<[f32; 2]>,
-    /// Shading: emission, phong, iso:VALUE (Levoy iso-surface at VALUE, data units), texture.
-    #[arg(long, default_value = "emission")]
-    pub shading: String,
-    /// What the volume is composited over: `black` (an RGB PNG), `transparent` (an RGBA PNG
-    /// with straight alpha, the render's coverage; PNG output only) or a PNG file of the output
-    /// size (read with --gamma's curve; a file named `black` or `transparent` needs a `./`).
-    #[arg(long, default_value = "black", value_parser = parse_background)]
-    pub background: Background,
-    /// PNG colour values: `linear` writes them as computed, with no curve (VTK and ParaView's
-    /// default, so presets show the colours they show there; PSNR is measured on these values);
-    /// `srgb` treats them as linear light and applies the sRGB curve. PNG output only.
-    #[arg(long, value_enum, default_value_t = GammaArg::Linear)]
-    pub gamma: GammaArg,
-    /// PNG bits per sample: 8 or 16. PNG output only.
-    #[arg(long, default_value = "8", value_parser = parse_depth)]
-    pub depth: u8,
-    /// Compositing direction (default back-to-front; a pipe's views impose theirs).
-    #[arg(long, value_enum)]
-    pub order: Option<OrderArg>,
-    /// Stream the volume a few sheets at a time instead of loading it: a raw file (with --dims and
-    /// --type), an NRRD with raw encoding or an uncompressed MetaImage; `-` reads raw z-slices from
-    /// standard input in file order (needs --dims and --type).
-    #[arg(long)]
-    pub stream: Option<PathBuf>,
-    /// Write a JSON summary here.
-    #[arg(long)]
-    pub json: Option<PathBuf>,
-    /// Raw volumes: dimensions X,Y,Z.
-    #[arg(long, value_parser = parse_dims, allow_hyphen_values = true)]
-    pub dims: Option<[usize; 3]>,
-    /// Raw volumes: sample type (u8, i8, u16, i16, u32, i32, f32, f64).
-    #[arg(long = "type")]
-    pub sample_type: Option<String>,
-    /// Raw volumes: byte order.
-    #[arg(long, default_value = "little")]
-    pub endian: String,
-    /// Raw volumes: spacing X,Y,Z in world units.
-    #[arg(long, default_value = "1,1,1", value_parser = parse_spacing, allow_hyphen_values = true)]
-    pub spacing: [f32; 3],
-    /// Output image: `.png` (RGB, the premultiplied colour over the background, clamped; RGBA
-    /// with --background transparent; see --gamma and --depth) or `.pfm` (float32 RGB, linear
-    /// values unclamped, over black or the background image); other extensions are refused. `render`
-    /// defaults to footprint.png; `verify` writes one only if asked. Every output is checked
-    /// before rendering, and none is written unless all are.
-    #[arg(short, long)]
-    pub out: Option<PathBuf>,
 }
 
 fn parse_dims(s: &str) -> Result<[usize; 3], String> {

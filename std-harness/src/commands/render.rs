@@ -21,11 +21,11 @@ pub struct RenderCommandArgs {
     /// An animated PNG (APNG) of N frames (2 to 360) turning the volume once around its vertical
     /// axis, as ParaView's orbit does: frame k at --view's azimuth + 360·k/N degrees, a full turn
     /// in about 4 s, looping. The volume is loaded and classified once. --out must be a .png.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(2..=360))]
+    #[arg(help_heading = "Picture", long, value_name = "N", value_parser = clap::value_parser!(u16).range(2..=360))]
     pub orbit: Option<u16>,
     /// Draw the transfer function's legend into the image (every frame of an --orbit): its
     /// colours, its opacity as a white line, and the window's values, in a panel at the right.
-    #[arg(long)]
+    #[arg(help_heading = "Picture", long)]
     pub colorbar: bool,
 }
 
