@@ -29,6 +29,7 @@ use crate::kernel::Kernel;
 use crate::render::{FloatPath, RenderBuffers, RenderStats, SheetRenderer, SheetRing};
 use crate::shade::{Sample, Shader, Shading, TransferFunction, OPACITY_TABLE_LEN};
 use crate::source::render_from;
+use crate::splat::Splatter;
 use crate::stencil::{self, Stencils};
 use crate::table::{GenericTable, Lookup, ViewTable};
 use crate::volume::MemoryVolume;
@@ -208,21 +209,47 @@ pub fn render_volume<T: Sample, const N: usize>(
         image: buffers.image,
         rows: buffers.rows,
     };
-    let order = settings.order;
+    let (order, sheets) = (settings.order, buffers.sheets);
+    // Footprints up to 128 px across through the phase stencils (as the CLI), wider ones through
+    // the view table; each its own monomorphised sheet loop.
     if stencil_len > 0 {
         let stencils = Stencils::build(&table, settings.phases, &mut rest[..stencil_len])?;
-        let path = FloatPath { sampler: &stencils };
-        let mut renderer = SheetRenderer::with_path(&frame, path, shader, order, render, None)?
-            .with_opacity_table(opacity)?;
-        let mut ring = SheetRing::for_renderer(buffers.sheets, &renderer)?;
-        render_from(&mut renderer, &mut ring, &mut volume)?;
-        Ok(renderer.finish())
+        run(
+            &frame,
+            &stencils,
+            (shader, order),
+            render,
+            opacity,
+            sheets,
+            &mut volume,
+        )
     } else {
-        let path = FloatPath { sampler: &table };
-        let mut renderer = SheetRenderer::with_path(&frame, path, shader, order, render, None)?
-            .with_opacity_table(opacity)?;
-        let mut ring = SheetRing::for_renderer(buffers.sheets, &renderer)?;
-        render_from(&mut renderer, &mut ring, &mut volume)?;
-        Ok(renderer.finish())
+        run(
+            &frame,
+            &table,
+            (shader, order),
+            render,
+            opacity,
+            sheets,
+            &mut volume,
+        )
     }
+}
+
+/// The sheets of `volume` through `sampler`'s float path into `render`.
+fn run<S: Splatter + ?Sized, T: Sample>(
+    frame: &FrameSetup,
+    sampler: &S,
+    (shader, order): (Shader<'_>, Order),
+    render: RenderBuffers<'_>,
+    opacity: &mut [f32],
+    sheets: &mut [T],
+    volume: &mut MemoryVolume<'_, T>,
+) -> Result<RenderStats, Error> {
+    let path = FloatPath { sampler };
+    let mut renderer = SheetRenderer::with_path(frame, path, shader, order, render, None)?
+        .with_opacity_table(opacity)?;
+    let mut ring = SheetRing::for_renderer(sheets, &renderer)?;
+    render_from(&mut renderer, &mut ring, volume)?;
+    Ok(renderer.finish())
 }
