@@ -20,6 +20,10 @@ pub trait SheetSource {
     type Error: From<RenderError>;
 
     /// Fills `out` (exactly one sheet) with sheet `index` along grid axis `axis`.
+    ///
+    /// The layout: the sheet's two other grid axes a < b ([`crate::geometry::in_sheet_axes`]),
+    /// row-major with a fastest: `out[v · dims[a] + u]` is the sample at index `index` on `axis`,
+    /// `u` on a and `v` on b. For `axis` = 2 (k) that is a z-slice as files store it, x fastest.
     fn read_sheet(
         &mut self,
         axis: usize,
