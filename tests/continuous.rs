@@ -3,8 +3,9 @@
 //! integral has a closed form along every ray.
 
 use footprint_harness::args::parse_args;
+use footprint_harness::pipeline::run::render_continuous_model;
 use footprint_harness::pipeline::{prepare, render_continuous_ref};
-use footprint_harness::reference::continuous::{Reconstruction, CONVERGED_DB};
+use footprint_harness::reference::continuous::{Absorption, Reconstruction, CONVERGED_DB};
 use footprint_suite::tmpdir;
 
 /// A 9³ volume, zero except its centre voxel (255); the transfer function maps 255 to white at
@@ -106,4 +107,77 @@ fn blob_matches_closed_form(r: f64, sigmas: f64, least_peak: f64) {
         c.step, c.passes
     );
     std::fs::remove_dir_all(&d).unwrap();
+}
+
+/// A uniform slab of `depth` voxels of `value` along the view (k), 24×24 across, rendered by the
+/// continuous reference (trilinear reconstruction, whose weights sum to exactly one inside the
+/// volume) with `absorption` at 32×32 looking along k: the centre pixel.
+fn slab_centre(depth: usize, value: u8, absorption: Absorption) -> [f64; 4] {
+    let dir = tmpdir("slab");
+    let raw = dir.join("slab.raw");
+    std::fs::write(&raw, vec![value; 24 * 24 * depth]).unwrap();
+    let dims = format!("24,24,{depth}");
+    let a = parse_args(&[
+        raw.to_str().unwrap(),
+        "--dims",
+        &dims,
+        "--type",
+        "u8",
+        "--size",
+        "32x32",
+        "--zoom",
+        "3",
+        "--tf",
+        "grey",
+        "--window",
+        "0,255",
+        "--lod",
+        "0",
+        "--supersample",
+        "1",
+    ])
+    .unwrap();
+    let p = prepare(&a).unwrap();
+    let (c, _) = render_continuous_model(&p, Reconstruction::Trilinear, absorption).unwrap();
+    assert!(c.converged);
+    c.image[16 * 32 + 16]
+}
+
+/// Closed forms on uniform slabs, for each absorption model (issue 41). The grey ramp gives a
+/// voxel of value v opacity α = v/255 per world unit and straight colour v/255.
+/// - Inside a uniform slab both models reconstruct the same σ = −ln(1 − α), so the slab's edges
+///   cancel in the ratio of two thicknesses: T(L + 10) / T(L) = (1 − α)^10 (T = 1 − alpha).
+/// - An opaque slab (α = 1): the opacity model has no cap, and the ray ends where the field's
+///   opacity reaches one, with the voxels' colour: the pixel is exactly opaque and white. The
+///   extinction model moves with its cap (1 − 10⁻⁶ per world unit): its straight colour is the
+///   premultiplied colour over the capped opacity, 1 / (1 − 10⁻⁶), so the pixel is white within
+///   2·10⁻⁶ (and would be within 10⁻³ at a cap of 10⁻³).
+#[test]
+fn uniform_slabs_match_their_closed_forms_in_both_models() {
+    for absorption in [Absorption::Extinction, Absorption::Opacity] {
+        let (thin, thick) = (
+            slab_centre(20, 51, absorption),
+            slab_centre(30, 51, absorption),
+        );
+        let alpha = 51.0 / 255.0;
+        let ratio = (1.0 - thick[3]) / (1.0 - thin[3]);
+        let expect = (1.0f64 - alpha).powi(10);
+        assert!(
+            (ratio / expect - 1.0).abs() < 2e-3,
+            "{absorption:?}: transmittance ratio {ratio:.6e}, closed form {expect:.6e}"
+        );
+        // The straight colour is the voxels' own: colour / alpha = 0.2.
+        assert!(
+            (thin[0] / thin[3] - alpha).abs() < 1e-6,
+            "{absorption:?}: {thin:?}"
+        );
+        let opaque = slab_centre(20, 255, absorption);
+        let tol = match absorption {
+            Absorption::Opacity => 1e-12,
+            Absorption::Extinction => 2e-6,
+        };
+        for (ch, v) in opaque.iter().enumerate() {
+            assert!((v - 1.0).abs() < tol, "{absorption:?}: channel {ch} = {v}");
+        }
+    }
 }

@@ -188,30 +188,30 @@ def test_bad_input_raises_the_right_exception(tmp_path):
 
 
 def test_threads_release_the_gil():
+    # While one thread renders, the main thread keeps running Python: the longest stretch in
+    # which it could not run is a small part of the render (with the GIL held it would be all of
+    # it). Not a speed ratio, so a loaded machine does not make it fail.
     v = blob((96, 96, 96), np.uint16)
+    span = {}
 
     def one():
-        footprint.render(v, size=(384, 384), view=(30, 20, 0), shading="phong", threads=1, window=(0, 3500))
+        span["start"] = time.perf_counter()
+        footprint.render(v, size=(512, 512), view=(30, 20, 0), shading="phong", threads=1, window=(0, 3500))
+        span["end"] = time.perf_counter()
 
-    one()
-    single = min(_timed(one) for _ in range(2))
-
-    def two():
-        ts = [threading.Thread(target=one) for _ in range(2)]
-        for t in ts:
-            t.start()
-        for t in ts:
-            t.join()
-
-    both = min(_timed(two) for _ in range(2))
-    print(f"one render {single:.3f} s, two at once {both:.3f} s")
-    assert both < 2 * single * 0.9, "two threads rendering at once take twice as long: the GIL is held"
-
-
-def _timed(f):
-    t = time.perf_counter()
-    f()
-    return time.perf_counter() - t
+    footprint.render(v, size=(64, 64), window=(0, 3500))  # warm-up
+    t = threading.Thread(target=one)
+    ticks = []
+    t.start()
+    while t.is_alive():
+        ticks.append(time.perf_counter())
+    t.join()
+    inside = [x for x in ticks if span["start"] <= x <= span["end"]]
+    edges = [span["start"], *inside, span["end"]]
+    longest = max(b - a for a, b in zip(edges, edges[1:]))
+    duration = span["end"] - span["start"]
+    print(f"render {duration:.3f} s; the main thread's longest wait during it {longest:.4f} s")
+    assert longest < 0.5 * duration, "the main thread could not run during the render: the GIL is held"
 
 
 def test_load_verify_bench_and_tables(tmp_path):

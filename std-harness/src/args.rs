@@ -116,6 +116,22 @@ impl From<ReconstructionArg> for crate::reference::continuous::Reconstruction {
     }
 }
 
+/// `verify --absorption`: the continuous reference's absorption model.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AbsorptionArg {
+    Extinction,
+    Opacity,
+}
+
+impl From<AbsorptionArg> for crate::reference::continuous::Absorption {
+    fn from(a: AbsorptionArg) -> Self {
+        match a {
+            AbsorptionArg::Extinction => Self::Extinction,
+            AbsorptionArg::Opacity => Self::Opacity,
+        }
+    }
+}
+
 impl SlicingArg {
     /// The name the command line and the JSON use.
     pub fn name(self) -> &'static str {

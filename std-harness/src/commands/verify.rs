@@ -4,15 +4,15 @@
 //! Colour space: the renderers' output, linear premultiplied RGBA in [0, 1], composited over the
 //! background (transparent black if none); the measures are [`crate::metrics`]'.
 
-use crate::args::{AccumArg, Lod, MethodArg, ReconstructionArg, ReferenceArg, RenderArgs};
+use crate::args::RenderArgs;
+use crate::args::{AbsorptionArg, AccumArg, Lod, MethodArg, ReconstructionArg, ReferenceArg};
 use crate::io::image::{check_style, encode_rgb_for, RGB_EXTENSIONS};
 use crate::io::json::Json;
 use crate::io::outputs::{self, Planned};
 use crate::metrics::compare;
+use crate::pipeline::run::{continuous_models, models_json, others, PIXEL_FILTER};
 use crate::pipeline::{choose::apply_quality, field::prepare_field, quality::quality_json};
-use crate::pipeline::{
-    describe, prepare, render_continuous_ref, render_core, render_core_with, render_ref,
-};
+use crate::pipeline::{describe, prepare, render_core, render_core_with, render_ref};
 use crate::reference::continuous::Reconstruction;
 use crate::CliError;
 use clap::Args;
@@ -46,6 +46,11 @@ pub struct VerifyArgs {
     /// trilinearly (as VTK's ray casters do).
     #[arg(long, value_enum, default_value_t = ReconstructionArg::Kernel)]
     pub reconstruction: ReconstructionArg,
+    /// With `--reference continuous` or `field`: the field reconstructs `extinction` (opaque voxels
+    /// capped; image slicing's model) or `opacity` and colour (no cap; object slicing's). The
+    /// figure against the other is reported too (JSON `continuous.models`).
+    #[arg(long, value_enum, default_value_t = AbsorptionArg::Extinction)]
+    pub absorption: AbsorptionArg,
 }
 
 pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
@@ -108,9 +113,10 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
                 _ => None,
             };
             let over = fine.as_ref().unwrap_or(&p);
-            let (c, secs) = render_continuous_ref(over, args.reconstruction.into())?;
+            let (recon, absorption) = (args.reconstruction.into(), args.absorption.into());
+            let (c, secs, models) = continuous_models(over, recon, absorption, &core)?;
             let (_, e) = compare(&core, &c.image);
-            Some((c, secs, e))
+            Some((c, secs, e, models))
         }
     };
     // A coarser level is also measured against full resolution: its own error counts there.
@@ -172,10 +178,11 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
              measures image slicing against the truth)"
         );
     }
-    if let Some((c, secs, e)) = &continuous {
+    if let Some((c, secs, e, models)) = &continuous {
         crate::say!(
             "{} {:>9.2} {:>9.2e} {:>9.2e}   (RGB, against the continuous integral{}, {} \
-             reconstruction; step {:.4} world units after {} passes, last change {:.1} dB{}; {:.1} s)",
+             reconstruction, {} model{}; step {:.4} world units after {} passes, last change \
+             {:.1} dB{}; {:.1} s)",
             args.reference.name(),
             e.psnr_db,
             e.rmse,
@@ -185,6 +192,8 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
                 _ => String::new(),
             },
             Reconstruction::from(args.reconstruction).name(),
+            models[0].0.name(),
+            others(models),
             c.step,
             c.passes,
             c.change_db,
@@ -247,7 +256,7 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
             summary = summary.obj("full_resolution", e.json());
         }
         summary = summary.str("reference", args.reference.name());
-        if let Some((c, secs, e)) = &continuous {
+        if let Some((c, secs, e, models)) = &continuous {
             let e = match args.reference {
                 ReferenceArg::Field => e.json().num("field_size", r.field_size as f64),
                 _ => e.json(),
@@ -258,6 +267,9 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
                     "reconstruction",
                     Reconstruction::from(args.reconstruction).name(),
                 )
+                .str("absorption", models[0].0.name())
+                .obj("models", models_json(models))
+                .str("pixel_filter", PIXEL_FILTER)
                 .num("step_world", c.step)
                 .num("passes", c.passes as f64)
                 .num("change_db", c.change_db)

@@ -15,8 +15,8 @@ use crate::io::progress::sheets;
 use crate::io::stream::{ColouredMemorySource, FileSource, MemorySource, PipeSource};
 use crate::io::try_filled;
 use crate::reference::continuous::{
-    render_continuous, render_continuous_at, Continuous, ContinuousScene, Reconstruction,
-    MAX_HALVINGS,
+    render_continuous, render_continuous_at, Absorption, Continuous, ContinuousScene,
+    Reconstruction, MAX_HALVINGS,
 };
 use crate::reference::render::{render_reference, ReferenceScene};
 use crate::{with_table_size, CliError};
@@ -435,6 +435,7 @@ pub fn render_ref(p: &Prepared) -> Result<(Vec<[f64; 4]>, f64), CliError> {
 fn continuous_scene(
     p: &Prepared,
     reconstruction: Reconstruction,
+    absorption: Absorption,
 ) -> Result<(&crate::io::volume::Volume, ContinuousScene<'_>), CliError> {
     let volume = p.volume().ok_or_else(|| {
         CliError::input("the continuous reference needs the volume in memory: drop --stream")
@@ -452,6 +453,7 @@ fn continuous_scene(
         shader: p.shader(),
         background: p.background.as_deref(),
         reconstruction,
+        absorption,
     };
     Ok((volume, scene))
 }
@@ -462,8 +464,64 @@ pub fn render_continuous_ref(
     p: &Prepared,
     reconstruction: Reconstruction,
 ) -> Result<(Continuous, f64), CliError> {
+    render_continuous_model(p, reconstruction, Absorption::Extinction)
+}
+
+/// PSNR (RGB, dB) against each absorption model, the chosen one first.
+pub type ModelFigures = Vec<(Absorption, f64)>;
+
+/// The continuous reference of `p` with `absorption` (as [`render_continuous_model`]) and, for
+/// context, `core`'s PSNR (RGB, dB) against each model, the chosen one first: the models differ
+/// by more than a renderer's error on opaque data, so the figure means little without its model.
+pub fn continuous_models(
+    p: &Prepared,
+    reconstruction: Reconstruction,
+    absorption: Absorption,
+    core: &[[f32; 4]],
+) -> Result<(Continuous, f64, ModelFigures), CliError> {
+    let (chosen, secs) = render_continuous_model(p, reconstruction, absorption)?;
+    let mut figures = vec![(
+        absorption,
+        crate::metrics::compare(core, &chosen.image).1.psnr_db,
+    )];
+    for other in [Absorption::Extinction, Absorption::Opacity] {
+        if other != absorption {
+            let (c, _) = render_continuous_model(p, reconstruction, other)?;
+            figures.push((other, crate::metrics::compare(core, &c.image).1.psnr_db));
+        }
+    }
+    Ok((chosen, secs, figures))
+}
+
+/// The continuous reference's pixel filter, as `verify` states it.
+pub const PIXEL_FILTER: &str = "one ray through each pixel centre; a frame supersampled k times \
+                                (--supersample) averages its k x k rays per pixel (a box filter)";
+
+/// `continuous.models` of `verify`'s JSON: PSNR (RGB, dB) against each absorption model.
+pub fn models_json(models: &[(Absorption, f64)]) -> crate::io::json::Json {
+    models
+        .iter()
+        .fold(crate::io::json::Json::object(), |j, (m, db)| {
+            j.num(m.name(), *db)
+        })
+}
+
+/// The figures against the models after the chosen one, as `verify` prints them after it.
+pub fn others(models: &[(Absorption, f64)]) -> String {
+    let other =
+        |(m, db): &(Absorption, f64)| format!(", {db:.2} dB against the {} model", m.name());
+    models.iter().skip(1).map(other).collect()
+}
+
+/// [`render_continuous_ref`] with the field's absorption model given (see
+/// [`crate::reference::continuous`]).
+pub fn render_continuous_model(
+    p: &Prepared,
+    reconstruction: Reconstruction,
+    absorption: Absorption,
+) -> Result<(Continuous, f64), CliError> {
     let start = Instant::now();
-    let (volume, scene) = continuous_scene(p, reconstruction)?;
+    let (volume, scene) = continuous_scene(p, reconstruction, absorption)?;
     let mut bar = sheets("continuous");
     let axis = p.frame.sheet_axis;
     let mut c = render_continuous(
@@ -483,7 +541,7 @@ pub fn render_continuous_ref(
 /// its seconds. Kernel reconstruction. The volume must be in memory.
 pub fn continuous_at(p: &Prepared, pixels: &[[usize; 2]]) -> Result<(Continuous, f64), CliError> {
     let start = Instant::now();
-    let (volume, scene) = continuous_scene(p, Reconstruction::Kernel)?;
+    let (volume, scene) = continuous_scene(p, Reconstruction::Kernel, Absorption::Extinction)?;
     let k = p.supersample;
     let rays: Vec<[usize; 2]> = pixels
         .iter()

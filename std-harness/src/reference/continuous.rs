@@ -19,6 +19,15 @@
 //!   models, not 3D kernels);
 //! - `Trilinear`: the eight surrounding voxels, trilinearly, as ray casters such as VTK do.
 //!
+//! **Absorption model** ([`Absorption`]). The above is *extinction reconstruction*: extinctions
+//! are reconstructed, which needs the cap for opaque voxels, and the image moves with it (41.0 dB
+//! against image slicing at a cap of 10⁻⁶, 38.1 dB at 10⁻³ on a CT head). *Opacity
+//! reconstruction* reconstructs what the paper's sheets splat, opacity per world unit and
+//! premultiplied colour, α(x) = Σᵥ w(x − v) αᵥ and C(x) = Σᵥ w(x − v) αᵥcᵥ, and integrates
+//! σ(x) = −ln(1 − α(x)) emitting the straight colour C(x)/α(x). It needs no cap: where α(x)
+//! reaches 1 the ray ends there, with that colour. Object slicing converges toward it, image
+//! slicing toward extinction reconstruction; `verify` reports the figure against both.
+//!
 //! **Quadrature and convergence.** Each step of length h (world units) takes σ and E at its
 //! midpoint and composites the step exactly for constant σ and E (T·E/σ·(1 − e^(−σh)), then
 //! T·e^(−σh)): second order in h. The image is computed at h₀ = half the smallest spacing, then at
@@ -65,6 +74,25 @@ impl Reconstruction {
     }
 }
 
+/// Which quantity the field reconstructs between voxels (see the module docs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Absorption {
+    /// Extinction σᵥ = −ln(1 − αᵥ), αᵥ capped at `SlabVoxel::MAX_UNIT_ALPHA`.
+    Extinction,
+    /// Opacity αᵥ and premultiplied colour, uncapped.
+    Opacity,
+}
+
+impl Absorption {
+    /// The name `--absorption` and the JSON use.
+    pub fn name(self) -> &'static str {
+        match self {
+            Absorption::Extinction => "extinction",
+            Absorption::Opacity => "opacity",
+        }
+    }
+}
+
 /// What the continuous reference renders.
 pub struct ContinuousScene<'a> {
     pub frame: &'a FrameSetup,
@@ -72,6 +100,7 @@ pub struct ContinuousScene<'a> {
     pub shader: Shader<'a>,
     pub background: Option<&'a [[f32; 4]]>,
     pub reconstruction: Reconstruction,
+    pub absorption: Absorption,
 }
 
 /// The converged image and how it converged.
@@ -95,11 +124,13 @@ struct Taps {
     d2: Vec<f64>,
 }
 
-/// Pre-classified voxels: σ and σ·c (rgb) per voxel, x fastest, and the block map.
+/// Pre-classified voxels per [`Absorption`]: σ and σ·c (rgb), or α and α·c, per voxel, x
+/// fastest, and the block map.
 struct Field {
     dims: [usize; 3],
-    /// [σ, σr, σg, σb] per voxel.
+    /// [σ, σr, σg, σb] (extinction) or [α, αr, αg, αb] (opacity) per voxel.
     voxels: Vec<[f32; 4]>,
+    absorption: Absorption,
     /// Whether a block's neighbourhood (its voxels ± the reconstruction's reach) holds σ > 0.
     active: Vec<bool>,
     blocks: [usize; 3],
@@ -150,6 +181,15 @@ impl Field {
                         idx,
                         dims,
                     );
+                    let at = (idx[2] * dims[1] + idx[1]) * dims[0] + idx[0];
+                    if scene.absorption == Absorption::Opacity {
+                        // Opacity and premultiplied colour as shaded, uncapped.
+                        if rgba[3] > 0.0 {
+                            let a = rgba[3].min(1.0);
+                            voxels[at] = [a, rgba[0], rgba[1], rgba[2]];
+                        }
+                        continue;
+                    }
                     let a = f64::from(rgba[3]).clamp(0.0, f64::from(SlabVoxel::MAX_UNIT_ALPHA));
                     if !(a > 0.0) {
                         continue;
@@ -206,6 +246,7 @@ impl Field {
         Ok(Field {
             dims,
             voxels,
+            absorption: scene.absorption,
             active,
             blocks,
             reach,
@@ -412,7 +453,13 @@ fn march(scene: &ContinuousScene<'_>, field: &Field, h: f64, rays: Rays<'_>) -> 
                             if v[0] <= 0.0 {
                                 continue;
                             }
-                            let att = (-v[0] * hw).exp();
+                            // The step's transmittance: exp(−σh), or (1 − α)^h with
+                            // σ = −ln(1 − α) (α ≥ 1: opaque, the ray ends here). Either way the
+                            // straight colour emitted is v[1..] / v[0].
+                            let att = match field.absorption {
+                                Absorption::Extinction => (-v[0] * hw).exp(),
+                                Absorption::Opacity => (1.0 - v[0].min(1.0)).powf(hw),
+                            };
                             let share = trans * (1.0 - att) / v[0];
                             for ch in 0..3 {
                                 colour[ch] += share * v[ch + 1];
