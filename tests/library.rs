@@ -319,6 +319,18 @@ fn ring_render(
     hi: f32,
     push: Option<usize>,
 ) -> Result<(u32, Vec<[f32; 4]>), RenderError> {
+    ring_render_ordered(lut, lo, hi, push, None)
+}
+
+/// [`ring_render`] (back to front) through a ring made for `ring_order` (`None`: the renderer's,
+/// [`SheetRing::for_renderer`]).
+fn ring_render_ordered(
+    lut: &[[f32; 4]],
+    lo: f32,
+    hi: f32,
+    push: Option<usize>,
+    ring_order: Option<Order>,
+) -> Result<(u32, Vec<[f32; 4]>), RenderError> {
     let dims = [6, 5, 8];
     let grid = Grid::from_spacing([1.0; 3]).unwrap();
     let view = View::from_angles([0.0; 3], 1.0, dims, &grid, [24, 24]).unwrap();
@@ -358,7 +370,10 @@ fn ring_render(
     let data = volume(dims, |i, j, k| (i + j + k) as u8);
     let mut vol = MemoryVolume::new(&data, dims).unwrap();
     let mut storage = vec![0u8; 3 * frame.sheet_shape().0];
-    let mut ring = SheetRing::new(&mut storage, &frame, order)?;
+    let mut ring = match ring_order {
+        Some(o) => SheetRing::new(&mut storage, &frame, o)?,
+        None => SheetRing::for_renderer(&mut storage, &r)?,
+    };
     match push {
         None => render_from(&mut r, &mut ring, &mut vol)?,
         Some(count) => {
@@ -466,50 +481,12 @@ fn the_in_memory_example_writes_the_cli_png_byte_for_byte() {
 /// the renderer, so it is given once.
 #[test]
 fn a_ring_for_another_order_is_refused() {
-    use footprint::prelude::*;
-    let (dims, size) = ([8, 8, 8], [16, 16]);
-    let data = vec![100u8; 512];
-    let s = Settings {
-        window: [0.0, 255.0],
-        ..Settings::new(size, Preset::Grey.lut())
-    };
-    let frame = s.frame(dims).unwrap();
-    let generic = GenericTable::<17>::build(s.kernel);
-    let table = ViewTable::<17>::build(
-        &frame.footprint,
-        &generic,
-        Lookup::Bilinear,
-        Lookup::Bilinear,
-    );
-    let shader = Shader {
-        tf: TransferFunction {
-            lut: s.lut,
-            lo: 0.0,
-            hi: 255.0,
-        },
-        shading: Shading::Emission,
-    };
-    let (mut acc, mut image, mut rows) = (
-        vec![[0.0; 4]; 256],
-        vec![[0.0; 4]; 256],
-        vec![RowSpan::EMPTY; 16],
-    );
-    let buffers = RenderBuffers {
-        accumulator: &mut acc,
-        image: &mut image,
-        rows: &mut rows,
-    };
-    let mut r =
-        SheetRenderer::new(&frame, &table, shader, Order::FrontToBack, buffers, None).unwrap();
-    let mut vol = MemoryVolume::new(&data, dims).unwrap();
-    let mut storage = vec![0u8; 3 * frame.sheet_shape().0];
-    let mut ring = SheetRing::new(&mut storage, &frame, Order::BackToFront).unwrap();
-    let e = render_from(&mut r, &mut ring, &mut vol).unwrap_err();
+    let lut = [[0.0; 4], [1.0, 1.0, 1.0, 0.3]];
+    let e = ring_render_ordered(&lut, 0.0, 16.0, None, Some(Order::FrontToBack)).unwrap_err();
     assert!(matches!(e, RenderError::RingOrder { .. }), "{e:?}");
     assert!(e.to_string().contains("for_renderer"), "{e}");
-    let mut ring = SheetRing::for_renderer(&mut storage, &r).unwrap();
-    render_from(&mut r, &mut ring, &mut vol).unwrap();
-    assert_eq!(r.finish().sheets, 8);
+    let same = ring_render_ordered(&lut, 0.0, 16.0, None, Some(Order::BackToFront)).unwrap();
+    assert_eq!(same, ring_render(&lut, 0.0, 16.0, None).unwrap());
 }
 
 /// Every public error of the front door prints a message and is a `std::error::Error`.
