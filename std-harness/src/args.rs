@@ -313,9 +313,10 @@ pub struct RenderArgs {
     /// inside the volume (or within a kernel radius of it, or among its sheets) is refused.
     #[arg(help_heading = "Camera", long, value_name = "D", value_parser = parse_positive, requires = "perspective")]
     pub eye_distance: Option<f32>,
-    /// Transfer function: a preset (grey, ct-bone-skin, density) or a file of `t r g b a` lines.
-    /// Default: density for the built-in scene, ct-bone-skin for a volume (transparent over the
-    /// window's first 18 %).
+    /// Transfer function: a preset (grey, ct-bone-skin, density; ParaView's Grayscale, Cool to
+    /// Warm, Viridis, X Ray), a ParaView preset file (`.json`, `FILE.json#NAME` for one of
+    /// several) or a file of `t r g b a` lines. Default: density for the built-in scene,
+    /// ct-bone-skin for a volume (transparent over the window's first 18 %).
     #[arg(help_heading = "Picture", long)]
     pub tf: Option<String>,
     /// Value window LO,HI mapped onto the transfer function. Default for a volume: Otsu's
