@@ -104,13 +104,18 @@ impl<'a> Settings<'a> {
     /// The buffer lengths [`render_volume`] needs for a volume of `dims` samples.
     pub fn lengths(&self, dims: [usize; 3]) -> Result<Lengths, Error> {
         let frame = self.frame(dims)?;
-        let pixels = frame.image_len();
         Ok(Lengths {
-            pixels,
+            pixels: frame.image_len(),
             rows: frame.size[1],
             sheets: 3 * frame.sheet_shape().0,
-            work: 4 * pixels + OPACITY_TABLE_LEN + self.stencil_len(&frame),
+            work: self.work_len(&frame),
         })
+    }
+
+    /// The `work` buffer's layout: the accumulator (4 per pixel), the opacity table, the
+    /// stencils.
+    fn work_len(&self, frame: &FrameSetup) -> usize {
+        4 * frame.image_len() + OPACITY_TABLE_LEN + self.stencil_len(frame)
     }
 
     fn stencil_len(&self, frame: &FrameSetup) -> usize {
@@ -190,9 +195,8 @@ pub fn render_volume<T: Sample, const N: usize>(
         shading: settings.shading,
     };
     let table = ViewTable::<N>::build(&frame.footprint, generic, settings.lookup, settings.lookup);
-    let stencil_len = settings.stencil_len(&frame);
-    let pixels = frame.image_len();
-    let needed = 4 * pixels + OPACITY_TABLE_LEN + stencil_len;
+    let (stencil_len, pixels) = (settings.stencil_len(&frame), frame.image_len());
+    let needed = settings.work_len(&frame);
     if buffers.work.len() < needed {
         return Err(BufferError::TooSmall {
             needed,
