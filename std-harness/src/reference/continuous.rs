@@ -181,28 +181,25 @@ impl Field {
                         idx,
                         dims,
                     );
-                    let at = (idx[2] * dims[1] + idx[1]) * dims[0] + idx[0];
-                    if scene.absorption == Absorption::Opacity {
+                    let stored = match scene.absorption {
                         // Opacity and premultiplied colour as shaded, uncapped.
-                        if rgba[3] > 0.0 {
-                            let a = rgba[3].min(1.0);
-                            voxels[at] = [a, rgba[0], rgba[1], rgba[2]];
+                        Absorption::Opacity => {
+                            (rgba[3] > 0.0).then(|| [rgba[3].min(1.0), rgba[0], rgba[1], rgba[2]])
                         }
-                        continue;
+                        Absorption::Extinction => {
+                            let a =
+                                f64::from(rgba[3]).clamp(0.0, f64::from(SlabVoxel::MAX_UNIT_ALPHA));
+                            (a > 0.0).then(|| {
+                                let sigma = -(1.0 - a).ln();
+                                // Premultiplied colour / α = the straight colour.
+                                let c = [0, 1, 2].map(|ch| f64::from(rgba[ch]) / a);
+                                [sigma, sigma * c[0], sigma * c[1], sigma * c[2]].map(|x| x as f32)
+                            })
+                        }
+                    };
+                    if let Some(v) = stored {
+                        voxels[(idx[2] * dims[1] + idx[1]) * dims[0] + idx[0]] = v;
                     }
-                    let a = f64::from(rgba[3]).clamp(0.0, f64::from(SlabVoxel::MAX_UNIT_ALPHA));
-                    if !(a > 0.0) {
-                        continue;
-                    }
-                    let sigma = -(1.0 - a).ln();
-                    // Premultiplied colour / α = the straight colour.
-                    let c = [0, 1, 2].map(|ch| f64::from(rgba[ch]) / a);
-                    voxels[(idx[2] * dims[1] + idx[1]) * dims[0] + idx[0]] = [
-                        sigma as f32,
-                        (sigma * c[0]) as f32,
-                        (sigma * c[1]) as f32,
-                        (sigma * c[2]) as f32,
-                    ];
                 }
             }
         }
