@@ -50,6 +50,9 @@ pub fn run(command: &RenderCommandArgs) -> Result<(), CliError> {
     args.note_inputs();
     outputs::check(&planned)?;
     check_style(&out, args.png_style())?;
+    if command.orbit.is_some() {
+        check_orbit(args, &out)?;
+    }
     let (p, args, choice) = apply_quality(prepare(args)?, args)?;
     let args = &args;
     if let Some(n) = command.orbit {
@@ -133,15 +136,9 @@ pub fn run(command: &RenderCommandArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-/// `--orbit N`: N frames a 360/N-degree turn apart, reusing the loaded volume, its level and its
-/// visible-voxel lists, encoded into one animated PNG as they come.
-fn orbit(
-    mut p: Prepared,
-    args: &RenderArgs,
-    out: &Path,
-    n: usize,
-    bar: bool,
-) -> Result<(), CliError> {
+/// What `--orbit` cannot do, refused before the volume is loaded: another output than a PNG, the
+/// f64 reference, a pipe (each frame reads the volume again).
+fn check_orbit(args: &RenderArgs, out: &Path) -> Result<(), CliError> {
     if crate::io::outputs::extension(out).as_deref() != Some("png") {
         return Err(CliError::input(format!(
             "--orbit writes an animated PNG: {} is not a .png",
@@ -163,6 +160,18 @@ fn orbit(
              give the volume as a file (VOLUME, or --stream FILE)",
         ));
     }
+    Ok(())
+}
+
+/// `--orbit N`: N frames a 360/N-degree turn apart, reusing the loaded volume, its level and its
+/// visible-voxel lists, encoded into one animated PNG as they come.
+fn orbit(
+    mut p: Prepared,
+    args: &RenderArgs,
+    out: &Path,
+    n: usize,
+    bar: bool,
+) -> Result<(), CliError> {
     let start = Instant::now();
     let mut cache = FrameCache::default();
     let delay = (4000 / n).clamp(20, 1000) as u16;
