@@ -7,15 +7,7 @@ use footprint_harness::io::volume::{SampleType, Samples};
 use footprint_suite::tmpdir;
 use std::path::{Path, PathBuf};
 
-fn run(args: &[&str]) -> i32 {
-    let mut v = vec!["footprint"];
-    v.extend_from_slice(args);
-    footprint_harness::run(v)
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
+use footprint_suite::{path_str as s, run_cli as run};
 
 fn data(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))

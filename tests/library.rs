@@ -453,18 +453,15 @@ fn the_in_memory_example_writes_the_cli_png_byte_for_byte() {
     in_memory_example::render_png(lib.to_str().unwrap()).unwrap();
     let args = "render RAW --dims 64,64,48 --type u16 --spacing 1,1,1.5 --view 30,20,0 \
                 --tf ct-bone-skin --window 0,4000 --shading phong --size 256x256 --out OUT";
-    let args = args
+    let args: Vec<&str> = args
         .split_whitespace()
         .map(|a| match a {
             "RAW" => raw.to_str().unwrap(),
             "OUT" => cli.to_str().unwrap(),
             a => a,
         })
-        .map(String::from);
-    assert_eq!(
-        footprint_harness::run(std::iter::once("footprint".into()).chain(args)),
-        0
-    );
+        .collect();
+    assert_eq!(footprint_suite::run_cli(&args), 0);
     let (a, b) = (std::fs::read(&lib).unwrap(), std::fs::read(&cli).unwrap());
     assert!(
         a == b,

@@ -270,10 +270,7 @@ fn render_and_verify_write_the_same_image() {
     for (n, flags) in cases.iter().enumerate() {
         let (r, v) = (dir.join(format!("r{n}.png")), dir.join(format!("v{n}.png")));
         let go = |cmd: &str, out: &std::path::Path| {
-            let mut a = vec!["footprint", cmd];
-            a.extend_from_slice(flags);
-            a.extend_from_slice(&["--out", out.to_str().unwrap()]);
-            footprint_harness::run(a)
+            footprint_suite::run_cli(&[&[cmd], *flags, &["--out", out.to_str().unwrap()]].concat())
         };
         assert_eq!(go("render", &r), 0, "{flags:?}");
         assert_eq!(go("verify", &v), 0, "{flags:?}");

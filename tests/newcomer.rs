@@ -7,13 +7,7 @@ use std::path::Path;
 
 const HEAD: &str = "tests/data/headsq_64x64x93_int16_le.nhdr";
 
-fn run(args: &[&str]) -> i32 {
-    footprint_harness::run(std::iter::once("footprint").chain(args.iter().copied()))
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
+use footprint_suite::{path_str as s, run_cli as run};
 
 /// The numbers of JSON array `key` in `text` (a flat array of numbers).
 fn json_numbers(text: &str, key: &str) -> Vec<f64> {

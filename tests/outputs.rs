@@ -9,9 +9,7 @@ fn tmpdir(name: &str) -> footprint_suite::TestDir {
     footprint_suite::tmpdir(&format!("out-{name}"))
 }
 
-fn run(args: &[&str]) -> i32 {
-    footprint_harness::run(std::iter::once("footprint").chain(args.iter().copied()))
-}
+use footprint_suite::run_cli as run;
 
 /// Files in `d` (temporaries included).
 fn listing(d: &Path) -> Vec<String> {

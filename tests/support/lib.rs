@@ -10,6 +10,17 @@ use footprint_harness::{args::SplatArgs, pipeline::single::splat_image};
 use glam::{DMat3, Mat3};
 use std::path::PathBuf;
 
+/// Runs the `footprint` command line `args` (without the program name) in-process, through
+/// `footprint_harness::run`, the binary's own entry point; returns its exit code.
+pub fn run_cli(args: &[&str]) -> i32 {
+    footprint_harness::run(std::iter::once("footprint").chain(args.iter().copied()))
+}
+
+/// A test path as the `&str` a command line takes.
+pub fn path_str(p: &std::path::Path) -> &str {
+    p.to_str().expect("a UTF-8 test path")
+}
+
 /// PSNR (dB, peak 1) of `a` against `b` over R, G and B together: the overall figure of the
 /// harness's `metrics::compare` (what `verify` reports), for two f32 images.
 pub fn rgb_psnr(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
