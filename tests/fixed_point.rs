@@ -38,12 +38,7 @@ fn float_and_fixed(
 ) -> (Vec<[f32; 4]>, Vec<[u32; 4]>) {
     let generic = GenericTable::<65>::build(Kernel::PAPER_GAUSSIAN);
     let view = ViewTable::<65>::build(&f.footprint, &generic, lookup, lookup);
-    let float = render_with(
-        f,
-        footprint::render::FloatPath { sampler: &view },
-        order,
-        sheet,
-    );
+    let float = render_with(f, footprint::render::FloatPath::new(&view), order, sheet);
     let mut table = Box::new(FixedTable::<65>::zeroed());
     table.build_view(f, &generic, lookup, lookup).unwrap();
     let fixed = render_with(f, FixedPath::new(f, &*table).unwrap(), order, sheet);
@@ -224,7 +219,7 @@ fn direct_fixed_matches_direct_float() {
     let sheet = |_| vec![[0.2, 0.3, 0.4, 0.6]];
     let float = render_with(
         &f,
-        footprint::render::FloatPath { sampler: &direct },
+        footprint::render::FloatPath::new(&direct),
         Order::BackToFront,
         &sheet,
     );

@@ -142,9 +142,7 @@ fn fixed_path_uses_the_same_layout() {
         .unwrap();
     let float = render_one_voxel(
         &f,
-        footprint::render::FloatPath {
-            sampler: &float_table,
-        },
+        footprint::render::FloatPath::new(&float_table),
         |p: &[f32; 4]| f64::from(p[3]),
     );
     let fixed = render_one_voxel(

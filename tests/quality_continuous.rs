@@ -5,8 +5,8 @@
 use footprint_harness::args::parse_args;
 use footprint_harness::args::QualityReferenceArg::Continuous;
 use footprint_harness::metrics::compare;
+use footprint_harness::pipeline::continuous::continuous_at;
 use footprint_harness::pipeline::pilot::{choose_continuous, sample_pixels, PILOT_RAYS};
-use footprint_harness::pipeline::run::continuous_at;
 use footprint_harness::pipeline::{prepare, render_continuous_ref, render_core, Prepared};
 use footprint_harness::reference::continuous::Reconstruction;
 

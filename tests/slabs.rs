@@ -473,3 +473,45 @@ fn image_slicing_refusals_say_why() {
         assert!(err.message.contains(says), "{extra:?}: {}", err.message);
     }
 }
+
+/// The opacity model's layer (issue 41): a chord of L world units whose mean opacity per world
+/// unit is ᾱ keeps (1 − ᾱ)^L of the light, emitting the mean straight colour; ᾱ ≥ 1 is opaque
+/// whatever the sum (no cap), and faint layers keep their bits through the series.
+#[test]
+fn opacity_layers_hold_the_mean_opacity_over_the_chord() {
+    use footprint::render::absorption::{opacity_layer, Absorption};
+    for (mean, chord) in [(0.5f32, 1.0f32), (0.3, 2.5), (0.9, 0.25), (2e-4, 3.0)] {
+        let a = mean * chord;
+        // Straight colour 0.6 in red: C = 0.6·A.
+        let l = opacity_layer([0.6 * a, 0.0, 0.0, a], chord);
+        let want = 1.0 - (1.0 - f64::from(mean)).powf(f64::from(chord));
+        assert!(
+            (f64::from(l[3]) - want).abs() < 2e-6 * want.max(1e-3),
+            "ᾱ {mean}, L {chord}: α {} against {want}",
+            l[3]
+        );
+        assert!((l[0] / l[3] - 0.6).abs() < 1e-5, "{l:?}");
+    }
+    // Opaque: the sum past the chord's length, by any amount.
+    for a in [1.0f32, 1.5, 1e6] {
+        let l = opacity_layer([0.2 * a, 0.4 * a, 0.0, a], 1.0);
+        assert_eq!(l[3], 1.0);
+        assert!(
+            (l[0] - 0.2).abs() < 1e-6 && (l[1] - 0.4).abs() < 1e-6,
+            "{l:?}"
+        );
+    }
+    assert_eq!(opacity_layer([-1.0, f32::NAN, 0.0, -3.0], 1.0), [0.0; 4]);
+    assert_eq!(opacity_layer([0.1, 0.0, 0.0, f32::NAN], 1.0), [0.0; 4]);
+    assert_eq!(opacity_layer([0.1, 0.0, 0.0, 0.2], 0.0), [0.0; 4]);
+    // The model's voxel values: opacity as shaded (no cap), extinction capped.
+    let v = Absorption::Opacity
+        .voxel_value([0.2, 0.1, 0.0, 1.0])
+        .unwrap();
+    assert_eq!(v, [0.2, 0.1, 0.0, 1.0]);
+    let e = Absorption::Extinction
+        .voxel_value([0.2, 0.1, 0.0, 1.0])
+        .unwrap();
+    // σ = −ln(1 − (1 − 10⁻⁶)) ≈ 13.8 (in f32, 1 − 10⁻⁶ rounds to 1 − 1.013·10⁻⁶).
+    assert!((e[3] - 13.8).abs() < 0.05, "{e:?}");
+}

@@ -250,7 +250,7 @@ fn run<S: Splatter + ?Sized, T: Sample>(
     sheets: &mut [T],
     volume: &mut MemoryVolume<'_, T>,
 ) -> Result<RenderStats, Error> {
-    let path = FloatPath { sampler };
+    let path = FloatPath::new(sampler);
     let mut renderer = SheetRenderer::with_path(frame, path, shader, order, render, None)?
         .with_opacity_table(opacity)?;
     let mut ring = SheetRing::for_renderer(sheets, &renderer)?;

@@ -116,14 +116,15 @@ impl From<ReconstructionArg> for crate::reference::continuous::Reconstruction {
     }
 }
 
-/// `verify --absorption`: the continuous reference's absorption model.
+/// `--absorption`: the continuous model both slicings render and the continuous reference
+/// integrates (`footprint::render::absorption`).
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum AbsorptionArg {
-    Extinction,
     Opacity,
+    Extinction,
 }
 
-impl From<AbsorptionArg> for crate::reference::continuous::Absorption {
+impl From<AbsorptionArg> for footprint::render::Absorption {
     fn from(a: AbsorptionArg) -> Self {
         match a {
             AbsorptionArg::Extinction => Self::Extinction,
@@ -397,6 +398,11 @@ pub struct RenderArgs {
     /// of the grid's three spacings).
     #[arg(help_heading = "Method", long, value_name = "T", default_value_t = 1.0, value_parser = parse_positive)]
     pub slab: f32,
+    /// The model both slicings render and `verify --reference continuous` integrates: `opacity`
+    /// (opacity and colour reconstructed, no cap: the paper's sheets) or `extinction` (opaque
+    /// voxels capped at 1 − 10⁻⁶ per world unit). See docs/accuracy.md, "The model".
+    #[arg(help_heading = "Method", long, value_enum, default_value_t = AbsorptionArg::Opacity)]
+    pub absorption: AbsorptionArg,
     /// View-table renders: sub-pixel phases per pixel (at most; wide footprints use fewer) of the
     /// phase stencils that splat footprints up to 128 px across: the view table (float, the
     /// core's `stencil` module) or the integer table (fixed, `fixed::stencil`) sampled once per

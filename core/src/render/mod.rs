@@ -20,6 +20,7 @@
 //! [`Splatter`]: a footprint sampler or phase stencils) or [`FixedPath`] (integer table, `i64` accumulator, Q24 image; see
 //! [`crate::fixed`]). One build holds both, so they can be compared on the same frame.
 
+pub mod absorption;
 mod band;
 mod error;
 mod perspective;
@@ -31,6 +32,7 @@ mod sheets;
 pub mod slabs;
 mod visible;
 
+pub use absorption::Absorption;
 pub use error::RenderError;
 pub use perspective::PerspectivePath;
 pub use precision::{FixedPath, FloatPath, Precision};
@@ -113,7 +115,7 @@ impl<'a, S: Splatter + ?Sized> SheetRenderer<'a, FloatPath<'a, S>> {
     ) -> Result<Self, RenderError> {
         Self::with_path(
             frame,
-            FloatPath { sampler },
+            FloatPath::new(sampler),
             shader,
             order,
             buffers,

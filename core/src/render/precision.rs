@@ -2,6 +2,7 @@
 //! accumulator and image, any [`Sampler`]) and [`FixedPath`] (integer table, `i64` accumulator, Q24
 //! image; see [`crate::fixed`]).
 
+use super::absorption::{extinction_layer, Absorption};
 use super::RenderError;
 use crate::composite::{clamp_unit, over};
 use crate::fixed::stencil::FixedStencils;
@@ -50,10 +51,32 @@ pub trait Precision {
 
 /// Float accumulation through any [`Splatter`]: a footprint [`Sampler`](crate::Sampler) (view
 /// table or direct) or a view's phase stencils ([`crate::stencil::Stencils`]).
+///
+/// A sheet composites the [`Absorption`] model it is given: opacity (the paper's sheets: the
+/// premultiplied values summed, clamped to [0, 1]) or extinction (each voxel's sheet opacity α
+/// splatted as its optical depth −ln(1 − α) and emission, the sheet a layer of opacity
+/// 1 − e^(−τ): [`super::absorption::extinction_layer`]).
 #[derive(Debug)]
 pub struct FloatPath<'a, S: ?Sized> {
     /// The footprint sampler.
     pub sampler: &'a S,
+    /// The model each sheet composites.
+    pub absorption: Absorption,
+}
+
+impl<'a, S: ?Sized> FloatPath<'a, S> {
+    /// Sheets through `sampler`, compositing the default model (opacity, the paper's).
+    pub fn new(sampler: &'a S) -> Self {
+        FloatPath {
+            sampler,
+            absorption: Absorption::Opacity,
+        }
+    }
+
+    /// The same path compositing `absorption`'s model.
+    pub fn with_absorption(self, absorption: Absorption) -> Self {
+        FloatPath { absorption, ..self }
+    }
 }
 
 impl<S: ?Sized> Clone for FloatPath<'_, S> {
@@ -73,7 +96,10 @@ impl<S: Splatter + ?Sized> Precision for FloatPath<'_, S> {
 
     #[inline]
     fn value(&self, rgba: [f32; 4]) -> [f32; 4] {
-        rgba
+        match self.absorption {
+            Absorption::Opacity => rgba,
+            Absorption::Extinction => Absorption::Extinction.voxel_value(rgba).unwrap_or([0.0; 4]),
+        }
     }
 
     #[inline]
@@ -102,11 +128,27 @@ impl<S: Splatter + ?Sized> Precision for FloatPath<'_, S> {
     }
 
     fn composite_row(&self, acc: &mut [[f32; 4]], image: &mut [[f32; 4]], order: Order) {
-        float_composite_row(acc, image, order);
+        match self.absorption {
+            Absorption::Opacity => float_composite_row(acc, image, order),
+            Absorption::Extinction => extinction_composite_row(acc, image, order),
+        }
     }
 
     fn over_row(&self, front: &mut [[f32; 4]], back: &[[f32; 4]]) {
         float_over_row(front, back);
+    }
+}
+
+/// An extinction sheet's compositing: each pixel's [E, τ] as a layer
+/// ([`super::absorption::extinction_layer`]), over or under the image; clears the accumulator.
+fn extinction_composite_row(acc: &mut [[f32; 4]], image: &mut [[f32; 4]], order: Order) {
+    for (a, i) in acc.iter_mut().zip(image.iter_mut()) {
+        let layer = extinction_layer(*a);
+        *i = match order {
+            Order::BackToFront => over(layer, *i),
+            Order::FrontToBack => over(*i, layer),
+        };
+        *a = [0.0; 4];
     }
 }
 

@@ -21,12 +21,15 @@
 //! [`SectionTable`]. For an anisotropic grid z* ≠ 0: the chord's midpoint moves with the pixel.
 //!
 //! # Values and compositing
-//! Voxels carry extinction and emission per world unit ([`SlabVoxel::from_unit_rgba`]): σ =
-//! −ln(1 − α₁), α₁ the voxel's opacity over one world unit, and σ·c with c its straight colour.
-//! A slab accumulates τ = ∫σ dl and E = ∫σc dl per pixel, and is composited as a layer of
-//! constant colour E/τ and opacity 1 − e^(−τ): the emission–absorption integral of the continuous
-//! field Σᵥ w(x − v)(σᵥ, σᵥcᵥ), with only the ordering inside each slab approximated. Thinner slabs
-//! converge to that integral; a slab does not need the per-sheet opacity correction of object
+//! A voxel's value is what its [`Absorption`] model reconstructs, per world unit
+//! ([`SlabSetup::voxel`]): its opacity α₁ over one world unit and premultiplied colour α₁c
+//! (opacity, the default), or its extinction σ = −ln(1 − α₁) and σc (extinction). A slab
+//! accumulates the integral of that field along each pixel's chord through it and is composited
+//! as one layer ([`Absorption::layer`]): opacity 1 − (1 − ᾱ)^L with ᾱ the mean opacity over the
+//! chord of L world units, or 1 − e^(−τ); colour the mean straight colour. That is the
+//! emission–absorption integral of the continuous field Σᵥ w(x − v)·valueᵥ, with only the
+//! ordering inside each slab (and, for opacity, α by its mean over the chord) approximated:
+//! thinner slabs converge to it. A slab does not need the per-sheet opacity correction of object
 //! slicing, and nothing depends on which grid axis is most parallel to the image (no pop at 45°).
 //!
 //! # Slabs
@@ -44,6 +47,7 @@
 //! variant (compositing takes an exponential per pixel and slab); perspective frames are refused
 //! ([`SlabError::Perspective`]).
 
+use super::absorption::{extinction_layer, Absorption, MAX_UNIT_ALPHA};
 use super::band::{check_band, start_image};
 use super::precision::float_over_row;
 use super::{RenderError, RenderStats};
@@ -132,33 +136,25 @@ pub struct SlabVoxel {
     /// Screen position, pixels (x right, y down, z depth growing away from the viewer):
     /// [`FrameSetup::affine_position`] of the voxel's grid index.
     pub position: [f32; 3],
-    /// [σr, σg, σb, σ]: extinction σ per world unit and σ times the straight colour.
+    /// Per world unit, as the setup's [`Absorption`] model reads the voxel: [α₁r, α₁g, α₁b, α₁]
+    /// (opacity over one world unit and the premultiplied colour) or [σr, σg, σb, σ] (extinction
+    /// and σ times the straight colour).
     pub value: [f32; 4],
 }
 
 impl SlabVoxel {
-    /// The most opacity per world unit taken as is; above it α counts as this (σ ≈ 13.8).
-    pub const MAX_UNIT_ALPHA: f32 = 1.0 - 1e-6;
+    /// The most opacity per world unit the extinction model takes as is
+    /// ([`super::absorption::MAX_UNIT_ALPHA`]).
+    pub const MAX_UNIT_ALPHA: f32 = MAX_UNIT_ALPHA;
 
-    /// Extinction and emission per world unit from a voxel's premultiplied RGBA shaded for one
-    /// world unit of thickness (the shader with `sheet_distance` = `reference_distance`). `None`
-    /// for a transparent (or NaN) voxel.
+    /// Extinction and emission per world unit (the [`Absorption::Extinction`] model) from a
+    /// voxel's premultiplied RGBA shaded for one world unit of thickness (the shader with
+    /// `sheet_distance` = `reference_distance`). `None` for a transparent (or NaN) voxel. A setup's
+    /// own model: [`SlabSetup::voxel`].
     pub fn from_unit_rgba(position: [f32; 3], rgba: [f32; 4]) -> Option<SlabVoxel> {
-        if !(rgba[3] > 0.0) {
-            return None;
-        }
-        let a = rgba[3].min(Self::MAX_UNIT_ALPHA);
-        let sigma = -math::ln(1.0 - a);
-        let k = sigma / a;
-        Some(SlabVoxel {
-            position,
-            value: [
-                rgba[0].max(0.0) * k,
-                rgba[1].max(0.0) * k,
-                rgba[2].max(0.0) * k,
-                sigma,
-            ],
-        })
+        Absorption::Extinction
+            .voxel_value(rgba)
+            .map(|value| SlabVoxel { position, value })
     }
 }
 
@@ -182,11 +178,15 @@ pub struct SlabSetup {
     count: usize,
     /// |G·d| / (|d|·R²): a section's weight per unit of table difference.
     scale: f32,
+    /// The model the slabs composite, and a slab's chord along the ray, world units.
+    absorption: Absorption,
+    chord: f32,
 }
 
 impl SlabSetup {
     /// Slabs `thickness` smallest-grid-spacings thick for `frame` (orthographic), cutting
-    /// `kernel` (a Gaussian).
+    /// `kernel` (a Gaussian), compositing the default [`Absorption`] model (opacity; see
+    /// [`SlabSetup::with_absorption`]).
     pub fn new(frame: &FrameSetup, kernel: &Kernel, thickness: f32) -> Result<Self, SlabError> {
         if frame.camera().is_some() {
             return Err(SlabError::Perspective);
@@ -255,7 +255,33 @@ impl SlabSetup {
             thickness: t,
             count: (math::floor(needed) as usize + 1).max(1),
             scale: world_per_z / (dl * r2),
+            absorption: Absorption::default(),
+            chord: thickness * min_spacing,
         })
+    }
+
+    /// The same slabs compositing `absorption`'s model (voxels made with [`SlabSetup::voxel`]).
+    pub fn with_absorption(self, absorption: Absorption) -> Self {
+        SlabSetup { absorption, ..self }
+    }
+
+    /// The model the slabs composite.
+    pub fn absorption(&self) -> Absorption {
+        self.absorption
+    }
+
+    /// A slab's chord along the ray, world units (the thickness given × the smallest spacing).
+    pub fn chord(&self) -> f32 {
+        self.chord
+    }
+
+    /// The voxel at screen `position` shaded to premultiplied `rgba` for one world unit of
+    /// thickness, valued as this setup's model reads it; `None` for a transparent (or NaN) voxel.
+    #[inline]
+    pub fn voxel(&self, position: [f32; 3], rgba: [f32; 4]) -> Option<SlabVoxel> {
+        self.absorption
+            .voxel_value(rgba)
+            .map(|value| SlabVoxel { position, value })
     }
 
     /// The most slabs one kernel overlaps (at most [`MAX_RING`]): how many slab accumulators a
@@ -511,16 +537,16 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
         Ok(())
     }
 
-    /// Composites the next slab in compositing order (opacity 1 − e^(−τ), colour
-    /// E·(1 − e^(−τ))/τ) into the image over the rows it touched, and clears its slot. Nothing
-    /// once every slab is done.
+    /// Composites the next slab in compositing order (as one layer of the setup's model,
+    /// [`Absorption::layer`]) into the image over the rows it touched, and clears its slot.
+    /// Nothing once every slab is done.
     pub fn composite_next(&mut self) {
         let Some(slab) = self.next_slab() else {
             return;
         };
         let (w, ring, bn) = (self.setup.size[0], self.ring, self.band.1);
         let slot = slab % ring;
-        let order = self.order;
+        let (order, model, chord) = (self.order, self.setup.absorption, self.setup.chord);
         let (acc, img) = (&mut *self.buffers.accumulators, &mut *self.buffers.image);
         for (y, span) in self.buffers.rows[slot * bn..(slot + 1) * bn]
             .iter_mut()
@@ -532,7 +558,7 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
             let (lo, hi) = (y * w + span.lo as usize, y * w + span.hi as usize + 1);
             for (p, i) in (lo..hi).zip(&mut img[lo..hi]) {
                 let a = &mut acc[p * ring + slot];
-                let layer = slab_layer(*a);
+                let layer = model.layer(*a, chord);
                 *a = [0.0; 4];
                 *i = match order {
                     Order::BackToFront => over(layer, *i),
@@ -560,23 +586,9 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
     }
 }
 
-/// A slab's accumulated [E, τ] as a premultiplied layer: α = 1 − e^(−τ), colour E·α/τ.
+/// A slab's accumulated [E, τ] as a premultiplied layer of the extinction model
+/// ([`extinction_layer`]): α = 1 − e^(−τ), colour E·α/τ.
 #[inline]
 pub fn slab_layer(acc: [f32; 4]) -> [f32; 4] {
-    // max, not clamp: NaN becomes 0.
-    let tau = acc[3].max(0.0);
-    let (alpha, k) = if tau > 1e-3 {
-        let alpha = 1.0 - math::exp(-tau);
-        (alpha, alpha / tau)
-    } else {
-        // Series to τ³: relative error < τ³/24 < 5·10⁻¹¹.
-        let k = 1.0 - tau * (0.5 - tau / 6.0);
-        (tau * k, k)
-    };
-    [
-        acc[0].max(0.0) * k,
-        acc[1].max(0.0) * k,
-        acc[2].max(0.0) * k,
-        alpha,
-    ]
+    extinction_layer(acc)
 }

@@ -259,7 +259,7 @@ pub fn render_float(
     b.table
         .build_into(&f.footprint, &GENERIC, Lookup::Bilinear, Lookup::Bilinear);
     let (shader, lighting) = (shader(), Lighting::new(&f));
-    let path = footprint::render::FloatPath { sampler: &*b.table };
+    let path = footprint::render::FloatPath::new(&*b.table);
     let buffers = (&mut *b.acc, &mut *b.image, &mut *b.rows);
     let shade = |x: u8| shader.shade(&lighting, f32::from(x), || Vec3::ZERO, [0; 3], f.dims);
     render_bands(&f, path, shader, buffers, shade, emit, |c: f32, crc| {

@@ -5,12 +5,12 @@
 //! background (transparent black if none); the measures are [`crate::metrics`]'.
 
 use crate::args::RenderArgs;
-use crate::args::{AbsorptionArg, AccumArg, Lod, MethodArg, ReconstructionArg, ReferenceArg};
+use crate::args::{AccumArg, Lod, MethodArg, ReconstructionArg, ReferenceArg};
 use crate::io::image::{check_style, encode_rgb_for, RGB_EXTENSIONS};
 use crate::io::json::Json;
 use crate::io::outputs::{self, Planned};
 use crate::metrics::compare;
-use crate::pipeline::run::{continuous_models, models_json, others, PIXEL_FILTER};
+use crate::pipeline::continuous::{continuous_models, models_json, others, PIXEL_FILTER};
 use crate::pipeline::{choose::apply_quality, field::prepare_field, quality::quality_json};
 use crate::pipeline::{describe, prepare, render_core, render_core_with, render_ref};
 use crate::reference::continuous::Reconstruction;
@@ -46,11 +46,6 @@ pub struct VerifyArgs {
     /// trilinearly (as VTK's ray casters do).
     #[arg(long, value_enum, default_value_t = ReconstructionArg::Kernel)]
     pub reconstruction: ReconstructionArg,
-    /// With `--reference continuous` or `field`: the field reconstructs `extinction` (opaque voxels
-    /// capped; image slicing's model) or `opacity` and colour (no cap; object slicing's). The
-    /// figure against the other is reported too (JSON `continuous.models`).
-    #[arg(long, value_enum, default_value_t = AbsorptionArg::Extinction)]
-    pub absorption: AbsorptionArg,
 }
 
 pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
@@ -113,7 +108,7 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
                 _ => None,
             };
             let over = fine.as_ref().unwrap_or(&p);
-            let (recon, absorption) = (args.reconstruction.into(), args.absorption.into());
+            let (recon, absorption) = (args.reconstruction.into(), r.absorption.into());
             let (c, secs, models) = continuous_models(over, recon, absorption, &core)?;
             let (_, e) = compare(&core, &c.image);
             Some((c, secs, e, models))

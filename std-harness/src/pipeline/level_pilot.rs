@@ -216,7 +216,7 @@ where
             image: &mut image[..],
             rows: &mut spans[..],
         };
-        let path = FloatPath { sampler };
+        let path = FloatPath::new(sampler).with_absorption(p.absorption);
         renderers.push(
             SheetRenderer::with_band(f, path, p.shader(), p.order, buffers, bg, band)?
                 .with_opacity_table(&mut opacity[..])?,

@@ -37,6 +37,7 @@
 pub mod bands;
 pub mod choose;
 pub mod config;
+pub mod continuous;
 pub mod describe;
 pub mod entry;
 pub mod field;
@@ -59,12 +60,11 @@ pub mod supply;
 pub mod visible;
 pub mod window;
 
+pub use continuous::render_continuous_ref;
 pub use describe::describe;
 pub use entry::prepare;
 pub use prepare::Prepared;
-pub use run::{
-    render_continuous_ref, render_core, render_core_with, render_frame, render_ref, CoreFrame,
-};
+pub use run::{render_core, render_core_with, render_frame, render_ref, CoreFrame};
 
 /// `base` turned `degrees` of azimuth further about the volume's vertical axis: `--view`'s
 /// azimuth plus `degrees`, or a `--view-matrix` V as V · Ry(degrees) (the same turn). What

@@ -37,9 +37,10 @@
 //! sheet reference is what the table configuration alone controls.
 
 use super::config::Config;
+use super::continuous::continuous_at;
 use super::prepare::Prepared;
 use super::quality::{self, Choice, Estimate, Pilot};
-use super::run::{continuous_at, render_frame};
+use super::run::render_frame;
 use super::sampling::mix;
 use super::visible::FrameCache;
 use crate::args::{QualityReferenceArg, RenderArgs, SlicingArg};

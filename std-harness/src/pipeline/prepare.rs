@@ -97,6 +97,8 @@ pub struct Prepared {
     pub options: FootprintOptions,
     /// The frame is set up at `supersample` × the output size (see [`super::supersample`]).
     pub supersample: usize,
+    /// The continuous model both slicings composite (`--absorption`).
+    pub absorption: footprint::render::Absorption,
 }
 
 impl Prepared {
@@ -173,6 +175,7 @@ impl Prepared {
             order: self.order,
             options: self.options,
             supersample,
+            absorption: self.absorption,
         })
     }
 
@@ -544,6 +547,7 @@ pub fn prepare_as_asked(args: &RenderArgs) -> Result<Prepared, CliError> {
         order,
         options,
         supersample,
+        absorption: args.absorption.into(),
     })
 }
 

@@ -305,7 +305,7 @@ pub fn render_refined(
                 let mut opacity = vec![0.0f32; OPACITY_TABLE_LEN];
                 let mut scratch = crate::io::try_filled(2 * f.sheet_shape().0, 0.0f32, "refinement scratch sheets")?;
                 let buffers = RenderBuffers { accumulator: &mut acc, image, rows: &mut spans };
-                let path = FloatPath { sampler: tables.rates[2] };
+                let path = FloatPath::new(tables.rates[2]).with_absorption(p.absorption);
                 let mut r = SheetRenderer::with_band(f, path, p.shader(), p.order, buffers, bg, rows)?
                     .with_opacity_table(&mut opacity)?;
                 let t = Instant::now();

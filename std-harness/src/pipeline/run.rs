@@ -14,14 +14,11 @@ use crate::args::{AccumArg, MethodArg, RenderArgs, SlicingArg};
 use crate::io::progress::sheets;
 use crate::io::stream::{ColouredMemorySource, FileSource, MemorySource, PipeSource};
 use crate::io::try_filled;
-use crate::reference::continuous::{
-    render_continuous, render_continuous_at, Absorption, Continuous, ContinuousScene,
-    Reconstruction, MAX_HALVINGS,
-};
 use crate::reference::render::{render_reference, ReferenceScene};
 use crate::{with_table_size, CliError};
 use footprint::fixed::stencil::FixedStencils;
 use footprint::fixed::{self, FixedTable};
+use footprint::render::Absorption;
 use footprint::render::{
     FixedPath, FloatPath, PerspectivePath, Precision, RenderBuffers, RenderStats, ShadeCacheEntry,
     SheetRenderer, SheetRing, SHADE_CACHE_LEN,
@@ -82,6 +79,7 @@ pub fn render_frame(
     if args.slicing == SlicingArg::Image {
         return super::slabs::render_slabs(p, args, accum, cache);
     }
+    check_absorption(p, accum)?;
     let fa = &args.footprint;
     let lookup = Lookup::from(fa.lookup);
     let threads = args.thread_count();
@@ -103,7 +101,7 @@ pub fn render_frame(
             (AccumArg::Float, MethodArg::Direct) => {
                 let sampler = Direct { footprint: p.frame.footprint, table: &*generic, lookup };
                 let tables = start.elapsed().as_secs_f64();
-                let r = run_path(p, FloatPath { sampler: &sampler }, p.background.as_deref(), cache, threads)?;
+                let r = run_path(p, FloatPath::new(&sampler).with_absorption(p.absorption), p.background.as_deref(), cache, threads)?;
                 (r.0, r.1, Phases { tables, ..r.2 }, r.3)
             }
             (AccumArg::Float, _) => {
@@ -113,12 +111,12 @@ pub fn render_frame(
                     let mut buffer = vec![0.0f32; len];
                     let stencils = build_stencils(&*table, args.phases, &mut buffer, threads)?;
                     let tables = start.elapsed().as_secs_f64();
-                    let path = FloatPath { sampler: &stencils };
+                    let path = FloatPath::new(&stencils).with_absorption(p.absorption);
                     let r = run_path(p, path, p.background.as_deref(), cache, threads)?;
                     (r.0, r.1, Phases { tables, ..r.2 }, r.3)
                 } else {
                     let tables = start.elapsed().as_secs_f64();
-                    let r = run_path(p, FloatPath { sampler: &*table }, p.background.as_deref(), cache, threads)?;
+                    let r = run_path(p, FloatPath::new(&*table).with_absorption(p.absorption), p.background.as_deref(), cache, threads)?;
                     (r.0, r.1, Phases { tables, ..r.2 }, r.3)
                 };
                 r
@@ -180,6 +178,28 @@ pub fn render_frame(
             visible,
         }
     })
+}
+
+/// Object slicing renders the extinction model with the float path in orthographic frames
+/// only: the fixed path accumulates clamped opacity, and the perspective path corrects each
+/// voxel's opacity per ray before it is splatted.
+fn check_absorption(p: &Prepared, accum: AccumArg) -> Result<(), CliError> {
+    if p.absorption == Absorption::Extinction {
+        let why = if accum == AccumArg::Fixed {
+            Some("--accum fixed composites the opacity model only: use --accum float")
+        } else if p.frame.camera().is_some() {
+            Some("--perspective composites the opacity model only")
+        } else {
+            None
+        };
+        if let Some(why) = why {
+            return Err(CliError::input(format!(
+                "{}: --absorption extinction: {why} (or --absorption opacity)",
+                p.name
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// The float path's phase stencils of `sampler` (at most `phases` per pixel) in `buffer`,
@@ -417,6 +437,7 @@ pub fn render_ref(p: &Prepared) -> Result<(Vec<[f64; 4]>, f64), CliError> {
         shader: p.shader(),
         order: p.order,
         background: p.background.as_deref(),
+        absorption: p.absorption,
     };
     let axis = p.frame.sheet_axis;
     let img = render_reference(
@@ -429,147 +450,4 @@ pub fn render_ref(p: &Prepared) -> Result<(Vec<[f64; 4]>, f64), CliError> {
         k => downsample(&img, p.out_size(), k, |v| v),
     };
     Ok((img, start.elapsed().as_secs_f64()))
-}
-
-/// `p`'s volume (it must be in memory) and the continuous reference's scene of it.
-fn continuous_scene(
-    p: &Prepared,
-    reconstruction: Reconstruction,
-    absorption: Absorption,
-) -> Result<(&crate::io::volume::Volume, ContinuousScene<'_>), CliError> {
-    let volume = p.volume().ok_or_else(|| {
-        CliError::input("the continuous reference needs the volume in memory: drop --stream")
-    })?;
-    if volume.is_coloured() {
-        return Err(CliError::input(format!(
-            "the continuous reference integrates the volume at full resolution, not level {} of \
-             it: give --lod 0",
-            p.level
-        )));
-    }
-    let scene = ContinuousScene {
-        frame: &p.frame,
-        kernel: &p.kernel,
-        shader: p.shader(),
-        background: p.background.as_deref(),
-        reconstruction,
-        absorption,
-    };
-    Ok((volume, scene))
-}
-
-/// The continuous reference of `p` (see [`crate::reference::continuous`]): the converged image
-/// (at the output size) and how it converged, and its seconds. The volume must be in memory.
-pub fn render_continuous_ref(
-    p: &Prepared,
-    reconstruction: Reconstruction,
-) -> Result<(Continuous, f64), CliError> {
-    render_continuous_model(p, reconstruction, Absorption::Extinction)
-}
-
-/// PSNR (RGB, dB) against each absorption model, the chosen one first.
-pub type ModelFigures = Vec<(Absorption, f64)>;
-
-/// The continuous reference of `p` with `absorption` (as [`render_continuous_model`]) and, for
-/// context, `core`'s PSNR (RGB, dB) against each model, the chosen one first: the models differ
-/// by more than a renderer's error on opaque data, so the figure means little without its model.
-pub fn continuous_models(
-    p: &Prepared,
-    reconstruction: Reconstruction,
-    absorption: Absorption,
-    core: &[[f32; 4]],
-) -> Result<(Continuous, f64, ModelFigures), CliError> {
-    let (chosen, secs) = render_continuous_model(p, reconstruction, absorption)?;
-    let mut figures = vec![(
-        absorption,
-        crate::metrics::compare(core, &chosen.image).1.psnr_db,
-    )];
-    for other in [Absorption::Extinction, Absorption::Opacity] {
-        if other != absorption {
-            let (c, _) = render_continuous_model(p, reconstruction, other)?;
-            figures.push((other, crate::metrics::compare(core, &c.image).1.psnr_db));
-        }
-    }
-    Ok((chosen, secs, figures))
-}
-
-/// The continuous reference's pixel filter, as `verify` states it.
-pub const PIXEL_FILTER: &str = "one ray through each pixel centre; a frame supersampled k times \
-                                (--supersample) averages its k x k rays per pixel (a box filter)";
-
-/// `continuous.models` of `verify`'s JSON: PSNR (RGB, dB) against each absorption model.
-pub fn models_json(models: &[(Absorption, f64)]) -> crate::io::json::Json {
-    models
-        .iter()
-        .fold(crate::io::json::Json::object(), |j, (m, db)| {
-            j.num(m.name(), *db)
-        })
-}
-
-/// The figures against the models after the chosen one, as `verify` prints them after it.
-pub fn others(models: &[(Absorption, f64)]) -> String {
-    let other =
-        |(m, db): &(Absorption, f64)| format!(", {db:.2} dB against the {} model", m.name());
-    models.iter().skip(1).map(other).collect()
-}
-
-/// [`render_continuous_ref`] with the field's absorption model given (see
-/// [`crate::reference::continuous`]).
-pub fn render_continuous_model(
-    p: &Prepared,
-    reconstruction: Reconstruction,
-    absorption: Absorption,
-) -> Result<(Continuous, f64), CliError> {
-    let start = Instant::now();
-    let (volume, scene) = continuous_scene(p, reconstruction, absorption)?;
-    let mut bar = sheets("continuous");
-    let axis = p.frame.sheet_axis;
-    let mut c = render_continuous(
-        &scene,
-        |s, out| volume.sheet_into(axis, s, out),
-        |pass, _| bar(pass, MAX_HALVINGS + 1),
-    )?;
-    if p.supersample > 1 {
-        c.image = downsample(&c.image, p.out_size(), p.supersample, |v| v);
-    }
-    Ok((c, start.elapsed().as_secs_f64()))
-}
-
-/// The continuous reference of `p` at the listed pixels of the *output* image only ((x, y), each
-/// below [`Prepared::out_size`]; a supersampled frame marches the k×k rays of each and averages
-/// them, as the renders are averaged): their values in the order given, how it converged, and
-/// its seconds. Kernel reconstruction. The volume must be in memory.
-pub fn continuous_at(p: &Prepared, pixels: &[[usize; 2]]) -> Result<(Continuous, f64), CliError> {
-    let start = Instant::now();
-    let (volume, scene) = continuous_scene(p, Reconstruction::Kernel, Absorption::Extinction)?;
-    let k = p.supersample;
-    let rays: Vec<[usize; 2]> = pixels
-        .iter()
-        .flat_map(|&[x, y]| (0..k * k).map(move |i| [x * k + i % k, y * k + i / k]))
-        .collect();
-    let mut bar = sheets("continuous pilot");
-    let axis = p.frame.sheet_axis;
-    let mut c = render_continuous_at(
-        &scene,
-        |s, out| volume.sheet_into(axis, s, out),
-        |pass, _| bar(pass, MAX_HALVINGS + 1),
-        &rays,
-    )?;
-    if k > 1 {
-        let scale = 1.0 / (k * k) as f64;
-        c.image = c
-            .image
-            .chunks(k * k)
-            .map(|block| {
-                let mut sum = [0.0f64; 4];
-                for v in block {
-                    for ch in 0..4 {
-                        sum[ch] += v[ch];
-                    }
-                }
-                sum.map(|v| v * scale)
-            })
-            .collect();
-    }
-    Ok((c, start.elapsed().as_secs_f64()))
 }

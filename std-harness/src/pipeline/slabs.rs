@@ -2,8 +2,8 @@
 //! visible voxels of a volume in memory, on several cores.
 //!
 //! 1. The visible lists (classified once per volume, as for sheets: [`super::visible`]) are
-//!    shaded for one world unit of thickness and turned into extinction and emission
-//!    ([`SlabVoxel::from_unit_rgba`]), placed on screen, and sorted by the slab each reaches
+//!    shaded for one world unit of thickness and valued as the `--absorption` model reads them
+//!    ([`SlabSetup::voxel`]), placed on screen, and sorted by the slab each reaches
 //!    first in compositing order (counting sorts: the voxel order within a slab does not depend
 //!    on the thread count).
 //! 2. Each thread owns a band of image rows and walks the slabs in compositing order: the voxels
@@ -55,8 +55,9 @@ pub fn render_slabs(
              streamed sheets: drop --stream (the volume is loaded) or use --slicing object",
         )
     })?;
-    let setup =
-        SlabSetup::new(&p.frame, &p.kernel, args.slab).map_err(|e| refuse(&e.to_string()))?;
+    let setup = SlabSetup::new(&p.frame, &p.kernel, args.slab)
+        .map_err(|e| refuse(&e.to_string()))?
+        .with_absorption(p.absorption);
     let threads = args.thread_count();
     let start = Instant::now();
     let mut table = Box::new(SectionTable::<ROWS, COLUMNS>::zeroed(p.kernel));
@@ -121,7 +122,7 @@ fn slab_voxels(
 ) -> Result<SlabVoxels, CliError> {
     let f = &p.frame;
     let shader = p.shader();
-    // Opacity per world unit (the slab integrates σ along the ray itself).
+    // Opacity per world unit (the slab integrates the model's field along the ray itself).
     let lighting = Lighting::per_world_unit(f);
     let needs_gradient = shader.shading.needs_gradient();
     let mut placed: Vec<(SlabVoxel, (usize, usize))> = Vec::new();
@@ -142,7 +143,7 @@ fn slab_voxels(
             let colour = sheet.colours.get(k).copied();
             let rgba = shader.shade_coloured(&lighting, None, vox.value, colour, g, idx, f.dims);
             let position = f.affine_position(idx.map(|c| c as f32)).to_array();
-            if let Some(v) = SlabVoxel::from_unit_rgba(position, rgba) {
+            if let Some(v) = setup.voxel(position, rgba) {
                 placed.push((v, setup.slabs_of(position[2])));
             }
         }

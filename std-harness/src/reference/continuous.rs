@@ -1,32 +1,32 @@
 //! The continuous reference (issue 12): what the voxels, the kernel and the transfer function
 //! define, with no sheets, tables or splats. Every pixel's ray is marched through the field, in
-//! f64, and the emission–absorption integral
-//!
-//! ```text
-//! I = ∫ E(t) · exp(−∫₀ᵗ σ) dt,   σ(x) = Σᵥ w(x − v) σᵥ,   E(x) = Σᵥ w(x − v) σᵥ cᵥ
-//! ```
-//!
-//! is evaluated, then composited over the background (`I + T·background`, T the ray's
-//! transmittance; α = 1 − T). The voxels are pre-classified: each voxel's colour cᵥ and opacity
-//! αᵥ *per world unit* come from the renderer's own shader (transfer function, and Phong with the
-//! voxel's gradient, at an opacity exponent of one world unit), and σᵥ = −ln(1 − αᵥ) is its
-//! extinction per world unit (αᵥ is capped at `SlabVoxel::MAX_UNIT_ALPHA` = 1 − 10⁻⁶, σᵥ ≤ 13.8
-//! per world unit: an opaque voxel has no finite extinction, and the renderer's image slabs
-//! take the same cap, so that both model the same field). The field is reconstructed with
+//! f64, and the emission–absorption integral is evaluated, then composited over the background
+//! (`I + T·background`, T the ray's transmittance; α = 1 − T). The voxels are pre-classified: each
+//! voxel's straight colour cᵥ and opacity αᵥ *per world unit* come from the renderer's own shader
+//! (transfer function, and Phong with the voxel's gradient, at an opacity exponent of one world
+//! unit). The field is reconstructed with
 //! - `Kernel`: the kernel itself, w(d) = h(|d|/R) / (R³ ∫_ball h), d in grid steps, so that the
 //!   weights of a lattice sum to one (the renderer's own model, integrated exactly instead of as
 //!   whole-kernel footprints in sheets); Gaussian kernels only (the others are 2D footprint
 //!   models, not 3D kernels);
 //! - `Trilinear`: the eight surrounding voxels, trilinearly, as ray casters such as VTK do.
 //!
-//! **Absorption model** ([`Absorption`]). The above is *extinction reconstruction*: extinctions
-//! are reconstructed, which needs the cap for opaque voxels, and the image moves with it (41.0 dB
-//! against image slicing at a cap of 10⁻⁶, 38.1 dB at 10⁻³ on a CT head). *Opacity
-//! reconstruction* reconstructs what the paper's sheets splat, opacity per world unit and
-//! premultiplied colour, α(x) = Σᵥ w(x − v) αᵥ and C(x) = Σᵥ w(x − v) αᵥcᵥ, and integrates
-//! σ(x) = −ln(1 − α(x)) emitting the straight colour C(x)/α(x). It needs no cap: where α(x)
-//! reaches 1 the ray ends there, with that colour. Object slicing converges toward it, image
-//! slicing toward extinction reconstruction; `verify` reports the figure against both.
+//! **Absorption model** ([`Absorption`], `--absorption`; the renderer's slicings composite the
+//! same one, `footprint::render::absorption`).
+//! - *Opacity reconstruction* (the default): α(x) = Σᵥ w(x − v) αᵥ and C(x) = Σᵥ w(x − v) αᵥcᵥ,
+//!   and light crossing dl keeps (1 − α(x))^dl, emitting the straight colour C(x)/α(x):
+//!
+//!   ```text
+//!   I = ∫ σ(t)·C(t)/α(t) · exp(−∫₀ᵗ σ) dt,   σ(x) = −ln(1 − α(x))
+//!   ```
+//!
+//!   It is the continuous form of what the paper's sheets splat and needs no constant: where α(x)
+//!   reaches one the ray ends there, with that colour.
+//! - *Extinction reconstruction*: σ(x) = Σᵥ w(x − v) σᵥ and E(x) = Σᵥ w(x − v) σᵥcᵥ with
+//!   σᵥ = −ln(1 − αᵥ), I = ∫ E(t)·exp(−∫₀ᵗ σ) dt. An opaque voxel has no finite σᵥ: αᵥ is capped at
+//!   1 − [`ContinuousScene::cap`] (10⁻⁶, the renderer's), and an opaque scene's image moves with
+//!   the cap (41.0 dB against image slicing at a cap of 10⁻⁶, 38.1 dB at 10⁻³ on a CT head);
+//!   every opaque structure also thickens by most of a kernel radius.
 //!
 //! **Quadrature and convergence.** Each step of length h (world units) takes σ and E at its
 //! midpoint and composites the step exactly for constant σ and E (T·E/σ·(1 − e^(−σh)), then
@@ -43,7 +43,7 @@
 use crate::CliError;
 use footprint::frame::FrameSetup;
 use footprint::render::gradient;
-use footprint::render::{SheetWindow, SlabVoxel};
+use footprint::render::SheetWindow;
 use footprint::shade::{Lighting, Shader};
 use footprint::Kernel;
 use glam::{DMat3, DVec3};
@@ -74,24 +74,9 @@ impl Reconstruction {
     }
 }
 
-/// Which quantity the field reconstructs between voxels (see the module docs).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Absorption {
-    /// Extinction σᵥ = −ln(1 − αᵥ), αᵥ capped at `SlabVoxel::MAX_UNIT_ALPHA`.
-    Extinction,
-    /// Opacity αᵥ and premultiplied colour, uncapped.
-    Opacity,
-}
-
-impl Absorption {
-    /// The name `--absorption` and the JSON use.
-    pub fn name(self) -> &'static str {
-        match self {
-            Absorption::Extinction => "extinction",
-            Absorption::Opacity => "opacity",
-        }
-    }
-}
+/// Which quantity the field reconstructs between voxels (see the module docs): the core's
+/// model, so the reference and both slicings read the same field.
+pub use footprint::render::Absorption;
 
 /// What the continuous reference renders.
 pub struct ContinuousScene<'a> {
@@ -101,7 +86,14 @@ pub struct ContinuousScene<'a> {
     pub background: Option<&'a [[f32; 4]]>,
     pub reconstruction: Reconstruction,
     pub absorption: Absorption,
+    /// The least transmittance per world unit a voxel keeps in the extinction model (its opacity
+    /// is capped at 1 − `cap`): [`DEFAULT_CAP`], the renderer's. The opacity model has no cap and
+    /// ignores it (`tests/continuous.rs` moves it from 10⁻⁴ to 10⁻⁹ and checks that).
+    pub cap: f64,
 }
+
+/// [`ContinuousScene::cap`] as the renderer takes it: 1 − `SlabVoxel::MAX_UNIT_ALPHA` = 10⁻⁶.
+pub const DEFAULT_CAP: f64 = 1e-6;
 
 /// The converged image and how it converged.
 pub struct Continuous {
@@ -187,8 +179,7 @@ impl Field {
                             (rgba[3] > 0.0).then(|| [rgba[3].min(1.0), rgba[0], rgba[1], rgba[2]])
                         }
                         Absorption::Extinction => {
-                            let a =
-                                f64::from(rgba[3]).clamp(0.0, f64::from(SlabVoxel::MAX_UNIT_ALPHA));
+                            let a = f64::from(rgba[3]).clamp(0.0, 1.0 - scene.cap);
                             (a > 0.0).then(|| {
                                 let sigma = -(1.0 - a).ln();
                                 // Premultiplied colour / α = the straight colour.

@@ -8,7 +8,7 @@ use super::ReferenceFootprint;
 use crate::CliError;
 use footprint::frame::{FrameSetup, Order};
 use footprint::lod::Coloured;
-use footprint::render::{gradient, SheetWindow};
+use footprint::render::{gradient, Absorption, SheetWindow};
 use footprint::shade::{Lighting, Shader};
 use footprint::Kernel;
 
@@ -22,6 +22,9 @@ pub struct ReferenceScene<'a> {
     pub shader: Shader<'a>,
     pub order: Order,
     pub background: Option<&'a [[f32; 4]]>,
+    /// The model each sheet composites, as the core's `FloatPath` does (orthographic frames only
+    /// for extinction: the harness refuses it in perspective).
+    pub absorption: Absorption,
 }
 
 /// Renders the sheets `sheet(s, buffer)` supplies and returns the premultiplied RGBA image (f64,
@@ -39,6 +42,7 @@ pub fn render_reference(
         shader,
         order,
         background,
+        absorption,
     } = *scene;
     let g2s = frame.grid_to_screen.as_dmat3();
     let fp = ReferenceFootprint::new(kernel, &g2s, f64::from(min_radius_px))?;
@@ -141,7 +145,10 @@ pub fn render_reference(
                                 continue;
                             }
                             let p = origin + ck * s as f64 + ca * u as f64 + cb * v as f64;
-                            let c = rgba.map(|x| f64::from(x) * area);
+                            let Some(value) = absorption.voxel_value(rgba) else {
+                                continue;
+                            };
+                            let c = value.map(|x| f64::from(x) * area);
                             fp.for_each_weight([p.x, p.y], w, rows.clone(), |i, wt| add(i, &c, wt));
                         }
                     }
@@ -157,7 +164,10 @@ pub fn render_reference(
             if *acc == [0.0; 4] {
                 continue;
             }
-            let src = acc.map(|x| x.clamp(0.0, 1.0));
+            let src = match absorption {
+                Absorption::Opacity => acc.map(|x| x.clamp(0.0, 1.0)),
+                Absorption::Extinction => extinction_layer64(*acc),
+            };
             *img = match order {
                 Order::BackToFront => over64(src, *img),
                 Order::FrontToBack => over64(*img, src),
@@ -172,6 +182,22 @@ pub fn render_reference(
         }
     }
     Ok(image)
+}
+
+/// An extinction sheet's [E, τ] as a premultiplied layer, in f64: α = 1 − e^(−τ), colour E·α/τ.
+fn extinction_layer64(acc: [f64; 4]) -> [f64; 4] {
+    let tau = acc[3].max(0.0);
+    let k = if tau > 0.0 {
+        -(-tau).exp_m1() / tau
+    } else {
+        1.0
+    };
+    [
+        acc[0].max(0.0) * k,
+        acc[1].max(0.0) * k,
+        acc[2].max(0.0) * k,
+        tau * k,
+    ]
 }
 
 fn over64(front: [f64; 4], back: [f64; 4]) -> [f64; 4] {

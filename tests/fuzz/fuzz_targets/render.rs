@@ -109,7 +109,7 @@ fuzz_target!(|data: &[u8]| {
             for order in [Order::BackToFront, Order::FrontToBack] {
                 let img = footprint_fuzz::render_volume(
                     &frame,
-                    FloatPath { sampler: &table },
+                    FloatPath::new(&table),
                     order,
                     &samples,
                     &lut,
@@ -174,7 +174,7 @@ fuzz_target!(|data: &[u8]| {
                     let img = footprint_fuzz::render_level(
                         &level,
                         dims,
-                        FloatPath { sampler: &table },
+                        FloatPath::new(&table),
                         order,
                         &samples,
                         &lut,
@@ -237,7 +237,7 @@ fuzz_target!(|data: &[u8]| {
     let expected = scale * weights.iter().sum::<f64>();
     let tolerance = 0.02 * expected;
     let table = ViewTable::<N>::build(&frame.footprint, &generic, lookup, lookup);
-    let acc = footprint_fuzz::splat_one(&frame, &FloatPath { sampler: &table }, W);
+    let acc = footprint_fuzz::splat_one(&frame, &FloatPath::new(&table), W);
     assert!(
         acc.iter().flatten().all(|c| c.is_finite()),
         "float: non-finite weight"

@@ -123,7 +123,7 @@ pub fn render_refined<const N: usize>(
         image: &mut img,
         rows: &mut rows,
     };
-    let path = FloatPath { sampler: table };
+    let path = FloatPath::new(table);
     let mut r = SheetRenderer::with_path(frame, path, emission(lut), order, buffers, None)
         .expect("valid frame");
     let axis = |a: usize| RefinedAxis::new(a, frame.dims[a], &factors[a]).expect("factors 1, 2, 4");
