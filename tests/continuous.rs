@@ -3,9 +3,11 @@
 //! integral has a closed form along every ray.
 
 use footprint_harness::args::parse_args;
-use footprint_harness::pipeline::continuous::render_continuous_model;
+use footprint_harness::pipeline::continuous::{render_continuous_as, render_continuous_model};
 use footprint_harness::pipeline::prepare;
-use footprint_harness::reference::continuous::{Absorption, Reconstruction, CONVERGED_DB};
+use footprint_harness::reference::continuous::{
+    Absorption, Model, Reconstruction, CONVERGED_DB, DEFAULT_CAP,
+};
 use footprint_suite::tmpdir;
 
 /// A 9³ volume, zero except its centre voxel (255); the transfer function maps 255 to white at
@@ -114,6 +116,16 @@ fn blob_matches_closed_form(r: f64, sigmas: f64, least_peak: f64) {
 /// continuous reference (trilinear reconstruction, whose weights sum to exactly one inside the
 /// volume) with `absorption` at 32×32 looking along k: the centre pixel.
 fn slab_centre(depth: usize, value: u8, absorption: Absorption) -> [f64; 4] {
+    slab_centre_as(
+        depth,
+        value,
+        Model::Pre(absorption),
+        Reconstruction::Trilinear,
+    )
+}
+
+/// [`slab_centre`] in any model and reconstruction.
+fn slab_centre_as(depth: usize, value: u8, model: Model, recon: Reconstruction) -> [f64; 4] {
     let dir = tmpdir("slab");
     let raw = dir.join("slab.raw");
     std::fs::write(&raw, vec![value; 24 * 24 * depth]).unwrap();
@@ -139,7 +151,7 @@ fn slab_centre(depth: usize, value: u8, absorption: Absorption) -> [f64; 4] {
     ])
     .unwrap();
     let p = prepare(&a).unwrap();
-    let (c, _) = render_continuous_model(&p, Reconstruction::Trilinear, absorption).unwrap();
+    let (c, _) = render_continuous_as(&p, recon, model, DEFAULT_CAP).unwrap();
     assert!(c.converged);
     c.image[16 * 32 + 16]
 }
@@ -278,4 +290,26 @@ fn the_opacity_models_figure_does_not_depend_on_a_cap() {
         spread(&extinction) > 0.1,
         "the extinction model no longer moves with its cap: {extinction:?}"
     );
+}
+
+/// Post-classification's closed form (issue 41's third model, issue 47's reference): values are
+/// reconstructed (normalised by the weights inside the volume, so a uniform volume stays
+/// uniform up to its faces) and classified per sample, and samples exist only inside the voxel
+/// box. A uniform slab of `depth` voxels along the ray is then exactly `depth − 1` world units of
+/// constant opacity α: the pixel is (1 − (1 − α)^(depth − 1))·(c, c, c, 1), with both
+/// reconstructions (the kernel's normalisation included), where the pre-classified models blur
+/// the faces by the kernel.
+#[test]
+fn post_classification_matches_its_closed_form_on_a_uniform_slab() {
+    let alpha = 51.0f64 / 255.0;
+    let want = 1.0 - (1.0 - alpha).powi(19);
+    for recon in [Reconstruction::Trilinear, Reconstruction::Kernel] {
+        let px = slab_centre_as(20, 51, Model::Post, recon);
+        assert!(
+            (px[3] - want).abs() < 1e-6,
+            "{recon:?}: alpha {} against {want}",
+            px[3]
+        );
+        assert!((px[0] / px[3] - alpha).abs() < 1e-6, "{recon:?}: {px:?}");
+    }
 }

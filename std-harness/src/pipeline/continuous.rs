@@ -6,7 +6,7 @@ use super::prepare::Prepared;
 use super::supersample::downsample;
 use crate::io::progress::sheets;
 use crate::reference::continuous::{
-    render_continuous, render_continuous_at, Absorption, Continuous, ContinuousScene,
+    render_continuous, render_continuous_at, Absorption, Continuous, ContinuousScene, Model,
     Reconstruction, DEFAULT_CAP, MAX_HALVINGS,
 };
 use crate::CliError;
@@ -16,7 +16,7 @@ use std::time::Instant;
 fn continuous_scene(
     p: &Prepared,
     reconstruction: Reconstruction,
-    absorption: Absorption,
+    model: Model,
     cap: f64,
 ) -> Result<(&crate::io::volume::Volume, ContinuousScene<'_>), CliError> {
     let volume = p.volume().ok_or_else(|| {
@@ -35,7 +35,7 @@ fn continuous_scene(
         shader: p.shader(),
         background: p.background.as_deref(),
         reconstruction,
-        absorption,
+        model,
         cap,
     };
     Ok((volume, scene))
@@ -51,12 +51,14 @@ pub fn render_continuous_ref(
     render_continuous_model(p, reconstruction, p.absorption)
 }
 
-/// PSNR (RGB, dB) against each absorption model, the chosen one first.
-pub type ModelFigures = Vec<(Absorption, f64)>;
+/// PSNR (RGB, dB) against each continuous model, the chosen one first.
+pub type ModelFigures = Vec<(Model, f64)>;
 
 /// The continuous reference of `p` with `absorption` (as [`render_continuous_model`]) and, for
-/// context, `core`'s PSNR (RGB, dB) against each model, the chosen one first: the models differ
-/// by more than a renderer's error on opaque data, so the figure means little without its model.
+/// context, `core`'s PSNR (RGB, dB) against each model, the chosen one first, then the other
+/// absorption model and post-classification (values reconstructed, then classified: what ray
+/// casters compute): the models differ by more than a renderer's error on opaque data, so the
+/// figure means little without its model.
 pub fn continuous_models(
     p: &Prepared,
     reconstruction: Reconstruction,
@@ -64,15 +66,19 @@ pub fn continuous_models(
     core: &[[f32; 4]],
 ) -> Result<(Continuous, f64, ModelFigures), CliError> {
     let (chosen, secs) = render_continuous_model(p, reconstruction, absorption)?;
+    let chosen_model = Model::Pre(absorption);
     let mut figures = vec![(
-        absorption,
+        chosen_model,
         crate::metrics::compare(core, &chosen.image).1.psnr_db,
     )];
-    for other in [Absorption::Extinction, Absorption::Opacity] {
-        if other != absorption {
-            let (c, _) = render_continuous_model(p, reconstruction, other)?;
-            figures.push((other, crate::metrics::compare(core, &c.image).1.psnr_db));
-        }
+    let all = [
+        Model::Pre(Absorption::Opacity),
+        Model::Pre(Absorption::Extinction),
+        Model::Post,
+    ];
+    for other in all.into_iter().filter(|&m| m != chosen_model) {
+        let (c, _) = render_continuous_as(p, reconstruction, other, DEFAULT_CAP)?;
+        figures.push((other, crate::metrics::compare(core, &c.image).1.psnr_db));
     }
     Ok((chosen, secs, figures))
 }
@@ -82,7 +88,7 @@ pub const PIXEL_FILTER: &str = "one ray through each pixel centre; a frame super
                                 (--supersample) averages its k x k rays per pixel (a box filter)";
 
 /// `continuous.models` of `verify`'s JSON: PSNR (RGB, dB) against each absorption model.
-pub fn models_json(models: &[(Absorption, f64)]) -> crate::io::json::Json {
+pub fn models_json(models: &[(Model, f64)]) -> crate::io::json::Json {
     models
         .iter()
         .fold(crate::io::json::Json::object(), |j, (m, db)| {
@@ -91,9 +97,8 @@ pub fn models_json(models: &[(Absorption, f64)]) -> crate::io::json::Json {
 }
 
 /// The figures against the models after the chosen one, as `verify` prints them after it.
-pub fn others(models: &[(Absorption, f64)]) -> String {
-    let other =
-        |(m, db): &(Absorption, f64)| format!(", {db:.2} dB against the {} model", m.name());
+pub fn others(models: &[(Model, f64)]) -> String {
+    let other = |(m, db): &(Model, f64)| format!(", {db:.2} dB against the {} model", m.name());
     models.iter().skip(1).map(other).collect()
 }
 
@@ -115,8 +120,18 @@ pub fn render_continuous_capped(
     absorption: Absorption,
     cap: f64,
 ) -> Result<(Continuous, f64), CliError> {
+    render_continuous_as(p, reconstruction, Model::Pre(absorption), cap)
+}
+
+/// The continuous reference of `p` in any [`Model`], post-classification included.
+pub fn render_continuous_as(
+    p: &Prepared,
+    reconstruction: Reconstruction,
+    model: Model,
+    cap: f64,
+) -> Result<(Continuous, f64), CliError> {
     let start = Instant::now();
-    let (volume, scene) = continuous_scene(p, reconstruction, absorption, cap)?;
+    let (volume, scene) = continuous_scene(p, reconstruction, model, cap)?;
     let mut bar = sheets("continuous");
     let axis = p.frame.sheet_axis;
     let mut c = render_continuous(
@@ -136,7 +151,12 @@ pub fn render_continuous_capped(
 /// its seconds. Kernel reconstruction, `p`'s model. The volume must be in memory.
 pub fn continuous_at(p: &Prepared, pixels: &[[usize; 2]]) -> Result<(Continuous, f64), CliError> {
     let start = Instant::now();
-    let (volume, scene) = continuous_scene(p, Reconstruction::Kernel, p.absorption, DEFAULT_CAP)?;
+    let (volume, scene) = continuous_scene(
+        p,
+        Reconstruction::Kernel,
+        Model::Pre(p.absorption),
+        DEFAULT_CAP,
+    )?;
     let k = p.supersample;
     let rays: Vec<[usize; 2]> = pixels
         .iter()

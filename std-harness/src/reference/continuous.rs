@@ -40,11 +40,11 @@
 //! between all cores. The rays are the frame's own: parallel to the view (orthographic) or from
 //! the eye through each pixel centre (perspective).
 
+use super::field::Field;
+pub use super::field::Model;
 use crate::CliError;
 use footprint::frame::FrameSetup;
-use footprint::render::gradient;
-use footprint::render::SheetWindow;
-use footprint::shade::{Lighting, Shader};
+use footprint::shade::Shader;
 use footprint::Kernel;
 use glam::{DMat3, DVec3};
 
@@ -52,8 +52,6 @@ use glam::{DMat3, DVec3};
 pub const CONVERGED_DB: f64 = 60.0;
 /// The most halvings of the step.
 pub const MAX_HALVINGS: usize = 6;
-/// Voxels per block side of the empty-space map.
-const BLOCK: usize = 8;
 
 /// How the continuous field is reconstructed from the voxels.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -85,7 +83,8 @@ pub struct ContinuousScene<'a> {
     pub shader: Shader<'a>,
     pub background: Option<&'a [[f32; 4]]>,
     pub reconstruction: Reconstruction,
-    pub absorption: Absorption,
+    /// Pre-classified in an absorption model, or post-classified ([`super::field`]).
+    pub model: Model,
     /// The least transmittance per world unit a voxel keeps in the extinction model (its opacity
     /// is capped at 1 − `cap`): [`DEFAULT_CAP`], the renderer's. The opacity model has no cap and
     /// ignores it (`tests/continuous.rs` moves it from 10⁻⁴ to 10⁻⁹ and checks that).
@@ -107,236 +106,6 @@ pub struct Continuous {
     pub change_db: f64,
     /// Whether that change reached [`CONVERGED_DB`].
     pub converged: bool,
-}
-
-/// Per-axis Gaussian factors and squared offsets of one sample, axis a at `[a·n ..][..n]`.
-struct Taps {
-    n: usize,
-    e: Vec<f64>,
-    d2: Vec<f64>,
-}
-
-/// Pre-classified voxels per [`Absorption`]: σ and σ·c (rgb), or α and α·c, per voxel, x
-/// fastest, and the block map.
-struct Field {
-    dims: [usize; 3],
-    /// [σ, σr, σg, σb] (extinction) or [α, αr, αg, αb] (opacity) per voxel.
-    voxels: Vec<[f32; 4]>,
-    absorption: Absorption,
-    /// Whether a block's neighbourhood (its voxels ± the reconstruction's reach) holds σ > 0.
-    active: Vec<bool>,
-    blocks: [usize; 3],
-    /// Reach of the reconstruction, grid steps (R for the kernel, 1 for trilinear).
-    reach: f64,
-    kernel: Option<(f64, f64, f64)>, // (R, sigmas, 1 / (R³ ∫h))
-}
-
-impl Field {
-    fn new(
-        scene: &ContinuousScene<'_>,
-        sheet: &mut dyn FnMut(usize, &mut [f32]),
-    ) -> Result<Self, CliError> {
-        let f = scene.frame;
-        let dims = f.dims;
-        let n = dims.iter().product::<usize>();
-        let mut voxels = Vec::new();
-        voxels.try_reserve_exact(n).map_err(|_| {
-            CliError::input(format!(
-                "cannot allocate the continuous reference's {n} pre-classified voxels"
-            ))
-        })?;
-        voxels.resize(n, [0.0f32; 4]);
-        // Opacity per world unit: the shader at an exponent of one.
-        let lighting = Lighting::per_world_unit(f);
-        let (len, na, nb) = f.sheet_shape();
-        let mut bufs = [vec![0.0f32; len], vec![0.0f32; len], vec![0.0f32; len]];
-        for s in 0..f.sheet_count() {
-            if s > 0 {
-                sheet(s - 1, &mut bufs[0]);
-            }
-            sheet(s, &mut bufs[1]);
-            if s + 1 < f.sheet_count() {
-                sheet(s + 1, &mut bufs[2]);
-            }
-            let window = SheetWindow {
-                lower: (s > 0).then_some(&bufs[0][..]),
-                current: &bufs[1][..],
-                upper: (s + 1 < f.sheet_count()).then_some(&bufs[2][..]),
-            };
-            for v in 0..nb {
-                for u in 0..na {
-                    let idx = f.grid_index(s, u, v);
-                    let rgba = scene.shader.shade(
-                        &lighting,
-                        window.current[v * na + u],
-                        || gradient(f, &window, u, v),
-                        idx,
-                        dims,
-                    );
-                    let stored = match scene.absorption {
-                        // Opacity and premultiplied colour as shaded, uncapped.
-                        Absorption::Opacity => {
-                            (rgba[3] > 0.0).then(|| [rgba[3].min(1.0), rgba[0], rgba[1], rgba[2]])
-                        }
-                        Absorption::Extinction => {
-                            let a = f64::from(rgba[3]).clamp(0.0, 1.0 - scene.cap);
-                            (a > 0.0).then(|| {
-                                let sigma = -(1.0 - a).ln();
-                                // Premultiplied colour / α = the straight colour.
-                                let c = [0, 1, 2].map(|ch| f64::from(rgba[ch]) / a);
-                                [sigma, sigma * c[0], sigma * c[1], sigma * c[2]].map(|x| x as f32)
-                            })
-                        }
-                    };
-                    if let Some(v) = stored {
-                        voxels[(idx[2] * dims[1] + idx[1]) * dims[0] + idx[0]] = v;
-                    }
-                }
-            }
-        }
-        let (reach, kernel) = match (scene.reconstruction, *scene.kernel) {
-            (Reconstruction::Trilinear, _) => (1.0, None),
-            (Reconstruction::Kernel, Kernel::Gaussian { spread, sigmas }) => {
-                let r = f64::from(spread);
-                let norm = 1.0 / (r.powi(3) * super::integral_f64(scene.kernel));
-                (r, Some((r, f64::from(sigmas), norm)))
-            }
-            (Reconstruction::Kernel, other) => {
-                return Err(CliError::input(format!(
-                    "--reference continuous reconstructs with the kernel in 3D, which only a \
-                     Gaussian is ({other} is a footprint model): use a gaussian kernel or \
-                     --reconstruction trilinear"
-                )))
-            }
-        };
-        let blocks = dims.map(|d| d.div_ceil(BLOCK));
-        let mut active = vec![false; blocks.iter().product()];
-        let pad = reach.ceil() as usize + 1;
-        for z in 0..dims[2] {
-            for y in 0..dims[1] {
-                for x in 0..dims[0] {
-                    if voxels[(z * dims[1] + y) * dims[0] + x][0] <= 0.0 {
-                        continue;
-                    }
-                    let range = |c: usize, a: usize| {
-                        (c.saturating_sub(pad) / BLOCK)..=((c + pad).min(dims[a] - 1) / BLOCK)
-                    };
-                    for bz in range(z, 2) {
-                        for by in range(y, 1) {
-                            for bx in range(x, 0) {
-                                active[(bz * blocks[1] + by) * blocks[0] + bx] = true;
-                            }
-                        }
-                    }
-                }
-            }
-        }
-        Ok(Field {
-            dims,
-            voxels,
-            absorption: scene.absorption,
-            active,
-            blocks,
-            reach,
-            kernel,
-        })
-    }
-
-    /// Scratch for [`Field::at`]'s per-axis kernel factors, sized for this field's kernel (one
-    /// per thread, reused for every sample).
-    fn taps(&self) -> Taps {
-        // Lattice offsets within R of a point: at most ⌊2R⌋ + 1 per axis; one spare.
-        let n = (2.0 * self.reach).floor() as usize + 2;
-        Taps {
-            n,
-            e: vec![0.0; 3 * n],
-            d2: vec![0.0; 3 * n],
-        }
-    }
-
-    /// [σ, σr, σg, σb] at grid point `g` (continuous index coordinates).
-    #[inline]
-    fn at(&self, g: DVec3, taps: &mut Taps) -> [f64; 4] {
-        let d = self.dims;
-        let b = [g.x, g.y, g.z].map(|c| (c.max(0.0) as usize) / BLOCK);
-        let bi = (b[2].min(self.blocks[2] - 1) * self.blocks[1] + b[1].min(self.blocks[1] - 1))
-            * self.blocks[0]
-            + b[0].min(self.blocks[0] - 1);
-        if !self.active[bi] {
-            return [0.0; 4];
-        }
-        let mut out = [0.0f64; 4];
-        let voxel = |x: i64, y: i64, z: i64| -> Option<&[f32; 4]> {
-            if x < 0 || y < 0 || z < 0 || x >= d[0] as i64 || y >= d[1] as i64 || z >= d[2] as i64 {
-                return None;
-            }
-            Some(&self.voxels[(z as usize * d[1] + y as usize) * d[0] + x as usize])
-        };
-        match self.kernel {
-            None => {
-                let f = [g.x.floor(), g.y.floor(), g.z.floor()];
-                let t = [g.x - f[0], g.y - f[1], g.z - f[2]];
-                let f = f.map(|v| v as i64);
-                for c in 0..8 {
-                    let o = [c & 1, (c >> 1) & 1, (c >> 2) & 1];
-                    let w = (0..3)
-                        .map(|a| if o[a] == 1 { t[a] } else { 1.0 - t[a] })
-                        .product::<f64>();
-                    if w == 0.0 {
-                        continue;
-                    }
-                    if let Some(v) =
-                        voxel(f[0] + o[0] as i64, f[1] + o[1] as i64, f[2] + o[2] as i64)
-                    {
-                        for ch in 0..4 {
-                            out[ch] += w * f64::from(v[ch]);
-                        }
-                    }
-                }
-            }
-            Some((r, sigmas, norm)) => {
-                // The Gaussian factors per axis (separable inside the ball), one per lattice
-                // offset within R of the sample: at most `taps.n` per axis.
-                let k = sigmas * sigmas / (2.0 * r * r);
-                let gc = [g.x, g.y, g.z];
-                let lo = gc.map(|c| (c - r).ceil() as i64);
-                let hi = gc.map(|c| (c + r).floor() as i64);
-                let n = taps.n;
-                for a in 0..3 {
-                    for (j, v) in (lo[a]..=hi[a]).enumerate() {
-                        let dd = (gc[a] - v as f64).powi(2);
-                        taps.d2[a * n + j] = dd;
-                        taps.e[a * n + j] = (-k * dd).exp();
-                    }
-                }
-                let (e, d2) = (&taps.e, &taps.d2);
-                let r2 = r * r;
-                for (jz, z) in (lo[2]..=hi[2]).enumerate() {
-                    for (jy, y) in (lo[1]..=hi[1]).enumerate() {
-                        let dyz = d2[2 * n + jz] + d2[n + jy];
-                        if dyz >= r2 {
-                            continue;
-                        }
-                        let eyz = e[2 * n + jz] * e[n + jy];
-                        for (jx, x) in (lo[0]..=hi[0]).enumerate() {
-                            if dyz + d2[jx] >= r2 {
-                                continue;
-                            }
-                            if let Some(v) = voxel(x, y, z) {
-                                if v[0] > 0.0 {
-                                    let w = eyz * e[jx] * norm;
-                                    for ch in 0..4 {
-                                        out[ch] += w * f64::from(v[ch]);
-                                    }
-                                }
-                            }
-                        }
-                    }
-                }
-            }
-        }
-        out
-    }
 }
 
 /// Which rays to march: every pixel's, or those through the listed pixels.
@@ -373,11 +142,11 @@ fn march(scene: &ContinuousScene<'_>, field: &Field, h: f64, rays: Rays<'_>) -> 
     // Grid steps to world: G = ((G⁻ᵀ)⁻¹)ᵀ.
     let grid = f.grid_inverse_transpose.as_dmat3().inverse().transpose();
     let camera = f.camera().copied();
-    let lo = DVec3::splat(-field.reach);
+    let lo = DVec3::splat(-field.extent());
     let hi = DVec3::new(
-        (f.dims[0] - 1) as f64 + field.reach,
-        (f.dims[1] - 1) as f64 + field.reach,
-        (f.dims[2] - 1) as f64 + field.reach,
+        (f.dims[0] - 1) as f64 + field.extent(),
+        (f.dims[1] - 1) as f64 + field.extent(),
+        (f.dims[2] - 1) as f64 + field.extent(),
     );
     let threads = std::thread::available_parallelism()
         .map_or(1, |n| n.get())
@@ -444,7 +213,7 @@ fn march(scene: &ContinuousScene<'_>, field: &Field, h: f64, rays: Rays<'_>) -> 
                             // The step's transmittance: exp(−σh), or (1 − α)^h with
                             // σ = −ln(1 − α) (α ≥ 1: opaque, the ray ends here). Either way the
                             // straight colour emitted is v[1..] / v[0].
-                            let att = match field.absorption {
+                            let att = match field.absorption() {
                                 Absorption::Extinction => (-v[0] * hw).exp(),
                                 Absorption::Opacity => (1.0 - v[0].min(1.0)).powf(hw),
                             };

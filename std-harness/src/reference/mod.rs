@@ -14,6 +14,7 @@
 //! core: that is part of the model, not an approximation.
 
 pub mod continuous;
+pub mod field;
 pub mod perspective;
 pub mod render;
 

@@ -1,0 +1,353 @@
+//! The continuous field the reference marches ([`super::continuous`]): the voxels as each model
+//! reads them, reconstructed between them by the kernel or trilinearly, and a block map of where
+//! the field can be seen.
+//!
+//! - **Pre-classified** ([`Model::Pre`]): each voxel shaded once (colour and opacity per world
+//!   unit, Phong with its own central-difference gradient), stored as the [`Absorption`] model
+//!   reads it ([α, αr, αg, αb] or [σ, σr, σg, σb]) and reconstructed as is.
+//! - **Post-classified** ([`Model::Post`]): each voxel's value and world gradient (the renderer's
+//!   central differences) are reconstructed, *normalised by the weights that fall inside the
+//!   volume* (so a constant field stays constant up to the faces, where the kernel's lattice sum
+//!   drops below one), and classified and shaded per sample through the same shader: the sample
+//!   has opacity α per world unit and premultiplied colour, marched as [α, αr, αg, αb] (light
+//!   keeps (1 − α)^dl). This is what ray casters such as VTK's compute (they interpolate
+//!   gradients the same way). Samples only exist inside the voxel box (the grid's own extent:
+//!   nothing is extrapolated past its faces); a NaN value is a missing sample (weight zero) and a
+//!   sample whose weights are all missing is transparent.
+
+use super::continuous::{Absorption, ContinuousScene, Reconstruction};
+use crate::CliError;
+use footprint::render::{gradient, SheetWindow};
+use footprint::shade::{Lighting, Shader};
+use footprint::Kernel;
+use glam::{DVec3, Vec3};
+
+/// Voxels per block side of the empty-space map.
+const BLOCK: usize = 8;
+
+/// Which continuous integral the field defines.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Model {
+    /// Pre-classified voxels, reconstructed as the absorption model says.
+    Pre(Absorption),
+    /// Values and gradients reconstructed, then classified per sample.
+    Post,
+}
+
+impl Model {
+    /// The name the JSON uses: `opacity`, `extinction` or `post-classified`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Model::Pre(a) => a.name(),
+            Model::Post => "post-classified",
+        }
+    }
+}
+
+/// Per-axis Gaussian factors and squared offsets of one sample, axis a at `[a·n ..][..n]`.
+pub(super) struct Taps {
+    n: usize,
+    e: Vec<f64>,
+    d2: Vec<f64>,
+}
+
+/// The voxels as the model reads them, x fastest, and the block map.
+pub(super) struct Field<'s> {
+    dims: [usize; 3],
+    /// Pre: [α, αr, αg, αb] or [σ, σr, σg, σb]; post: [value, gx, gy, gz] (world gradient).
+    voxels: Vec<[f32; 4]>,
+    model: Model,
+    /// Post: the shader and lighting that classify each sample.
+    classify: Option<(Shader<'s>, Lighting)>,
+    /// Whether a block's neighbourhood (its voxels ± the reconstruction's reach) can be seen.
+    active: Vec<bool>,
+    blocks: [usize; 3],
+    /// Reach of the reconstruction, grid steps (R for the kernel, 1 for trilinear).
+    reach: f64,
+    kernel: Option<(f64, f64, f64)>, // (R, sigmas, 1 / (R³ ∫h))
+}
+
+impl<'s> Field<'s> {
+    pub(super) fn new(
+        scene: &ContinuousScene<'s>,
+        sheet: &mut dyn FnMut(usize, &mut [f32]),
+    ) -> Result<Self, CliError> {
+        let f = scene.frame;
+        let dims = f.dims;
+        let n = dims.iter().product::<usize>();
+        let mut voxels = Vec::new();
+        voxels.try_reserve_exact(n).map_err(|_| {
+            CliError::input(format!(
+                "cannot allocate the continuous reference's {n} voxels"
+            ))
+        })?;
+        voxels.resize(n, [0.0f32; 4]);
+        // Opacity per world unit: the shader at an exponent of one.
+        let lighting = Lighting::per_world_unit(f);
+        let (len, na, nb) = f.sheet_shape();
+        let mut bufs = [vec![0.0f32; len], vec![0.0f32; len], vec![0.0f32; len]];
+        for s in 0..f.sheet_count() {
+            if s > 0 {
+                sheet(s - 1, &mut bufs[0]);
+            }
+            sheet(s, &mut bufs[1]);
+            if s + 1 < f.sheet_count() {
+                sheet(s + 1, &mut bufs[2]);
+            }
+            let window = SheetWindow {
+                lower: (s > 0).then_some(&bufs[0][..]),
+                current: &bufs[1][..],
+                upper: (s + 1 < f.sheet_count()).then_some(&bufs[2][..]),
+            };
+            for v in 0..nb {
+                for u in 0..na {
+                    let idx = f.grid_index(s, u, v);
+                    let value = window.current[v * na + u];
+                    let stored = match scene.model {
+                        Model::Pre(absorption) => {
+                            let rgba = scene.shader.shade(
+                                &lighting,
+                                value,
+                                || gradient(f, &window, u, v),
+                                idx,
+                                dims,
+                            );
+                            pre_classified(rgba, absorption, scene.cap)
+                        }
+                        Model::Post => {
+                            let g = gradient(f, &window, u, v);
+                            Some([value, g.x, g.y, g.z])
+                        }
+                    };
+                    if let Some(v) = stored {
+                        voxels[(idx[2] * dims[1] + idx[1]) * dims[0] + idx[0]] = v;
+                    }
+                }
+            }
+        }
+        let (reach, kernel) = match (scene.reconstruction, *scene.kernel) {
+            (Reconstruction::Trilinear, _) => (1.0, None),
+            (Reconstruction::Kernel, Kernel::Gaussian { spread, sigmas }) => {
+                let r = f64::from(spread);
+                let norm = 1.0 / (r.powi(3) * super::integral_f64(scene.kernel));
+                (r, Some((r, f64::from(sigmas), norm)))
+            }
+            (Reconstruction::Kernel, other) => {
+                return Err(CliError::input(format!(
+                    "--reference continuous reconstructs with the kernel in 3D, which only a \
+                     Gaussian is ({other} is a footprint model): use a gaussian kernel or \
+                     --reconstruction trilinear"
+                )))
+            }
+        };
+        // A voxel that can be seen: pre, any opacity; post, a value above every transparent one
+        // (a sample is a convex combination of its neighbours' values, so a block whose
+        // neighbourhood stays at or below that bound is transparent throughout).
+        let clear = scene.shader.transparent_at_or_below();
+        let seen = |v: &[f32; 4]| match scene.model {
+            Model::Pre(_) => v[0] > 0.0,
+            Model::Post => !(v[0] <= clear),
+        };
+        let blocks = dims.map(|d| d.div_ceil(BLOCK));
+        let mut active = vec![false; blocks.iter().product()];
+        let pad = reach.ceil() as usize + 1;
+        for z in 0..dims[2] {
+            for y in 0..dims[1] {
+                for x in 0..dims[0] {
+                    if !seen(&voxels[(z * dims[1] + y) * dims[0] + x]) {
+                        continue;
+                    }
+                    let range = |c: usize, a: usize| {
+                        (c.saturating_sub(pad) / BLOCK)..=((c + pad).min(dims[a] - 1) / BLOCK)
+                    };
+                    for bz in range(z, 2) {
+                        for by in range(y, 1) {
+                            for bx in range(x, 0) {
+                                active[(bz * blocks[1] + by) * blocks[0] + bx] = true;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        Ok(Field {
+            dims,
+            voxels,
+            model: scene.model,
+            classify: (scene.model == Model::Post).then_some((scene.shader, lighting)),
+            active,
+            blocks,
+            reach,
+            kernel,
+        })
+    }
+
+    /// How far past the voxel box the field reaches, grid steps: the reconstruction's reach for
+    /// pre-classified voxels, none for post-classification (samples only inside the grid).
+    pub(super) fn extent(&self) -> f64 {
+        match self.model {
+            Model::Pre(_) => self.reach,
+            Model::Post => 0.0,
+        }
+    }
+
+    /// How a marched step attenuates: extinction for the extinction model, else opacity.
+    pub(super) fn absorption(&self) -> Absorption {
+        match self.model {
+            Model::Pre(a) => a,
+            Model::Post => Absorption::Opacity,
+        }
+    }
+
+    /// Scratch for [`Field::at`]'s per-axis kernel factors, sized for this field's kernel (one
+    /// per thread, reused for every sample).
+    pub(super) fn taps(&self) -> Taps {
+        // Lattice offsets within R of a point: at most ⌊2R⌋ + 1 per axis; one spare.
+        let n = (2.0 * self.reach).floor() as usize + 2;
+        Taps {
+            n,
+            e: vec![0.0; 3 * n],
+            d2: vec![0.0; 3 * n],
+        }
+    }
+
+    /// [σ, σr, σg, σb] (extinction) or [α, αr, αg, αb] (opacity, post-classified) at grid point
+    /// `g` (continuous index coordinates).
+    #[inline]
+    pub(super) fn at(&self, g: DVec3, taps: &mut Taps) -> [f64; 4] {
+        let b = [g.x, g.y, g.z].map(|c| (c.max(0.0) as usize) / BLOCK);
+        let bi = (b[2].min(self.blocks[2] - 1) * self.blocks[1] + b[1].min(self.blocks[1] - 1))
+            * self.blocks[0]
+            + b[0].min(self.blocks[0] - 1);
+        if !self.active[bi] {
+            return [0.0; 4];
+        }
+        let mut out = [0.0f64; 4];
+        let Some((shader, lighting)) = &self.classify else {
+            self.weights(g, taps, |v, w| {
+                if v[0] > 0.0 {
+                    for ch in 0..4 {
+                        out[ch] += w * f64::from(v[ch]);
+                    }
+                }
+            });
+            return out;
+        };
+        let mut total = 0.0f64;
+        self.weights(g, taps, |v, w| {
+            if v[0].is_finite() {
+                total += w;
+                for ch in 0..4 {
+                    out[ch] += w * f64::from(v[ch]);
+                }
+            }
+        });
+        if !(total > 0.0) {
+            return [0.0; 4];
+        }
+        let [value, gx, gy, gz] = out.map(|c| (c / total) as f32);
+        let nearest = [g.x, g.y, g.z]
+            .map(|c| c.round().max(0.0) as usize)
+            .iter()
+            .zip(self.dims)
+            .map(|(&c, d)| c.min(d - 1))
+            .collect::<Vec<_>>();
+        let rgba = shader.shade(
+            lighting,
+            value,
+            || Vec3::new(gx, gy, gz),
+            [nearest[0], nearest[1], nearest[2]],
+            self.dims,
+        );
+        [rgba[3], rgba[0], rgba[1], rgba[2]].map(f64::from)
+    }
+
+    /// Calls `visit(voxel, weight)` for every voxel of the volume whose reconstruction weight at
+    /// `g` is above zero (trilinear, or the kernel with its lattice normalisation).
+    #[inline]
+    fn weights(&self, g: DVec3, taps: &mut Taps, mut visit: impl FnMut(&[f32; 4], f64)) {
+        let d = self.dims;
+        let voxel = |x: i64, y: i64, z: i64| -> Option<&[f32; 4]> {
+            if x < 0 || y < 0 || z < 0 || x >= d[0] as i64 || y >= d[1] as i64 || z >= d[2] as i64 {
+                return None;
+            }
+            Some(&self.voxels[(z as usize * d[1] + y as usize) * d[0] + x as usize])
+        };
+        match self.kernel {
+            None => {
+                let f = [g.x.floor(), g.y.floor(), g.z.floor()];
+                let t = [g.x - f[0], g.y - f[1], g.z - f[2]];
+                let f = f.map(|v| v as i64);
+                for c in 0..8 {
+                    let o = [c & 1, (c >> 1) & 1, (c >> 2) & 1];
+                    let w = (0..3)
+                        .map(|a| if o[a] == 1 { t[a] } else { 1.0 - t[a] })
+                        .product::<f64>();
+                    if w == 0.0 {
+                        continue;
+                    }
+                    if let Some(v) =
+                        voxel(f[0] + o[0] as i64, f[1] + o[1] as i64, f[2] + o[2] as i64)
+                    {
+                        visit(v, w);
+                    }
+                }
+            }
+            Some((r, sigmas, norm)) => {
+                // The Gaussian factors per axis (separable inside the ball), one per lattice
+                // offset within R of the sample: at most `taps.n` per axis.
+                let k = sigmas * sigmas / (2.0 * r * r);
+                let gc = [g.x, g.y, g.z];
+                let lo = gc.map(|c| (c - r).ceil() as i64);
+                let hi = gc.map(|c| (c + r).floor() as i64);
+                let n = taps.n;
+                for a in 0..3 {
+                    for (j, v) in (lo[a]..=hi[a]).enumerate() {
+                        let dd = (gc[a] - v as f64).powi(2);
+                        taps.d2[a * n + j] = dd;
+                        taps.e[a * n + j] = (-k * dd).exp();
+                    }
+                }
+                let (e, d2) = (&taps.e, &taps.d2);
+                let r2 = r * r;
+                for (jz, z) in (lo[2]..=hi[2]).enumerate() {
+                    for (jy, y) in (lo[1]..=hi[1]).enumerate() {
+                        let dyz = d2[2 * n + jz] + d2[n + jy];
+                        if dyz >= r2 {
+                            continue;
+                        }
+                        let eyz = e[2 * n + jz] * e[n + jy];
+                        for (jx, x) in (lo[0]..=hi[0]).enumerate() {
+                            if dyz + d2[jx] >= r2 {
+                                continue;
+                            }
+                            if let Some(v) = voxel(x, y, z) {
+                                visit(v, eyz * e[jx] * norm);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// A voxel shaded to premultiplied `rgba` (opacity per world unit) as `absorption` stores it:
+/// [α, αr, αg, αb] uncapped, or [σ, σr, σg, σb] with α capped at 1 − `cap`; `None` if
+/// transparent.
+fn pre_classified(rgba: [f32; 4], absorption: Absorption, cap: f64) -> Option<[f32; 4]> {
+    match absorption {
+        Absorption::Opacity => {
+            (rgba[3] > 0.0).then(|| [rgba[3].min(1.0), rgba[0], rgba[1], rgba[2]])
+        }
+        Absorption::Extinction => {
+            let a = f64::from(rgba[3]).clamp(0.0, 1.0 - cap);
+            (a > 0.0).then(|| {
+                let sigma = -(1.0 - a).ln();
+                // Premultiplied colour / α = the straight colour.
+                let c = [0, 1, 2].map(|ch| f64::from(rgba[ch]) / a);
+                [sigma, sigma * c[0], sigma * c[1], sigma * c[2]].map(|x| x as f32)
+            })
+        }
+    }
+}
