@@ -45,8 +45,11 @@ fn streamed_and_in_memory_levels_agree() {
     }
 }
 
-/// A smooth 96³ volume (a Gaussian blob and a shell) at 32×32: its samples project about 0.17 px
-/// apart, so `auto` coarsens, and the image stays within 38 dB of full resolution.
+/// A smooth 96³ volume (one wide Gaussian blob) at 96×96: its samples project about 0.6 px apart,
+/// so `auto` coarsens, the level is rendered without supersampling (levels and supersampling
+/// never act on one frame, issue 41), and the image stays within 38 dB of full resolution. A
+/// blob with a thin shell at 32×32 would need a level *and* supersampling: its level alone
+/// measures 19.8 dB against full resolution, so `auto` keeps level 0 (supersampled) there.
 #[test]
 fn auto_coarsens_a_minified_volume_and_stays_close() {
     let d = tmpdir("lod-auto");
@@ -57,9 +60,7 @@ fn auto_coarsens_a_minified_volume_and_stays_close() {
             for x in 0..n {
                 let p = [x, y, z].map(|c| c as f32 / (n - 1) as f32 * 2.0 - 1.0);
                 let r2 = p.iter().map(|c| c * c).sum::<f32>();
-                let blob = (-(r2) / (2.0 * 0.15f32 * 0.15)).exp();
-                let shell = 0.6 * (-((r2.sqrt() - 0.8).powi(2)) / (2.0 * 0.05f32 * 0.05)).exp();
-                v[(z * n + y) * n + x] = ((blob + shell).min(1.0) * 255.0) as u8;
+                v[(z * n + y) * n + x] = ((-(r2) / (2.0 * 0.3f32 * 0.3)).exp() * 255.0) as u8;
             }
         }
     }
@@ -67,20 +68,60 @@ fn auto_coarsens_a_minified_volume_and_stays_close() {
     std::fs::write(&raw, &v).unwrap();
     let raw = raw.to_str().unwrap();
     let base = [
-        raw, "--dims", "96,96,96", "--type", "u8", "--size", "32x32", "--view", "30,20,0",
+        raw, "--dims", "96,96,96", "--type", "u8", "--size", "96x96", "--view", "30,20,0",
     ];
     let with = |lod: &str| {
         let mut a = base.to_vec();
         a.extend_from_slice(&["--lod", lod]);
-        render(&a)
+        let p = prepare(&parse_args(&a).unwrap()).unwrap();
+        (p.level, p.supersample)
     };
-    let (full, l0) = with("0");
-    let (auto, la) = with("auto");
+    let (l0, _) = with("0");
+    let (la, ka) = with("auto");
     assert_eq!(l0, 0);
     assert!(la >= 1, "auto stayed at level {la}");
+    assert_eq!(ka, 1, "level {la} was supersampled {ka}x");
+    let full = render(&[&base[..], &["--lod", "0"]].concat()).0;
+    let auto = render(&[&base[..], &["--lod", "auto"]].concat()).0;
     let db = rgb_psnr(&auto, &full);
     assert!(db >= 38.0, "auto (level {la}) against level 0: {db:.1} dB");
     std::fs::remove_dir_all(&d).unwrap();
+}
+
+/// Levels and supersampling never act on one frame (issue 41): a level asked for with a
+/// supersampling factor is refused, `auto` with one stays at full resolution, and a level's frame
+/// is never supersampled by `--supersample auto`.
+#[test]
+fn levels_and_supersampling_never_share_a_frame() {
+    let a = parse_args(&[
+        HEADSQ,
+        "--size",
+        "64x64",
+        "--lod",
+        "1",
+        "--supersample",
+        "2",
+    ])
+    .unwrap();
+    let e = prepare(&a).err().expect("refused").to_string();
+    assert!(e.contains("--lod 1 and --supersample 2"), "{e}");
+    let a = parse_args(&[
+        HEADSQ,
+        "--size",
+        "32x32",
+        "--lod",
+        "auto",
+        "--supersample",
+        "3",
+    ])
+    .unwrap();
+    let p = prepare(&a).unwrap();
+    assert_eq!((p.level, p.supersample), (0, 3));
+    for lod in ["1", "2"] {
+        let a = parse_args(&[HEADSQ, "--size", "32x32", "--lod", lod]).unwrap();
+        let p = prepare(&a).unwrap();
+        assert_eq!((p.level, p.supersample), (lod.parse().unwrap(), 1));
+    }
 }
 
 #[test]

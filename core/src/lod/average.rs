@@ -1,6 +1,7 @@
 //! How a 2×2×2 block of samples becomes one sample of the next level (see the parent module):
 //! the [`Averaging`] rules, and the [`Coloured`] samples a level carries.
 
+use crate::render::Absorption;
 use crate::shade::{Sample, TransferFunction};
 
 /// A sample of a coarser level: its value (which sets its opacity through the transfer function
@@ -85,8 +86,13 @@ impl Averaging for Linear {
 ///
 /// Only transfer functions whose opacity never decreases with the value have an inverse
 /// ([`Extinction::new`] returns `None` otherwise).
+///
+/// For the opacity model ([`Extinction::for_model`] with [`Absorption::Opacity`]) the block's
+/// mean *opacity* is kept instead: that model reconstructs opacity, so its mean is what the
+/// field holds over the block.
 pub struct Extinction<'a> {
     tf: TransferFunction<'a>,
+    model: Absorption,
 }
 
 /// The largest opacity [`Extinction`] takes (an opaque sample has no finite extinction).
@@ -95,9 +101,16 @@ pub const MAX_ALPHA: f32 = 1.0 - 1e-6;
 impl<'a> Extinction<'a> {
     /// Extinction averaging through `tf`, if its opacity is non-decreasing over its entries.
     pub fn new(tf: TransferFunction<'a>) -> Option<Self> {
+        Self::for_model(tf, Absorption::Extinction)
+    }
+
+    /// Averaging through `tf` that keeps the quantity `model` reconstructs: the mean extinction
+    /// ([`Absorption::Extinction`]) or the mean opacity ([`Absorption::Opacity`]); `None` unless
+    /// `tf`'s opacity is non-decreasing over its entries.
+    pub fn for_model(tf: TransferFunction<'a>, model: Absorption) -> Option<Self> {
         tf.check().ok()?;
         let monotone = tf.lut.windows(2).all(|w| w[1][3] >= w[0][3]);
-        monotone.then_some(Extinction { tf })
+        monotone.then_some(Extinction { tf, model })
     }
 
     fn alpha(&self, value: f32) -> f32 {
@@ -117,7 +130,15 @@ impl<'a> Extinction<'a> {
     /// A value whose extinction is `sigma`: `plain` if it qualifies (a transfer function flat
     /// over a range has many), else the lowest.
     pub fn value_for(&self, sigma: f32, plain: f32) -> f32 {
-        let target = (1.0 - crate::math::exp(-sigma)).clamp(0.0, MAX_ALPHA);
+        self.value_for_alpha(
+            (1.0 - crate::math::exp(-sigma)).clamp(0.0, MAX_ALPHA),
+            plain,
+        )
+    }
+
+    /// A value whose opacity is `target` (in [0, [`MAX_ALPHA`]]): `plain` if it qualifies, else
+    /// the lowest.
+    pub fn value_for_alpha(&self, target: f32, plain: f32) -> f32 {
         if (self.alpha(plain) - target).abs() <= 1e-6 {
             return plain;
         }
@@ -174,12 +195,18 @@ impl Averaging for Extinction<'_> {
                         *w += wt * c;
                     }
                     weights += wt;
-                    sum += -crate::math::ln(1.0 - wt);
+                    sum += match self.model {
+                        Absorption::Extinction => -crate::math::ln(1.0 - wt),
+                        Absorption::Opacity => wt,
+                    };
                 }
                 n += 1;
             }
         }
-        let value = self.value_for(sum / n as f32, plain);
+        let value = match self.model {
+            Absorption::Extinction => self.value_for(sum / n as f32, plain),
+            Absorption::Opacity => self.value_for_alpha(sum / n as f32, plain),
+        };
         // The colour of the block's mean premultiplied colour, Σ αᵢcᵢ / Σ αᵢ (αᵢ each sample's
         // opacity at one world unit): how RGBA is filtered. The colour at the mean-extinction
         // value instead darkens a thin bright shell (a grey ramp maps an isolated opaque voxel's

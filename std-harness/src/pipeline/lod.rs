@@ -93,15 +93,17 @@ pub fn deepest_level(dims: [usize; 3]) -> u32 {
     level
 }
 
-/// How the levels average their samples: by extinction ([`Extinction`]) for emission and Phong
-/// shading through a transfer function whose opacity never decreases with the value; the values
-/// themselves otherwise (iso-surfaces and the texture shade from the value, not the opacity).
+/// How the levels average their samples: keeping the quantity the `model` reconstructs (mean
+/// opacity or mean extinction, [`Extinction::for_model`]) for emission and Phong shading through
+/// a transfer function whose opacity never decreases with the value; the values themselves
+/// otherwise (iso-surfaces and the texture shade from the value, not the opacity).
 pub fn averaging_for<'a>(
     shading: &Shading,
     tf: TransferFunction<'a>,
+    model: footprint::render::Absorption,
 ) -> Box<dyn Averaging + Sync + 'a> {
     match shading {
-        Shading::Emission | Shading::Phong(_) => match Extinction::new(tf) {
+        Shading::Emission | Shading::Phong(_) => match Extinction::for_model(tf, model) {
             Some(e) => Box::new(e),
             None => Box::new(Linear),
         },

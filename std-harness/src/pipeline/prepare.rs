@@ -149,7 +149,7 @@ impl Prepared {
         let kernel = kernel_at(&a, &self.kernel, level);
         let min_spacing = frame.spacing.iter().copied().fold(f32::INFINITY, f32::min);
         let shading = parse_shading(&args.shading, min_spacing)?;
-        let averaging = super::lod::averaging_for(&shading, self.shader().tf);
+        let averaging = super::lod::averaging_for(&shading, self.shader().tf, self.absorption);
         let volume = match from {
             Some(Prepared {
                 voxels: Voxels::Memory(v),
@@ -321,10 +321,21 @@ pub fn setup_frame(
              or auto"
         )));
     }
-    let level = match args.refine {
-        // Refinement is for magnified volumes: it always starts from full resolution.
-        Some(_) => 0,
-        None => super::lod::choose_level(args.lod, &fine, kernel),
+    let fixed_k = match args.supersample {
+        crate::args::Supersample::Fixed(k @ 2..) => Some(k),
+        _ => None,
+    };
+    if let (Some(k), Lod::Level(n @ 1..)) = (fixed_k, args.lod) {
+        return Err(CliError::input(format!(
+            "--lod {n} and --supersample {k} would both act on one frame (a coarser level seen \
+             at k x the size): give one of them (--lod 0, or --supersample 1 or auto)"
+        )));
+    }
+    let level = match (args.refine, fixed_k) {
+        // Refinement is for magnified volumes: it always starts from full resolution; so does
+        // a frame supersampled on request.
+        (Some(_), _) | (None, Some(_)) => 0,
+        (None, None) => super::lod::choose_level(args.lod, &fine, kernel),
     };
     let coarse_kernel = kernel_at(args, kernel, level);
     let at_level = |fine: &FrameSetup, view: &View| {
@@ -332,7 +343,12 @@ pub fn setup_frame(
             .map_err(|e| CliError::input(format!("--lod {level}: {e}")))
     };
     let frame = at_level(&fine, &view)?;
-    let k = supersample::factor(args.supersample, &frame, options);
+    // Levels and supersampling never act on one frame: a coarser level is rendered at the
+    // output size (its own error is what `--lod auto` validates, `super::level_pilot`).
+    let k = match level {
+        0 => supersample::factor(args.supersample, &frame, options),
+        _ => 1,
+    };
     if k == 1 {
         return Ok((frame, 1, level));
     }
@@ -515,7 +531,7 @@ pub fn prepare_as_asked(args: &RenderArgs) -> Result<Prepared, CliError> {
                 lo: window[0],
                 hi: window[1],
             };
-            let averaging = super::lod::averaging_for(&shading, tf);
+            let averaging = super::lod::averaging_for(&shading, tf, args.absorption.into());
             Voxels::Memory(Arc::new(super::lod::coarsen_volume(
                 &v,
                 level,

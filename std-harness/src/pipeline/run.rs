@@ -336,7 +336,7 @@ fn run_sheets<P: Precision>(
     // A streamed volume is coarsened to the frame's level as it streams (a volume in memory
     // already was, when prepared).
     let (axis, fine, level) = (f.sheet_axis, p.fine_dims, p.level);
-    let averaging = super::lod::averaging_for(&p.shading, p.shader().tf);
+    let averaging = super::lod::averaging_for(&p.shading, p.shader().tf, p.absorption);
     let (r, s) = (&mut renderer, &mut show);
     match &p.voxels {
         Voxels::Memory(v) if v.is_coloured() => stream(r, s, &mut ColouredMemorySource(v))?,
