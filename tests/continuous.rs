@@ -5,6 +5,7 @@
 use footprint_harness::args::parse_args;
 use footprint_harness::pipeline::continuous::{render_continuous_as, render_continuous_model};
 use footprint_harness::pipeline::prepare;
+use footprint_harness::plan::plan;
 use footprint_harness::reference::continuous::{
     Absorption, Model, Reconstruction, CONVERGED_DB, DEFAULT_CAP,
 };
@@ -241,7 +242,8 @@ fn opaque_ball_figures(model: &str, caps: &[f64]) -> Vec<f64> {
     ])
     .unwrap();
     let p = prepare(&a).unwrap();
-    let (core, _, _) = footprint_harness::pipeline::run::render_core(&p, &a).unwrap();
+    let (core, _, _) =
+        footprint_harness::pipeline::run::render_core(&p, &plan(&a).unwrap()).unwrap();
     let figures = caps
         .iter()
         .map(|&cap| {

@@ -63,10 +63,12 @@ fn node(path: &[String], files: &BTreeSet<Vec<String>>) -> Option<String> {
 
 fn rank(node: &str) -> u32 {
     match node.split('/').next().unwrap_or(node) {
-        "cli" => 7,
-        "commands" => 6,
-        "charts" => 5,
-        "pipeline" => 4,
+        "cli" => 8,
+        "commands" => 7,
+        "charts" => 6,
+        "pipeline" => 5,
+        // The render plan: resolved from the arguments, read by the pipeline.
+        "plan" => 4,
         "args" | "metrics" => 3,
         "scene" | "tf" => 2,
         "io" | "reference" | "dispatch" => 1,

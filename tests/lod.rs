@@ -5,6 +5,7 @@
 use footprint_harness::args::parse_args;
 use footprint_harness::metrics::compare;
 use footprint_harness::pipeline::{prepare, render_core};
+use footprint_harness::plan::plan;
 use footprint_suite::{rgb_psnr, tmpdir};
 
 const HEADSQ: &str = concat!(
@@ -16,7 +17,7 @@ fn render(args: &[&str]) -> (Vec<[f32; 4]>, u32) {
     let a = parse_args(args).unwrap();
     let p = prepare(&a).unwrap();
     let level = p.level;
-    (render_core(&p, &a).unwrap().0, level)
+    (render_core(&p, &plan(&a).unwrap()).unwrap().0, level)
 }
 
 #[test]
@@ -202,7 +203,7 @@ fn the_reference_renders_a_level_with_its_colours() {
         .unwrap();
         let p = prepare(&a).unwrap();
         assert_eq!(p.level, 1);
-        let core = render_core(&p, &a).unwrap().0;
+        let core = render_core(&p, &plan(&a).unwrap()).unwrap().0;
         let (reference, _) = footprint_harness::pipeline::render_ref(&p).unwrap();
         let db = compare(&core, &reference).1.psnr_db;
         assert!(

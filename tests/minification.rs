@@ -6,6 +6,7 @@
 
 use footprint_harness::args::parse_args;
 use footprint_harness::pipeline::{prepare, render_core};
+use footprint_harness::plan::plan;
 use std::path::PathBuf;
 
 /// A 128³ u8 volume with detail finer than the small render's pixels: three thin concentric
@@ -39,7 +40,7 @@ fn render<S: AsRef<str>>(volume: &str, extra: &[S]) -> (Vec<[f64; 3]>, usize) {
     args.extend(extra.iter().map(AsRef::as_ref));
     let args = parse_args(&args).unwrap();
     let p = prepare(&args).unwrap();
-    let (img, _, _) = render_core(&p, &args).unwrap();
+    let (img, _, _) = render_core(&p, &plan(&args).unwrap()).unwrap();
     (
         img.iter()
             .map(|c| [c[0], c[1], c[2]].map(f64::from))

@@ -8,6 +8,7 @@
 use footprint::frame::FrameSetup;
 use footprint::geometry::FootprintOptions;
 use footprint::{Grid, Kernel, View};
+use footprint_harness::plan::plan;
 use footprint_harness::reference::perspective::PerspectiveVoxel;
 use footprint_suite::tmpdir;
 use std::io::Write;
@@ -458,7 +459,7 @@ fn verify_reaches_40_db_and_refusals_are_clear() {
             Err(e) => e.message,
             Ok(a) => match footprint_harness::pipeline::prepare(&a) {
                 Err(e) => e.message,
-                Ok(p) => footprint_harness::pipeline::render_core(&p, &a)
+                Ok(p) => footprint_harness::pipeline::render_core(&p, &plan(&a).unwrap())
                     .err()
                     .map(|e| e.message)
                     .unwrap_or_default(),

@@ -8,6 +8,7 @@ use footprint_harness::metrics::compare;
 use footprint_harness::pipeline::continuous::continuous_at;
 use footprint_harness::pipeline::pilot::{choose_continuous, sample_pixels, PILOT_RAYS};
 use footprint_harness::pipeline::{prepare, render_continuous_ref, render_core, Prepared};
+use footprint_harness::plan::plan;
 use footprint_harness::reference::continuous::Reconstruction;
 
 const HEART: &str = concat!(
@@ -51,7 +52,7 @@ fn the_pilot_reference_is_the_whole_reference_at_its_pixels() {
 
 /// The whole image's PSNR against the continuous integral with `args`.
 fn actual_db(p: &Prepared, args: &footprint_harness::args::RenderArgs) -> f64 {
-    let (img, _, _) = render_core(p, args).unwrap();
+    let (img, _, _) = render_core(p, &plan(args).unwrap()).unwrap();
     let (whole, _) = render_continuous_ref(p, Reconstruction::Kernel).unwrap();
     compare(&img, &whole.image).1.psnr_db
 }

@@ -8,6 +8,7 @@ use footprint_harness::metrics::compare;
 use footprint_harness::pipeline::choose::apply_quality;
 use footprint_harness::pipeline::level_pilot::{pilot_rows, render_rows, PILOT_ROWS};
 use footprint_harness::pipeline::{prepare, render_core, render_ref};
+use footprint_harness::plan::plan;
 use footprint_suite::tmpdir;
 
 const HEADSQ: &str = concat!(
@@ -35,9 +36,9 @@ fn pilot_rows_are_the_frames_rows_bit_for_bit() {
             p.supersample > 1 || lod != "0",
             "level 0 at 40x40 supersamples"
         );
-        let (whole, _, _) = render_core(&p, &args).unwrap();
+        let (whole, _, _) = render_core(&p, &plan(&args).unwrap()).unwrap();
         let rows = [0usize, 7, 8, 23, 39];
-        let got = render_rows(&p, &args, &rows).unwrap();
+        let got = render_rows(&p, &plan(&args).unwrap(), &rows).unwrap();
         for (i, &y) in rows.iter().enumerate() {
             assert_eq!(
                 &got[i * 40..(i + 1) * 40],
@@ -86,7 +87,7 @@ fn quality_40(raw: &str, n: usize, size: &str) -> (u32, f64) {
     let choice = choice.expect("--quality was given");
     assert_eq!(choice.level, p.level);
     assert!(choice.level_pilot.is_some(), "levels were candidates");
-    let (img, _, _) = render_core(&p, &chosen).unwrap();
+    let (img, _, _) = render_core(&p, &plan(&chosen).unwrap()).unwrap();
     let mut full = flags.to_vec();
     full.extend_from_slice(&["--lod", "0"]);
     let (reference, _) = render_ref(&prepare(&parse_args(&full).unwrap()).unwrap()).unwrap();
@@ -143,7 +144,7 @@ fn quality_meets_its_target_where_voxel_scale_detail_breaks_levels() {
     ];
     let auto = parse_args(&base).unwrap();
     let p = prepare(&auto).unwrap();
-    let (img, _, _) = render_core(&p, &auto).unwrap();
+    let (img, _, _) = render_core(&p, &plan(&auto).unwrap()).unwrap();
     let mut full = base.to_vec();
     full.extend_from_slice(&["--lod", "0"]);
     let (reference, _) = render_ref(&prepare(&parse_args(&full).unwrap()).unwrap()).unwrap();
@@ -163,7 +164,7 @@ fn streamed_and_perspective_renders_keep_level_0_and_refuse_an_explicit_level() 
         let args = parse_args(&a).unwrap();
         let (p, chosen, choice) = apply_quality(prepare(&args).unwrap(), &args).unwrap();
         assert_eq!((p.level, choice.unwrap().level), (0, 0), "{first:?}");
-        assert!(render_core(&p, &chosen).is_ok());
+        assert!(render_core(&p, &plan(&chosen).unwrap()).is_ok());
     }
     // An explicit level cannot be measured on a stream, nor placed for a perspective view.
     let streamed = refusal(&["--stream", HEADSQ, "--lod", "1"]);

@@ -8,12 +8,13 @@ use footprint_harness::args::parse_args;
 use footprint_harness::metrics::compare;
 use footprint_harness::pipeline::visible::FrameCache;
 use footprint_harness::pipeline::{prepare, render_frame, CoreFrame};
+use footprint_harness::plan::plan;
 use footprint_suite::rgb_psnr;
 
 fn frame(args: &[&str]) -> CoreFrame {
     let a = parse_args(args).unwrap();
     let p = prepare(&a).unwrap();
-    render_frame(&p, &a, a.accum, &mut FrameCache::default()).unwrap()
+    render_frame(&p, &plan(&a).unwrap(), &mut FrameCache::default()).unwrap()
 }
 
 fn refused(args: &[&str]) -> String {
@@ -21,11 +22,15 @@ fn refused(args: &[&str]) -> String {
         Ok(a) => a,
         Err(e) => return e.to_string(),
     };
+    let plan = match plan(&a) {
+        Ok(plan) => plan,
+        Err(e) => return e.to_string(),
+    };
     let p = match prepare(&a) {
         Ok(p) => p,
         Err(e) => return e.to_string(),
     };
-    match render_frame(&p, &a, a.accum, &mut FrameCache::default()) {
+    match render_frame(&p, &plan, &mut FrameCache::default()) {
         Ok(_) => panic!("{args:?} rendered"),
         Err(e) => e.to_string(),
     }
@@ -190,7 +195,7 @@ fn quality_chooses_refinement_against_the_field() {
     assert!(c.predicted_db >= target);
     assert_eq!(pilot.field_size, Some(128));
     let chosen = c.config.apply(&args);
-    let f = render_frame(&p, &chosen, chosen.accum, &mut FrameCache::default()).unwrap();
+    let f = render_frame(&p, &plan(&chosen).unwrap(), &mut FrameCache::default()).unwrap();
     let (truth, _) =
         render_continuous_ref(&prepare_field(&args).unwrap(), Reconstruction::Kernel).unwrap();
     let got = compare(&f.image, &truth.image).1.psnr_db;

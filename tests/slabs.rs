@@ -313,6 +313,7 @@ use footprint_harness::args::parse_args;
 use footprint_harness::metrics::compare;
 use footprint_harness::pipeline::visible::FrameCache;
 use footprint_harness::pipeline::{prepare, render_continuous_ref, render_frame};
+use footprint_harness::plan::plan;
 use footprint_harness::reference::continuous::Reconstruction;
 
 const HEADSQ: &str = concat!(
@@ -323,7 +324,7 @@ const HEADSQ: &str = concat!(
 fn slab_image(extra: &[&str]) -> Vec<[f32; 4]> {
     let args = parse_args(extra).unwrap();
     let p = prepare(&args).unwrap();
-    render_frame(&p, &args, args.accum, &mut FrameCache::default())
+    render_frame(&p, &plan(&args).unwrap(), &mut FrameCache::default())
         .unwrap()
         .image
 }
@@ -467,7 +468,7 @@ fn image_slicing_refusals_say_why() {
         a.extend_from_slice(extra);
         let args = parse_args(&a).unwrap();
         let err = prepare(&args)
-            .and_then(|p| render_frame(&p, &args, args.accum, &mut FrameCache::default()))
+            .and_then(|p| render_frame(&p, &plan(&args).unwrap(), &mut FrameCache::default()))
             .map(|_| ())
             .unwrap_err();
         assert!(err.message.contains(says), "{extra:?}: {}", err.message);

@@ -6,13 +6,15 @@
 use footprint_harness::args::parse_args;
 use footprint_harness::pipeline::visible::FrameCache;
 use footprint_harness::pipeline::{prepare, render_frame, subsample, CoreFrame};
+use footprint_harness::plan::plan;
 use footprint_suite::{rgb_psnr, tmpdir};
 
 /// The built-in scene with `extra` flags.
 fn frame(extra: &[&str]) -> Result<CoreFrame, String> {
     let args = parse_args(extra).map_err(|e| e.to_string())?;
+    let plan = plan(&args).map_err(|e| e.to_string())?;
     let p = prepare(&args).map_err(|e| e.to_string())?;
-    render_frame(&p, &args, args.accum, &mut FrameCache::default()).map_err(|e| e.to_string())
+    render_frame(&p, &plan, &mut FrameCache::default()).map_err(|e| e.to_string())
 }
 
 /// A magnified view (footprints about 8 px in semi-axis at 150×110).
@@ -102,7 +104,7 @@ fn subsampled_frames_do_not_depend_on_threads() {
 fn auto_picks_by_footprint_size() {
     let args = parse_args(&with(&["--subsample", "auto"])).unwrap();
     let p = prepare(&args).unwrap();
-    let s = p.subsample_factor(&args).unwrap();
+    let s = p.subsample_factor(&plan(&args).unwrap()).unwrap();
     let r = p.frame.footprint.natural_minor_px;
     assert_eq!(
         s,

@@ -5,6 +5,7 @@
 use footprint_harness::args::parse_args;
 use footprint_harness::pipeline::visible::FrameCache;
 use footprint_harness::pipeline::{prepare, render_frame};
+use footprint_harness::plan::plan;
 use footprint_suite::tmpdir;
 
 /// The core's image of the built-in scene with `extra` flags on `threads` threads, as bits, and
@@ -15,7 +16,7 @@ fn frame(extra: &[&str], threads: usize) -> (Vec<[u32; 4]>, [u64; 4]) {
     a.extend_from_slice(extra);
     let args = parse_args(&a).unwrap();
     let p = prepare(&args).unwrap();
-    let f = render_frame(&p, &args, args.accum, &mut FrameCache::default()).unwrap();
+    let f = render_frame(&p, &plan(&args).unwrap(), &mut FrameCache::default()).unwrap();
     assert_eq!(f.threads, threads, "bands used");
     let s = f.stats;
     (
@@ -159,7 +160,7 @@ fn cached_lists_render_what_a_full_scan_renders() {
                     let args = parse_args(a).unwrap();
                     let p = prepare(&args).unwrap();
                     assert_eq!(p.frame.sheet_axis, axis, "view {view}");
-                    let f = render_frame(&p, &args, args.accum, cache).unwrap();
+                    let f = render_frame(&p, &plan(&args).unwrap(), cache).unwrap();
                     (
                         f.image
                             .iter()
@@ -226,12 +227,13 @@ fn kept_buffers_render_what_fresh_ones_render() {
                         .map(|c| c.map(f32::to_bits))
                         .collect::<Vec<_>>()
                 };
-                let fresh =
-                    bits(render_frame(&p, &args, args.accum, &mut FrameCache::default()).unwrap());
+                let fresh = bits(
+                    render_frame(&p, &plan(&args).unwrap(), &mut FrameCache::default()).unwrap(),
+                );
                 let mut cache = FrameCache::default();
                 for k in 0..3 {
                     cache.recycle(vec![[f32::NAN; 4]; 64 * 48]);
-                    let again = bits(render_frame(&p, &args, args.accum, &mut cache).unwrap());
+                    let again = bits(render_frame(&p, &plan(&args).unwrap(), &mut cache).unwrap());
                     assert!(
                         again == fresh,
                         "{accum} {order} {threads} threads, frame {k}"

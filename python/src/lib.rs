@@ -15,7 +15,7 @@
 // The one use of `unsafe`: reading a numpy array's buffer as a slice (see the module docs).
 #![deny(unsafe_op_in_unsafe_fn)]
 
-use footprint_harness::args::{parse_args, MethodArg, RenderArgs};
+use footprint_harness::args::{parse_args, RenderArgs};
 use footprint_harness::io::stream::{InMemory, Pipe};
 use footprint_harness::io::volume::{check_spacing, Data, Samples, Volume};
 use footprint_harness::pipeline::choose::apply_quality;
@@ -171,15 +171,17 @@ type Loaded<'py> = (Bound<'py, PyAny>, (f32, f32, f32), Bound<'py, PyDict>);
 /// The frame `args` describe, as `footprint render` renders it: premultiplied RGBA and its
 /// (width, height).
 fn frame(args: &RenderArgs) -> Result<Frame, CliError> {
+    footprint_harness::plan::plan(args)?;
     let (p, args, _) = apply_quality(prepare(args)?, args)?;
-    let image = if args.footprint.method == MethodArg::Reference {
+    let plan = footprint_harness::plan::plan(&args)?;
+    let image = if plan.end == footprint_harness::plan::End::Reference {
         render_ref(&p)?
             .0
             .iter()
             .map(|c| c.map(|x| x as f32))
             .collect()
     } else {
-        render_frame(&p, &args, args.accum, &mut FrameCache::default())?.image
+        render_frame(&p, &plan, &mut FrameCache::default())?.image
     };
     Ok((image, args.size))
 }

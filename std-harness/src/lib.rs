@@ -10,15 +10,17 @@
 //!  └ commands   one thin adapter per subcommand: parse, call, report
 //!     └ charts     sweeps and plots for `chart`
 //!        └ pipeline   load → prepare → run (core, reference), configurations, --quality
-//!           └ args, metrics   shared argument structs; image comparisons
-//!              └ scene, tf   the built-in volume; transfer functions
-//!                 └ io, reference, dispatch, threads   files and formats; the f64 reference; N → const N; threads
+//!           └ plan       the render plan, resolved once from the arguments
+//!              └ args, metrics   shared argument structs; image comparisons
+//!                 └ scene, tf   the built-in volume; transfer functions
+//!                    └ io, reference, dispatch, threads   files and formats; the f64 reference; N → const N; threads
 //! ```
 //!
 //! - [`cli`]: the entry point [`run`].
 //! - [`commands`]: one module per subcommand.
 //! - [`charts`]: `footprint chart`'s sweeps and drawing.
 //! - [`pipeline`]: the render pipeline the commands share.
+//! - [`plan`](mod@plan): the render plan, every flag-only compatibility rule in one function.
 //! - [`args`]: argument structs and value parsers shared by several commands.
 //! - [`metrics`]: PSNR, RMSE, max error; max relative footprint difference.
 //! - [`reference`](mod@reference): the f64, table-free footprint (exact line integrals) and renderer.
@@ -62,6 +64,7 @@ pub mod dispatch;
 pub mod io;
 pub mod metrics;
 pub mod pipeline;
+pub mod plan;
 pub mod reference;
 pub mod scene;
 pub mod tf;

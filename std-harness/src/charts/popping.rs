@@ -6,7 +6,7 @@
 //! dip in that curve that the continuous reference does not have. Each frame's PSNR against the
 //! continuous reference is recorded too.
 
-use crate::args::{AccumArg, RenderArgs, SlicingArg};
+use crate::args::{RenderArgs, SlicingArg};
 use crate::metrics::compare;
 use crate::pipeline::visible::FrameCache;
 use crate::pipeline::{prepare, render_continuous_ref, render_frame};
@@ -66,7 +66,8 @@ pub fn popping(
             .enumerate()
         {
             args.slicing = slicing;
-            let f = render_frame(&p, &args, AccumArg::Float, &mut caches[k])?;
+            let plan = crate::plan::plan(&args)?.with_precision(crate::plan::Precision::Float);
+            let f = render_frame(&p, &plan, &mut caches[k])?;
             out.truth_db[k].push(compare(&f.image, &truth.image).1.psnr_db);
             let img64 = f.image.iter().map(|c| c.map(f64::from)).collect();
             advance(&mut out, k, &f.image, img64);

@@ -48,11 +48,12 @@ pub fn sweep(base: &RenderArgs, reference: usize, runs: usize) -> Result<Vec<Ref
     fine.refine = None;
     fine.refine_sheets = false;
     let pf = prepare(&fine)?;
-    let truth: Vec<[f64; 4]> = render_frame(&pf, &fine, fine.accum, &mut FrameCache::default())?
-        .image
-        .iter()
-        .map(|c| c.map(f64::from))
-        .collect();
+    let truth: Vec<[f64; 4]> =
+        render_frame(&pf, &crate::plan::plan(&fine)?, &mut FrameCache::default())?
+            .image
+            .iter()
+            .map(|c| c.map(f64::from))
+            .collect();
     drop(pf);
     let mut configs: Vec<(RenderArgs, Option<f32>, bool)> = Vec::new();
     let mut with = |t: Option<f32>, sheets: bool| {
@@ -75,7 +76,7 @@ pub fn sweep(base: &RenderArgs, reference: usize, runs: usize) -> Result<Vec<Ref
     let mut times = vec![Vec::new(); configs.len()];
     for run in 0..=runs.max(1) {
         for (((a, t, sheets), p), times) in configs.iter().zip(&prepared).zip(&mut times) {
-            let f = render_frame(p, a, a.accum, &mut FrameCache::default())?;
+            let f = render_frame(p, &crate::plan::plan(a)?, &mut FrameCache::default())?;
             if run == 0 {
                 // The first pass gives the image (and warms caches); the rest are timed.
                 rows.push(RefineRow {

@@ -3,7 +3,7 @@
 use crate::args::RenderArgs;
 use crate::metrics::compare;
 use crate::pipeline::config::{accum_name, lookup_name, method_name, Config};
-use crate::pipeline::{prepare, quality, render_continuous_ref, render_core_with, render_ref};
+use crate::pipeline::{prepare, quality, render_continuous_ref, render_core, render_ref};
 use crate::reference::continuous::Reconstruction;
 use crate::CliError;
 
@@ -65,17 +65,18 @@ pub fn sweep(
         truth.change_db
     );
     // One untimed render first, so the first configuration is not timed with cold caches.
+    let base_plan = crate::plan::plan(base)?;
     if let Some(c) = configs.first() {
-        render_core_with(&p, &c.apply(base), c.accum)?;
+        render_core(&p, &c.plan(&base_plan))?;
     }
     let mut out = Vec::new();
     let bar = crate::io::progress::Progress::new("chart", configs.len(), "configurations");
     for c in configs {
-        let args = c.apply(base);
+        let plan = c.plan(&base_plan);
         let mut times = Vec::with_capacity(runs);
         let mut image = Vec::new();
         for _ in 0..runs.max(1) {
-            let (img, _, secs) = render_core_with(&p, &args, c.accum)?;
+            let (img, _, secs) = render_core(&p, &plan)?;
             times.push(secs);
             image = img;
         }

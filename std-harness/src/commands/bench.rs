@@ -53,6 +53,8 @@ fn phases_json(p: &Phases) -> Json {
 }
 
 pub fn run(args: &BenchArgs) -> Result<(), CliError> {
+    // Every rule the flags decide, before anything is loaded.
+    crate::plan::plan(&args.render)?;
     if args.frames == 0 {
         return Err(CliError::input("--frames must be at least 1"));
     }
@@ -83,7 +85,7 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
         if k > 0 {
             p.reframe(&a)?;
         }
-        let f = render_frame(&p, &a, a.accum, &mut cache)?;
+        let f = render_frame(&p, &crate::plan::plan(&a)?, &mut cache)?;
         crate::say!(
             "frame {:>3}: {:8.2} ms (classify {:.2}, tables {:.2}, splat {:.2}, composite {:.2}, resample {:.2}); sheets along {}",
             k + 1,

@@ -8,6 +8,7 @@ use crate::io::outputs::{self, Planned};
 use crate::pipeline::visible::FrameCache;
 use crate::pipeline::{choose::apply_quality, quality::quality_json};
 use crate::pipeline::{describe, prepare, render_frame, render_ref, turned, Prepared};
+use crate::plan::End;
 use crate::CliError;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -53,18 +54,21 @@ pub fn run(command: &RenderCommandArgs) -> Result<(), CliError> {
     if command.orbit.is_some() {
         check_orbit(args, &out)?;
     }
+    // Every rule the flags decide, before anything is loaded.
+    crate::plan::plan(args)?;
     let (p, args, choice) = apply_quality(prepare(args)?, args)?;
     let args = &args;
     if let Some(n) = command.orbit {
         return orbit(p, args, &out, usize::from(n), command.colorbar);
     }
-    let (mut rgb, summary) = if args.footprint.method == MethodArg::Reference {
+    let plan = crate::plan::plan(args)?;
+    let (mut rgb, summary) = if plan.end == End::Reference {
         let (img, secs) = render_ref(&p)?;
         let rgb: Vec<[f32; 4]> = img.iter().map(|c| c.map(|x| x as f32)).collect();
         crate::say!("{}: f64 reference render in {:.3} s", p.name, secs);
         (rgb, describe(&p, args).num("seconds", secs))
     } else {
-        let frame = render_frame(&p, args, args.accum, &mut FrameCache::default())?;
+        let frame = render_frame(&p, &plan, &mut FrameCache::default())?;
         let (img, stats, secs) = (frame.image, frame.stats, frame.seconds);
         if let Some(r) = &frame.refine {
             crate::say!(
@@ -83,7 +87,7 @@ pub fn run(command: &RenderCommandArgs) -> Result<(), CliError> {
             p.name,
             args.size.0,
             args.size.1,
-            match (p.supersample, p.subsample_factor(args)?) {
+            match (p.supersample, p.subsample_factor(&plan)?) {
                 (1, 1) => String::new(),
                 (1, s) => format!(" (subsampled: rendered at 1/{s} and resampled)"),
                 (k, _) => format!(" (supersampled {k}x: voxels project closer than --min-radius)"),
@@ -180,7 +184,7 @@ fn orbit(
         if k > 0 {
             p.reframe(&a)?;
         }
-        let mut f = render_frame(&p, &a, a.accum, &mut cache)?;
+        let mut f = render_frame(&p, &crate::plan::plan(&a)?, &mut cache)?;
         crate::say!("{}: frame {}/{n} in {:.3} s", p.name, k + 1, f.seconds);
         if bar {
             colorbar::draw(&mut f.image, args.size, &p.lut, p.window)?;

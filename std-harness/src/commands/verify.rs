@@ -12,7 +12,8 @@ use crate::io::outputs::{self, Planned};
 use crate::metrics::compare;
 use crate::pipeline::continuous::{continuous_models, models_json, others, PIXEL_FILTER};
 use crate::pipeline::{choose::apply_quality, field::prepare_field, quality::quality_json};
-use crate::pipeline::{describe, prepare, render_core, render_core_with, render_ref};
+use crate::pipeline::{describe, prepare, render_core, render_ref};
+use crate::plan::Precision;
 use crate::reference::continuous::Reconstruction;
 use crate::CliError;
 use clap::Args;
@@ -50,6 +51,8 @@ pub struct VerifyArgs {
 
 pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
     let r = &args.render;
+    // Every rule the flags decide, before anything is loaded.
+    crate::plan::plan(r)?;
     if r.footprint.method == MethodArg::Reference {
         return Err(CliError::input(
             "verify compares a table method with the reference: choose robust, paper or direct",
@@ -96,7 +99,8 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
     };
     let (p, chosen, choice) = apply_quality(prepare(r)?, r)?;
     let r = &chosen;
-    let (core, stats, core_s) = render_core(&p, r)?;
+    let plan = crate::plan::plan(r)?;
+    let (core, stats, core_s) = render_core(&p, &plan)?;
     let (reference, ref_s) = render_ref(&p)?;
     let (per, overall) = compare(&core, &reference);
     let continuous = match args.reference {
@@ -198,7 +202,7 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
     }
     // The fixed path is also measured against the float path of the same table and method.
     let fixed_vs_float = if r.accum == AccumArg::Fixed {
-        let (float, _, _) = render_core_with(&p, r, AccumArg::Float)?;
+        let (float, _, _) = render_core(&p, &plan.with_precision(Precision::Float))?;
         let float: Vec<[f64; 4]> = float.iter().map(|c| c.map(f64::from)).collect();
         let (_, e) = compare(&core, &float);
         crate::say!(

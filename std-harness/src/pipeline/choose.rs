@@ -132,7 +132,8 @@ fn choose_sheets(
     // Per level tried: the RMSE it spends (its bound and the pilot's two table errors), and
     // the pilot table's own error at that level (the least a final table is sure to need).
     let mut spends: Vec<(f64, f64)> = Vec::new();
-    let (pilot, mut accepted) = measure(&p0, args, &levels, |_, p, e| {
+    let plan = c0.plan(&crate::plan::plan(args)?);
+    let (pilot, mut accepted) = measure(&p0, args, &plan, &levels, |_, p, e| {
         let t0l = table_rmse(p, &c0)?;
         let spent = rmse(e.bound_db) + t00 + t0l;
         spends.push((spent, t0l));

@@ -3,6 +3,7 @@
 //! `--quality` chooses among, with the names the benches use.
 
 use crate::args::{AccumArg, LookupArg, MethodArg, RenderArgs, SlicingArg};
+use crate::plan::{End, Footprints, Plan, Precision};
 
 /// Slab thicknesses the chart sweeps with `--slicing image`, voxel spacings.
 pub const SLABS: [f32; 4] = [0.25, 0.5, 1.0, 2.0];
@@ -133,6 +134,36 @@ impl Config {
             a.refine_sheets = false;
         }
         a
+    }
+}
+
+impl Config {
+    /// `base` with this configuration's table, lookup, method, accumulation and slicing, and
+    /// refined at threshold 0 if it refines (`base`'s own refinement is kept otherwise): the plan
+    /// `--quality` and `chart` render, derived, not rewritten from flags.
+    pub fn plan(&self, base: &Plan) -> Plan {
+        let mut p = base.clone();
+        p.table.size = self.table;
+        p.table.file = None;
+        p.table.lookup = footprint::Lookup::from(self.lookup);
+        p.table.footprints = match self.method {
+            MethodArg::Direct => Footprints::Direct,
+            _ => Footprints::ViewTable,
+        };
+        let precision = match self.accum {
+            AccumArg::Float => Precision::Float,
+            AccumArg::Fixed => Precision::Fixed,
+        };
+        p.end = match (self.slab(), self.refine, base.end) {
+            (_, true, _) => End::Refined {
+                threshold: 0.0,
+                sheets: false,
+            },
+            (Some(thickness), false, _) => End::Slabs { thickness },
+            (None, false, End::Refined { threshold, sheets }) => End::Refined { threshold, sheets },
+            (None, false, _) => End::Sheets(precision),
+        };
+        p
     }
 }
 

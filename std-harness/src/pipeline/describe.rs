@@ -58,7 +58,12 @@ pub fn describe(p: &Prepared, args: &RenderArgs) -> Json {
                 .map(|e| f64::from(e) / p.supersample as f64),
         )
         .num("supersample", p.supersample as f64)
-        .num("subsample", p.subsample_factor(args).unwrap_or(1) as f64)
+        .num(
+            "subsample",
+            crate::plan::plan(args)
+                .and_then(|plan| p.subsample_factor(&plan))
+                .unwrap_or(1) as f64,
+        )
         .num("lod", f64::from(p.level))
         .arr_usize("lod_dims", &p.frame.dims)
         .str(

@@ -32,13 +32,14 @@ use super::supersample::downsample;
 use crate::args::RenderArgs;
 use crate::io::stream::{ColouredMemorySource, MemorySource};
 use crate::io::try_filled;
+use crate::plan::Plan;
 use crate::{with_table_size, CliError};
 use footprint::composite::RowSpan;
 use footprint::render::{FloatPath, RenderBuffers, SheetRenderer, SheetRing};
 use footprint::shade::{Sample, OPACITY_TABLE_LEN};
 use footprint::source::{render_all_from, SheetSource};
 use footprint::splat::Splatter;
-use footprint::{Lookup, ViewTable};
+use footprint::ViewTable;
 use std::time::Instant;
 
 /// Rows the pilot samples (all of them in an image no taller).
@@ -97,15 +98,11 @@ pub fn row_estimate(got: &[[f32; 4]], want: &[[f32; 4]], w: usize, height: usize
     Estimate::of(&per_row, height, Z)
 }
 
-/// The core's float render of `p` (in memory) at output rows `rows` only, with `args`' table
+/// The core's float render of `p` (in memory) at output rows `rows` only, with `plan`'s table
 /// size, lookup and phases through the view table (the robust method): `rows.len()` rows of the
 /// output width, in the order given. Each equals that row of the whole frame's float render with
-/// the same flags, bit for bit.
-pub fn render_rows(
-    p: &Prepared,
-    args: &RenderArgs,
-    rows: &[usize],
-) -> Result<Vec<[f32; 4]>, CliError> {
+/// the same plan, bit for bit.
+pub fn render_rows(p: &Prepared, plan: &Plan, rows: &[usize]) -> Result<Vec<[f32; 4]>, CliError> {
     let Voxels::Memory(volume) = &p.voxels else {
         return Err(CliError::input(
             "the level pilot renders a volume in memory: drop --stream",
@@ -118,19 +115,18 @@ pub fn render_rows(
             "pilot row {y} is outside an image {h} rows high"
         )));
     }
-    let fa = &args.footprint;
-    let lookup = Lookup::from(fa.lookup);
-    with_table_size!(fa.table, N => {
-        let generic = fa.generic_table::<N>(&p.kernel)?;
+    let lookup = plan.table.lookup;
+    with_table_size!(plan.table.size, N => {
+        let generic = plan.table.generic::<N>(&p.kernel)?;
         let table = Box::new(ViewTable::<N>::build(&f.footprint, &generic, lookup, lookup));
         // The sampler the whole frame's render uses (`super::run`): phase stencils where the
         // footprint allows them, else the view table.
-        let len = stencil_len(p, args);
-        let threads = args.thread_count();
+        let len = stencil_len(p, plan.phases);
+        let threads = plan.threads;
         let bands = match len {
             Some(len) => {
                 let mut buffer = vec![0.0f32; len];
-                let stencils = build_stencils(&*table, args.phases, &mut buffer, threads)?;
+                let stencils = build_stencils(&*table, plan.phases, &mut buffer, threads)?;
                 split_rows(p, &stencils, volume, rows, threads)?
             }
             None => split_rows(p, &*table, volume, rows, threads)?,
@@ -247,12 +243,13 @@ pub fn candidate_levels(p: &Prepared, explicit: Option<u32>) -> Vec<u32> {
         .collect()
 }
 
-/// Measures `levels` of `p0` (level 0, in memory) in order against level 0 on the pilot rows,
-/// keeping each level's prepared render; stops after the first level `accept` refuses.
-/// Returns the pilot and the prepared levels accepted, in order.
+/// Measures `levels` of `p0` (level 0, in memory, prepared from `args`) in order against level 0
+/// on the pilot rows rendered with `plan`, keeping each level's prepared render; stops after the
+/// first level `accept` refuses. Returns the pilot and the prepared levels accepted, in order.
 pub fn measure(
     p0: &Prepared,
     args: &RenderArgs,
+    plan: &Plan,
     levels: &[u32],
     mut accept: impl FnMut(u32, &Prepared, &Estimate) -> Result<bool, CliError>,
 ) -> Result<(LevelPilot, Vec<Prepared>), CliError> {
@@ -260,13 +257,13 @@ pub fn measure(
     let (_, h) = p0.out_size();
     let rows = pilot_rows(h, PILOT_ROWS);
     let w = p0.out_size().0;
-    let base = render_rows(p0, args, &rows)?;
+    let base = render_rows(p0, plan, &rows)?;
     let base_seconds = start.elapsed().as_secs_f64();
     let mut tried = Vec::new();
     let mut accepted: Vec<Prepared> = Vec::new();
     for &level in levels {
         let p = p0.at_level(args, level, accepted.last())?;
-        let got = render_rows(&p, args, &rows)?;
+        let got = render_rows(&p, plan, &rows)?;
         let e = row_estimate(&got, &base, w, h);
         tried.push((level, e));
         if !accept(level, &p, &e)? {
@@ -303,7 +300,10 @@ pub fn validated_auto(p0: Prepared, args: &RenderArgs) -> Result<Prepared, CliEr
         return Ok(p0);
     }
     let levels: Vec<u32> = (1..=deepest).collect();
-    let (_, mut accepted) = measure(&p0, args, &levels, |_, _, e| Ok(e.bound_db >= AUTO_MIN_DB))?;
+    let plan = crate::plan::plan(args)?;
+    let (_, mut accepted) = measure(&p0, args, &plan, &levels, |_, _, e| {
+        Ok(e.bound_db >= AUTO_MIN_DB)
+    })?;
     Ok(accepted.pop().unwrap_or(p0))
 }
 

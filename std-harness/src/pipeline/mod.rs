@@ -31,8 +31,11 @@
 //!   magnified frames rendered smaller and resampled (image-space level of detail).
 //! - [`describe`](mod@describe): the JSON fields every render and verify summary share.
 //!
-//! It reads the shared argument structs of [`crate::args`] and calls down into [`crate::io`],
-//! [`crate::reference`] and the core; it imports no command.
+//! A frame renders `(&Prepared, &Plan)` ([`render_frame`], [`crate::plan`]): the end point
+//! (sheets, slabs, refined), tables, phases, threads and the subsampling decorator come from the
+//! plan, never from the command line. Loading and preparing still read the shared argument
+//! structs of [`crate::args`]; it calls down into [`crate::io`], [`crate::reference`] and the
+//! core, and imports no command.
 
 pub mod bands;
 pub mod choose;
@@ -64,7 +67,7 @@ pub use continuous::render_continuous_ref;
 pub use describe::describe;
 pub use entry::prepare;
 pub use prepare::Prepared;
-pub use run::{render_core, render_core_with, render_frame, render_ref, CoreFrame};
+pub use run::{render_core, render_frame, render_ref, CoreFrame};
 
 /// `base` turned `degrees` of azimuth further about the volume's vertical axis: `--view`'s
 /// azimuth plus `degrees`, or a `--view-matrix` V as V · Ry(degrees) (the same turn). What

@@ -43,7 +43,8 @@ use super::quality::{self, Choice, Estimate, Pilot};
 use super::run::render_frame;
 use super::sampling::mix;
 use super::visible::FrameCache;
-use crate::args::{QualityReferenceArg, RenderArgs, SlicingArg};
+use crate::args::{QualityReferenceArg, RenderArgs};
+use crate::plan::{End, Plan};
 use crate::CliError;
 use std::time::Instant;
 
@@ -103,12 +104,12 @@ pub fn estimate(
 /// refined one only against the `field` reference.
 fn candidates(
     p: &Prepared,
-    args: &RenderArgs,
+    base: &Plan,
     target_db: f64,
     reference: QualityReferenceArg,
 ) -> Result<Vec<Config>, CliError> {
     let mut v: Vec<Config> = Vec::new();
-    if args.slicing == SlicingArg::Object {
+    if !matches!(base.end, End::Slabs { .. }) {
         for aim in [target_db, target_db + TABLE_HEADROOM_DB] {
             let c = quality::pick(p, aim)?.0.config;
             if !v.contains(&c) {
@@ -117,7 +118,7 @@ fn candidates(
         }
     }
     if let (Some(last), QualityReferenceArg::Field) = (v.last().copied(), reference) {
-        if super::refine::worth_trying(p, &last.refined().apply(args)) {
+        if super::refine::worth_trying(p, &last.refined().plan(base)) {
             v.push(last.refined());
         }
     }
@@ -150,7 +151,8 @@ pub fn choose_continuous(
         QualityReferenceArg::Field => Some(super::field::prepare_field(args)?),
         _ => None,
     };
-    let candidates = candidates(p, args, target_db, reference)?;
+    let base = crate::plan::plan(args)?;
+    let candidates = candidates(p, &base, target_db, reference)?;
     let (w, h) = p.out_size();
     let (pixels, stride) = sample_pixels(w, h, PILOT_RAYS);
     let (reference_image, reference_seconds) = continuous_at(fine.as_ref().unwrap_or(p), &pixels)?;
@@ -160,7 +162,7 @@ pub fn choose_continuous(
     let mut tried: Vec<(Config, Estimate)> = Vec::new();
     let mut chosen = None;
     for c in candidates {
-        let frame = render_frame(p, &c.apply(args), c.accum, &mut cache)?;
+        let frame = render_frame(p, &c.plan(&base), &mut cache)?;
         let e = estimate(&frame.image, w, &pixels, &reference_image.image, w * h);
         tried.push((c, e));
         if e.bound_db >= target_db {

@@ -11,6 +11,7 @@ use super::load::{load_background, load_voxels, Loaded, Voxels};
 use super::supersample;
 use crate::args::{Lod, RenderArgs};
 use crate::io::volume::Volume;
+use crate::plan::Plan;
 use crate::{tf, CliError};
 use footprint::frame::{FrameSetup, Order};
 use footprint::geometry::FootprintOptions;
@@ -99,6 +100,9 @@ pub struct Prepared {
     pub supersample: usize,
     /// The continuous model both slicings composite (`--absorption`).
     pub absorption: footprint::render::Absorption,
+    /// The view at the output size (`--view`, `--zoom`, `--view-matrix`): what a subsampled
+    /// frame scales.
+    pub view: View,
 }
 
 impl Prepared {
@@ -116,6 +120,7 @@ impl Prepared {
             self.options,
         )?;
         self.frame = frame;
+        self.view = view_for(&args, self.fine_dims, &self.grid)?;
         self.supersample = k;
         self.background = at_frame(self.background_out.as_ref(), args.size, k);
         Ok(())
@@ -176,35 +181,31 @@ impl Prepared {
             options: self.options,
             supersample,
             absorption: self.absorption,
+            view: self.view,
         })
     }
 
     /// The `--subsample` factor `args` asks for with this render (1: off; see
     /// [`super::subsample::factor`], which refuses what cannot be honoured).
-    pub fn subsample_factor(&self, args: &RenderArgs) -> Result<usize, CliError> {
+    pub fn subsample_factor(&self, plan: &Plan) -> Result<usize, CliError> {
         super::subsample::factor(
             &self.frame,
             &self.kernel,
             self.options,
             self.supersample,
             self.level,
-            args,
+            plan,
         )
     }
 
-    /// This render (prepared at the output size) seen at 1/s of it, and `args` for that frame
+    /// This render (prepared at the output size) seen at 1/s of it, and `plan` for that frame
     /// (see [`super::subsample`]): the same volume (shared, not copied), transfer function and
     /// shading; the frame set up again with the view scaled by 1/s at
     /// [`super::subsample::low_size`]; no background (it is composited at the output size).
-    pub fn subsampled(
-        &self,
-        args: &RenderArgs,
-        s: usize,
-    ) -> Result<(Prepared, RenderArgs), CliError> {
-        let view = view_for(args, self.fine_dims, &self.grid)?;
-        let view = View::new(view.to_screen() * (1.0 / s as f32))
+    pub fn subsampled(&self, plan: &Plan, s: usize) -> Result<(Prepared, Plan), CliError> {
+        let view = View::new(self.view.to_screen() * (1.0 / s as f32))
             .map_err(|e| CliError::input(format!("--subsample {s}: view: {e}")))?;
-        let (w, h) = super::subsample::low_size(args.size, s);
+        let (w, h) = super::subsample::low_size(self.out_size(), s);
         let frame = FrameSetup::new(
             self.fine_dims,
             &self.grid,
@@ -215,11 +216,11 @@ impl Prepared {
         )?;
         let mut low = self.clone();
         low.frame = frame;
+        low.view = view;
         low.background = None;
         low.background_out = None;
-        let mut at_low = args.clone();
+        let mut at_low = plan.clone();
         at_low.subsample = crate::args::Supersample::Fixed(1);
-        at_low.size = (w, h);
         Ok((low, at_low))
     }
 
@@ -564,6 +565,7 @@ pub fn prepare_as_asked(args: &RenderArgs) -> Result<Prepared, CliError> {
         options,
         supersample,
         absorption: args.absorption.into(),
+        view: view_for(args, dims, &grid)?,
     })
 }
 

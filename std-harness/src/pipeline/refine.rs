@@ -24,8 +24,8 @@ use super::bands::{equal_bands, on_bands, CoreFrame, Phases};
 use super::prepare::Prepared;
 pub use super::refinement::Refinement;
 use super::supersample::to_output;
-use crate::args::{AccumArg, MethodArg, RenderArgs, SlicingArg};
 use crate::io::volume::Volume;
+use crate::plan::{End, Plan};
 use crate::{with_table_size, CliError};
 use footprint::composite::RowSpan;
 use footprint::refine::{factor_for, RefinedAxis};
@@ -37,7 +37,7 @@ use footprint::shade::{Lighting, Shader, Shading, OPACITY_TABLE_LEN};
 use footprint::splat::{BufferError, ImageMut, Pixel, SplatStats, Splatter};
 use footprint::stencil::{self, Stencils};
 use footprint::Sampler;
-use footprint::{Footprint, Lookup, ViewTable};
+use footprint::{Footprint, ViewTable};
 use std::time::Instant;
 
 /// Samples that must share a border spacing for its scaled footprint to be resampled into a
@@ -50,23 +50,12 @@ pub const REFINE_PHASES: usize = 8;
 /// The closest a refined step may project, pixels.
 pub const MIN_STEP_PX: f32 = 6.0;
 
-/// Checks that `args` can refine `p` with accumulation `accum`, with a message saying what to
-/// drop if not.
-pub fn check(p: &Prepared, args: &RenderArgs, accum: AccumArg) -> Result<(), CliError> {
+/// Checks that `p` can be refined, with a message saying what to drop if not (the plan has
+/// checked what the flags decide: float, object slicing, the robust method, orthographic).
+pub fn check(p: &Prepared) -> Result<(), CliError> {
     let refuse = |why: &str| Err(CliError::input(format!("--refine: {why}")));
-    if accum != AccumArg::Float {
-        return refuse("float accumulation only (drop --accum fixed)");
-    }
-    if args.slicing != SlicingArg::Object {
-        return refuse("the paper's sheets only (drop --slicing image)");
-    }
     if p.frame.camera().is_some() {
         return refuse("orthographic views only (drop --perspective)");
-    }
-    if !matches!(args.footprint.method, MethodArg::Robust) {
-        return refuse(
-            "the rate tables are view tables built by the robust method (drop --method)",
-        );
     }
     if p.volume().is_none() {
         return refuse("the volume must be in memory (drop --stream)");
@@ -74,16 +63,19 @@ pub fn check(p: &Prepared, args: &RenderArgs, accum: AccumArg) -> Result<(), Cli
     Ok(())
 }
 
-/// Whether `--refine` with `args` can add samples to `p`'s grid: [`check`] passes, `p` is at full
-/// resolution, and an in-sheet grid step (or, with `--refine-sheets`, the sheet step) projects
-/// at least 2 × [`MIN_STEP_PX`] (otherwise every interval keeps factor 1 and the refined render
-/// is the unrefined one).
-pub fn worth_trying(p: &Prepared, args: &RenderArgs) -> bool {
-    if check(p, args, args.accum).is_err() || p.level != 0 {
+/// Whether refining `p` as `plan` says (a [`End::Refined`] plan) can add samples to its grid:
+/// [`check`] passes, `p` is at full resolution, and an in-sheet grid step (or, when it refines
+/// across sheets, the sheet step) projects at least 2 × [`MIN_STEP_PX`] (otherwise every
+/// interval keeps factor 1 and the refined render is the unrefined one).
+pub fn worth_trying(p: &Prepared, plan: &Plan) -> bool {
+    let End::Refined { sheets, .. } = plan.end else {
+        return false;
+    };
+    if check(p).is_err() || p.level != 0 {
         return false;
     }
     (0..3).any(|axis| {
-        (axis != p.frame.sheet_axis || args.refine_sheets)
+        (axis != p.frame.sheet_axis || sheets)
             && p.frame.grid_to_screen.col(axis).length() >= 2.0 * MIN_STEP_PX
     })
 }
@@ -177,18 +169,18 @@ pub fn choose(
     })
 }
 
-/// Renders `p` refined at `threshold` (see the module docs) on `args.threads` bands, after
-/// [`check`]ing that it can with accumulation `accum`.
+/// Renders `p` refined at `threshold` (see the module docs; across sheets too if `sheets`) with
+/// `plan`'s tables on `plan.threads` bands, after [`check`]ing that it can.
 pub fn render_refined(
     p: &Prepared,
-    args: &RenderArgs,
-    accum: AccumArg,
+    plan: &Plan,
     threshold: f32,
+    sheets: bool,
 ) -> Result<CoreFrame, CliError> {
-    check(p, args, accum)?;
+    check(p)?;
     let volume = p.volume().expect("checked");
     let start = Instant::now();
-    let refinement = choose(p, volume, threshold, args.refine_sheets)?;
+    let refinement = choose(p, volume, threshold, sheets)?;
     let classify = start.elapsed().as_secs_f64();
     let f = &p.frame;
     let axis = |a: usize| {
@@ -198,14 +190,13 @@ pub fn render_refined(
     let grid = RefinedGrid {
         axes: [axis(0)?, axis(1)?, axis(2)?],
     };
-    let fa = &args.footprint;
-    let lookup = Lookup::from(fa.lookup);
-    let threads = args.thread_count();
+    let lookup = plan.table.lookup;
+    let threads = plan.threads;
     let dims = volume.dims;
     let value = |[i, j, k]: [usize; 3]| volume.value(i + dims[0] * (j + dims[1] * k));
-    with_table_size!(fa.table, N => {
+    with_table_size!(plan.table.size, N => {
         let t0 = Instant::now();
-        let generic = fa.generic_table::<N>(&p.kernel)?;
+        let generic = plan.table.generic::<N>(&p.kernel)?;
         let footprint_for = |m: &glam::Mat3| {
             Footprint::with_sheet_axis(&p.kernel, m, p.options, f.sheet_axis)
                 .map_err(|e| CliError::input(format!("--refine: a local spacing's footprint: {e}")))
@@ -214,7 +205,7 @@ pub fn render_refined(
         let map = sheet_map(f);
         // Refined footprints are many and small: their stencils get at most REFINE_PHASES
         // phases per pixel (a 1/16-px placement), which keeps building them cheap.
-        let phases = args.phases.min(REFINE_PHASES);
+        let phases = plan.phases.min(REFINE_PHASES);
         // Samples per spacing key (see the core's `spacing_key`).
         let bins = |axis: usize| {
             let mut c = [0usize; 9];

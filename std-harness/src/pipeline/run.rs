@@ -10,15 +10,14 @@ use super::prepare::Prepared;
 use super::subsample;
 use super::supersample::{downsample, to_output};
 use super::visible::FrameCache;
-use crate::args::{AccumArg, MethodArg, RenderArgs, SlicingArg};
 use crate::io::progress::sheets;
 use crate::io::stream::{ColouredMemorySource, FileSource, MemorySource, PipeSource};
 use crate::io::try_filled;
+use crate::plan::{End, Footprints, Plan, Precision as PlanPrecision};
 use crate::reference::render::{render_reference, ReferenceScene};
 use crate::{with_table_size, CliError};
 use footprint::fixed::stencil::FixedStencils;
 use footprint::fixed::{self, FixedTable};
-use footprint::render::Absorption;
 use footprint::render::{
     FixedPath, FloatPath, PerspectivePath, Precision, RenderBuffers, RenderStats, ShadeCacheEntry,
     SheetRenderer, SheetRing, SHADE_CACHE_LEN,
@@ -27,45 +26,36 @@ use footprint::shade::{Sample, OPACITY_TABLE_LEN};
 use footprint::source::{render_from, SheetSource};
 use footprint::splat::Direct;
 use footprint::stencil::{self, Stencils};
-use footprint::{composite::RowSpan, Lookup, ViewTable};
+use footprint::{composite::RowSpan, ViewTable};
 use std::time::Instant;
 
-/// The core's render of `p` with `args`' table, method and accumulation: premultiplied RGBA
-/// (fixed-point output converted exactly to f32), counts, seconds.
+/// The core's render of `p` with `plan`: premultiplied RGBA (fixed-point output converted
+/// exactly to f32), counts, seconds.
 pub fn render_core(
     p: &Prepared,
-    args: &RenderArgs,
+    plan: &Plan,
 ) -> Result<(Vec<[f32; 4]>, RenderStats, f64), CliError> {
-    render_core_with(p, args, args.accum)
-}
-
-/// [`render_core`] with the accumulation given explicitly.
-pub fn render_core_with(
-    p: &Prepared,
-    args: &RenderArgs,
-    accum: AccumArg,
-) -> Result<(Vec<[f32; 4]>, RenderStats, f64), CliError> {
-    let f = render_frame(p, args, accum, &mut FrameCache::default())?;
+    let f = render_frame(p, plan, &mut FrameCache::default())?;
     Ok((f.image, f.stats, f.seconds))
 }
 
-/// Renders one frame of `p` with `args`' table, method, accumulation and `--threads`, reusing
-/// (and filling) `cache`'s visible-voxel lists when the volume is in memory. A streamed volume
-/// renders on one thread, straight from its sheets.
+/// Renders one frame of `p` with `plan`, reusing (and filling) `cache`'s visible-voxel lists
+/// when the volume is in memory. A streamed volume renders on one thread, straight from its
+/// sheets. The subsampling decorator wraps every end point that allows it.
 pub fn render_frame(
     p: &Prepared,
-    args: &RenderArgs,
-    accum: AccumArg,
+    plan: &Plan,
     cache: &mut FrameCache,
 ) -> Result<CoreFrame, CliError> {
-    let s = p.subsample_factor(args)?;
+    let s = p.subsample_factor(plan)?;
     if s > 1 {
         // Rendered at 1/s of the size and resampled (`super::subsample`); timed as one frame.
         let start = Instant::now();
-        let (low, at_low) = p.subsampled(args, s)?;
-        let mut f = render_frame(&low, &at_low, accum, cache)?;
+        let (low, at_low) = p.subsampled(plan, s)?;
+        let mut f = render_frame(&low, &at_low, cache)?;
         let resample = Instant::now();
-        f.image = subsample::magnify(&f.image, at_low.size, args.size, s, args.thread_count())?;
+        let size = p.out_size();
+        f.image = subsample::magnify(&f.image, low.out_size(), size, s, plan.threads)?;
         if let Some(bg) = &p.background {
             subsample::under_background(&mut f.image, bg);
         }
@@ -73,43 +63,55 @@ pub fn render_frame(
         f.seconds = start.elapsed().as_secs_f64();
         return Ok(f);
     }
-    if let Some(threshold) = args.refine {
-        return super::refine::render_refined(p, args, accum, threshold);
+    match plan.end {
+        End::Refined { threshold, sheets } => {
+            super::refine::render_refined(p, plan, threshold, sheets)
+        }
+        End::Slabs { thickness } => super::slabs::render_slabs(p, thickness, plan.threads, cache),
+        End::Sheets(precision) => render_sheets(p, plan, precision, cache),
+        End::Reference => Err(CliError::input(
+            "the f64 reference is not a core render: use render_ref (--method reference)",
+        )),
     }
-    if args.slicing == SlicingArg::Image {
-        return super::slabs::render_slabs(p, args, accum, cache);
-    }
-    check_absorption(p, accum)?;
-    let fa = &args.footprint;
-    let lookup = Lookup::from(fa.lookup);
-    let threads = args.thread_count();
+}
+
+/// The paper's sheets of `p` through `plan`'s tables in `precision`.
+fn render_sheets(
+    p: &Prepared,
+    plan: &Plan,
+    precision: PlanPrecision,
+    cache: &mut FrameCache,
+) -> Result<CoreFrame, CliError> {
+    let lookup = plan.table.lookup;
+    let threads = plan.threads;
+    let direct = plan.table.footprints == Footprints::Direct;
     let fixed_range =
         |e: fixed::FixedError| CliError::input(format!("{}: --accum fixed: {e}", p.name));
     let start = Instant::now();
-    with_table_size!(fa.table, N => {
-        let generic = fa.generic_table::<N>(&p.kernel)?;
+    with_table_size!(plan.table.size, N => {
+        let generic = plan.table.generic::<N>(&p.kernel)?;
         // Each path gets its own monomorphised sheet loop: no virtual call per pixel.
         let perspective = p.frame.camera().is_some();
-        let (image, stats, mut phases, visible) = match (accum, fa.method) {
-            (AccumArg::Float, _) if perspective => {
+        let (image, stats, mut phases, visible) = match precision {
+            PlanPrecision::Float if perspective => {
                 // Every voxel its own footprint, sampled from the generic table (no view table).
                 let path = PerspectivePath::new(&p.frame, &p.kernel, p.options, &*generic, lookup)?;
                 let tables = start.elapsed().as_secs_f64();
                 let r = run_path(p, path, p.background.as_deref(), cache, threads)?;
                 (r.0, r.1, Phases { tables, ..r.2 }, r.3)
             }
-            (AccumArg::Float, MethodArg::Direct) => {
+            PlanPrecision::Float if direct => {
                 let sampler = Direct { footprint: p.frame.footprint, table: &*generic, lookup };
                 let tables = start.elapsed().as_secs_f64();
                 let r = run_path(p, FloatPath::new(&sampler).with_absorption(p.absorption), p.background.as_deref(), cache, threads)?;
                 (r.0, r.1, Phases { tables, ..r.2 }, r.3)
             }
-            (AccumArg::Float, _) => {
+            PlanPrecision::Float => {
                 let table = Box::new(ViewTable::<N>::build(&p.frame.footprint, &generic, lookup, lookup));
-                let r = if let Some(len) = stencil_len(p, args) {
+                let r = if let Some(len) = stencil_len(p, plan.phases) {
                     // Footprints up to 128 px across: the view table sampled once per phase.
                     let mut buffer = vec![0.0f32; len];
-                    let stencils = build_stencils(&*table, args.phases, &mut buffer, threads)?;
+                    let stencils = build_stencils(&*table, plan.phases, &mut buffer, threads)?;
                     let tables = start.elapsed().as_secs_f64();
                     let path = FloatPath::new(&stencils).with_absorption(p.absorption);
                     let r = run_path(p, path, p.background.as_deref(), cache, threads)?;
@@ -121,11 +123,12 @@ pub fn render_frame(
                 };
                 r
             }
-            (AccumArg::Fixed, method) => {
+            PlanPrecision::Fixed => {
                 let mut table = Box::new(FixedTable::<N>::zeroed());
-                match method {
-                    MethodArg::Direct => table.build_direct(&p.frame, &generic, lookup),
-                    _ => table.build_view(&p.frame, &generic, lookup, lookup),
+                if direct {
+                    table.build_direct(&p.frame, &generic, lookup)
+                } else {
+                    table.build_view(&p.frame, &generic, lookup, lookup)
                 }
                 .map_err(fixed_range)?;
                 // Shaded voxels never exceed opacity 1: the stencils may add unsaturated where
@@ -137,13 +140,13 @@ pub fn render_frame(
                 // the float path's stencils, with as many phases); wider ones, or --phases 0, walk
                 // the table.
                 // Blended to the edge where the float stencils are (the same phases), else edged.
-                let plan = stencil::plan_for(&p.frame.footprint, args.phases);
-                let blended = plan.is_some_and(|q| !q.edged);
-                let phases = match plan {
+                let sp = stencil::plan_for(&p.frame.footprint, plan.phases);
+                let blended = sp.is_some_and(|q| !q.edged);
+                let phases = match sp {
                     Some(q) if blended => q.phases,
-                    _ => stencil::edged_phases_for(&p.frame.footprint, args.phases),
+                    _ => stencil::edged_phases_for(&p.frame.footprint, plan.phases),
                 };
-                let len = (args.phases > 0 && method != MethodArg::Direct)
+                let len = (plan.phases > 0 && !direct)
                     .then(|| fixed::stencil::len_for(&table, phases))
                     .flatten();
                 let mut buffer = vec![0i32; len.unwrap_or(0)];
@@ -180,28 +183,6 @@ pub fn render_frame(
     })
 }
 
-/// Object slicing renders the extinction model with the float path in orthographic frames
-/// only: the fixed path accumulates clamped opacity, and the perspective path corrects each
-/// voxel's opacity per ray before it is splatted.
-fn check_absorption(p: &Prepared, accum: AccumArg) -> Result<(), CliError> {
-    if p.absorption == Absorption::Extinction {
-        let why = if accum == AccumArg::Fixed {
-            Some("--accum fixed composites the opacity model only: use --accum float")
-        } else if p.frame.camera().is_some() {
-            Some("--perspective composites the opacity model only")
-        } else {
-            None
-        };
-        if let Some(why) = why {
-            return Err(CliError::input(format!(
-                "{}: --absorption extinction: {why} (or --absorption opacity)",
-                p.name
-            )));
-        }
-    }
-    Ok(())
-}
-
 /// The float path's phase stencils of `sampler` (at most `phases` per pixel) in `buffer`,
 /// sampled on `threads` threads, whole stencils each: the same bits for any number.
 pub fn build_stencils<'a, S: footprint::Sampler + Sync + ?Sized>(
@@ -226,11 +207,11 @@ pub fn build_stencils<'a, S: footprint::Sampler + Sync + ?Sized>(
     })
 }
 
-/// The buffer length of the float path's phase stencils for `p`'s footprint with `args`'
-/// `--phases` (`None`: `--phases 0`, or a footprint too large for them; the view table serves).
-pub fn stencil_len(p: &Prepared, args: &RenderArgs) -> Option<usize> {
-    (args.phases > 0)
-        .then(|| stencil::len_for(&p.frame.footprint, args.phases))
+/// The buffer length of the float path's phase stencils for `p`'s footprint with `phases`
+/// (`None`: `--phases 0`, or a footprint too large for them; the view table serves).
+pub fn stencil_len(p: &Prepared, phases: usize) -> Option<usize> {
+    (phases > 0)
+        .then(|| stencil::len_for(&p.frame.footprint, phases))
         .flatten()
 }
 

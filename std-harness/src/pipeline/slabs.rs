@@ -21,7 +21,6 @@ use super::bands::{equal_bands, on_bands, CoreFrame, Phases};
 use super::prepare::Prepared;
 use super::supersample::to_output;
 use super::visible::FrameCache;
-use crate::args::{AccumArg, RenderArgs};
 use crate::CliError;
 use footprint::composite::RowSpan;
 use footprint::frame::Order;
@@ -35,30 +34,24 @@ use std::time::Instant;
 const ROWS: usize = 257;
 const COLUMNS: usize = 1025;
 
-/// Renders one frame of `p` with image-aligned slabs `args.slab` voxel spacings thick.
+/// Renders one frame of `p` with image-aligned slabs `thickness` voxel spacings thick on
+/// `threads` bands (float: the plan refuses fixed-point slabs).
 pub fn render_slabs(
     p: &Prepared,
-    args: &RenderArgs,
-    accum: AccumArg,
+    thickness: f32,
+    threads: usize,
     cache: &mut FrameCache,
 ) -> Result<CoreFrame, CliError> {
     let refuse = |why: &str| CliError::input(format!("{}: --slicing image: {why}", p.name));
-    if accum == AccumArg::Fixed {
-        return Err(refuse(
-            "there is no fixed-point slab path (each slab is composited with an exponential per \
-             pixel): use --accum float or --slicing object",
-        ));
-    }
     let volume = p.volume().ok_or_else(|| {
         refuse(
             "a slab of an oblique view crosses every sheet, so it cannot be fed from a few \
              streamed sheets: drop --stream (the volume is loaded) or use --slicing object",
         )
     })?;
-    let setup = SlabSetup::new(&p.frame, &p.kernel, args.slab)
+    let setup = SlabSetup::new(&p.frame, &p.kernel, thickness)
         .map_err(|e| refuse(&e.to_string()))?
         .with_absorption(p.absorption);
-    let threads = args.thread_count();
     let start = Instant::now();
     let mut table = Box::new(SectionTable::<ROWS, COLUMNS>::zeroed(p.kernel));
     table

@@ -27,7 +27,8 @@
 //! edges: channels are clamped at 0 and opacity at 1. A background image is composited under the
 //! resampled frame at the output size (C + (1 − A)·background, what the core's sheet loop does).
 
-use crate::args::{RenderArgs, Supersample};
+use crate::args::Supersample;
+use crate::plan::{End, Plan};
 use crate::CliError;
 use footprint::frame::FrameSetup;
 use footprint::geometry::FootprintOptions;
@@ -45,21 +46,22 @@ pub const MAX_FACTOR: usize = 8;
 /// (the walnut at s = 2) and 1.9 px (the CT head at s = 4) resample to 59.7 and 56.6 dB.
 pub const AUTO_MIN_RADIUS_PX: f32 = 2.0;
 
-/// The factor `args` asks for with a render prepared at the output size (its `frame`, `kernel`,
+/// The factor `plan` asks for with a render prepared at the output size (its `frame`, `kernel`,
 /// footprint `options`, `supersample` factor and level of detail `level`, as
 /// `Prepared::subsample_factor` passes them): 1 (off) unless `--subsample` gives s ≥ 2 or `auto`
-/// finds one. An explicit s ≥ 2 that cannot be honoured is refused: with a perspective view,
-/// `--refine`, `--quality`, a supersampled or coarser-level frame, or when the footprints would be
-/// narrower than `--min-radius` at 1/s of the size (they would be widened: a blurred image).
+/// finds one. An explicit s ≥ 2 that cannot be honoured here is refused: with a perspective view,
+/// a supersampled or coarser-level frame, or when the footprints would be narrower than
+/// `--min-radius` at 1/s of the size (they would be widened: a blurred image). (`--quality` and
+/// `--refine` with a factor are refused by the plan, `crate::plan::plan`.)
 pub fn factor(
     frame: &FrameSetup,
     kernel: &Kernel,
     options: FootprintOptions,
     supersample: usize,
     level: u32,
-    args: &RenderArgs,
+    plan: &Plan,
 ) -> Result<usize, CliError> {
-    let explicit = match args.subsample {
+    let explicit = match plan.subsample {
         Supersample::Fixed(1) => return Ok(1),
         Supersample::Fixed(s) => Some(s),
         Supersample::Auto => None,
@@ -70,14 +72,10 @@ pub fn factor(
             explicit.map_or("auto".to_string(), |s| s.to_string())
         ))
     };
-    if args.quality.is_some() {
-        return Err(refuse(
-            "--quality chooses the method from measured errors at the output size; drop one",
-        ));
-    }
+    let refined = matches!(plan.end, End::Refined { .. });
     let blocked = if frame.camera().is_some() {
         Some("orthographic views only (a perspective view's footprints vary per voxel)")
-    } else if args.refine.is_some() {
+    } else if refined {
         Some("--refine adds samples for magnified volumes; subsampling removes pixels: drop one")
     } else if supersample > 1 {
         Some(
