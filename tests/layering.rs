@@ -269,6 +269,39 @@ fn nothing_imports_the_command_line_or_another_command() {
     }
 }
 
+/// The pipeline renders `(&Prepared, &Plan)` and prepares from `Inputs` (issue 41): the
+/// command-line struct is resolved into those once, in `plan.rs`, and no file of `pipeline/`
+/// names it (in code; comments may).
+#[test]
+fn the_pipeline_never_reads_the_command_line_struct() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("std-harness/src/pipeline");
+    let mut files = Vec::new();
+    rs_files(&dir, &mut files);
+    assert!(files.len() > 10, "the pipeline's files: {files:?}");
+    let named: Vec<String> = files
+        .iter()
+        .filter(|f| {
+            let code = code_of(&std::fs::read_to_string(f).unwrap());
+            names_render_args(&code)
+        })
+        .map(|f| f.display().to_string())
+        .collect();
+    assert!(named.is_empty(), "RenderArgs named in {named:?}");
+    // The checker sees the name where it is code, and only there.
+    assert!(names_render_args(&code_of(
+        "fn f(a: &crate::args::RenderArgs) {}"
+    )));
+    assert!(!names_render_args(&code_of(
+        "// RenderArgs\nfn f(a: &MyRenderArgs) {}"
+    )));
+}
+
+/// Whether `code` has the identifier `RenderArgs` (not as part of a longer one).
+fn names_render_args(code: &str) -> bool {
+    code.split(|c: char| !is_ident(c))
+        .any(|t| t == "RenderArgs")
+}
+
 #[test]
 fn the_checker_sees_a_planted_cycle() {
     // The scan itself: a command that imported another, and an upward import, would be seen.

@@ -6,10 +6,10 @@ use footprint_harness::args::parse_args;
 use footprint_harness::args::QualityReferenceArg::Continuous;
 use footprint_harness::metrics::compare;
 use footprint_harness::pipeline::continuous::continuous_at;
-use footprint_harness::pipeline::pilot::{choose_continuous, sample_pixels, PILOT_RAYS};
+use footprint_harness::pipeline::pilot::{sample_pixels, PILOT_RAYS};
 use footprint_harness::pipeline::{prepare, render_continuous_ref, render_core, Prepared};
-use footprint_harness::plan::plan;
 use footprint_harness::reference::continuous::Reconstruction;
+use footprint_suite::{choose_continuous, plan_with};
 
 const HEART: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -51,8 +51,8 @@ fn the_pilot_reference_is_the_whole_reference_at_its_pixels() {
 }
 
 /// The whole image's PSNR against the continuous integral with `args`.
-fn actual_db(p: &Prepared, args: &footprint_harness::args::RenderArgs) -> f64 {
-    let (img, _, _) = render_core(p, &plan(args).unwrap()).unwrap();
+fn actual_db(p: &Prepared, plan: &footprint_harness::plan::Plan) -> f64 {
+    let (img, _, _) = render_core(p, plan).unwrap();
     let (whole, _) = render_continuous_ref(p, Reconstruction::Kernel).unwrap();
     compare(&img, &whole.image).1.psnr_db
 }
@@ -78,7 +78,7 @@ fn the_choice_reaches_its_target_with_the_cheapest_slicing_that_does() {
         "object slicing was tried first and measured short"
     );
     for (choice, target) in [(&low, 20.0), (&high, 45.0)] {
-        let got = actual_db(&p, &choice.config.apply(&args));
+        let got = actual_db(&p, &plan_with(&args, &choice.config));
         assert!(
             got >= target,
             "{}: {got:.1} dB on the whole image, below {target}",
@@ -112,7 +112,7 @@ fn the_flags_are_checked() {
     assert!(parse_args(&[HEART, "--quality", "40", "--slab", "1"]).is_err());
     // Image slicing with the default (sheet) reference has no table to choose: a typed error.
     let (args, p) = heart(&["--quality", "40", "--slicing", "image"]);
-    let e = footprint_harness::pipeline::choose::apply_quality(p, &args)
+    let e = footprint_suite::apply_quality(p, &args)
         .err()
         .expect("image slicing has no table to choose");
     assert!(

@@ -5,11 +5,10 @@
 
 use footprint_harness::args::parse_args;
 use footprint_harness::metrics::compare;
-use footprint_harness::pipeline::choose::apply_quality;
 use footprint_harness::pipeline::level_pilot::{pilot_rows, render_rows, PILOT_ROWS};
 use footprint_harness::pipeline::{prepare, render_core, render_ref};
 use footprint_harness::plan::plan;
-use footprint_suite::tmpdir;
+use footprint_suite::{apply_quality, tmpdir};
 
 const HEADSQ: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -87,7 +86,7 @@ fn quality_40(raw: &str, n: usize, size: &str) -> (u32, f64) {
     let choice = choice.expect("--quality was given");
     assert_eq!(choice.level, p.level);
     assert!(choice.level_pilot.is_some(), "levels were candidates");
-    let (img, _, _) = render_core(&p, &plan(&chosen).unwrap()).unwrap();
+    let (img, _, _) = render_core(&p, &chosen).unwrap();
     let mut full = flags.to_vec();
     full.extend_from_slice(&["--lod", "0"]);
     let (reference, _) = render_ref(&prepare(&parse_args(&full).unwrap()).unwrap()).unwrap();
@@ -164,7 +163,7 @@ fn streamed_and_perspective_renders_keep_level_0_and_refuse_an_explicit_level() 
         let args = parse_args(&a).unwrap();
         let (p, chosen, choice) = apply_quality(prepare(&args).unwrap(), &args).unwrap();
         assert_eq!((p.level, choice.unwrap().level), (0, 0), "{first:?}");
-        assert!(render_core(&p, &plan(&chosen).unwrap()).is_ok());
+        assert!(render_core(&p, &chosen).is_ok());
     }
     // An explicit level cannot be measured on a stream, nor placed for a perspective view.
     let streamed = refusal(&["--stream", HEADSQ, "--lod", "1"]);

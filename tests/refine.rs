@@ -167,9 +167,9 @@ fn verify_measures_refinement_only_against_the_field() {
 fn quality_chooses_refinement_against_the_field() {
     use footprint_harness::args::QualityReferenceArg::Field;
     use footprint_harness::pipeline::field::prepare_field;
-    use footprint_harness::pipeline::pilot::choose_continuous;
     use footprint_harness::pipeline::render_continuous_ref;
     use footprint_harness::reference::continuous::Reconstruction;
+    use footprint_suite::{choose_continuous, plan_with};
     // 16³ at 256² zoomed 2×: steps of 19.7 px, as at 512² (measured: unrefined 26.0 dB against
     // the 128³ field on the pilot, refined 30.6 dB; the target sits between them).
     let common = [
@@ -194,10 +194,11 @@ fn quality_chooses_refinement_against_the_field() {
     );
     assert!(c.predicted_db >= target);
     assert_eq!(pilot.field_size, Some(128));
-    let chosen = c.config.apply(&args);
-    let f = render_frame(&p, &plan(&chosen).unwrap(), &mut FrameCache::default()).unwrap();
+    let chosen = plan_with(&args, &c.config);
+    let f = render_frame(&p, &chosen, &mut FrameCache::default()).unwrap();
+    let inputs = footprint_harness::plan::Inputs::from(&args);
     let (truth, _) =
-        render_continuous_ref(&prepare_field(&args).unwrap(), Reconstruction::Kernel).unwrap();
+        render_continuous_ref(&prepare_field(&inputs).unwrap(), Reconstruction::Kernel).unwrap();
     let got = compare(&f.image, &truth.image).1.psnr_db;
     assert!(got >= target, "refined: {got:.2} dB against the field");
     // Unzoomed at 256², steps of 9.9 px: refinement cannot split an interval, so it is not tried.
@@ -228,9 +229,15 @@ fn quality_chooses_refinement_against_the_field() {
         "/tests/data/heart_32x32x12_float32_le.nhdr"
     );
     let args = parse_args(&[file, "--size", "32x32"]).unwrap();
-    let e = prepare_field(&args).err().expect("refused").to_string();
+    let e = prepare_field(&(&args).into())
+        .err()
+        .expect("refused")
+        .to_string();
     assert!(e.contains("nothing finer"), "{e}");
     let args = parse_args(&["--scene-size", "16", "--field-size", "16"]).unwrap();
-    let e = prepare_field(&args).err().expect("refused").to_string();
+    let e = prepare_field(&(&args).into())
+        .err()
+        .expect("refused")
+        .to_string();
     assert!(e.contains("must be finer"), "{e}");
 }

@@ -171,9 +171,9 @@ type Loaded<'py> = (Bound<'py, PyAny>, (f32, f32, f32), Bound<'py, PyDict>);
 /// The frame `args` describe, as `footprint render` renders it: premultiplied RGBA and its
 /// (width, height).
 fn frame(args: &RenderArgs) -> Result<Frame, CliError> {
-    footprint_harness::plan::plan(args)?;
-    let (p, args, _) = apply_quality(prepare(args)?, args)?;
-    let plan = footprint_harness::plan::plan(&args)?;
+    let asked = footprint_harness::plan::plan(args)?;
+    let inputs = footprint_harness::plan::Inputs::from(args);
+    let (p, plan, _) = apply_quality(prepare(args)?, &inputs, &asked)?;
     let image = if plan.end == footprint_harness::plan::End::Reference {
         render_ref(&p)?
             .0
@@ -332,7 +332,10 @@ fn load<'py>(py: Python<'py>, path: &str, flags: Vec<String>) -> PyResult<Loaded
     let mut all = vec![path.to_string()];
     all.extend(flags);
     let args = parse(&all)?;
-    let raw = footprint_harness::pipeline::load::raw_options(&args).map_err(py_err)?;
+    let raw = footprint_harness::pipeline::load::raw_options(
+        &footprint_harness::plan::Inputs::from(&args),
+    )
+    .map_err(py_err)?;
     let volume = py
         .detach(|| {
             footprint_harness::io::formats::load_array(

@@ -5,7 +5,7 @@
 //! by slabs or a subsampling factor too large for the footprints, stay where those are known, each
 //! once). The pipeline renders `(&Prepared, &Plan)` ([`crate::pipeline::render_frame`]); `verify`,
 //! `bench`, `chart` and `--quality` build or derive plans ([`Plan::with_precision`],
-//! [`crate::pipeline::config::Config::apply`]) instead of rewriting flags, so `verify` renders the
+//! [`crate::pipeline::config::Config::plan`]) instead of rewriting flags, so `verify` renders the
 //! plan `render` would, defaults included.
 //!
 //! ```text
@@ -20,7 +20,10 @@
 //! Levels of detail and supersampling are the other decorators; they are decided with the frame
 //! and never act on one frame together (`pipeline::prepare::setup_frame`).
 
-use crate::args::{AccumArg, LookupArg, MethodArg, RenderArgs, SlicingArg, Supersample};
+use crate::args::{
+    AccumArg, Background, FootprintArgs, GammaArg, Lod, LookupArg, MethodArg, OrderArg,
+    QualityReferenceArg, RenderArgs, SlicingArg, Supersample,
+};
 use crate::CliError;
 use footprint::render::Absorption;
 use footprint::Lookup;
@@ -115,6 +118,18 @@ pub struct Plan {
     /// The subsampling decorator (`--subsample`): `Fixed(1)` off, `Fixed(s)` at 1/s of the size,
     /// `Auto` where the footprints allow it.
     pub subsample: Supersample,
+    /// `--quality DB`: the table, level and slicing are chosen by measured error
+    /// (`pipeline::choose::apply_quality` returns the plan it chose, with this `None`).
+    pub quality: Option<Quality>,
+}
+
+/// `--quality DB --quality-reference R`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Quality {
+    /// The target PSNR, dB.
+    pub target_db: f64,
+    /// What it is measured against.
+    pub reference: QualityReferenceArg,
 }
 
 impl Plan {
@@ -238,6 +253,10 @@ pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
         phases: args.phases,
         threads: args.thread_count(),
         subsample: args.subsample,
+        quality: args.quality.map(|target_db| Quality {
+            target_db,
+            reference: args.quality_reference,
+        }),
     })
 }
 
@@ -247,5 +266,156 @@ impl From<Lookup> for LookupArg {
             Lookup::Nearest => LookupArg::Nearest,
             Lookup::Bilinear => LookupArg::Bilinear,
         }
+    }
+}
+
+/// What a render loads and how it sees it, resolved from the command line: the volume and its
+/// layout, classification, camera, picture, kernel and the resolution decorators decided with
+/// the frame (levels, supersampling). The pipeline prepares from these ([`crate::pipeline::prepare()`])
+/// and never reads the command-line struct; what draws the frame is the [`Plan`].
+#[derive(Clone, Debug)]
+pub struct Inputs {
+    /// A volume already in memory (set by a program, such as the Python package).
+    pub memory: Option<crate::io::stream::InMemory>,
+    /// What `--stream -` reads instead of standard input.
+    pub stdin: Option<crate::io::stream::Pipe>,
+    /// The volume file; `None`: the built-in scene.
+    pub volume: Option<PathBuf>,
+    /// `--stream FILE|-`.
+    pub stream: Option<PathBuf>,
+    /// Raw layout: `--dims`, `--type`, `--endian`, `--spacing`; `--array`.
+    pub dims: Option<[usize; 3]>,
+    pub sample_type: Option<String>,
+    pub endian: String,
+    pub spacing: [f32; 3],
+    pub array: Option<String>,
+    /// The built-in scene's grid, and its finer field's (`--reference field`).
+    pub scene_size: usize,
+    pub field_size: usize,
+    /// Output size, pixels (width, height).
+    pub size: (usize, usize),
+    /// Camera: VTK's azimuth, elevation, roll (degrees), zoom, an explicit matrix, perspective.
+    pub view: [f32; 3],
+    pub zoom: f32,
+    pub view_matrix: Option<[f32; 9]>,
+    pub perspective: Option<f32>,
+    pub eye_distance: Option<f32>,
+    /// Classification: `--tf`, `--window`, `--shading`.
+    pub tf: Option<String>,
+    pub window: Option<[f32; 2]>,
+    pub shading: String,
+    /// Picture: background, gamma, PNG depth.
+    pub background: Background,
+    pub gamma: GammaArg,
+    pub depth: u8,
+    /// Kernel and footprint options (`--kernel`, `--min-radius`, `--method paper`'s mapping).
+    pub footprint: FootprintArgs,
+    /// The continuous model both slicings composite.
+    pub absorption: Absorption,
+    /// Compositing order; `None`: the default for the source.
+    pub order: Option<OrderArg>,
+    /// Decorators decided with the frame: supersampling and level of detail.
+    pub supersample: Supersample,
+    pub lod: Lod,
+    /// Whether the frame must stay at full resolution: `--refine` (it refines level 0) or
+    /// `--quality` (it measures the levels itself).
+    pub refine: bool,
+    pub quality: bool,
+}
+
+impl From<&RenderArgs> for Inputs {
+    fn from(a: &RenderArgs) -> Self {
+        Inputs {
+            memory: a.memory.clone(),
+            stdin: a.stdin.clone(),
+            volume: a.volume.clone(),
+            stream: a.stream.clone(),
+            dims: a.dims,
+            sample_type: a.sample_type.clone(),
+            endian: a.endian.clone(),
+            spacing: a.spacing,
+            array: a.array.clone(),
+            scene_size: a.scene_size,
+            field_size: a.field_size,
+            size: a.size,
+            view: a.view,
+            zoom: a.zoom,
+            view_matrix: a.view_matrix,
+            perspective: a.perspective,
+            eye_distance: a.eye_distance,
+            tf: a.tf.clone(),
+            window: a.window,
+            shading: a.shading.clone(),
+            background: a.background.clone(),
+            gamma: a.gamma,
+            depth: a.depth,
+            footprint: a.footprint.clone(),
+            absorption: a.absorption.into(),
+            order: a.order,
+            supersample: a.supersample,
+            lod: a.lod,
+            refine: a.refine.is_some(),
+            quality: a.quality.is_some(),
+        }
+    }
+}
+
+impl Inputs {
+    /// `--gamma` as the image module's curve.
+    pub fn gamma_curve(&self) -> crate::io::image::Gamma {
+        match self.gamma {
+            GammaArg::Linear => crate::io::image::Gamma::Linear,
+            GammaArg::Srgb => crate::io::image::Gamma::Srgb,
+        }
+    }
+
+    /// The background image file, if `--background` names one.
+    pub fn background_file(&self) -> Option<&std::path::Path> {
+        match &self.background {
+            Background::Image(p) => Some(p),
+            _ => None,
+        }
+    }
+}
+
+/// `base` turned `degrees` of azimuth further about the volume's vertical axis: `--view`'s
+/// azimuth plus `degrees`, or a `--view-matrix` V as V · Ry(degrees) (the same turn). What
+/// `render --orbit` and `bench --orbit` step by.
+pub fn turned(base: &RenderArgs, degrees: f32) -> RenderArgs {
+    let mut a = base.clone();
+    a.view[0] += degrees;
+    if let Some(m) = a.view_matrix {
+        let v = glam::Mat3::from_cols_array(&m).transpose()
+            * glam::Mat3::from_rotation_y(degrees.to_radians());
+        a.view_matrix = Some(v.transpose().to_cols_array());
+    }
+    a
+}
+
+/// What a render was asked for: its [`Inputs`] and its [`Plan`]. The command line's
+/// [`RenderArgs`] is one (and `(Inputs, Plan)`, for a program that builds them itself): the
+/// pipeline's entry ([`crate::pipeline::prepare()`]) takes any, so it never names the command line.
+pub trait Request {
+    /// What to load and how to see it.
+    fn inputs(&self) -> Inputs;
+    /// What draws the frame (its rules checked).
+    fn plan(&self) -> Result<Plan, CliError>;
+}
+
+impl Request for RenderArgs {
+    fn inputs(&self) -> Inputs {
+        Inputs::from(self)
+    }
+    fn plan(&self) -> Result<Plan, CliError> {
+        plan(self)
+    }
+}
+
+impl Request for (Inputs, Plan) {
+    fn inputs(&self) -> Inputs {
+        self.0.clone()
+    }
+    fn plan(&self) -> Result<Plan, CliError> {
+        Ok(self.1.clone())
     }
 }

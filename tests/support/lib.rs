@@ -226,3 +226,43 @@ impl AsRef<std::path::Path> for TestDir {
         self.0.path()
     }
 }
+
+/// `--quality`'s choice for the flags `args`, as `footprint render` applies it: the prepared
+/// render at the level chosen, the plan chosen (with no `quality`), and the choice.
+pub fn apply_quality(
+    p: footprint_harness::pipeline::Prepared,
+    args: &footprint_harness::args::RenderArgs,
+) -> Result<
+    (
+        footprint_harness::pipeline::Prepared,
+        footprint_harness::plan::Plan,
+        Option<footprint_harness::pipeline::quality::Choice>,
+    ),
+    footprint_harness::CliError,
+> {
+    let plan = footprint_harness::plan::plan(args)?;
+    let inputs = footprint_harness::plan::Inputs::from(args);
+    footprint_harness::pipeline::choose::apply_quality(p, &inputs, &plan)
+}
+
+/// The pilot's choice against the continuous integral for the flags `args` (see
+/// `pipeline::pilot::choose_continuous`).
+pub fn choose_continuous(
+    p: &footprint_harness::pipeline::Prepared,
+    args: &footprint_harness::args::RenderArgs,
+    target_db: f64,
+    reference: footprint_harness::args::QualityReferenceArg,
+) -> Result<footprint_harness::pipeline::quality::Choice, footprint_harness::CliError> {
+    let plan = footprint_harness::plan::plan(args)?;
+    let inputs = footprint_harness::plan::Inputs::from(args);
+    footprint_harness::pipeline::pilot::choose_continuous(p, &inputs, &plan, target_db, reference)
+}
+
+/// The plan `args` describes with configuration `c` applied (what `--quality` and `chart`
+/// render).
+pub fn plan_with(
+    args: &footprint_harness::args::RenderArgs,
+    c: &footprint_harness::pipeline::config::Config,
+) -> footprint_harness::plan::Plan {
+    c.plan(&footprint_harness::plan::plan(args).unwrap())
+}

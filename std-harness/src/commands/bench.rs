@@ -14,6 +14,7 @@ use crate::pipeline::bands::Phases;
 use crate::pipeline::visible::FrameCache;
 use crate::pipeline::{choose::apply_quality, quality::quality_json};
 use crate::pipeline::{describe, prepare, render_frame};
+use crate::plan::{plan, turned, Inputs};
 use crate::CliError;
 use clap::Args;
 
@@ -54,7 +55,7 @@ fn phases_json(p: &Phases) -> Json {
 
 pub fn run(args: &BenchArgs) -> Result<(), CliError> {
     // Every rule the flags decide, before anything is loaded.
-    crate::plan::plan(&args.render)?;
+    plan(&args.render)?;
     if args.frames == 0 {
         return Err(CliError::input("--frames must be at least 1"));
     }
@@ -74,18 +75,20 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
     if let Some(out) = &args.render.out {
         io::image::check_style(out, args.render.png_style())?;
     }
-    let (mut p, base, choice) = apply_quality(prepare(&args.render)?, &args.render)?;
+    let base = &args.render;
+    let inputs = Inputs::from(base);
+    let (mut p, plan, choice) = apply_quality(prepare(base)?, &inputs, &plan(base)?)?;
     let mut cache = FrameCache::default();
     let mut times = Vec::with_capacity(args.frames);
     let mut phases = Vec::with_capacity(args.frames);
     let mut first_image = None;
     let mut threads = 1;
     for k in 0..args.frames {
-        let a = crate::pipeline::turned(&base, args.orbit * k as f32);
+        // The same plan every frame; only the view turns.
         if k > 0 {
-            p.reframe(&a)?;
+            p.reframe(&Inputs::from(&turned(base, args.orbit * k as f32)))?;
         }
-        let f = render_frame(&p, &crate::plan::plan(&a)?, &mut cache)?;
+        let f = render_frame(&p, &plan, &mut cache)?;
         crate::say!(
             "frame {:>3}: {:8.2} ms (classify {:.2}, tables {:.2}, splat {:.2}, composite {:.2}, resample {:.2}); sheets along {}",
             k + 1,
@@ -140,7 +143,7 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
         ));
     }
     if let Some(j) = &base.json {
-        let mut summary = describe(&p, &base)
+        let mut summary = describe(&p, &inputs, &plan)
             .str("command", "bench")
             .num("frames", args.frames as f64)
             .num("orbit_deg", f64::from(args.orbit))

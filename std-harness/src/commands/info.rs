@@ -33,7 +33,7 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
             extensions: &[],
         }])?;
     }
-    let raw = raw_options(r)?;
+    let raw = raw_options(&crate::plan::Inputs::from(r))?;
     let v = crate::io::formats::load_array(path, raw.as_ref(), r.array.as_deref())?;
     let ty = match &v.samples {
         Samples::U8(_) => "uint8",

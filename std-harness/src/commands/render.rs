@@ -7,8 +7,8 @@ use crate::io::image::{check_style, encode_apng, encode_rgb_for, RGB_EXTENSIONS}
 use crate::io::outputs::{self, Planned};
 use crate::pipeline::visible::FrameCache;
 use crate::pipeline::{choose::apply_quality, quality::quality_json};
-use crate::pipeline::{describe, prepare, render_frame, render_ref, turned, Prepared};
-use crate::plan::End;
+use crate::pipeline::{describe, prepare, render_frame, render_ref, Prepared};
+use crate::plan::{plan, turned, End, Inputs, Plan};
 use crate::CliError;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -55,18 +55,17 @@ pub fn run(command: &RenderCommandArgs) -> Result<(), CliError> {
         check_orbit(args, &out)?;
     }
     // Every rule the flags decide, before anything is loaded.
-    crate::plan::plan(args)?;
-    let (p, args, choice) = apply_quality(prepare(args)?, args)?;
-    let args = &args;
+    let asked = plan(args)?;
+    let inputs = Inputs::from(args);
+    let (p, plan, choice) = apply_quality(prepare(args)?, &inputs, &asked)?;
     if let Some(n) = command.orbit {
-        return orbit(p, args, &out, usize::from(n), command.colorbar);
+        return orbit(p, args, &plan, &out, usize::from(n), command.colorbar);
     }
-    let plan = crate::plan::plan(args)?;
     let (mut rgb, summary) = if plan.end == End::Reference {
         let (img, secs) = render_ref(&p)?;
         let rgb: Vec<[f32; 4]> = img.iter().map(|c| c.map(|x| x as f32)).collect();
         crate::say!("{}: f64 reference render in {:.3} s", p.name, secs);
-        (rgb, describe(&p, args).num("seconds", secs))
+        (rgb, describe(&p, &inputs, &plan).num("seconds", secs))
     } else {
         let frame = render_frame(&p, &plan, &mut FrameCache::default())?;
         let (img, stats, secs) = (frame.image, frame.stats, frame.seconds);
@@ -108,7 +107,7 @@ pub fn run(command: &RenderCommandArgs) -> Result<(), CliError> {
             stats.pixel_updates,
             stats.pixels_composited
         );
-        let j = describe(&p, args)
+        let j = describe(&p, &inputs, &plan)
             .num("seconds", secs)
             .num("sheets", stats.sheets as f64)
             .num("voxels", stats.voxels as f64)
@@ -172,6 +171,7 @@ fn check_orbit(args: &RenderArgs, out: &Path) -> Result<(), CliError> {
 fn orbit(
     mut p: Prepared,
     args: &RenderArgs,
+    plan: &Plan,
     out: &Path,
     n: usize,
     bar: bool,
@@ -182,9 +182,9 @@ fn orbit(
     let image = encode_apng(args.size, args.png_style(), n, delay, |k| {
         let a = turned(args, 360.0 * k as f32 / n as f32);
         if k > 0 {
-            p.reframe(&a)?;
+            p.reframe(&Inputs::from(&a))?;
         }
-        let mut f = render_frame(&p, &crate::plan::plan(&a)?, &mut cache)?;
+        let mut f = render_frame(&p, plan, &mut cache)?;
         crate::say!("{}: frame {}/{n} in {:.3} s", p.name, k + 1, f.seconds);
         if bar {
             colorbar::draw(&mut f.image, args.size, &p.lut, p.window)?;
@@ -192,7 +192,7 @@ fn orbit(
         Ok(f.image)
     })?;
     let secs = start.elapsed().as_secs_f64();
-    let summary = describe(&p, args)
+    let summary = describe(&p, &Inputs::from(args), plan)
         .num("frames", n as f64)
         .num("frame_delay_ms", f64::from(delay))
         .num("seconds", secs)

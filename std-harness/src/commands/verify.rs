@@ -5,7 +5,7 @@
 //! background (transparent black if none); the measures are [`crate::metrics`]'.
 
 use crate::args::RenderArgs;
-use crate::args::{AccumArg, Lod, MethodArg, ReconstructionArg, ReferenceArg};
+use crate::args::{Lod, MethodArg, ReconstructionArg, ReferenceArg};
 use crate::io::image::{check_style, encode_rgb_for, RGB_EXTENSIONS};
 use crate::io::json::Json;
 use crate::io::outputs::{self, Planned};
@@ -13,7 +13,7 @@ use crate::metrics::compare;
 use crate::pipeline::continuous::{continuous_models, models_json, others, PIXEL_FILTER};
 use crate::pipeline::{choose::apply_quality, field::prepare_field, quality::quality_json};
 use crate::pipeline::{describe, prepare, render_core, render_ref};
-use crate::plan::Precision;
+use crate::plan::{plan, End, Inputs, Precision};
 use crate::reference::continuous::Reconstruction;
 use crate::CliError;
 use clap::Args;
@@ -52,7 +52,7 @@ pub struct VerifyArgs {
 pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
     let r = &args.render;
     // Every rule the flags decide, before anything is loaded.
-    crate::plan::plan(r)?;
+    plan(r)?;
     if r.footprint.method == MethodArg::Reference {
         return Err(CliError::input(
             "verify compares a table method with the reference: choose robust, paper or direct",
@@ -97,9 +97,8 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
     } else {
         r
     };
-    let (p, chosen, choice) = apply_quality(prepare(r)?, r)?;
-    let r = &chosen;
-    let plan = crate::plan::plan(r)?;
+    let inputs = Inputs::from(r);
+    let (p, plan, choice) = apply_quality(prepare(r)?, &inputs, &plan(r)?)?;
     let (core, stats, core_s) = render_core(&p, &plan)?;
     let (reference, ref_s) = render_ref(&p)?;
     let (per, overall) = compare(&core, &reference);
@@ -108,11 +107,11 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         reference => {
             // `field`: the same integral, over the finer sampling of the built-in scene.
             let fine = match reference {
-                ReferenceArg::Field => Some(prepare_field(r)?),
+                ReferenceArg::Field => Some(prepare_field(&inputs)?),
                 _ => None,
             };
             let over = fine.as_ref().unwrap_or(&p);
-            let (recon, absorption) = (args.reconstruction.into(), r.absorption.into());
+            let (recon, absorption) = (args.reconstruction.into(), p.absorption);
             let (c, secs, models) = continuous_models(over, recon, absorption, &core)?;
             let (_, e) = compare(&core, &c.image);
             Some((c, secs, e, models))
@@ -121,11 +120,12 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
     // A coarser level is also measured against full resolution: its own error counts there.
     let full_resolution = match (args.reference, p.level) {
         (ReferenceArg::Sheets, 1..) => {
-            let level0 = prepare(&RenderArgs {
+            let at_full = Inputs {
                 lod: Lod::Level(0),
-                quality: None,
-                ..r.clone()
-            })?;
+                quality: false,
+                ..inputs.clone()
+            };
+            let level0 = prepare(&(at_full, plan.clone()))?;
             let (full, _) = render_ref(&level0)?;
             Some(compare(&core, &full).1)
         }
@@ -164,13 +164,13 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
             p.level
         );
     }
-    if r.refine.is_some() {
+    if matches!(plan.end, End::Refined { .. }) {
         crate::say!(
             "(--refine: the sheet reference renders the grid as given, so `overall` above is what \
              refinement changed; the field line below measures it against the finer sampling)"
         );
     }
-    if r.slicing == crate::args::SlicingArg::Image {
+    if matches!(plan.end, End::Slabs { .. }) {
         crate::say!(
             "(--slicing image: the sheet reference renders the paper's object-aligned sheets, so \
              `overall` above is the difference between the two slicings; --reference continuous \
@@ -201,7 +201,7 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         );
     }
     // The fixed path is also measured against the float path of the same table and method.
-    let fixed_vs_float = if r.accum == AccumArg::Fixed {
+    let fixed_vs_float = if plan.precision() == Precision::Fixed {
         let (float, _, _) = render_core(&p, &plan.with_precision(Precision::Float))?;
         let float: Vec<[f64; 4]> = float.iter().map(|c| c.map(f64::from)).collect();
         let (_, e) = compare(&core, &float);
@@ -244,7 +244,7 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
             .obj("g", per[1].json())
             .obj("b", per[2].json())
             .obj("a", per[3].json());
-        let mut summary = describe(&p, r).str("command", "verify");
+        let mut summary = describe(&p, &inputs, &plan).str("command", "verify");
         if let Some(e) = fixed_vs_float {
             summary = summary.obj("fixed_vs_float", e.json());
         }

@@ -27,28 +27,31 @@ use super::config::Config;
 use super::level_pilot::{candidate_levels, measure};
 use super::prepare::Prepared;
 use super::quality::{self, choose, footprint_error, predict_db, Choice};
-use crate::args::{Lod, MethodArg, QualityReferenceArg, RenderArgs, SlicingArg};
+use crate::args::{Lod, MethodArg, QualityReferenceArg};
+use crate::plan::{End, Inputs, Plan};
 use crate::CliError;
 
-/// `args` with `--quality`'s choice applied (unchanged without `--quality`), the prepared render
-/// at the level chosen (`p` itself at level 0), and the choice.
+/// `plan` with `--quality`'s choice applied (unchanged without `--quality`; the plan returned
+/// has no `quality`), the prepared render at the level chosen (`p` itself at level 0), and the
+/// choice.
 pub fn apply_quality(
     p: Prepared,
-    args: &RenderArgs,
-) -> Result<(Prepared, RenderArgs, Option<Choice>), CliError> {
-    let Some(q) = args.quality else {
-        return Ok((p, args.clone(), None));
+    args: &Inputs,
+    plan: &Plan,
+) -> Result<(Prepared, Plan, Option<Choice>), CliError> {
+    let Some(quality) = plan.quality else {
+        return Ok((p, plan.clone(), None));
     };
-
-    let (p, choice) = match args.quality_reference {
-        QualityReferenceArg::Sheets if args.slicing == SlicingArg::Image => {
+    let q = quality.target_db;
+    let (p, choice) = match quality.reference {
+        QualityReferenceArg::Sheets if matches!(plan.end, End::Slabs { .. }) => {
             return Err(CliError::input(
                 "--quality aims at the sheet reference by default and chooses among the table \
                  configurations of object slicing; image slicing has no table to choose: give \
                  --slab, or --quality-reference continuous to choose the slab",
             ));
         }
-        QualityReferenceArg::Sheets => choose_sheets(p, args, q)?,
+        QualityReferenceArg::Sheets => choose_sheets(p, args, plan, q)?,
         r @ (QualityReferenceArg::Continuous | QualityReferenceArg::Field) => {
             if let Lod::Level(n @ 1..) = args.lod {
                 return Err(CliError::input(format!(
@@ -57,15 +60,14 @@ pub fn apply_quality(
                     quality::reference_name(r)
                 )));
             }
-            let c = super::pilot::choose_continuous(&p, args, q, r)?;
+            let c = super::pilot::choose_continuous(&p, args, plan, q, r)?;
             (p, c)
         }
     };
     let e = p.frame.footprint.half_extent;
     crate::say!("{}", choice.explain(2.0 * e[0].max(e[1])));
-    let mut chosen = choice.config.apply(args);
+    let mut chosen = choice.config.plan(plan);
     chosen.quality = None;
-    chosen.lod = Lod::Level(p.level);
     Ok((p, chosen, Some(choice)))
 }
 
@@ -91,7 +93,8 @@ fn table_rmse(p: &Prepared, c: &Config) -> Result<f64, CliError> {
 /// The level and the table against the sheet reference at full resolution (see the module docs).
 fn choose_sheets(
     p0: Prepared,
-    args: &RenderArgs,
+    args: &Inputs,
+    plan: &Plan,
     target: f64,
 ) -> Result<(Prepared, Choice), CliError> {
     quality::check_target(target)?;
@@ -118,10 +121,10 @@ fn choose_sheets(
         let c = choose(&p0, target)?;
         return Ok((p0, c));
     }
-    // What the pilot renders with: `args`' table (the default; --quality overrides the flags).
+    // What the pilot renders with: the plan's table (the default; --quality overrides it).
     let c0 = Config {
-        table: args.footprint.table,
-        lookup: args.footprint.lookup,
+        table: plan.table.size,
+        lookup: plan.table.lookup.into(),
         method: MethodArg::Robust,
         accum: crate::args::AccumArg::Float,
         slab_quarters: None,
@@ -132,8 +135,8 @@ fn choose_sheets(
     // Per level tried: the RMSE it spends (its bound and the pilot's two table errors), and
     // the pilot table's own error at that level (the least a final table is sure to need).
     let mut spends: Vec<(f64, f64)> = Vec::new();
-    let plan = c0.plan(&crate::plan::plan(args)?);
-    let (pilot, mut accepted) = measure(&p0, args, &plan, &levels, |_, p, e| {
+    let pilot_plan = c0.plan(plan);
+    let (pilot, mut accepted) = measure(&p0, args, &pilot_plan, &levels, |_, p, e| {
         let t0l = table_rmse(p, &c0)?;
         let spent = rmse(e.bound_db) + t00 + t0l;
         spends.push((spent, t0l));

@@ -2,7 +2,7 @@
 //! thickness, and whether the grid is refined (`--refine 0`): what `footprint chart` sweeps and
 //! `--quality` chooses among, with the names the benches use.
 
-use crate::args::{AccumArg, LookupArg, MethodArg, RenderArgs, SlicingArg};
+use crate::args::{AccumArg, LookupArg, MethodArg};
 use crate::plan::{End, Footprints, Plan, Precision};
 
 /// Slab thicknesses the chart sweeps with `--slicing image`, voxel spacings.
@@ -111,29 +111,6 @@ impl Config {
             refine: true,
             ..*self
         }
-    }
-
-    /// `args` with this configuration's table, lookup, method, accumulation and slicing, and
-    /// `--refine 0` if it refines (`args`' own `--refine` is kept otherwise).
-    pub fn apply(&self, args: &RenderArgs) -> RenderArgs {
-        let mut a = args.clone();
-        a.footprint.table = self.table;
-        a.footprint.table_file = None;
-        a.footprint.lookup = self.lookup;
-        a.footprint.method = self.method;
-        a.accum = self.accum;
-        match self.slab() {
-            Some(t) => {
-                a.slicing = SlicingArg::Image;
-                a.slab = t;
-            }
-            None => a.slicing = SlicingArg::Object,
-        }
-        if self.refine {
-            a.refine = Some(0.0);
-            a.refine_sheets = false;
-        }
-        a
     }
 }
 

@@ -1,41 +1,46 @@
 //! The JSON fields every render and verify summary share ([`describe`]): what was rendered and
-//! how, from a [`Prepared`] render and its arguments.
+//! how, from a [`Prepared`] render, its inputs and its plan.
 
 use super::prepare::Prepared;
-use crate::args::RenderArgs;
 use crate::io::json::Json;
+use crate::plan::{End, Footprints, Inputs, Plan, Precision};
 
 /// The JSON fields every render and verify summary share.
-pub fn describe(p: &Prepared, args: &RenderArgs) -> Json {
+pub fn describe(p: &Prepared, args: &Inputs, plan: &Plan) -> Json {
     let f = &p.frame;
+    let method = match (plan.end, plan.table.footprints) {
+        (End::Reference, _) => "reference".to_string(),
+        (_, Footprints::Direct) => "direct".to_string(),
+        _ => format!("{:?}", args.footprint.method).to_lowercase(),
+    };
     Json::object()
         .str("volume", &p.name)
         .arr_usize("dims", &p.frame.dims)
         .arr_f64("spacing", &p.frame.spacing.map(f64::from))
         .arr_usize("size", &[args.size.0, args.size.1])
         .str("kernel", &p.kernel.to_string())
-        .num("table", args.footprint.table as f64)
-        .str(
-            "lookup",
-            &format!("{:?}", args.footprint.lookup).to_lowercase(),
-        )
-        .str(
-            "method",
-            &format!("{:?}", args.footprint.method).to_lowercase(),
-        )
+        .num("table", plan.table.size as f64)
+        .str("lookup", &format!("{:?}", plan.table.lookup).to_lowercase())
+        .str("method", &method)
         .str("order", &format!("{:?}", p.order).to_lowercase())
-        .str("accum", &format!("{:?}", args.accum).to_lowercase())
+        .str(
+            "accum",
+            match plan.precision() {
+                Precision::Float => "float",
+                Precision::Fixed => "fixed",
+            },
+        )
         .bool("streamed", p.volume().is_none())
         .str("shading", &args.shading)
         .str("tf", &p.tf_name)
         .arr_f64("window", &p.window.map(f64::from))
         .str("sheet_axis", ["i", "j", "k"][f.sheet_axis])
-        .str("slicing", args.slicing.name())
+        .str("slicing", plan.slicing())
         .num(
             "slab",
-            match args.slicing {
-                crate::args::SlicingArg::Image => f64::from(args.slab),
-                crate::args::SlicingArg::Object => f64::NAN,
+            match plan.end {
+                End::Slabs { thickness } => f64::from(thickness),
+                _ => f64::NAN,
             },
         )
         .str(
@@ -58,12 +63,7 @@ pub fn describe(p: &Prepared, args: &RenderArgs) -> Json {
                 .map(|e| f64::from(e) / p.supersample as f64),
         )
         .num("supersample", p.supersample as f64)
-        .num(
-            "subsample",
-            crate::plan::plan(args)
-                .and_then(|plan| p.subsample_factor(&plan))
-                .unwrap_or(1) as f64,
-        )
+        .num("subsample", p.subsample_factor(plan).unwrap_or(1) as f64)
         .num("lod", f64::from(p.level))
         .arr_usize("lod_dims", &p.frame.dims)
         .str(

@@ -17,14 +17,14 @@
 //! The same box and the same view give the same world-to-screen map, so the finer sampling's
 //! image lines up pixel for pixel with the coarse one (the refinement chart relies on the same).
 
-use super::entry::prepare;
 use super::prepare::Prepared;
-use crate::args::{Lod, RenderArgs, SlicingArg};
+use crate::args::Lod;
+use crate::plan::Inputs;
 use crate::CliError;
 
 /// The finer sampling of `args`' built-in scene, prepared to render (full resolution, object
 /// slicing, unrefined, no `--quality`).
-pub fn prepare_field(args: &RenderArgs) -> Result<Prepared, CliError> {
+pub fn prepare_field(args: &Inputs) -> Result<Prepared, CliError> {
     if args.volume.is_some() || args.stream.is_some() {
         return Err(CliError::input(
             "the field reference is the built-in scene's analytic field sampled --field-size N³; \
@@ -38,13 +38,12 @@ pub fn prepare_field(args: &RenderArgs) -> Result<Prepared, CliError> {
             args.field_size, args.scene_size
         )));
     }
-    prepare(&RenderArgs {
+    // At level 0 with no --quality there is no level to validate: prepared as asked.
+    super::prepare::prepare_as_asked(&Inputs {
         scene_size: args.field_size,
-        refine: None,
-        refine_sheets: false,
-        quality: None,
+        refine: false,
+        quality: false,
         lod: Lod::Level(0),
-        slicing: SlicingArg::Object,
         ..args.clone()
     })
 }

@@ -29,9 +29,9 @@ use super::prepare::Prepared;
 use super::run::{build_stencils, stencil_len};
 use super::sampling::{mix, Estimate};
 use super::supersample::downsample;
-use crate::args::RenderArgs;
 use crate::io::stream::{ColouredMemorySource, MemorySource};
 use crate::io::try_filled;
+use crate::plan::Inputs;
 use crate::plan::Plan;
 use crate::{with_table_size, CliError};
 use footprint::composite::RowSpan;
@@ -248,7 +248,7 @@ pub fn candidate_levels(p: &Prepared, explicit: Option<u32>) -> Vec<u32> {
 /// first level `accept` refuses. Returns the pilot and the prepared levels accepted, in order.
 pub fn measure(
     p0: &Prepared,
-    args: &RenderArgs,
+    args: &Inputs,
     plan: &Plan,
     levels: &[u32],
     mut accept: impl FnMut(u32, &Prepared, &Estimate) -> Result<bool, CliError>,
@@ -292,7 +292,7 @@ pub const AUTO_MIN_DB: f64 = 40.0;
 /// was fitted on grey ramps and kept the CT head's level 1 at 64² at 30.9 dB under a transfer
 /// function with sharp opacity steps (`ct-bone-skin`); the pilot sees what the data and the
 /// transfer function do to a level.
-pub fn validated_auto(p0: Prepared, args: &RenderArgs) -> Result<Prepared, CliError> {
+pub fn validated_auto(p0: Prepared, args: &Inputs, plan: &Plan) -> Result<Prepared, CliError> {
     // The level the geometric rule picks for `args` (`--lod auto`), as prepare would have.
     let (_, _, deepest) =
         super::prepare::setup_frame(args, p0.fine_dims, &p0.grid, &p0.kernel, p0.options)?;
@@ -300,8 +300,7 @@ pub fn validated_auto(p0: Prepared, args: &RenderArgs) -> Result<Prepared, CliEr
         return Ok(p0);
     }
     let levels: Vec<u32> = (1..=deepest).collect();
-    let plan = crate::plan::plan(args)?;
-    let (_, mut accepted) = measure(&p0, args, &plan, &levels, |_, _, e| {
+    let (_, mut accepted) = measure(&p0, args, plan, &levels, |_, _, e| {
         Ok(e.bound_db >= AUTO_MIN_DB)
     })?;
     Ok(accepted.pop().unwrap_or(p0))

@@ -1,10 +1,10 @@
 //! Where a render's voxels come from: a volume file loaded whole, a file streamed a few sheets at a
 //! time, standard input, or the built-in scene; and the optional background image.
 
-use crate::args::RenderArgs;
 use crate::io::formats::{self, raw::RawOptions};
 use crate::io::stream::{file_summary, is_stdin, Layout, Pipe};
 use crate::io::volume::{SampleType, Volume};
+use crate::plan::Inputs;
 use crate::{io, scene, CliError};
 use glam::{Mat3, Vec3};
 use std::sync::Arc;
@@ -22,13 +22,13 @@ pub enum Voxels {
         dims: [usize; 3],
         ty: SampleType,
         big_endian: bool,
-        /// What to read instead of standard input (`RenderArgs::stdin`).
+        /// What to read instead of standard input (`Inputs::stdin`).
         pipe: Option<Pipe>,
     },
 }
 
 /// The raw-file options from `--dims`, `--type`, `--endian`, `--spacing`, if `--dims` was given.
-pub fn raw_options(args: &RenderArgs) -> Result<Option<RawOptions>, CliError> {
+pub fn raw_options(args: &Inputs) -> Result<Option<RawOptions>, CliError> {
     let given = args.dims.is_some() || args.sample_type.is_some();
     let file = args.volume.as_ref().or(args.stream.as_ref());
     if let Some(format) = file.and_then(|f| crate::io::formats::header_format(f)) {
@@ -86,7 +86,7 @@ pub(crate) struct Loaded {
     pub(crate) sample: Option<Vec<f32>>,
 }
 
-pub(crate) fn load_voxels(args: &RenderArgs) -> Result<Loaded, CliError> {
+pub(crate) fn load_voxels(args: &Inputs) -> Result<Loaded, CliError> {
     let raw = raw_options(args)?;
     if args.scene_size != scene::SIDE && (args.volume.is_some() || args.stream.is_some()) {
         return Err(CliError::input(

@@ -43,7 +43,8 @@ use super::quality::{self, Choice, Estimate, Pilot};
 use super::run::render_frame;
 use super::sampling::mix;
 use super::visible::FrameCache;
-use crate::args::{QualityReferenceArg, RenderArgs};
+use crate::args::QualityReferenceArg;
+use crate::plan::Inputs;
 use crate::plan::{End, Plan};
 use crate::CliError;
 use std::time::Instant;
@@ -142,7 +143,8 @@ fn candidates(
 /// [`super::field`]).
 pub fn choose_continuous(
     p: &Prepared,
-    args: &RenderArgs,
+    args: &Inputs,
+    base: &Plan,
     target_db: f64,
     reference: QualityReferenceArg,
 ) -> Result<Choice, CliError> {
@@ -151,8 +153,7 @@ pub fn choose_continuous(
         QualityReferenceArg::Field => Some(super::field::prepare_field(args)?),
         _ => None,
     };
-    let base = crate::plan::plan(args)?;
-    let candidates = candidates(p, &base, target_db, reference)?;
+    let candidates = candidates(p, base, target_db, reference)?;
     let (w, h) = p.out_size();
     let (pixels, stride) = sample_pixels(w, h, PILOT_RAYS);
     let (reference_image, reference_seconds) = continuous_at(fine.as_ref().unwrap_or(p), &pixels)?;
@@ -162,7 +163,7 @@ pub fn choose_continuous(
     let mut tried: Vec<(Config, Estimate)> = Vec::new();
     let mut chosen = None;
     for c in candidates {
-        let frame = render_frame(p, &c.plan(&base), &mut cache)?;
+        let frame = render_frame(p, &c.plan(base), &mut cache)?;
         let e = estimate(&frame.image, w, &pixels, &reference_image.image, w * h);
         tried.push((c, e));
         if e.bound_db >= target_db {

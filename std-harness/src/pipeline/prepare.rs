@@ -9,8 +9,9 @@
 
 use super::load::{load_background, load_voxels, Loaded, Voxels};
 use super::supersample;
-use crate::args::{Lod, RenderArgs};
+use crate::args::Lod;
 use crate::io::volume::Volume;
+use crate::plan::Inputs;
 use crate::plan::Plan;
 use crate::{tf, CliError};
 use footprint::frame::{FrameSetup, Order};
@@ -109,7 +110,7 @@ impl Prepared {
     /// The same volume, transfer function and shading seen with `args`' view (`--view`, `--zoom`,
     /// `--view-matrix`, `--size`): only the frame is set up again, nothing is loaded. The
     /// compositing order and the level of detail stay as prepared.
-    pub fn reframe(&mut self, args: &RenderArgs) -> Result<(), CliError> {
+    pub fn reframe(&mut self, args: &Inputs) -> Result<(), CliError> {
         let mut args = args.clone();
         args.lod = Lod::Level(self.level);
         let (frame, k, _) = setup_frame(
@@ -132,7 +133,7 @@ impl Prepared {
     /// Nothing is loaded again.
     pub fn at_level(
         &self,
-        args: &RenderArgs,
+        args: &Inputs,
         level: u32,
         from: Option<&Prepared>,
     ) -> Result<Prepared, CliError> {
@@ -255,7 +256,7 @@ impl Prepared {
 
 /// The view for `--view`/`--zoom` (VTK's camera fitted to a volume of `dims` on `grid`, the
 /// core's [`View::from_vtk_camera`]) or `--view-matrix` (exactly as given).
-pub fn view_for(args: &RenderArgs, dims: [usize; 3], grid: &Grid) -> Result<View, CliError> {
+pub fn view_for(args: &Inputs, dims: [usize; 3], grid: &Grid) -> Result<View, CliError> {
     let view = match args.view_matrix {
         Some(m) => View::from_rows(m).map_err(|e| CliError::input(format!("--view-matrix: {e}"))),
         None => {
@@ -284,7 +285,7 @@ pub fn view_for(args: &RenderArgs, dims: [usize; 3], grid: &Grid) -> Result<View
 
 /// The kernel level `level` is reconstructed with: a narrower one for a coarser level (the core's
 /// `lod::level_kernel`), unless `--table-file` fixes the table (and so the kernel) as given.
-fn kernel_at(args: &RenderArgs, kernel: &Kernel, level: u32) -> Kernel {
+fn kernel_at(args: &Inputs, kernel: &Kernel, level: u32) -> Kernel {
     if args.footprint.table_file.is_some() {
         *kernel
     } else {
@@ -300,7 +301,7 @@ fn kernel_at(args: &RenderArgs, kernel: &Kernel, level: u32) -> Kernel {
 /// of detail `--lod` picks ([`super::lod`]), placed exactly where level 0 would be seen, and the
 /// level is returned third.
 pub fn setup_frame(
-    args: &RenderArgs,
+    args: &Inputs,
     dims: [usize; 3],
     grid: &Grid,
     kernel: &Kernel,
@@ -316,10 +317,10 @@ pub fn setup_frame(
         return Ok((frame, k, 0));
     }
     let fine = FrameSetup::new(dims, grid, &view, kernel, options, size)?;
-    if let (Some(t), Lod::Level(n @ 1..)) = (args.refine, args.lod) {
+    if let (true, Lod::Level(n @ 1..)) = (args.refine, args.lod) {
         return Err(CliError::input(format!(
-            "--refine {t} adds samples to full resolution; --lod {n} removes them: give --lod 0 \
-             or auto"
+            "--refine adds samples to full resolution; --lod {n} removes them: give --lod 0 or \
+             auto"
         )));
     }
     let fixed_k = match args.supersample {
@@ -335,8 +336,8 @@ pub fn setup_frame(
     let level = match (args.refine, fixed_k) {
         // Refinement is for magnified volumes: it always starts from full resolution; so does
         // a frame supersampled on request.
-        (Some(_), _) | (None, Some(_)) => 0,
-        (None, None) => super::lod::choose_level(args.lod, &fine, kernel),
+        (true, _) | (false, Some(_)) => 0,
+        (false, None) => super::lod::choose_level(args.lod, &fine, kernel),
     };
     let coarse_kernel = kernel_at(args, kernel, level);
     let at_level = |fine: &FrameSetup, view: &View| {
@@ -372,7 +373,7 @@ pub fn no_level_in_perspective(n: u32) -> CliError {
 /// `--zoom` pixels. Supersampling (`auto`) is decided by the farthest voxels, whose footprints
 /// are the smallest.
 fn perspective_frame(
-    args: &RenderArgs,
+    args: &Inputs,
     fovy: f32,
     view: &View,
     dims: [usize; 3],
@@ -441,7 +442,7 @@ fn perspective_frame(
 
 /// Loads and sets up everything `args` describes, with `--lod` taken as it is (`auto`: the
 /// geometric rule of [`super::lod`]); [`super::entry::prepare`] validates that rule's level.
-pub fn prepare_as_asked(args: &RenderArgs) -> Result<Prepared, CliError> {
+pub fn prepare_as_asked(args: &Inputs) -> Result<Prepared, CliError> {
     let kernel = args.footprint.kernel()?;
     let Loaded {
         voxels,
@@ -460,8 +461,8 @@ pub fn prepare_as_asked(args: &RenderArgs) -> Result<Prepared, CliError> {
     // With --quality the volume is prepared at full resolution: the choice measures the levels
     // against it and builds the one it picks (`super::choose`).
     let at_full;
-    let framing = if args.quality.is_some() {
-        at_full = RenderArgs {
+    let framing = if args.quality {
+        at_full = Inputs {
             lod: Lod::Level(0),
             ..args.clone()
         };
@@ -532,7 +533,7 @@ pub fn prepare_as_asked(args: &RenderArgs) -> Result<Prepared, CliError> {
                 lo: window[0],
                 hi: window[1],
             };
-            let averaging = super::lod::averaging_for(&shading, tf, args.absorption.into());
+            let averaging = super::lod::averaging_for(&shading, tf, args.absorption);
             Voxels::Memory(Arc::new(super::lod::coarsen_volume(
                 &v,
                 level,
@@ -564,7 +565,7 @@ pub fn prepare_as_asked(args: &RenderArgs) -> Result<Prepared, CliError> {
         order,
         options,
         supersample,
-        absorption: args.absorption.into(),
+        absorption: args.absorption,
         view: view_for(args, dims, &grid)?,
     })
 }
