@@ -3,7 +3,9 @@
 //! integral has a closed form along every ray.
 
 use footprint_harness::args::parse_args;
-use footprint_harness::pipeline::continuous::{render_continuous_as, render_continuous_model};
+use footprint_harness::pipeline::ends::continuous::{
+    render_continuous_as, render_continuous_model,
+};
 use footprint_harness::pipeline::prepare;
 use footprint_harness::plan::plan;
 use footprint_harness::reference::continuous::{
@@ -243,11 +245,11 @@ fn opaque_ball_figures(model: &str, caps: &[f64]) -> Vec<f64> {
     .unwrap();
     let p = prepare(&a).unwrap();
     let (core, _, _) =
-        footprint_harness::pipeline::run::render_core(&p, &plan(&a).unwrap()).unwrap();
+        footprint_harness::pipeline::ends::run::render_core(&p, &plan(&a).unwrap()).unwrap();
     let figures = caps
         .iter()
         .map(|&cap| {
-            let (c, _) = footprint_harness::pipeline::continuous::render_continuous_capped(
+            let (c, _) = footprint_harness::pipeline::ends::continuous::render_continuous_capped(
                 &p,
                 Reconstruction::Kernel,
                 p.absorption,

@@ -211,10 +211,35 @@ fn data_flows_one_way() {
         wrong.join("\n")
     );
     assert!(
-        h.edges.contains_key("pipeline/run") && h.edges.contains_key("commands/render"),
+        h.edges.contains_key("pipeline/ends") && h.edges.contains_key("commands/render"),
         "the scan found the harness's modules: {:?}",
         h.edges.keys().collect::<Vec<_>>()
     );
+}
+
+/// The pipeline's folders are its stages (issue 41): `stages` (load → prepare → bands) import
+/// neither `ends` (what draws a frame) nor `quality` (what chooses and measures plans), and
+/// `ends` import no `quality`.
+#[test]
+fn the_pipelines_folders_flow_one_way() {
+    let h = harness();
+    let order = |n: &str| match n {
+        "pipeline/stages" => Some(0),
+        "pipeline/ends" => Some(1),
+        "pipeline/quality" => Some(2),
+        _ => None,
+    };
+    for group in ["pipeline/stages", "pipeline/ends", "pipeline/quality"] {
+        assert!(h.edges.contains_key(group), "{group} scanned");
+    }
+    for (from, tos) in &h.edges {
+        let Some(f) = order(from) else { continue };
+        for to in tos {
+            if let Some(t) = order(to) {
+                assert!(t <= f, "{from} imports {to}: against the pipeline's flow");
+            }
+        }
+    }
 }
 
 #[test]

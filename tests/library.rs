@@ -230,10 +230,13 @@ fn view_is_vtks_camera() {
     ] {
         let args =
             footprint_harness::args::parse_args(&["--view", name, "--size", "64x48"]).unwrap();
-        let via_cli =
-            footprint_harness::pipeline::prepare::view_for(&(&args).into(), [10, 20, 5], &grid)
-                .unwrap()
-                .to_screen();
+        let via_cli = footprint_harness::pipeline::stages::prepare::view_for(
+            &(&args).into(),
+            [10, 20, 5],
+            &grid,
+        )
+        .unwrap()
+        .to_screen();
         let want = View::looking(
             footprint::glam::Vec3::from_array(dop),
             footprint::glam::Vec3::from_array(up),
@@ -262,7 +265,7 @@ fn view_is_vtks_camera() {
     ])
     .unwrap();
     let via_cli =
-        footprint_harness::pipeline::prepare::view_for(&(&args).into(), [10, 20, 5], &grid)
+        footprint_harness::pipeline::stages::prepare::view_for(&(&args).into(), [10, 20, 5], &grid)
             .unwrap()
             .to_screen();
     let direct = View::from_vtk_camera([30.0, 20.0, 10.0], 1.5, [10, 20, 5], &grid, [64, 48])

@@ -2,7 +2,7 @@
 //! only in the format their extension names; messages that name the flag or the cause.
 
 use footprint_harness::io::outputs::{self, Planned};
-use footprint_harness::pipeline::prepare::{outside_data_warnings, parse_shading};
+use footprint_harness::pipeline::stages::prepare::{outside_data_warnings, parse_shading};
 use std::path::Path;
 
 fn tmpdir(name: &str) -> footprint_suite::TestDir {

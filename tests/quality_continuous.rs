@@ -5,8 +5,8 @@
 use footprint_harness::args::parse_args;
 use footprint_harness::args::QualityReferenceArg::Continuous;
 use footprint_harness::metrics::compare;
-use footprint_harness::pipeline::continuous::continuous_at;
-use footprint_harness::pipeline::pilot::{sample_pixels, PILOT_RAYS};
+use footprint_harness::pipeline::ends::continuous::continuous_at;
+use footprint_harness::pipeline::quality::pilot::{sample_pixels, PILOT_RAYS};
 use footprint_harness::pipeline::{prepare, render_continuous_ref, render_core, Prepared};
 use footprint_harness::reference::continuous::Reconstruction;
 use footprint_suite::{choose_continuous, plan_with};
@@ -94,7 +94,7 @@ fn the_choice_reaches_its_target_with_the_cheapest_slicing_that_does() {
     assert!(c.config.slab().is_some());
 }
 
-fn pilot_estimate(c: &footprint_harness::pipeline::quality::Choice) -> f64 {
+fn pilot_estimate(c: &footprint_harness::pipeline::quality::model::Choice) -> f64 {
     let pilot = c.pilot.as_ref().unwrap();
     pilot
         .tried

@@ -6,7 +6,7 @@
 
 use footprint_harness::args::parse_args;
 use footprint_harness::metrics::compare;
-use footprint_harness::pipeline::visible::FrameCache;
+use footprint_harness::pipeline::stages::visible::FrameCache;
 use footprint_harness::pipeline::{prepare, render_frame, CoreFrame};
 use footprint_harness::plan::plan;
 use footprint_suite::rgb_psnr;
@@ -166,7 +166,7 @@ fn verify_measures_refinement_only_against_the_field() {
 #[test]
 fn quality_chooses_refinement_against_the_field() {
     use footprint_harness::args::QualityReferenceArg::Field;
-    use footprint_harness::pipeline::field::prepare_field;
+    use footprint_harness::pipeline::quality::field::prepare_field;
     use footprint_harness::pipeline::render_continuous_ref;
     use footprint_harness::reference::continuous::Reconstruction;
     use footprint_suite::{choose_continuous, plan_with};

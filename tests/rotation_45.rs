@@ -3,7 +3,7 @@
 use footprint::geometry::{Footprint, FootprintOptions, Mapping};
 use footprint::{GeometryError, Grid, Kernel, View};
 use footprint_harness::args::MethodArg;
-use footprint_harness::pipeline::single::splat_image;
+use footprint_harness::pipeline::ends::single::splat_image;
 use footprint_harness::reference::ReferenceFootprint;
 use footprint_suite::{assert_le, max_rel_diff, splat_args, view, with_reference};
 

@@ -4,8 +4,8 @@
 //! `auto`, and refuses what it cannot honour with a typed error.
 
 use footprint_harness::args::parse_args;
-use footprint_harness::pipeline::visible::FrameCache;
-use footprint_harness::pipeline::{prepare, render_frame, subsample, CoreFrame};
+use footprint_harness::pipeline::stages::visible::FrameCache;
+use footprint_harness::pipeline::{prepare, render_frame, stages::subsample, CoreFrame};
 use footprint_harness::plan::plan;
 use footprint_suite::{rgb_psnr, tmpdir};
 

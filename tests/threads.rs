@@ -3,7 +3,7 @@
 //! full scan of every voxel, and `bench` writes the keys the issue names.
 
 use footprint_harness::args::parse_args;
-use footprint_harness::pipeline::visible::FrameCache;
+use footprint_harness::pipeline::stages::visible::FrameCache;
 use footprint_harness::pipeline::{prepare, render_frame};
 use footprint_harness::plan::plan;
 use footprint_suite::tmpdir;

@@ -18,8 +18,8 @@
 use footprint_harness::args::{parse_args, RenderArgs};
 use footprint_harness::io::stream::{InMemory, Pipe};
 use footprint_harness::io::volume::{check_spacing, Data, Samples, Volume};
-use footprint_harness::pipeline::choose::apply_quality;
-use footprint_harness::pipeline::visible::FrameCache;
+use footprint_harness::pipeline::quality::choose::apply_quality;
+use footprint_harness::pipeline::stages::visible::FrameCache;
 use footprint_harness::pipeline::{prepare, render_frame, render_ref};
 use footprint_harness::CliError;
 use numpy::{
@@ -332,7 +332,7 @@ fn load<'py>(py: Python<'py>, path: &str, flags: Vec<String>) -> PyResult<Loaded
     let mut all = vec![path.to_string()];
     all.extend(flags);
     let args = parse(&all)?;
-    let raw = footprint_harness::pipeline::load::raw_options(
+    let raw = footprint_harness::pipeline::stages::load::raw_options(
         &footprint_harness::plan::Inputs::from(&args),
     )
     .map_err(py_err)?;

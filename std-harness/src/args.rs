@@ -414,12 +414,12 @@ pub struct RenderArgs {
     pub order: Option<OrderArg>,
     /// Supersampling: `auto` renders at k× the size and averages k×k blocks when voxels project
     /// too close for the smallest footprint (removes the brightness bias of minified renders; see
-    /// the harness's `pipeline::supersample`); a number fixes k (1 = off).
+    /// the harness's `pipeline::stages::supersample`); a number fixes k (1 = off).
     #[arg(help_heading = "Resolution", long, default_value = "auto", value_parser = parse_supersample)]
     pub supersample: Supersample,
     /// Image-space level of detail for magnified volumes: a number s ≥ 2 renders the frame at
     /// 1/s of the size (plus a 2-pixel margin) and resamples it to the size with Catmull-Rom
-    /// cubic interpolation (the harness's `pipeline::subsample`); `auto` picks the largest s that
+    /// cubic interpolation (the harness's `pipeline::stages::subsample`); `auto` picks the largest s that
     /// keeps the footprints' shorter semi-axis at least 2 px at the lower resolution (Gaussian
     /// kernels, orthographic views only; otherwise 1). 1, the default, is off. Measured cost in
     /// accuracy: docs/modes.md, "Subsampling".

@@ -9,7 +9,7 @@
 //! cli        parse the command line, dispatch (nothing imports it)
 //!  └ commands   one thin adapter per subcommand: parse, call, report
 //!     └ charts     sweeps and plots for `chart`
-//!        └ pipeline   load → prepare → run (core, reference), configurations, --quality
+//!        └ pipeline   stages/ (load → prepare → bands), ends/ (what draws a frame), quality/
 //!           └ plan       the render plan, resolved once from the arguments
 //!              └ args, metrics   shared argument structs; image comparisons
 //!                 └ scene, tf   the built-in volume; transfer functions

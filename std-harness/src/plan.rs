@@ -5,7 +5,7 @@
 //! by slabs or a subsampling factor too large for the footprints, stay where those are known, each
 //! once). The pipeline renders `(&Prepared, &Plan)` ([`crate::pipeline::render_frame`]); `verify`,
 //! `bench`, `chart` and `--quality` build or derive plans ([`Plan::with_precision`],
-//! [`crate::pipeline::config::Config::plan`]) instead of rewriting flags, so `verify` renders the
+//! [`crate::pipeline::quality::config::Config::plan`]) instead of rewriting flags, so `verify` renders the
 //! plan `render` would, defaults included.
 //!
 //! ```text
@@ -18,7 +18,7 @@
 //! ```
 //!
 //! Levels of detail and supersampling are the other decorators; they are decided with the frame
-//! and never act on one frame together (`pipeline::prepare::setup_frame`).
+//! and never act on one frame together (`pipeline::stages::prepare::setup_frame`).
 
 use crate::args::{
     AccumArg, Background, FootprintArgs, GammaArg, Lod, LookupArg, MethodArg, OrderArg,
@@ -119,7 +119,7 @@ pub struct Plan {
     /// `Auto` where the footprints allow it.
     pub subsample: Supersample,
     /// `--quality DB`: the table, level and slicing are chosen by measured error
-    /// (`pipeline::choose::apply_quality` returns the plan it chose, with this `None`).
+    /// (`pipeline::quality::choose::apply_quality` returns the plan it chose, with this `None`).
     pub quality: Option<Quality>,
 }
 

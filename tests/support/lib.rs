@@ -6,7 +6,7 @@ use footprint::Kernel;
 use footprint_harness::args::{FootprintArgs, LookupArg, MethodArg};
 use footprint_harness::io::image::GreyImage;
 use footprint_harness::metrics::compare;
-use footprint_harness::{args::SplatArgs, pipeline::single::splat_image};
+use footprint_harness::{args::SplatArgs, pipeline::ends::single::splat_image};
 use glam::{DMat3, Mat3};
 use std::path::PathBuf;
 
@@ -236,33 +236,35 @@ pub fn apply_quality(
     (
         footprint_harness::pipeline::Prepared,
         footprint_harness::plan::Plan,
-        Option<footprint_harness::pipeline::quality::Choice>,
+        Option<footprint_harness::pipeline::quality::model::Choice>,
     ),
     footprint_harness::CliError,
 > {
     let plan = footprint_harness::plan::plan(args)?;
     let inputs = footprint_harness::plan::Inputs::from(args);
-    footprint_harness::pipeline::choose::apply_quality(p, &inputs, &plan)
+    footprint_harness::pipeline::quality::choose::apply_quality(p, &inputs, &plan)
 }
 
 /// The pilot's choice against the continuous integral for the flags `args` (see
-/// `pipeline::pilot::choose_continuous`).
+/// `pipeline::quality::pilot::choose_continuous`).
 pub fn choose_continuous(
     p: &footprint_harness::pipeline::Prepared,
     args: &footprint_harness::args::RenderArgs,
     target_db: f64,
     reference: footprint_harness::args::QualityReferenceArg,
-) -> Result<footprint_harness::pipeline::quality::Choice, footprint_harness::CliError> {
+) -> Result<footprint_harness::pipeline::quality::model::Choice, footprint_harness::CliError> {
     let plan = footprint_harness::plan::plan(args)?;
     let inputs = footprint_harness::plan::Inputs::from(args);
-    footprint_harness::pipeline::pilot::choose_continuous(p, &inputs, &plan, target_db, reference)
+    footprint_harness::pipeline::quality::pilot::choose_continuous(
+        p, &inputs, &plan, target_db, reference,
+    )
 }
 
 /// The plan `args` describes with configuration `c` applied (what `--quality` and `chart`
 /// render).
 pub fn plan_with(
     args: &footprint_harness::args::RenderArgs,
-    c: &footprint_harness::pipeline::config::Config,
+    c: &footprint_harness::pipeline::quality::config::Config,
 ) -> footprint_harness::plan::Plan {
     c.plan(&footprint_harness::plan::plan(args).unwrap())
 }

@@ -94,7 +94,7 @@ pub enum Supersample {
 /// `--lod`: `auto`, or a fixed level of detail.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Lod {
-    /// The level from the projected voxel size (`pipeline::lod::auto_level`).
+    /// The level from the projected voxel size (`pipeline::stages::lod::auto_level`).
     Auto,
     /// This level (0 = full resolution).
     Level(u32),

@@ -1,5 +1,5 @@
 //! The levels-of-detail sweep (`footprint chart`, `lod.csv` and `lod.svg`/`.png`): every level
-//! of the scene from 0 (full resolution) down to `pipeline::lod::deepest_level` (at most
+//! of the scene from 0 (full resolution) down to `pipeline::stages::lod::deepest_level` (at most
 //! [`MAX_CHARTED`]), each rendered with the
 //! chart's flags, its frame time (median over the runs, the levels timed in turn within each run
 //! so that drift hits them alike) and its PSNR (RGB) against level 0's image. `auto`'s pick is
@@ -8,7 +8,7 @@
 use super::plot::{plot_err, time_chart, time_spread, write_svg_png};
 use crate::args::{Lod, RenderArgs};
 use crate::metrics::compare;
-use crate::pipeline::visible::FrameCache;
+use crate::pipeline::stages::visible::FrameCache;
 use crate::pipeline::{prepare, render_frame, Prepared};
 use crate::CliError;
 use plotters::coord::Shift;
@@ -41,7 +41,7 @@ pub fn sweep(base: &RenderArgs, runs: usize) -> Result<(Vec<LevelRow>, u32), Cli
         a
     };
     let auto = prepare(&with(Lod::Auto))?;
-    let deepest = crate::pipeline::lod::deepest_level(auto.fine_dims).min(MAX_CHARTED);
+    let deepest = crate::pipeline::stages::lod::deepest_level(auto.fine_dims).min(MAX_CHARTED);
     let auto = auto.level;
     let mut levels: Vec<(RenderArgs, Prepared)> = Vec::new();
     for level in 0..=deepest {

@@ -5,7 +5,7 @@
 //! **Trade-off** (`DIR/tradeoff.csv`, `.svg`, `.png`): every configuration of table size
 //! N ∈ {5, 11, 21, 33, 65, 101, 129}, lookup (nearest, bilinear), method (`view`: the two-stage
 //! view table; `direct`) and accumulation (float, fixed), and image-aligned slabs of the
-//! [`crate::pipeline::config::SLABS`] thicknesses the frame can run, renders the scene `--runs`
+//! [`crate::pipeline::quality::config::SLABS`] thicknesses the frame can run, renders the scene `--runs`
 //! times. Time is
 //! the whole frame as `render` does it (table build, every sheet), median and min–max; error is
 //! against the f64 reference of the same scene (PSNR over RGB, max abs), as in `verify`. The

@@ -7,7 +7,7 @@ use super::stability::Curve;
 use super::sweep::Measured;
 use crate::args::{AccumArg, LookupArg, MethodArg};
 use crate::io;
-use crate::pipeline::config::{accum_name, lookup_name, method_name, Config};
+use crate::pipeline::quality::config::{accum_name, lookup_name, method_name, Config};
 use crate::CliError;
 use plotters::coord::Shift;
 use plotters::prelude::*;

@@ -8,7 +8,7 @@
 
 use crate::args::{RenderArgs, SlicingArg};
 use crate::metrics::compare;
-use crate::pipeline::visible::FrameCache;
+use crate::pipeline::stages::visible::FrameCache;
 use crate::pipeline::{prepare, render_continuous_ref, render_frame};
 use crate::reference::continuous::Reconstruction;
 use crate::CliError;

@@ -9,7 +9,7 @@
 use super::plot::{plot_err, time_chart, time_spread, write_svg_png};
 use crate::args::RenderArgs;
 use crate::metrics::compare;
-use crate::pipeline::visible::FrameCache;
+use crate::pipeline::stages::visible::FrameCache;
 use crate::pipeline::{prepare, render_frame, Prepared};
 use crate::CliError;
 use plotters::coord::Shift;

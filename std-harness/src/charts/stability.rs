@@ -3,7 +3,7 @@
 
 use crate::args::{FootprintArgs, LookupArg, MethodArg, SplatArgs};
 use crate::metrics::max_rel_diff;
-use crate::pipeline::single::splat_image;
+use crate::pipeline::ends::single::splat_image;
 use std::path::PathBuf;
 
 /// One stability curve: (x, error) points, `None` where the method failed.

@@ -2,8 +2,9 @@
 
 use crate::args::RenderArgs;
 use crate::metrics::compare;
-use crate::pipeline::config::{accum_name, lookup_name, method_name, Config};
-use crate::pipeline::{prepare, quality, render_continuous_ref, render_core, render_ref};
+use crate::pipeline::quality::config::{accum_name, lookup_name, method_name, Config};
+use crate::pipeline::quality::model as quality;
+use crate::pipeline::{prepare, render_continuous_ref, render_core, render_ref};
 use crate::reference::continuous::Reconstruction;
 use crate::CliError;
 

@@ -10,10 +10,10 @@
 
 use crate::args::RenderArgs;
 use crate::io::{self, json::Json};
-use crate::pipeline::bands::Phases;
-use crate::pipeline::visible::FrameCache;
-use crate::pipeline::{choose::apply_quality, quality::quality_json};
+use crate::pipeline::stages::bands::Phases;
+use crate::pipeline::stages::visible::FrameCache;
 use crate::pipeline::{describe, prepare, render_frame};
+use crate::pipeline::{quality::choose::apply_quality, quality::model::quality_json};
 use crate::plan::{plan, turned, Inputs};
 use crate::CliError;
 use clap::Args;

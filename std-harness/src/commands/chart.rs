@@ -4,8 +4,9 @@
 use crate::args::{Lod, RenderArgs};
 use crate::charts::{lod, plot, popping, refine, stability, sweep};
 use crate::io;
-use crate::pipeline::config::Config;
-use crate::pipeline::{prepare, quality};
+use crate::pipeline::prepare;
+use crate::pipeline::quality::config::Config;
+use crate::pipeline::quality::model as quality;
 use crate::CliError;
 use clap::Args;
 

@@ -5,8 +5,8 @@ use crate::args::RenderArgs;
 use crate::io::json::Json;
 use crate::io::outputs::{self, Planned};
 use crate::io::volume::Samples;
-use crate::pipeline::load::raw_options;
-use crate::pipeline::window;
+use crate::pipeline::stages::load::raw_options;
+use crate::pipeline::stages::window;
 use crate::CliError;
 use clap::Args;
 

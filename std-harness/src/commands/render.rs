@@ -1,13 +1,13 @@
 //! `footprint render`: a volume (or the built-in scene) rendered by the core, sheet by sheet, to a
-//! PNG (see [`crate::pipeline::prepare`](mod@crate::pipeline::prepare) for the view conventions).
+//! PNG (see [`crate::pipeline::prepare`](mod@crate::pipeline::stages::prepare) for the view conventions).
 
 use crate::args::{MethodArg, RenderArgs};
 use crate::charts::colorbar;
 use crate::io::image::{check_style, encode_apng, encode_rgb_for, RGB_EXTENSIONS};
 use crate::io::outputs::{self, Planned};
-use crate::pipeline::visible::FrameCache;
-use crate::pipeline::{choose::apply_quality, quality::quality_json};
+use crate::pipeline::stages::visible::FrameCache;
 use crate::pipeline::{describe, prepare, render_frame, render_ref, Prepared};
+use crate::pipeline::{quality::choose::apply_quality, quality::model::quality_json};
 use crate::plan::{plan, turned, End, Inputs, Plan};
 use crate::CliError;
 use std::path::{Path, PathBuf};

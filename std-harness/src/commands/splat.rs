@@ -1,10 +1,10 @@
 //! `footprint splat`: one voxel of value 1, its raw footprint weights written as an image (see
-//! [`crate::pipeline::single`] for the conventions). PFM rows are stored bottom to top, as PFM
+//! [`crate::pipeline::ends::single`] for the conventions). PFM rows are stored bottom to top, as PFM
 //! requires.
 
 use crate::args::SplatArgs;
 use crate::io::image::save_grey;
-use crate::pipeline::single::splat_image;
+use crate::pipeline::ends::single::splat_image;
 use crate::CliError;
 
 pub fn run(args: &SplatArgs) -> Result<(), CliError> {

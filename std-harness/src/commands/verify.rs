@@ -4,14 +4,13 @@
 //! Colour space: the renderers' output, linear premultiplied RGBA in [0, 1], composited over the
 //! background (transparent black if none); the measures are [`crate::metrics`]'.
 
-use crate::args::RenderArgs;
-use crate::args::{Lod, MethodArg, ReconstructionArg, ReferenceArg};
+use crate::args::{Lod, MethodArg, ReconstructionArg, ReferenceArg, RenderArgs};
 use crate::io::image::{check_style, encode_rgb_for, RGB_EXTENSIONS};
 use crate::io::json::Json;
 use crate::io::outputs::{self, Planned};
 use crate::metrics::compare;
-use crate::pipeline::continuous::{continuous_models, models_json, others, PIXEL_FILTER};
-use crate::pipeline::{choose::apply_quality, field::prepare_field, quality::quality_json};
+use crate::pipeline::ends::continuous::{continuous_models, models_json, others, PIXEL_FILTER};
+use crate::pipeline::quality::{choose::apply_quality, field::prepare_field, model::quality_json};
 use crate::pipeline::{describe, prepare, render_core, render_ref};
 use crate::plan::{plan, End, Inputs, Precision};
 use crate::reference::continuous::Reconstruction;

@@ -1,7 +1,7 @@
 //! The JSON fields every render and verify summary share ([`describe`]): what was rendered and
 //! how, from a [`Prepared`] render, its inputs and its plan.
 
-use super::prepare::Prepared;
+use super::stages::prepare::Prepared;
 use crate::io::json::Json;
 use crate::plan::{End, Footprints, Inputs, Plan, Precision};
 

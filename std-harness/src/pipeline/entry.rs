@@ -1,9 +1,9 @@
 //! `prepare`, the pipeline's entry: load and set up everything the command line describes
-//! ([`super::prepare::prepare_as_asked`]), with `--lod auto` validated on a pilot where it can be
-//! ([`super::level_pilot::validated_auto`]).
+//! ([`super::stages::prepare::prepare_as_asked`]), with `--lod auto` validated on a pilot where it can be
+//! ([`super::quality::level_pilot::validated_auto`]).
 
-use super::level_pilot::validated_auto;
-use super::prepare::{prepare_as_asked, Prepared};
+use super::quality::level_pilot::validated_auto;
+use super::stages::prepare::{prepare_as_asked, Prepared};
 use crate::args::Lod;
 use crate::plan::{Inputs, Request};
 use crate::CliError;

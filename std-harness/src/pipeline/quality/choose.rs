@@ -1,5 +1,5 @@
 //! `--quality DB`'s entry point: the choice against the reference `--quality-reference` names,
-//! from the sheet model ([`super::quality`], the default) or the continuous pilot
+//! from the sheet model ([`super::model`], the default) or the continuous pilot
 //! ([`super::pilot`]), applied to the render's arguments.
 //!
 //! # Against the sheet reference, with levels of detail
@@ -25,9 +25,9 @@
 
 use super::config::Config;
 use super::level_pilot::{candidate_levels, measure};
-use super::prepare::Prepared;
-use super::quality::{self, choose, footprint_error, predict_db, Choice};
+use super::model::{self as quality, choose, footprint_error, predict_db, Choice};
 use crate::args::{Lod, MethodArg, QualityReferenceArg};
+use crate::pipeline::stages::prepare::Prepared;
 use crate::plan::{End, Inputs, Plan};
 use crate::CliError;
 
@@ -114,7 +114,7 @@ fn choose_sheets(
         return Ok((p0, c));
     }
     if let (Some(n @ 1..), Some(_)) = (explicit, p0.frame.camera()) {
-        return Err(super::prepare::no_level_in_perspective(n));
+        return Err(crate::pipeline::stages::prepare::no_level_in_perspective(n));
     }
     let levels = candidate_levels(&p0, explicit);
     if levels.is_empty() {

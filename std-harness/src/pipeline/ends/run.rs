@@ -1,18 +1,18 @@
 //! Running a prepared render: the core's sheet loop (float or fixed, any table method) over the
-//! visible voxels of a volume in memory, on several cores ([`super::bands`]), or driven through a
+//! visible voxels of a volume in memory, on several cores ([`crate::pipeline::stages::bands`]), or driven through a
 //! [`SheetRing`] as a streaming source would drive it; and the f64 reference.
 
-pub use super::bands::CoreFrame;
-use super::bands::{run_bands, Phases};
-use super::load::Voxels;
-use super::lod::{with_level, DynSource};
-use super::prepare::Prepared;
-use super::subsample;
-use super::supersample::{downsample, to_output};
-use super::visible::FrameCache;
 use crate::io::progress::sheets;
 use crate::io::stream::{ColouredMemorySource, FileSource, MemorySource, PipeSource};
 use crate::io::try_filled;
+pub use crate::pipeline::stages::bands::CoreFrame;
+use crate::pipeline::stages::bands::{run_bands, Phases};
+use crate::pipeline::stages::load::Voxels;
+use crate::pipeline::stages::lod::{with_level, DynSource};
+use crate::pipeline::stages::prepare::Prepared;
+use crate::pipeline::stages::subsample;
+use crate::pipeline::stages::supersample::{downsample, to_output};
+use crate::pipeline::stages::visible::FrameCache;
 use crate::plan::{End, Footprints, Plan, Precision as PlanPrecision};
 use crate::reference::render::{render_reference, ReferenceScene};
 use crate::{with_table_size, CliError};
@@ -49,7 +49,7 @@ pub fn render_frame(
 ) -> Result<CoreFrame, CliError> {
     let s = p.subsample_factor(plan)?;
     if s > 1 {
-        // Rendered at 1/s of the size and resampled (`super::subsample`); timed as one frame.
+        // Rendered at 1/s of the size and resampled (`crate::pipeline::stages::subsample`); timed as one frame.
         let start = Instant::now();
         let (low, at_low) = p.subsampled(plan, s)?;
         let mut f = render_frame(&low, &at_low, cache)?;
@@ -317,7 +317,8 @@ fn run_sheets<P: Precision>(
     // A streamed volume is coarsened to the frame's level as it streams (a volume in memory
     // already was, when prepared).
     let (axis, fine, level) = (f.sheet_axis, p.fine_dims, p.level);
-    let averaging = super::lod::averaging_for(&p.shading, p.shader().tf, p.absorption);
+    let averaging =
+        crate::pipeline::stages::lod::averaging_for(&p.shading, p.shader().tf, p.absorption);
     let (r, s) = (&mut renderer, &mut show);
     match &p.voxels {
         Voxels::Memory(v) if v.is_coloured() => stream(r, s, &mut ColouredMemorySource(v))?,

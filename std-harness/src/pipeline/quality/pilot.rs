@@ -3,7 +3,7 @@
 //!
 //! # Why a measurement, not a model
 //! Against the sheet reference the error is the table's, and one footprint predicts it
-//! ([`super::quality`]). Against the integral, object slicing's error is dominated by compositing
+//! ([`super::model`]). Against the integral, object slicing's error is dominated by compositing
 //! each kernel whole in one sheet, which depends on the data along every ray (27.9–77.9 dB over
 //! the shared volumes at 256×256, docs/accuracy.md, "Image-aligned slicing"): no one-voxel model sees it.
 //! So the choice is measured, on a **pilot**:
@@ -20,8 +20,8 @@
 //!    ([`super::field`]: the grid's own field is what refinement moves away from), that table
 //!    with the grid refined (`--refine 0`, the paper's adaptive re-sampling, 1.3–2.4× an
 //!    unrefined frame on docs/modes.md's refinement chart), where refinement can add samples
-//!    ([`super::refine::worth_trying`]: float, the robust method, orthographic, in memory, full
-//!    resolution, and grid steps projecting at least twice [`super::refine::MIN_STEP_PX`]);
+//!    ([`crate::pipeline::ends::refine::worth_trying`]: float, the robust method, orthographic, in memory, full
+//!    resolution, and grid steps projecting at least twice [`crate::pipeline::ends::refine::MIN_STEP_PX`]);
 //!    then image slicing (3–13× an object frame) at each thickness of `Config::SLABS` the
 //!    frame accepts, thickest (fastest) first. With `--slicing image` only the slabs are tried;
 //!    a perspective frame or a non-Gaussian kernel has no slabs.
@@ -37,13 +37,13 @@
 //! sheet reference is what the table configuration alone controls.
 
 use super::config::Config;
-use super::continuous::continuous_at;
-use super::prepare::Prepared;
-use super::quality::{self, Choice, Estimate, Pilot};
-use super::run::render_frame;
+use super::model::{self as quality, Choice, Estimate, Pilot};
 use super::sampling::mix;
-use super::visible::FrameCache;
 use crate::args::QualityReferenceArg;
+use crate::pipeline::ends::continuous::continuous_at;
+use crate::pipeline::ends::run::render_frame;
+use crate::pipeline::stages::prepare::Prepared;
+use crate::pipeline::stages::visible::FrameCache;
 use crate::plan::Inputs;
 use crate::plan::{End, Plan};
 use crate::CliError;
@@ -119,7 +119,7 @@ fn candidates(
         }
     }
     if let (Some(last), QualityReferenceArg::Field) = (v.last().copied(), reference) {
-        if super::refine::worth_trying(p, &last.refined().plan(base)) {
+        if crate::pipeline::ends::refine::worth_trying(p, &last.refined().plan(base)) {
             v.push(last.refined());
         }
     }

@@ -27,10 +27,10 @@
 
 use super::config::Config;
 use super::level_pilot::LevelPilot;
-use super::prepare::Prepared;
 pub use super::sampling::Estimate;
 use crate::args::{AccumArg, LookupArg, MethodArg, QualityReferenceArg};
 use crate::io::json::Json;
+use crate::pipeline::stages::prepare::Prepared;
 use crate::reference::ReferenceFootprint;
 use crate::{with_table_size, CliError};
 use footprint::splat::{splat, Direct, ImageMut, Sampler};

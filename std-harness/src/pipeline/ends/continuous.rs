@@ -2,9 +2,9 @@
 //! each absorption model's image, the figures against every model, and a sample of pixels (the
 //! pilots). What `verify --reference continuous`, `--quality` and `chart` measure against.
 
-use super::prepare::Prepared;
-use super::supersample::downsample;
 use crate::io::progress::sheets;
+use crate::pipeline::stages::prepare::Prepared;
+use crate::pipeline::stages::supersample::downsample;
 use crate::reference::continuous::{
     render_continuous, render_continuous_at, Absorption, Continuous, ContinuousScene, Model,
     Reconstruction, DEFAULT_CAP, MAX_HALVINGS,

@@ -346,7 +346,7 @@ pub fn setup_frame(
     };
     let frame = at_level(&fine, &view)?;
     // Levels and supersampling never act on one frame: a coarser level is rendered at the
-    // output size (its own error is what `--lod auto` validates, `super::level_pilot`).
+    // output size (its own error is what `--lod auto` validates, `crate::pipeline::quality::level_pilot`).
     let k = match level {
         0 => supersample::factor(args.supersample, &frame, options),
         _ => 1,
@@ -441,7 +441,7 @@ fn perspective_frame(
 }
 
 /// Loads and sets up everything `args` describes, with `--lod` taken as it is (`auto`: the
-/// geometric rule of [`super::lod`]); [`super::entry::prepare`] validates that rule's level.
+/// geometric rule of [`super::lod`]); [`crate::pipeline::entry::prepare`] validates that rule's level.
 pub fn prepare_as_asked(args: &Inputs) -> Result<Prepared, CliError> {
     let kernel = args.footprint.kernel()?;
     let Loaded {
@@ -459,7 +459,7 @@ pub fn prepare_as_asked(args: &Inputs) -> Result<Prepared, CliError> {
         min_radius_px: args.footprint.min_radius,
     };
     // With --quality the volume is prepared at full resolution: the choice measures the levels
-    // against it and builds the one it picks (`super::choose`).
+    // against it and builds the one it picks (`crate::pipeline::quality::choose`).
     let at_full;
     let framing = if args.quality {
         at_full = Inputs {

@@ -17,14 +17,14 @@
 //!    table of its own where at least [`RESAMPLE_SAMPLES`] do; and the view tables of the rates
 //!    ρ ∈ {¼, ½, 1, 2, 4} (the kernel scaled by ρ along the sheet axis) that the remaining border
 //!    samples read at scaled coordinates.
-//! 4. **Render.** On bands of rows like every render ([`super::bands::on_bands`]): byte-identical
+//! 4. **Render.** On bands of rows like every render ([`crate::pipeline::stages::bands::on_bands`]): byte-identical
 //!    for any number of threads.
 
-use super::bands::{equal_bands, on_bands, CoreFrame, Phases};
-use super::prepare::Prepared;
-pub use super::refinement::Refinement;
-use super::supersample::to_output;
 use crate::io::volume::Volume;
+use crate::pipeline::stages::bands::{equal_bands, on_bands, CoreFrame, Phases};
+use crate::pipeline::stages::prepare::Prepared;
+pub use crate::pipeline::stages::refinement::Refinement;
+use crate::pipeline::stages::supersample::to_output;
 use crate::plan::{End, Plan};
 use crate::{with_table_size, CliError};
 use footprint::composite::RowSpan;

@@ -1,4 +1,4 @@
-//! What `--refine` refined ([`super::refine`]): the record a frame carries to the JSON.
+//! What `--refine` refined ([`crate::pipeline::ends::refine`]): the record a frame carries to the JSON.
 
 /// What `--refine` did, for the JSON and the summary.
 #[derive(Clone, Debug, PartialEq)]

@@ -298,7 +298,7 @@ where
 #[cfg(test)]
 mod tests {
     use super::{balanced_rows, band_rows};
-    use crate::pipeline::visible::{RowRun, VisibleLists};
+    use crate::pipeline::stages::visible::{RowRun, VisibleLists};
     use footprint::frame::FrameSetup;
     use footprint::geometry::FootprintOptions;
     use footprint::{Grid, Kernel, View};

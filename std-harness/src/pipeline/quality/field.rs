@@ -17,8 +17,8 @@
 //! The same box and the same view give the same world-to-screen map, so the finer sampling's
 //! image lines up pixel for pixel with the coarse one (the refinement chart relies on the same).
 
-use super::prepare::Prepared;
 use crate::args::Lod;
+use crate::pipeline::stages::prepare::Prepared;
 use crate::plan::Inputs;
 use crate::CliError;
 
@@ -39,7 +39,7 @@ pub fn prepare_field(args: &Inputs) -> Result<Prepared, CliError> {
         )));
     }
     // At level 0 with no --quality there is no level to validate: prepared as asked.
-    super::prepare::prepare_as_asked(&Inputs {
+    crate::pipeline::stages::prepare::prepare_as_asked(&Inputs {
         scene_size: args.field_size,
         refine: false,
         quality: false,

@@ -24,13 +24,13 @@
 //! deeper level averages the failing level's blocks again. The caller
 //! ([`super::choose`]) splits the target between the level and the table.
 
-use super::load::Voxels;
-use super::prepare::Prepared;
-use super::run::{build_stencils, stencil_len};
 use super::sampling::{mix, Estimate};
-use super::supersample::downsample;
 use crate::io::stream::{ColouredMemorySource, MemorySource};
 use crate::io::try_filled;
+use crate::pipeline::ends::run::{build_stencils, stencil_len};
+use crate::pipeline::stages::load::Voxels;
+use crate::pipeline::stages::prepare::Prepared;
+use crate::pipeline::stages::supersample::downsample;
 use crate::plan::Inputs;
 use crate::plan::Plan;
 use crate::{with_table_size, CliError};
@@ -119,7 +119,7 @@ pub fn render_rows(p: &Prepared, plan: &Plan, rows: &[usize]) -> Result<Vec<[f32
     with_table_size!(plan.table.size, N => {
         let generic = plan.table.generic::<N>(&p.kernel)?;
         let table = Box::new(ViewTable::<N>::build(&f.footprint, &generic, lookup, lookup));
-        // The sampler the whole frame's render uses (`super::run`): phase stencils where the
+        // The sampler the whole frame's render uses (`crate::pipeline::ends::run`): phase stencils where the
         // footprint allows them, else the view table.
         let len = stencil_len(p, plan.phases);
         let threads = plan.threads;
@@ -234,11 +234,15 @@ pub fn candidate_levels(p: &Prepared, explicit: Option<u32>) -> Vec<u32> {
     if let Some(n) = explicit {
         return if n == 0 { Vec::new() } else { vec![n] };
     }
-    let spacing = match super::lod::projected_spacing(&p.frame, p.kernel.spread(), p.supersample) {
+    let spacing = match crate::pipeline::stages::lod::projected_spacing(
+        &p.frame,
+        p.kernel.spread(),
+        p.supersample,
+    ) {
         Some(d) if p.volume().is_some() => d,
         _ => return Vec::new(),
     };
-    (1..=super::lod::deepest_level(p.fine_dims))
+    (1..=crate::pipeline::stages::lod::deepest_level(p.fine_dims))
         .take_while(|&l| spacing * (1u64 << l) as f32 <= MAX_SPACING_PX)
         .collect()
 }
@@ -286,7 +290,7 @@ pub fn measure(
 pub const AUTO_MIN_DB: f64 = 40.0;
 
 /// `--lod auto` for `p0` (prepared at level 0, `args` otherwise as given): the deepest level the
-/// geometric rule allows ([`super::lod::auto_level`]) whose pilot bound stays at or above
+/// geometric rule allows ([`crate::pipeline::stages::lod::auto_level`]) whose pilot bound stays at or above
 /// [`AUTO_MIN_DB`] against level 0, the levels tried from 1 down and the first to fail ending the
 /// search; level 0 when none passes, for a stream, or in perspective. The geometric rule alone
 /// was fitted on grey ramps and kept the CT head's level 1 at 64² at 30.9 dB under a transfer
@@ -294,8 +298,13 @@ pub const AUTO_MIN_DB: f64 = 40.0;
 /// transfer function do to a level.
 pub fn validated_auto(p0: Prepared, args: &Inputs, plan: &Plan) -> Result<Prepared, CliError> {
     // The level the geometric rule picks for `args` (`--lod auto`), as prepare would have.
-    let (_, _, deepest) =
-        super::prepare::setup_frame(args, p0.fine_dims, &p0.grid, &p0.kernel, p0.options)?;
+    let (_, _, deepest) = crate::pipeline::stages::prepare::setup_frame(
+        args,
+        p0.fine_dims,
+        &p0.grid,
+        &p0.kernel,
+        p0.options,
+    )?;
     if deepest == 0 || p0.volume().is_none() {
         return Ok(p0);
     }

@@ -1,7 +1,7 @@
 //! `--slicing image`: the core's image-aligned slabs (`footprint::render::slabs`) over the
 //! visible voxels of a volume in memory, on several cores.
 //!
-//! 1. The visible lists (classified once per volume, as for sheets: [`super::visible`]) are
+//! 1. The visible lists (classified once per volume, as for sheets: [`crate::pipeline::stages::visible`]) are
 //!    shaded for one world unit of thickness and valued as the `--absorption` model reads them
 //!    ([`SlabSetup::voxel`]), placed on screen, and sorted by the slab each reaches
 //!    first in compositing order (counting sorts: the voxel order within a slab does not depend
@@ -17,10 +17,10 @@
 //! view crosses every sheet, so a streamed volume (`--stream`) is refused: feeding it from a
 //! bounded window of sheets is not possible (see the core module's docs).
 
-use super::bands::{equal_bands, on_bands, CoreFrame, Phases};
-use super::prepare::Prepared;
-use super::supersample::to_output;
-use super::visible::FrameCache;
+use crate::pipeline::stages::bands::{equal_bands, on_bands, CoreFrame, Phases};
+use crate::pipeline::stages::prepare::Prepared;
+use crate::pipeline::stages::supersample::to_output;
+use crate::pipeline::stages::visible::FrameCache;
 use crate::CliError;
 use footprint::composite::RowSpan;
 use footprint::frame::Order;
@@ -111,7 +111,7 @@ struct SlabVoxels {
 fn slab_voxels(
     p: &Prepared,
     setup: &SlabSetup,
-    lists: &super::visible::VisibleLists,
+    lists: &crate::pipeline::stages::visible::VisibleLists,
 ) -> Result<SlabVoxels, CliError> {
     let f = &p.frame;
     let shader = p.shader();
