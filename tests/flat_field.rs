@@ -9,8 +9,8 @@
 use footprint::geometry::{Footprint, FootprintOptions};
 use footprint::splat::{splat, ImageMut};
 use footprint::{GenericTable, Grid, Kernel, Lookup, View, ViewTable};
+use footprint_harness::dispatch::{with_size, TableSize};
 use footprint_harness::reference::ReferenceFootprint;
-use footprint_harness::with_table_size;
 use footprint_suite::{assert_le, default_kernels};
 use glam::Mat3;
 
@@ -60,16 +60,22 @@ fn g2s() -> Mat3 {
 
 fn core_sheet(kernel: Kernel, n: usize, lookup: Lookup, sheet: &Sheet) -> Vec<f64> {
     let fp = Footprint::new(&kernel, &g2s(), FootprintOptions::default()).unwrap();
-    let mut px = vec![0.0f32; sheet.side * sheet.side];
-    with_table_size!(n, N => {
-        let generic = Box::new(GenericTable::<N>::build(kernel));
-        let table = Box::new(ViewTable::<N>::build(&fp, &generic, lookup, lookup));
-        let mut img = ImageMut::new(&mut px, sheet.side, sheet.side, sheet.side).unwrap();
-        for c in sheet.centres() {
-            splat(&*table, c, &1.0f32, &mut img).unwrap();
+    struct Splats<'a>(Kernel, Footprint, Lookup, &'a Sheet);
+    impl TableSize for Splats<'_> {
+        type Output = Vec<f32>;
+        fn run<const N: usize>(self) -> Result<Vec<f32>, footprint_harness::CliError> {
+            let Splats(kernel, fp, lookup, sheet) = self;
+            let mut px = vec![0.0f32; sheet.side * sheet.side];
+            let generic = Box::new(GenericTable::<N>::build(kernel));
+            let table = Box::new(ViewTable::<N>::build(&fp, &generic, lookup, lookup));
+            let mut img = ImageMut::new(&mut px, sheet.side, sheet.side, sheet.side).unwrap();
+            for c in sheet.centres() {
+                splat(&*table, c, &1.0f32, &mut img).unwrap();
+            }
+            Ok(px)
         }
-    })
-    .unwrap();
+    }
+    let px = with_size(n, Splats(kernel, fp, lookup, sheet)).unwrap();
     px.into_iter().map(f64::from).collect()
 }
 

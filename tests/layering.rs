@@ -50,7 +50,7 @@ fn module_path(src: &Path, file: &Path) -> Vec<String> {
 fn node(path: &[String], files: &BTreeSet<Vec<String>>) -> Option<String> {
     let first = path.first()?;
     if !files.contains(&vec![first.clone()]) {
-        return None; // an item of the crate root: CliError, say!, with_table_size!
+        return None; // an item of the crate root: CliError, say!
     }
     if GROUPS.contains(&first.as_str()) && path.len() > 1 {
         let sub = vec![first.clone(), path[1].clone()];
@@ -71,9 +71,10 @@ fn rank(node: &str) -> u32 {
         "plan" => 4,
         "args" | "metrics" => 3,
         "scene" | "tf" => 2,
-        "io" | "reference" | "dispatch" => 1,
-        // Threads that may fail to start: used by the reference and the pipeline alike.
-        "threads" => 0,
+        "io" | "reference" => 1,
+        // Threads that may fail to start, and the one table-size dispatch: used by io, the
+        // reference and the pipeline alike.
+        "threads" | "dispatch" => 0,
         other => panic!("module '{other}' has no layer: add it to tests/layering.rs"),
     }
 }
@@ -325,6 +326,28 @@ fn the_pipeline_never_reads_the_command_line_struct() {
 fn names_render_args(code: &str) -> bool {
     code.split(|c: char| !is_ident(c))
         .any(|t| t == "RenderArgs")
+}
+
+/// A runtime table size becomes a const generic in one place (`dispatch::with_size`, issue 41):
+/// every other site writes its work once, generic over N (`dispatch::TableSize`), instead of
+/// expanding a match over every size where it stands.
+#[test]
+fn table_sizes_are_dispatched_in_one_place() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut files = Vec::new();
+    for dir in ["std-harness/src", "python/src", "tests", "benches"] {
+        rs_files(&root.join(dir), &mut files);
+    }
+    let sites: Vec<String> = files
+        .iter()
+        .filter(|f| !f.ends_with("dispatch.rs") && !f.ends_with("layering.rs"))
+        .filter(|f| {
+            let code = code_of(&std::fs::read_to_string(f).unwrap_or_default());
+            code.contains("with_table_size!")
+        })
+        .map(|f| f.display().to_string())
+        .collect();
+    assert!(sites.is_empty(), "the size match expanded at {sites:?}");
 }
 
 #[test]

@@ -410,10 +410,16 @@ fn run_command(
 fn generic_table<'py>(py: Python<'py>, kernel: &str, size: usize) -> PyResult<Bound<'py, PyAny>> {
     let k = footprint::Kernel::parse(kernel)
         .map_err(|e| PyValueError::new_err(format!("--kernel '{kernel}': {e}")))?;
-    let values: Vec<f32> = footprint_harness::with_table_size!(size, N => {
-        footprint::GenericTable::<N>::build(k).as_slice().to_vec()
-    })
-    .map_err(py_err)?;
+    struct Values(footprint::Kernel);
+    impl footprint_harness::dispatch::TableSize for Values {
+        type Output = Vec<f32>;
+        fn run<const N: usize>(self) -> Result<Vec<f32>, CliError> {
+            Ok(footprint::GenericTable::<N>::build(self.0)
+                .as_slice()
+                .to_vec())
+        }
+    }
+    let values = footprint_harness::dispatch::with_size(size, Values(k)).map_err(py_err)?;
     Ok(PyArray1::from_vec(py, values)
         .reshape([size, size])?
         .into_any())

@@ -5,8 +5,7 @@
 pub const TABLE_SIZES: [usize; 12] = [3, 5, 7, 9, 11, 17, 21, 33, 65, 101, 129, 257];
 
 /// Calls `$body` with `const $n: usize` bound to the runtime value `$size`, or evaluates to
-/// `Err(CliError)` for a size not in [`TABLE_SIZES`].
-#[macro_export]
+/// `Err(CliError)` for a size not in [`TABLE_SIZES`]. Only [`with_size`] uses it.
 macro_rules! with_table_size {
     ($size:expr, $n:ident => $body:expr) => {
         match $size {
@@ -64,4 +63,20 @@ macro_rules! with_table_size {
             ))),
         }
     };
+}
+
+/// Code generic over the table side N: what [`with_size`] runs with the N asked for at run time.
+/// A site that needs a table writes its work once, as a function generic over `N`, and a small
+/// struct carrying its arguments implements this; the list of sizes is matched in one place.
+pub trait TableSize {
+    /// What the work returns.
+    type Output;
+    /// The work, with the table side `N`.
+    fn run<const N: usize>(self) -> Result<Self::Output, crate::CliError>;
+}
+
+/// Runs `work` with `const N` = `size`, or refuses a size not in [`TABLE_SIZES`]: the one place
+/// a runtime table size becomes a const generic.
+pub fn with_size<W: TableSize>(size: usize, work: W) -> Result<W::Output, crate::CliError> {
+    with_table_size!(size, N => work.run::<N>())?
 }

@@ -13,7 +13,8 @@
 //!           └ plan       the render plan, resolved once from the arguments
 //!              └ args, metrics   shared argument structs; image comparisons
 //!                 └ scene, tf   the built-in volume; transfer functions
-//!                    └ io, reference, dispatch, threads   files and formats; the f64 reference; N → const N; threads
+//!                    └ io, reference   files and formats; the f64 reference
+//!                       └ dispatch, threads   N → const N (once); threads
 //! ```
 //!
 //! - [`cli`]: the entry point [`run`].

@@ -1,18 +1,24 @@
 //! Generic footprint tables on disk, in the core's byte format (`footprint tables` writes them,
 //! `--table-file` reads them).
 
-use crate::{io, with_table_size, CliError};
+use crate::dispatch::{with_size, TableSize};
+use crate::{io, CliError};
 use footprint::{GenericTable, Kernel};
 
 /// Builds a table and returns its serialised bytes.
 pub fn table_bytes(kernel: &Kernel, size: usize) -> Result<Vec<u8>, CliError> {
-    with_table_size!(size, N => {
-        let table = Box::new(GenericTable::<N>::build(*kernel));
-        let mut bytes = vec![0u8; table.serialized_len()];
-        let len = table.write_bytes(&mut bytes)?;
-        bytes.truncate(len);
-        bytes
-    })
+    struct Bytes<'a>(&'a Kernel);
+    impl TableSize for Bytes<'_> {
+        type Output = Vec<u8>;
+        fn run<const N: usize>(self) -> Result<Vec<u8>, CliError> {
+            let table = Box::new(GenericTable::<N>::build(*self.0));
+            let mut bytes = vec![0u8; table.serialized_len()];
+            let len = table.write_bytes(&mut bytes)?;
+            bytes.truncate(len);
+            Ok(bytes)
+        }
+    }
+    with_size(size, Bytes(kernel))
 }
 
 /// Loads a table file for a `GenericTable<N>`, with the path in any error.

@@ -26,7 +26,7 @@ use crate::pipeline::stages::prepare::Prepared;
 pub use crate::pipeline::stages::refinement::Refinement;
 use crate::pipeline::stages::supersample::to_output;
 use crate::plan::{End, Plan};
-use crate::{with_table_size, CliError};
+use crate::CliError;
 use footprint::composite::RowSpan;
 use footprint::refine::{factor_for, RefinedAxis};
 use footprint::render::{
@@ -182,6 +182,46 @@ pub fn render_refined(
     let start = Instant::now();
     let refinement = choose(p, volume, threshold, sheets)?;
     let classify = start.elapsed().as_secs_f64();
+    /// The refined frame through tables of side N.
+    struct Refined<'a> {
+        p: &'a Prepared,
+        plan: &'a Plan,
+        refinement: Refinement,
+        start: Instant,
+        classify: f64,
+    }
+    impl crate::dispatch::TableSize for Refined<'_> {
+        type Output = CoreFrame;
+        fn run<const N: usize>(self) -> Result<CoreFrame, CliError> {
+            refined_at::<N>(
+                self.p,
+                self.plan,
+                self.refinement,
+                self.start,
+                self.classify,
+            )
+        }
+    }
+    let work = Refined {
+        p,
+        plan,
+        refinement,
+        start,
+        classify,
+    };
+    crate::dispatch::with_size(plan.table.size, work)
+}
+
+/// [`render_refined`] with tables of side `N`, its refinement chosen at `start` in `classify`
+/// seconds.
+fn refined_at<const N: usize>(
+    p: &Prepared,
+    plan: &Plan,
+    refinement: Refinement,
+    start: Instant,
+    classify: f64,
+) -> Result<CoreFrame, CliError> {
+    let volume = p.volume().expect("checked");
     let f = &p.frame;
     let axis = |a: usize| {
         RefinedAxis::new(a, f.dims[a], &refinement.factors[a])
@@ -194,7 +234,7 @@ pub fn render_refined(
     let threads = plan.threads;
     let dims = volume.dims;
     let value = |[i, j, k]: [usize; 3]| volume.value(i + dims[0] * (j + dims[1] * k));
-    with_table_size!(plan.table.size, N => {
+    {
         let t0 = Instant::now();
         let generic = plan.table.generic::<N>(&p.kernel)?;
         let footprint_for = |m: &glam::Mat3| {
@@ -236,17 +276,32 @@ pub fn render_refined(
             needed[rate_index(sa, sb, w)] = true;
         }
         let mut rate_tables = Vec::with_capacity(5);
-        for (r, rho) in RefineTables::<ViewTable<N>, Exact<'_, N>>::RATES.into_iter().enumerate() {
+        for (r, rho) in RefineTables::<ViewTable<N>, Exact<'_, N>>::RATES
+            .into_iter()
+            .enumerate()
+        {
             if rho != 1.0 && !needed[r] {
                 continue;
             }
             let mut m = f.grid_to_screen;
             *m.col_mut(k) *= rho;
-            let fp = if rho == 1.0 { f.footprint } else { footprint_for(&m)? };
-            rate_tables.push((r, Box::new(ViewTable::<N>::build(&fp, &generic, lookup, lookup))));
+            let fp = if rho == 1.0 {
+                f.footprint
+            } else {
+                footprint_for(&m)?
+            };
+            rate_tables.push((
+                r,
+                Box::new(ViewTable::<N>::build(&fp, &generic, lookup, lookup)),
+            ));
         }
         let base = &*rate_tables.iter().find(|(r, _)| *r == 2).expect("built").1;
-        let rates = [0, 1, 2, 3, 4].map(|r| rate_tables.iter().find(|(j, _)| *j == r).map_or(base, |t| &*t.1));
+        let rates = [0, 1, 2, 3, 4].map(|r| {
+            rate_tables
+                .iter()
+                .find(|(j, _)| *j == r)
+                .map_or(base, |t| &*t.1)
+        });
         // Per key: a symmetric spacing's exact footprint, or the scaled rate footprint.
         let mut exact_tables = Vec::new();
         let mut scaled = Vec::new();
@@ -256,10 +311,17 @@ pub fn render_refined(
                 let mut sigma = [1.0f32; 3];
                 (sigma[a], sigma[b], sigma[k]) = (sa[0], sb[0], w);
                 let m = f.grid_to_screen * glam::Mat3::from_diagonal(glam::Vec3::from_array(sigma));
-                let table = Box::new(ViewTable::<N>::build(&footprint_for(&m)?, &generic, lookup, lookup));
+                let table = Box::new(ViewTable::<N>::build(
+                    &footprint_for(&m)?,
+                    &generic,
+                    lookup,
+                    lookup,
+                ));
                 let len = stencil_len(table.footprint(), n, phases);
                 exact_tables.push((key, table, vec![0.0f32; len.unwrap_or(0)]));
-            } else if let Some(fp) = ScaledFootprint::new(rates[rate_index(sa, sb, w)], map, [sa, sb]) {
+            } else if let Some(fp) =
+                ScaledFootprint::new(rates[rate_index(sa, sb, w)], map, [sa, sb])
+            {
                 // A scaled footprint's read costs about twice a table's: half the samples' worth
                 // for stencils; else, shared by a few samples, its own table (the row walk).
                 if let Some(len) = stencil_len(fp.footprint(), n / 2, phases) {
@@ -282,7 +344,10 @@ pub fn render_refined(
         for (key, fp, buffer) in scaled.iter_mut() {
             splatters[*key] = Some(Exact::Scaled(Stencils::build(&*fp, phases, buffer)?));
         }
-        let tables = RefineTables { rates, splatters: &splatters };
+        let tables = RefineTables {
+            rates,
+            splatters: &splatters,
+        };
         let table_secs = t0.elapsed().as_secs_f64();
         let (image, stats, phases) = on_bands(
             crate::io::try_filled(f.size[0] * f.size[1], [0.0f32; 4], "the image")?,
@@ -294,28 +359,47 @@ pub fn render_refined(
                 let mut acc = crate::io::try_filled(n, [0.0f32; 4], "a band's sheet accumulator")?;
                 let mut spans = vec![RowSpan::EMPTY; rows.len()];
                 let mut opacity = vec![0.0f32; OPACITY_TABLE_LEN];
-                let mut scratch = crate::io::try_filled(2 * f.sheet_shape().0, 0.0f32, "refinement scratch sheets")?;
-                let buffers = RenderBuffers { accumulator: &mut acc, image, rows: &mut spans };
+                let mut scratch = crate::io::try_filled(
+                    2 * f.sheet_shape().0,
+                    0.0f32,
+                    "refinement scratch sheets",
+                )?;
+                let buffers = RenderBuffers {
+                    accumulator: &mut acc,
+                    image,
+                    rows: &mut spans,
+                };
                 let path = FloatPath::new(tables.rates[2]).with_absorption(p.absorption);
-                let mut r = SheetRenderer::with_band(f, path, p.shader(), p.order, buffers, bg, rows)?
-                    .with_opacity_table(&mut opacity)?;
+                let mut r =
+                    SheetRenderer::with_band(f, path, p.shader(), p.order, buffers, bg, rows)?
+                        .with_opacity_table(&mut opacity)?;
                 let t = Instant::now();
                 r.render_refined(&grid, &tables, value, &mut scratch)?;
                 let splat = t.elapsed().as_secs_f64();
-                Ok((r.finish(), Phases { splat, ..Phases::default() }))
+                Ok((
+                    r.finish(),
+                    Phases {
+                        splat,
+                        ..Phases::default()
+                    },
+                ))
             },
         )?;
         let image = to_output(image, p.out_size(), p.supersample);
-        CoreFrame {
-                image,
-                stats,
-                seconds: start.elapsed().as_secs_f64(),
-                phases: Phases { classify, tables: table_secs, ..phases },
-                threads: threads.clamp(1, f.size[1]),
-                visible: None,
-                refine: Some(refinement),
-            }
-    })
+        Ok(CoreFrame {
+            image,
+            stats,
+            seconds: start.elapsed().as_secs_f64(),
+            phases: Phases {
+                classify,
+                tables: table_secs,
+                ..phases
+            },
+            threads: threads.clamp(1, f.size[1]),
+            visible: None,
+            refine: Some(refinement),
+        })
+    }
 }
 
 /// One spacing's footprint: a symmetric spacing's exact footprint (its phase stencils, or its

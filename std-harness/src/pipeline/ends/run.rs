@@ -2,6 +2,7 @@
 //! visible voxels of a volume in memory, on several cores ([`crate::pipeline::stages::bands`]), or driven through a
 //! [`SheetRing`] as a streaming source would drive it; and the f64 reference.
 
+use crate::dispatch::{with_size, TableSize};
 use crate::io::progress::sheets;
 use crate::io::stream::{ColouredMemorySource, FileSource, MemorySource, PipeSource};
 use crate::io::try_filled;
@@ -15,7 +16,7 @@ use crate::pipeline::stages::supersample::{downsample, to_output};
 use crate::pipeline::stages::visible::FrameCache;
 use crate::plan::{End, Footprints, Plan, Precision as PlanPrecision};
 use crate::reference::render::{render_reference, ReferenceScene};
-use crate::{with_table_size, CliError};
+use crate::CliError;
 use footprint::fixed::stencil::FixedStencils;
 use footprint::fixed::{self, FixedTable};
 use footprint::render::{
@@ -82,13 +83,41 @@ fn render_sheets(
     precision: PlanPrecision,
     cache: &mut FrameCache,
 ) -> Result<CoreFrame, CliError> {
+    struct Sheets<'a> {
+        p: &'a Prepared,
+        plan: &'a Plan,
+        precision: PlanPrecision,
+        cache: &'a mut FrameCache,
+    }
+    impl TableSize for Sheets<'_> {
+        type Output = CoreFrame;
+        fn run<const N: usize>(self) -> Result<CoreFrame, CliError> {
+            sheets_at::<N>(self.p, self.plan, self.precision, self.cache)
+        }
+    }
+    let work = Sheets {
+        p,
+        plan,
+        precision,
+        cache,
+    };
+    with_size(plan.table.size, work)
+}
+
+/// [`render_sheets`] with tables of side `N`.
+fn sheets_at<const N: usize>(
+    p: &Prepared,
+    plan: &Plan,
+    precision: PlanPrecision,
+    cache: &mut FrameCache,
+) -> Result<CoreFrame, CliError> {
     let lookup = plan.table.lookup;
     let threads = plan.threads;
     let direct = plan.table.footprints == Footprints::Direct;
     let fixed_range =
         |e: fixed::FixedError| CliError::input(format!("{}: --accum fixed: {e}", p.name));
     let start = Instant::now();
-    with_table_size!(plan.table.size, N => {
+    {
         let generic = plan.table.generic::<N>(&p.kernel)?;
         // Each path gets its own monomorphised sheet loop: no virtual call per pixel.
         let perspective = p.frame.camera().is_some();
@@ -101,13 +130,28 @@ fn render_sheets(
                 (r.0, r.1, Phases { tables, ..r.2 }, r.3)
             }
             PlanPrecision::Float if direct => {
-                let sampler = Direct { footprint: p.frame.footprint, table: &*generic, lookup };
+                let sampler = Direct {
+                    footprint: p.frame.footprint,
+                    table: &*generic,
+                    lookup,
+                };
                 let tables = start.elapsed().as_secs_f64();
-                let r = run_path(p, FloatPath::new(&sampler).with_absorption(p.absorption), p.background.as_deref(), cache, threads)?;
+                let r = run_path(
+                    p,
+                    FloatPath::new(&sampler).with_absorption(p.absorption),
+                    p.background.as_deref(),
+                    cache,
+                    threads,
+                )?;
                 (r.0, r.1, Phases { tables, ..r.2 }, r.3)
             }
             PlanPrecision::Float => {
-                let table = Box::new(ViewTable::<N>::build(&p.frame.footprint, &generic, lookup, lookup));
+                let table = Box::new(ViewTable::<N>::build(
+                    &p.frame.footprint,
+                    &generic,
+                    lookup,
+                    lookup,
+                ));
                 let r = if let Some(len) = stencil_len(p, plan.phases) {
                     // Footprints up to 128 px across: the view table sampled once per phase.
                     let mut buffer = vec![0.0f32; len];
@@ -118,7 +162,13 @@ fn render_sheets(
                     (r.0, r.1, Phases { tables, ..r.2 }, r.3)
                 } else {
                     let tables = start.elapsed().as_secs_f64();
-                    let r = run_path(p, FloatPath::new(&*table).with_absorption(p.absorption), p.background.as_deref(), cache, threads)?;
+                    let r = run_path(
+                        p,
+                        FloatPath::new(&*table).with_absorption(p.absorption),
+                        p.background.as_deref(),
+                        cache,
+                        threads,
+                    )?;
                     (r.0, r.1, Phases { tables, ..r.2 }, r.3)
                 };
                 r
@@ -150,7 +200,11 @@ fn render_sheets(
                     .then(|| fixed::stencil::len_for(&table, phases))
                     .flatten();
                 let mut buffer = vec![0i32; len.unwrap_or(0)];
-                let build = if blended { FixedStencils::build_blended } else { FixedStencils::build };
+                let build = if blended {
+                    FixedStencils::build_blended
+                } else {
+                    FixedStencils::build
+                };
                 let path = match len.map(|_| build(&table, phases, &mut buffer)) {
                     Some(Ok(stencils)) => path.with_stencils(stencils),
                     // --phases 0, the direct method, a footprint past the stencils' limits, or
@@ -158,29 +212,41 @@ fn render_sheets(
                     _ => path,
                 };
                 let tables = start.elapsed().as_secs_f64();
-                let bg: Option<Vec<[u32; 4]>> =
-                    p.background.as_ref().map(|b| b.iter().map(|&c| fixed::quantise(c)).collect());
+                let bg: Option<Vec<[u32; 4]>> = p
+                    .background
+                    .as_ref()
+                    .map(|b| b.iter().map(|&c| fixed::quantise(c)).collect());
                 // A kept float image (a frame handed back) serves as this one's, its bits as
                 // they are: the renderer starts every pixel afresh.
                 let [w, h] = p.frame.size;
                 cache.reuse_image_as(w * h, |px: [f32; 4]| px.map(f32::to_bits));
-                let (img, stats, phases, visible) = run_path(p, path, bg.as_deref(), cache, threads)?;
-                (img.into_iter().map(fixed::to_f32).collect(), stats, Phases { tables, ..phases }, visible)
+                let (img, stats, phases, visible) =
+                    run_path(p, path, bg.as_deref(), cache, threads)?;
+                (
+                    img.into_iter().map(fixed::to_f32).collect(),
+                    stats,
+                    Phases { tables, ..phases },
+                    visible,
+                )
             }
         };
         phases.tables = phases.tables.max(0.0);
         // Supersampled: the mean of each k×k block (timed with the frame: it is part of it).
         let image = to_output(image, p.out_size(), p.supersample);
-        CoreFrame {
+        Ok(CoreFrame {
             image,
             stats,
             seconds: start.elapsed().as_secs_f64(),
             phases,
-            threads: if visible.is_some() { threads.clamp(1, p.frame.size[1]) } else { 1 },
+            threads: if visible.is_some() {
+                threads.clamp(1, p.frame.size[1])
+            } else {
+                1
+            },
             refine: None,
             visible,
-        }
-    })
+        })
+    }
 }
 
 /// The float path's phase stencils of `sampler` (at most `phases` per pixel) in `buffer`,

@@ -9,7 +9,7 @@
 use crate::args::{MethodArg, SplatArgs};
 use crate::io::image::GreyImage;
 use crate::reference::ReferenceFootprint;
-use crate::{with_table_size, CliError};
+use crate::CliError;
 use footprint::geometry::{Footprint, FootprintOptions, Mapping};
 use footprint::splat::{splat, Direct, ImageMut, Sampler};
 use footprint::{Grid, Lookup, View, ViewTable};
@@ -111,15 +111,44 @@ pub fn splat_image(args: &SplatArgs) -> Result<(GreyImage, SplatReport), CliErro
         },
     )?;
     let mut pixels = vec![0.0f32; w * h];
-    with_table_size!(fa.table, N => {
-        let generic = fa.generic_table::<N>(&kernel)?;
-        let mut image = ImageMut::new(&mut pixels, w, h, w)?;
-        let sampler: Box<dyn Sampler + '_> = match fa.method {
-            MethodArg::Direct => Box::new(Direct { footprint: fp, table: &*generic, lookup }),
-            _ => Box::new(ViewTable::<N>::build(&fp, &generic, lookup, lookup)),
-        };
-        splat(&*sampler, center, &1.0f32, &mut image)?;
-    })?;
+    /// One splat of `fp` at `center` into `pixels` (w × h) through tables of side N.
+    struct One<'a> {
+        fa: &'a crate::args::FootprintArgs,
+        kernel: footprint::Kernel,
+        fp: Footprint,
+        lookup: footprint::Lookup,
+        center: [f32; 2],
+        pixels: &'a mut [f32],
+        size: (usize, usize),
+    }
+    impl crate::dispatch::TableSize for One<'_> {
+        type Output = ();
+        fn run<const N: usize>(self) -> Result<(), CliError> {
+            let (fp, lookup) = (self.fp, self.lookup);
+            let generic = self.fa.generic_table::<N>(&self.kernel)?;
+            let mut image = ImageMut::new(self.pixels, self.size.0, self.size.1, self.size.0)?;
+            let sampler: Box<dyn Sampler + '_> = match self.fa.method {
+                MethodArg::Direct => Box::new(Direct {
+                    footprint: fp,
+                    table: &*generic,
+                    lookup,
+                }),
+                _ => Box::new(ViewTable::<N>::build(&fp, &generic, lookup, lookup)),
+            };
+            splat(&*sampler, self.center, &1.0f32, &mut image)?;
+            Ok(())
+        }
+    }
+    let one = One {
+        fa,
+        kernel,
+        fp,
+        lookup,
+        center,
+        pixels: &mut pixels,
+        size: (w, h),
+    };
+    crate::dispatch::with_size(fa.table, one)?;
     let seconds = start.elapsed().as_secs_f64();
     let img = GreyImage {
         width: w,

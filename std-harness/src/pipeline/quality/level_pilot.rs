@@ -33,7 +33,7 @@ use crate::pipeline::stages::prepare::Prepared;
 use crate::pipeline::stages::supersample::downsample;
 use crate::plan::Inputs;
 use crate::plan::Plan;
-use crate::{with_table_size, CliError};
+use crate::CliError;
 use footprint::composite::RowSpan;
 use footprint::render::{FloatPath, RenderBuffers, SheetRenderer, SheetRing};
 use footprint::shade::{Sample, OPACITY_TABLE_LEN};
@@ -108,35 +108,63 @@ pub fn render_rows(p: &Prepared, plan: &Plan, rows: &[usize]) -> Result<Vec<[f32
             "the level pilot renders a volume in memory: drop --stream",
         ));
     };
-    let (f, k) = (&p.frame, p.supersample);
-    let (w, h) = p.out_size();
+    let h = p.out_size().1;
     if let Some(&y) = rows.iter().find(|&&y| y >= h) {
         return Err(CliError::input(format!(
             "pilot row {y} is outside an image {h} rows high"
         )));
     }
-    let lookup = plan.table.lookup;
-    with_table_size!(plan.table.size, N => {
-        let generic = plan.table.generic::<N>(&p.kernel)?;
-        let table = Box::new(ViewTable::<N>::build(&f.footprint, &generic, lookup, lookup));
-        // The sampler the whole frame's render uses (`crate::pipeline::ends::run`): phase stencils where the
-        // footprint allows them, else the view table.
-        let len = stencil_len(p, plan.phases);
-        let threads = plan.threads;
-        let bands = match len {
-            Some(len) => {
-                let mut buffer = vec![0.0f32; len];
-                let stencils = build_stencils(&*table, plan.phases, &mut buffer, threads)?;
-                split_rows(p, &stencils, volume, rows, threads)?
+    /// The rows through tables of side N.
+    struct Rows<'a> {
+        p: &'a Prepared,
+        plan: &'a Plan,
+        volume: &'a crate::io::volume::Volume,
+        rows: &'a [usize],
+    }
+    impl crate::dispatch::TableSize for Rows<'_> {
+        type Output = Vec<[f32; 4]>;
+        fn run<const N: usize>(self) -> Result<Vec<[f32; 4]>, CliError> {
+            let Rows {
+                p,
+                plan,
+                volume,
+                rows,
+            } = self;
+            let (f, k, w) = (&p.frame, p.supersample, p.out_size().0);
+            let lookup = plan.table.lookup;
+            let generic = plan.table.generic::<N>(&p.kernel)?;
+            let table = Box::new(ViewTable::<N>::build(
+                &f.footprint,
+                &generic,
+                lookup,
+                lookup,
+            ));
+            // The sampler the whole frame's render uses (`crate::pipeline::ends::run`): phase
+            // stencils where the footprint allows them, else the view table.
+            let len = stencil_len(p, plan.phases);
+            let threads = plan.threads;
+            let bands = match len {
+                Some(len) => {
+                    let mut buffer = vec![0.0f32; len];
+                    let stencils = build_stencils(&*table, plan.phases, &mut buffer, threads)?;
+                    split_rows(p, &stencils, volume, rows, threads)?
+                }
+                None => split_rows(p, &*table, volume, rows, threads)?,
+            };
+            let mut out = Vec::with_capacity(rows.len() * w);
+            for band in bands {
+                out.extend(downsample(&band, (w, 1), k, |v| v as f32));
             }
-            None => split_rows(p, &*table, volume, rows, threads)?,
-        };
-        let mut out = Vec::with_capacity(rows.len() * w);
-        for band in bands {
-            out.extend(downsample(&band, (w, 1), k, |v| v as f32));
+            Ok(out)
         }
-        out
-    })
+    }
+    let work = Rows {
+        p,
+        plan,
+        volume,
+        rows,
+    };
+    crate::dispatch::with_size(plan.table.size, work)
 }
 
 /// [`bands_from`] with `rows` split between `threads` cores, each reading the sheets for its

@@ -32,7 +32,7 @@ use crate::args::{AccumArg, LookupArg, MethodArg, QualityReferenceArg};
 use crate::io::json::Json;
 use crate::pipeline::stages::prepare::Prepared;
 use crate::reference::ReferenceFootprint;
-use crate::{with_table_size, CliError};
+use crate::CliError;
 use footprint::splat::{splat, Direct, ImageMut, Sampler};
 use footprint::{Footprint, Lookup, ViewTable};
 
@@ -292,33 +292,64 @@ fn one_footprint_error(
     let min_r = f64::from(p.options.min_radius_px);
     let reference = ReferenceFootprint::with_sheet_axis(&p.kernel, map, min_r, p.frame.sheet_axis)
         .map_err(|e| CliError::input(format!("{}: {e}", p.name)))?;
-    let lookup = Lookup::from(c.lookup);
-    let mut worst = 0.0f64;
-    with_table_size!(c.table, N => {
-        let generic = Box::new(footprint::GenericTable::<N>::build(p.kernel));
-        let sampler: Box<dyn Sampler> = if c.method == MethodArg::Direct {
-            Box::new(Direct { footprint: fp, table: &*generic, lookup })
-        } else {
-            Box::new(ViewTable::<N>::build(&fp, &generic, lookup, lookup))
-        };
-        for phase in PHASES {
-            let centre = [side as f32 / 2.0 + phase[0], side as f32 / 2.0 + phase[1]];
-            let mut want = vec![0.0f64; side * side];
-            reference.splat([f64::from(centre[0]), f64::from(centre[1])], side, side, &mut want);
-            let mut got = vec![0.0f32; side * side];
-            let mut image = ImageMut::new(&mut got, side, side, side)?;
-            splat(&*sampler, centre, &1.0f32, &mut image)?;
-            let peak = want.iter().fold(0.0f64, |m, &v| m.max(v));
-            if peak > 0.0 {
-                let e = got
-                    .iter()
-                    .zip(&want)
-                    .fold(0.0f64, |m, (&g, &w)| m.max((f64::from(g) - w).abs()));
-                worst = worst.max(e / peak);
+    /// The worst footprint error through tables of side N.
+    struct Worst<'a> {
+        p: &'a Prepared,
+        c: &'a Config,
+        fp: Footprint,
+        reference: &'a ReferenceFootprint,
+        side: usize,
+    }
+    impl crate::dispatch::TableSize for Worst<'_> {
+        type Output = f64;
+        fn run<const N: usize>(self) -> Result<f64, CliError> {
+            let Worst {
+                p,
+                c,
+                fp,
+                reference,
+                side,
+            } = self;
+            let lookup = Lookup::from(c.lookup);
+            let mut worst = 0.0f64;
+            let generic = Box::new(footprint::GenericTable::<N>::build(p.kernel));
+            let sampler: Box<dyn Sampler> = if c.method == MethodArg::Direct {
+                Box::new(Direct {
+                    footprint: fp,
+                    table: &*generic,
+                    lookup,
+                })
+            } else {
+                Box::new(ViewTable::<N>::build(&fp, &generic, lookup, lookup))
+            };
+            for phase in PHASES {
+                let centre = [side as f32 / 2.0 + phase[0], side as f32 / 2.0 + phase[1]];
+                let mut want = vec![0.0f64; side * side];
+                let at = [f64::from(centre[0]), f64::from(centre[1])];
+                reference.splat(at, side, side, &mut want);
+                let mut got = vec![0.0f32; side * side];
+                let mut image = ImageMut::new(&mut got, side, side, side)?;
+                splat(&*sampler, centre, &1.0f32, &mut image)?;
+                let peak = want.iter().fold(0.0f64, |m, &v| m.max(v));
+                if peak > 0.0 {
+                    let e = got
+                        .iter()
+                        .zip(&want)
+                        .fold(0.0f64, |m, (&g, &w)| m.max((f64::from(g) - w).abs()));
+                    worst = worst.max(e / peak);
+                }
             }
+            Ok(worst)
         }
-    })?;
-    Ok(worst)
+    }
+    let work = Worst {
+        p,
+        c,
+        fp,
+        reference: &reference,
+        side,
+    };
+    crate::dispatch::with_size(c.table, work)
 }
 
 /// `Ok` if `target_db` is a PSNR `--quality` can aim at.
