@@ -577,3 +577,68 @@ fn one_footprint_per_depth_band_is_far_less_accurate_than_per_voxel_footprints()
         "a depth band's footprint {band_worst:.3e} vs per-voxel {table_worst:.3e}"
     );
 }
+
+/// Perspective is a placement of the one float path (`PerVoxel`, issue 41), so it renders either
+/// absorption model: each voxel's optical depth is scaled to its own ray (τ' = τ·Δ/Δ₀) where its
+/// opacity is corrected (α' = 1 − (1 − α)^(Δ/Δ₀)). Each model's render agrees with the f64 sheet
+/// reference of the same model and is nearer its own continuous model than the other's.
+#[test]
+fn perspective_renders_both_absorption_models() {
+    use footprint_harness::metrics::compare;
+    use footprint_harness::pipeline::ends::continuous::render_continuous_model;
+    use footprint_harness::pipeline::{prepare, render_core, render_ref};
+    use footprint_harness::reference::continuous::{Absorption, Reconstruction};
+    let head = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/headsq_64x64x93_int16_le.nhdr"
+    );
+    let mut images = Vec::new();
+    for (model, own, other) in [
+        ("opacity", Absorption::Opacity, Absorption::Extinction),
+        ("extinction", Absorption::Extinction, Absorption::Opacity),
+    ] {
+        let a = footprint_harness::args::parse_args(&[
+            head,
+            "-s",
+            "64x64",
+            "--view",
+            "30,20,0",
+            "--perspective",
+            "40",
+            "--absorption",
+            model,
+        ])
+        .unwrap();
+        let p = prepare(&a).unwrap();
+        let (core, _, _) = render_core(&p, &plan(&a).unwrap()).unwrap();
+        let (sheets, _) = render_ref(&p).unwrap();
+        let vs_sheets = compare(&core, &sheets).1.psnr_db;
+        assert!(
+            vs_sheets >= 60.0,
+            "{model}: {vs_sheets:.1} dB against its sheet reference"
+        );
+        let db = |m| {
+            let (c, _) = render_continuous_model(&p, Reconstruction::Kernel, m).unwrap();
+            compare(&core, &c.image).1.psnr_db
+        };
+        let (mine, theirs) = (db(own), db(other));
+        eprintln!("perspective, {model}: {vs_sheets:.1} dB vs sheets, {mine:.1} vs its model, {theirs:.1} vs the other");
+        assert!(
+            mine > theirs + 3.0,
+            "{model}: {mine:.1} dB vs {theirs:.1} dB"
+        );
+        images.push(core);
+    }
+    assert!(
+        compare(
+            &images[0],
+            &images[1]
+                .iter()
+                .map(|c| c.map(f64::from))
+                .collect::<Vec<_>>()
+        )
+        .1
+        .psnr_db
+            < 60.0
+    );
+}

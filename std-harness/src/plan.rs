@@ -206,17 +206,12 @@ pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
     }
     let extinction = Absorption::from(args.absorption) == Absorption::Extinction;
     if extinction && matches!(end, End::Sheets(_) | End::Refined { .. }) {
+        // (Perspective sheets place each voxel's optical depth along its own ray: `PerVoxel`.)
         if precision == Precision::Fixed {
             return refuse(
                 "--absorption extinction",
                 "--accum fixed composites the opacity model only: use --accum float (or \
                  --absorption opacity)",
-            );
-        }
-        if args.perspective.is_some() {
-            return refuse(
-                "--absorption extinction",
-                "--perspective composites the opacity model only (or --absorption opacity)",
             );
         }
     }

@@ -23,7 +23,7 @@ pub enum FixedError {
     },
     /// A perspective frame: the fixed path is orthographic only (one integer affine placement
     /// and one integer table per view); render perspective in float
-    /// ([`crate::render::PerspectivePath`]).
+    /// ([`crate::render::PerVoxel`]).
     Perspective,
 }
 

@@ -44,7 +44,7 @@ pub enum RenderError {
     /// A transfer function that cannot classify.
     TransferFunction(crate::shade::TransferFunctionError),
     /// A perspective frame given to a precision that splats with one footprint per view
-    /// ([`FloatPath`](super::FloatPath), [`FixedPath`](super::FixedPath)): use [`PerspectivePath`](super::PerspectivePath).
+    /// ([`FloatPath`](super::FloatPath), [`FixedPath`](super::FixedPath)): use a float path placing each voxel ([`PerVoxel`](super::PerVoxel)).
     Projection,
     /// A voxel's own footprint (perspective) could not be built.
     Geometry(crate::geometry::GeometryError),
@@ -100,7 +100,7 @@ impl fmt::Display for RenderError {
             }
             Self::TransferFunction(e) => e.fmt(f),
             Self::Projection => f.write_str(
-                "a perspective frame needs per-voxel footprints (PerspectivePath); this path has one footprint per view",
+                "a perspective frame needs per-voxel footprints (FloatPath over PerVoxel); this path has one footprint per view",
             ),
             Self::Geometry(e) => write!(f, "a voxel's footprint: {e}"),
             Self::SlabOrder {

@@ -1,6 +1,7 @@
-//! [`PerspectivePath`]: float accumulation for perspective frames, every voxel splatted with its
-//! own footprint (the paper: "the image plane footprint extent and mapping must be generated for
-//! each sample").
+//! [`PerVoxel`]: how the float path ([`super::FloatPath`]) places the voxels of a perspective
+//! frame, every voxel splatted with its own footprint (the paper: "the image plane footprint
+//! extent and mapping must be generated for each sample"). Perspective is a placement of the one
+//! float path, not a path of its own: `FloatPath::new(&PerVoxel::new(…)?)`.
 //!
 //! Per voxel: its screen position and the Jacobian of the projection there
 //! ([`crate::geometry::Perspective::project`]); the footprint of the kernel under that local
@@ -11,14 +12,16 @@
 //! - the sheet cell's screen area under the voxel's Jacobian replaces the frame's `cell_area`;
 //! - the opacity, corrected by the shader for the distance Δ₀ between sheets along the central
 //!   ray, is corrected again to the distance Δ along the voxel's own ray: α' = 1 − (1 − α)^(Δ/Δ₀),
-//!   with the colour scaled as α (premultiplied).
+//!   with the colour scaled as α (premultiplied); in the extinction model the optical depth τ
+//!   simply scales, τ' = τ·Δ/Δ₀ (and its emission with it).
 //!
 //! Lighting stays a directional head-light along the central view direction (as VTK's default
 //! light).
 
-use super::precision::{float_composite_row, float_over_row};
-use super::{Precision, RenderError};
-use crate::frame::{FrameSetup, Order};
+use super::absorption::Absorption;
+use super::precision::VoxelSplat;
+use super::RenderError;
+use crate::frame::FrameSetup;
 use crate::geometry::{Footprint, FootprintOptions, Perspective};
 use crate::kernel::Kernel;
 use crate::math;
@@ -26,10 +29,10 @@ use crate::splat::{splat_rows, Direct, ImageMut, SplatStats};
 use crate::table::{GenericTable, Lookup};
 use glam::Vec3;
 
-/// Float accumulation with a footprint per voxel, sampled straight from the generic table: the
-/// precision for perspective frames ([`FrameSetup::perspective`]).
+/// A footprint per voxel, sampled straight from the generic table: how the float path places the
+/// voxels of a perspective frame ([`FrameSetup::perspective`]).
 #[derive(Clone, Copy, Debug)]
-pub struct PerspectivePath<'a, const N: usize> {
+pub struct PerVoxel<'a, const N: usize> {
     table: &'a GenericTable<N>,
     lookup: Lookup,
     kernel: Kernel,
@@ -41,8 +44,8 @@ pub struct PerspectivePath<'a, const N: usize> {
     central_k: f32,
 }
 
-impl<'a, const N: usize> PerspectivePath<'a, N> {
-    /// The path for a perspective `frame` (made with `kernel` and `options`), reading `table`
+impl<'a, const N: usize> PerVoxel<'a, N> {
+    /// The placement for a perspective `frame` (made with `kernel` and `options`), reading `table`
     /// with `lookup`. Refused ([`RenderError::Projection`]) for an orthographic frame.
     pub fn new(
         frame: &FrameSetup,
@@ -55,7 +58,7 @@ impl<'a, const N: usize> PerspectivePath<'a, N> {
         let inv = frame.grid_to_screen.inverse();
         let k = frame.sheet_axis;
         let inv_row_k = inv.row(k);
-        Ok(PerspectivePath {
+        Ok(PerVoxel {
             table,
             lookup,
             kernel: *kernel,
@@ -93,41 +96,34 @@ impl<'a, const N: usize> PerspectivePath<'a, N> {
     }
 }
 
-impl<const N: usize> Precision for PerspectivePath<'_, N> {
-    type Value = [f32; 4];
-    type Acc = [f32; 4];
-    type Pixel = [f32; 4];
+impl<const N: usize> VoxelSplat for PerVoxel<'_, N> {
     const PERSPECTIVE: bool = true;
-    const ACC_ZERO: [f32; 4] = [0.0; 4];
-    const CLEAR: [f32; 4] = [0.0; 4];
 
-    #[inline]
-    fn value(&self, rgba: [f32; 4]) -> [f32; 4] {
-        rgba
-    }
-
-    #[inline]
-    fn is_transparent(value: &[f32; 4]) -> bool {
-        !(value[3] > 0.0)
-    }
-
-    fn splat(
+    fn splat_voxel_of(
         &self,
         f: &FrameSetup,
         sheet: usize,
         (u, v): (usize, usize),
         row0: usize,
         value: &[f32; 4],
+        absorption: Absorption,
         acc: &mut ImageMut<'_, [f32; 4]>,
         touched: impl FnMut(usize, usize, usize),
     ) -> Result<SplatStats, RenderError> {
         let idx = f.grid_index(sheet, u, v).map(|i| i as f32);
         let (footprint, center, area, exponent) = self.voxel(f, idx)?;
-        let alpha = value[3];
-        let scale = if alpha < 1.0 && exponent.is_finite() && exponent != 1.0 {
-            (1.0 - math::powf(1.0 - alpha, exponent)) / alpha
-        } else {
-            1.0
+        let scale = match absorption {
+            Absorption::Opacity => {
+                let alpha = value[3];
+                if alpha < 1.0 && exponent.is_finite() && exponent != 1.0 {
+                    (1.0 - math::powf(1.0 - alpha, exponent)) / alpha
+                } else {
+                    1.0
+                }
+            }
+            // Optical depth is linear in the distance.
+            Absorption::Extinction if exponent.is_finite() => exponent,
+            Absorption::Extinction => 1.0,
         };
         let value = value.map(|c| c * scale * area);
         let sampler = Direct {
@@ -142,13 +138,5 @@ impl<const N: usize> Precision for PerspectivePath<'_, N> {
             acc,
             touched,
         )?)
-    }
-
-    fn composite_row(&self, acc: &mut [[f32; 4]], image: &mut [[f32; 4]], order: Order) {
-        float_composite_row(acc, image, order);
-    }
-
-    fn over_row(&self, front: &mut [[f32; 4]], back: &[[f32; 4]]) {
-        float_over_row(front, back);
     }
 }

@@ -49,8 +49,55 @@ pub trait Precision {
     fn over_row(&self, front: &mut [Self::Pixel], back: &[Self::Pixel]);
 }
 
-/// Float accumulation through any [`Splatter`]: a footprint [`Sampler`](crate::Sampler) (view
-/// table or direct) or a view's phase stencils ([`crate::stencil::Stencils`]).
+/// How the float path places one voxel of a sheet in the accumulator: any [`Splatter`] (a
+/// footprint sampler or phase stencils shared by the whole orthographic view, the voxel at its
+/// screen position with the frame's cell area), or one footprint per voxel for a perspective
+/// frame ([`super::PerVoxel`]). The float path is one, whatever places its voxels.
+pub trait VoxelSplat {
+    /// Whether it places the voxels of a perspective frame (a renderer refuses a perspective
+    /// frame with [`RenderError::Projection`] otherwise).
+    const PERSPECTIVE: bool = false;
+    /// Splats voxel (u, v) of sheet `sheet` of `frame`, valued `value` in `absorption`'s model
+    /// ([`FloatPath`]'s accumulation), into `acc`, whose first row is image row `row0`;
+    /// reports touched rows (relative to `acc`).
+    #[allow(clippy::too_many_arguments)]
+    fn splat_voxel_of(
+        &self,
+        frame: &FrameSetup,
+        sheet: usize,
+        uv: (usize, usize),
+        row0: usize,
+        value: &[f32; 4],
+        absorption: Absorption,
+        acc: &mut ImageMut<'_, [f32; 4]>,
+        touched: impl FnMut(usize, usize, usize),
+    ) -> Result<SplatStats, RenderError>;
+}
+
+impl<S: Splatter + ?Sized> VoxelSplat for S {
+    #[inline]
+    fn splat_voxel_of(
+        &self,
+        f: &FrameSetup,
+        sheet: usize,
+        (u, v): (usize, usize),
+        row0: usize,
+        value: &[f32; 4],
+        _: Absorption,
+        acc: &mut ImageMut<'_, [f32; 4]>,
+        touched: impl FnMut(usize, usize, usize),
+    ) -> Result<SplatStats, RenderError> {
+        let p = float_position(f, sheet, u, v);
+        let value = value.map(|c| c * f.cell_area);
+        // Subtracting a whole number of rows is exact here (|p.y| < 2²⁴), so every pixel of a
+        // band sees the offsets, and so the weights, of a whole-image render.
+        Ok(self.splat_voxel([p[0], p[1] - row0 as f32], &value, acc, touched)?)
+    }
+}
+
+/// Float accumulation: f32 accumulator and image, each voxel placed by a [`VoxelSplat`] (a
+/// footprint [`Sampler`](crate::Sampler) (view table or direct) or a view's phase stencils
+/// ([`crate::stencil::Stencils`]) in an orthographic frame; [`super::PerVoxel`] in perspective).
 ///
 /// A sheet composites the [`Absorption`] model it is given: opacity (the paper's sheets: the
 /// premultiplied values summed, clamped to [0, 1]) or extinction (each voxel's sheet opacity α
@@ -87,10 +134,11 @@ impl<S: ?Sized> Clone for FloatPath<'_, S> {
 
 impl<S: ?Sized> Copy for FloatPath<'_, S> {}
 
-impl<S: Splatter + ?Sized> Precision for FloatPath<'_, S> {
+impl<S: VoxelSplat + ?Sized> Precision for FloatPath<'_, S> {
     type Value = [f32; 4];
     type Acc = [f32; 4];
     type Pixel = [f32; 4];
+    const PERSPECTIVE: bool = S::PERSPECTIVE;
     const ACC_ZERO: [f32; 4] = [0.0; 4];
     const CLEAR: [f32; 4] = [0.0; 4];
 
@@ -112,19 +160,14 @@ impl<S: Splatter + ?Sized> Precision for FloatPath<'_, S> {
         &self,
         f: &FrameSetup,
         sheet: usize,
-        (u, v): (usize, usize),
+        uv: (usize, usize),
         row0: usize,
         value: &[f32; 4],
         acc: &mut ImageMut<'_, [f32; 4]>,
         touched: impl FnMut(usize, usize, usize),
     ) -> Result<SplatStats, RenderError> {
-        let p = float_position(f, sheet, u, v);
-        let value = value.map(|c| c * f.cell_area);
-        // Subtracting a whole number of rows is exact here (|p.y| < 2²⁴), so every pixel of a
-        // band sees the offsets, and so the weights, of a whole-image render.
-        Ok(self
-            .sampler
-            .splat_voxel([p[0], p[1] - row0 as f32], &value, acc, touched)?)
+        self.sampler
+            .splat_voxel_of(f, sheet, uv, row0, value, self.absorption, acc, touched)
     }
 
     fn composite_row(&self, acc: &mut [[f32; 4]], image: &mut [[f32; 4]], order: Order) {
@@ -154,7 +197,7 @@ fn extinction_composite_row(acc: &mut [[f32; 4]], image: &mut [[f32; 4]], order:
 
 /// The float paths' compositing: clamp the accumulated sheet to [0, 1], over or under the image,
 /// clear the accumulator.
-pub(super) fn float_composite_row(acc: &mut [[f32; 4]], image: &mut [[f32; 4]], order: Order) {
+fn float_composite_row(acc: &mut [[f32; 4]], image: &mut [[f32; 4]], order: Order) {
     // The order settled per row, so each loop is straight-line per pixel.
     match order {
         Order::BackToFront => {

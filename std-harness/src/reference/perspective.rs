@@ -1,7 +1,7 @@
 //! The f64 reference for perspective frames: every voxel's weight at a pixel is the exact
 //! integral of its kernel along that pixel's own ray from the eye (no affine approximation), so
 //! `verify` measures the core's per-voxel affine footprints
-//! ([`footprint::render::PerspectivePath`]).
+//! ([`footprint::render::PerVoxel`]).
 //!
 //! In the frame's affine screen units (see [`footprint::geometry::Perspective`]) the eye is the
 //! origin and the ray through pixel centre (X, Y) runs along d = (X − cₓ, Y − c_y, f)/|…|. With

@@ -22,8 +22,7 @@ pub struct ReferenceScene<'a> {
     pub shader: Shader<'a>,
     pub order: Order,
     pub background: Option<&'a [[f32; 4]]>,
-    /// The model each sheet composites, as the core's `FloatPath` does (orthographic frames only
-    /// for extinction: the harness refuses it in perspective).
+    /// The model each sheet composites, as the core's `FloatPath` does.
     pub absorption: Absorption,
 }
 
@@ -134,13 +133,22 @@ pub fn render_reference(
                                     *failed.lock().expect("no panics hold it") = true;
                                     continue;
                                 };
-                                let a = f64::from(rgba[3]);
-                                let scale = if a < 1.0 && pv.exponent != 1.0 {
-                                    (1.0 - (1.0 - a).powf(pv.exponent)) / a
-                                } else {
-                                    1.0
+                                let Some(value) = absorption.voxel_value(rgba) else {
+                                    continue;
                                 };
-                                let c = rgba.map(|x| f64::from(x) * scale);
+                                let scale = match absorption {
+                                    Absorption::Opacity => {
+                                        let a = f64::from(rgba[3]);
+                                        if a < 1.0 && pv.exponent != 1.0 {
+                                            (1.0 - (1.0 - a).powf(pv.exponent)) / a
+                                        } else {
+                                            1.0
+                                        }
+                                    }
+                                    // Optical depth is linear in the distance along the ray.
+                                    Absorption::Extinction => pv.exponent,
+                                };
+                                let c = value.map(|x| f64::from(x) * scale);
                                 pv.for_each_weight(w, rows.clone(), |i, wt| add(i, &c, wt));
                                 continue;
                             }

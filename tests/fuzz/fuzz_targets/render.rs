@@ -25,7 +25,7 @@
 use footprint::fixed::{FixedTable, ONE};
 use footprint::frame::{FrameSetup, Order};
 use footprint::lod::level_frame;
-use footprint::render::{FixedPath, FloatPath, PerspectivePath, SlabSetup};
+use footprint::render::{FixedPath, FloatPath, PerVoxel, SlabSetup};
 use footprint::table::SectionTable;
 use footprint::{FootprintOptions, GenericTable, Grid, Kernel, Lookup, View, ViewTable};
 use footprint_harness::reference::ReferenceFootprint;
@@ -136,7 +136,8 @@ fuzz_target!(|data: &[u8]| {
     if let Ok(view) = View::from_angles(angles, zoom, dims, &grid, size) {
         if let Ok(frame) = FrameSetup::perspective(dims, &grid, &view, &kernel, options, size, eye)
         {
-            if let Ok(path) = PerspectivePath::new(&frame, &kernel, options, &generic, lookup) {
+            if let Ok(per) = PerVoxel::new(&frame, &kernel, options, &generic, lookup) {
+                let path = FloatPath::new(&per);
                 for order in [Order::BackToFront, Order::FrontToBack] {
                     let img = footprint_fuzz::render_volume(&frame, path, order, &samples, &lut);
                     check_image(&img, "perspective render");

@@ -20,7 +20,7 @@ use crate::CliError;
 use footprint::fixed::stencil::FixedStencils;
 use footprint::fixed::{self, FixedTable};
 use footprint::render::{
-    FixedPath, FloatPath, PerspectivePath, Precision, RenderBuffers, RenderStats, ShadeCacheEntry,
+    FixedPath, FloatPath, PerVoxel, Precision, RenderBuffers, RenderStats, ShadeCacheEntry,
     SheetRenderer, SheetRing, SHADE_CACHE_LEN,
 };
 use footprint::shade::{Sample, OPACITY_TABLE_LEN};
@@ -124,7 +124,8 @@ fn sheets_at<const N: usize>(
         let (image, stats, mut phases, visible) = match precision {
             PlanPrecision::Float if perspective => {
                 // Every voxel its own footprint, sampled from the generic table (no view table).
-                let path = PerspectivePath::new(&p.frame, &p.kernel, p.options, &*generic, lookup)?;
+                let per = PerVoxel::new(&p.frame, &p.kernel, p.options, &*generic, lookup)?;
+                let path = FloatPath::new(&per).with_absorption(p.absorption);
                 let tables = start.elapsed().as_secs_f64();
                 let r = run_path(p, path, p.background.as_deref(), cache, threads)?;
                 (r.0, r.1, Phases { tables, ..r.2 }, r.3)
