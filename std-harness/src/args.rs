@@ -239,18 +239,7 @@ impl FootprintArgs {
         &self,
         kernel: &footprint::Kernel,
     ) -> Result<Box<footprint::GenericTable<N>>, CliError> {
-        let Some(path) = &self.table_file else {
-            return Ok(Box::new(footprint::GenericTable::<N>::build(*kernel)));
-        };
-        let table = crate::io::table::load_table::<N>(path)?;
-        if table.kernel() != kernel {
-            return Err(CliError::input(format!(
-                "{}: table is for kernel {}, but --kernel is {kernel}",
-                path.display(),
-                table.kernel()
-            )));
-        }
-        Ok(table)
+        crate::io::table::generic_for::<N>(self.table_file.as_deref(), kernel)
     }
 }
 

@@ -89,18 +89,7 @@ impl Table {
         &self,
         kernel: &footprint::Kernel,
     ) -> Result<Box<footprint::GenericTable<N>>, CliError> {
-        let Some(path) = &self.file else {
-            return Ok(Box::new(footprint::GenericTable::<N>::build(*kernel)));
-        };
-        let table = crate::io::table::load_table::<N>(path)?;
-        if table.kernel() != kernel {
-            return Err(CliError::input(format!(
-                "{}: table is for kernel {}, but --kernel is {kernel}",
-                path.display(),
-                table.kernel()
-            )));
-        }
-        Ok(table)
+        crate::io::table::generic_for::<N>(self.file.as_deref(), kernel)
     }
 }
 

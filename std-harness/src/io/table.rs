@@ -21,6 +21,26 @@ pub fn table_bytes(kernel: &Kernel, size: usize) -> Result<Vec<u8>, CliError> {
     with_size(size, Bytes(kernel))
 }
 
+/// The generic table for `kernel`: loaded from `file` (which must be for `kernel` and of side N)
+/// or built. What `--table-file` and `--kernel` ask for, whichever command asks.
+pub fn generic_for<const N: usize>(
+    file: Option<&std::path::Path>,
+    kernel: &Kernel,
+) -> Result<Box<GenericTable<N>>, CliError> {
+    let Some(path) = file else {
+        return Ok(Box::new(GenericTable::<N>::build(*kernel)));
+    };
+    let table = load_table::<N>(path)?;
+    if table.kernel() != kernel {
+        return Err(CliError::input(format!(
+            "{}: table is for kernel {}, but --kernel is {kernel}",
+            path.display(),
+            table.kernel()
+        )));
+    }
+    Ok(table)
+}
+
 /// Loads a table file for a `GenericTable<N>`, with the path in any error.
 pub fn load_table<const N: usize>(
     path: &std::path::Path,

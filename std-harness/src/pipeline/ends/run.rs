@@ -27,7 +27,7 @@ use footprint::shade::{Sample, OPACITY_TABLE_LEN};
 use footprint::source::{render_from, SheetSource};
 use footprint::splat::Direct;
 use footprint::stencil::{self, Stencils};
-use footprint::{composite::RowSpan, ViewTable};
+use footprint::{composite::RowSpan, GenericTable, ViewTable};
 use std::time::Instant;
 
 /// The core's render of `p` with `plan`: premultiplied RGBA (fixed-point output converted
@@ -114,8 +114,6 @@ fn sheets_at<const N: usize>(
     let lookup = plan.table.lookup;
     let threads = plan.threads;
     let direct = plan.table.footprints == Footprints::Direct;
-    let fixed_range =
-        |e: fixed::FixedError| CliError::input(format!("{}: --accum fixed: {e}", p.name));
     let start = Instant::now();
     {
         let generic = plan.table.generic::<N>(&p.kernel)?;
@@ -174,62 +172,7 @@ fn sheets_at<const N: usize>(
                 };
                 r
             }
-            PlanPrecision::Fixed => {
-                let mut table = Box::new(FixedTable::<N>::zeroed());
-                if direct {
-                    table.build_direct(&p.frame, &generic, lookup)
-                } else {
-                    table.build_view(&p.frame, &generic, lookup, lookup)
-                }
-                .map_err(fixed_range)?;
-                // Shaded voxels never exceed opacity 1: the stencils may add unsaturated where
-                // that keeps every sum in range (the same bits).
-                let path = FixedPath::new(&p.frame, &*table)
-                    .map_err(fixed_range)?
-                    .with_value_bound(fixed::ONE);
-                // Footprints up to 128 px across: the integer table sampled once per phase (as
-                // the float path's stencils, with as many phases); wider ones, or --phases 0, walk
-                // the table.
-                // Blended to the edge where the float stencils are (the same phases), else edged.
-                let sp = stencil::plan_for(&p.frame.footprint, plan.phases);
-                let blended = sp.is_some_and(|q| !q.edged);
-                let phases = match sp {
-                    Some(q) if blended => q.phases,
-                    _ => stencil::edged_phases_for(&p.frame.footprint, plan.phases),
-                };
-                let len = (plan.phases > 0 && !direct)
-                    .then(|| fixed::stencil::len_for(&table, phases))
-                    .flatten();
-                let mut buffer = vec![0i32; len.unwrap_or(0)];
-                let build = if blended {
-                    FixedStencils::build_blended
-                } else {
-                    FixedStencils::build
-                };
-                let path = match len.map(|_| build(&table, phases, &mut buffer)) {
-                    Some(Ok(stencils)) => path.with_stencils(stencils),
-                    // --phases 0, the direct method, a footprint past the stencils' limits, or
-                    // renormalised weights too large for 32 bits: the walk serves this view.
-                    _ => path,
-                };
-                let tables = start.elapsed().as_secs_f64();
-                let bg: Option<Vec<[u32; 4]>> = p
-                    .background
-                    .as_ref()
-                    .map(|b| b.iter().map(|&c| fixed::quantise(c)).collect());
-                // A kept float image (a frame handed back) serves as this one's, its bits as
-                // they are: the renderer starts every pixel afresh.
-                let [w, h] = p.frame.size;
-                cache.reuse_image_as(w * h, |px: [f32; 4]| px.map(f32::to_bits));
-                let (img, stats, phases, visible) =
-                    run_path(p, path, bg.as_deref(), cache, threads)?;
-                (
-                    img.into_iter().map(fixed::to_f32).collect(),
-                    stats,
-                    Phases { tables, ..phases },
-                    visible,
-                )
-            }
+            PlanPrecision::Fixed => fixed_sheets(p, plan, &generic, cache, start)?,
         };
         phases.tables = phases.tables.max(0.0);
         // Supersampled: the mean of each k×k block (timed with the frame: it is part of it).
@@ -248,6 +191,74 @@ fn sheets_at<const N: usize>(
             visible,
         })
     }
+}
+
+/// The fixed-point sheets of `p` through `plan`'s tables built from `generic` (integer table,
+/// stencils where they serve), timed from `start`; the image converted exactly to f32.
+fn fixed_sheets<const N: usize>(
+    p: &Prepared,
+    plan: &Plan,
+    generic: &GenericTable<N>,
+    cache: &mut FrameCache,
+    start: Instant,
+) -> Result<PathResult<[f32; 4]>, CliError> {
+    let (lookup, threads) = (plan.table.lookup, plan.threads);
+    let direct = plan.table.footprints == Footprints::Direct;
+    let fixed_range =
+        |e: fixed::FixedError| CliError::input(format!("{}: --accum fixed: {e}", p.name));
+    let mut table = Box::new(FixedTable::<N>::zeroed());
+    if direct {
+        table.build_direct(&p.frame, generic, lookup)
+    } else {
+        table.build_view(&p.frame, generic, lookup, lookup)
+    }
+    .map_err(fixed_range)?;
+    // Shaded voxels never exceed opacity 1: the stencils may add unsaturated where
+    // that keeps every sum in range (the same bits).
+    let path = FixedPath::new(&p.frame, &*table)
+        .map_err(fixed_range)?
+        .with_value_bound(fixed::ONE);
+    // Footprints up to 128 px across: the integer table sampled once per phase (as
+    // the float path's stencils, with as many phases); wider ones, or --phases 0, walk
+    // the table.
+    // Blended to the edge where the float stencils are (the same phases), else edged.
+    let sp = stencil::plan_for(&p.frame.footprint, plan.phases);
+    let blended = sp.is_some_and(|q| !q.edged);
+    let phases = match sp {
+        Some(q) if blended => q.phases,
+        _ => stencil::edged_phases_for(&p.frame.footprint, plan.phases),
+    };
+    let len = (plan.phases > 0 && !direct)
+        .then(|| fixed::stencil::len_for(&table, phases))
+        .flatten();
+    let mut buffer = vec![0i32; len.unwrap_or(0)];
+    let build = if blended {
+        FixedStencils::build_blended
+    } else {
+        FixedStencils::build
+    };
+    let path = match len.map(|_| build(&table, phases, &mut buffer)) {
+        Some(Ok(stencils)) => path.with_stencils(stencils),
+        // --phases 0, the direct method, a footprint past the stencils' limits, or
+        // renormalised weights too large for 32 bits: the walk serves this view.
+        _ => path,
+    };
+    let tables = start.elapsed().as_secs_f64();
+    let bg: Option<Vec<[u32; 4]>> = p
+        .background
+        .as_ref()
+        .map(|b| b.iter().map(|&c| fixed::quantise(c)).collect());
+    // A kept float image (a frame handed back) serves as this one's, its bits as
+    // they are: the renderer starts every pixel afresh.
+    let [w, h] = p.frame.size;
+    cache.reuse_image_as(w * h, |px: [f32; 4]| px.map(f32::to_bits));
+    let (img, stats, phases, visible) = run_path(p, path, bg.as_deref(), cache, threads)?;
+    Ok((
+        img.into_iter().map(fixed::to_f32).collect(),
+        stats,
+        Phases { tables, ..phases },
+        visible,
+    ))
 }
 
 /// The float path's phase stencils of `sampler` (at most `phases` per pixel) in `buffer`,
