@@ -137,6 +137,17 @@ pub(crate) fn load_voxels(args: &Inputs) -> Result<Loaded, CliError> {
             range,
         });
     };
+    load_stream(args, stream, raw)
+}
+
+/// `--stream FILE|-`: the layout a streamed volume is read through (standard input, a raw file,
+/// NRRD or MetaImage with raw data), checked against the file, and, without `--window`, the
+/// range and sample the default window needs (one pass over the file).
+fn load_stream(
+    args: &Inputs,
+    stream: &std::path::Path,
+    raw: Option<RawOptions>,
+) -> Result<Loaded, CliError> {
     if args.volume.is_some() {
         return Err(CliError::input(
             "give the volume either as VOLUME or with --stream, not both",
@@ -170,7 +181,7 @@ pub(crate) fn load_voxels(args: &Inputs) -> Result<Loaded, CliError> {
     let lower = name.to_ascii_lowercase();
     let (layout, spacing, directions) = if let Some(o) = &raw {
         let layout = Layout {
-            path: stream.clone(),
+            path: stream.to_path_buf(),
             offset: 0,
             dims: o.dims,
             ty: o.ty,

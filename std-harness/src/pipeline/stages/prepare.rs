@@ -473,29 +473,7 @@ pub fn prepare_as_asked(args: &Inputs) -> Result<Prepared, CliError> {
     let (frame, supersample, level) = setup_frame(framing, dims, &grid, &kernel, options)?;
     let kernel = kernel_at(args, &kernel, level);
 
-    let order = match &voxels {
-        Voxels::Stdin { .. } => {
-            if frame.sheet_axis != 2 {
-                return Err(CliError::input(format!(
-                    "standard input delivers z-slices in file order, but this view's sheets run along {}: \
-                     only views looking within 45° of the z axis work from a pipe (for example --view 0,0,0, \
-                     --view 180,0,0 or --view 30,20,0); stream a file to render any view",
-                    ["x", "y", "z"][frame.sheet_axis]
-                )));
-            }
-            let needed = frame.order_for_ascending();
-            if let Some(asked) = args.order.map(Order::from) {
-                if asked != needed {
-                    return Err(CliError::input(format!(
-                        "from a pipe this view composites {needed:?} (file order runs {} the viewer); drop --order",
-                        if frame.ascending_recedes { "away from" } else { "toward" }
-                    )));
-                }
-            }
-            needed
-        }
-        _ => args.order.map_or(Order::BackToFront, Order::from),
-    };
+    let order = compositing_order(args, &voxels, &frame)?;
     let tf_name = args.tf.clone().unwrap_or_else(|| {
         if args.volume.is_none() && args.stream.is_none() && args.memory.is_none() {
             "density"
@@ -567,6 +545,39 @@ pub fn prepare_as_asked(args: &Inputs) -> Result<Prepared, CliError> {
         supersample,
         absorption: args.absorption,
         view: view_for(args, dims, &grid)?,
+    })
+}
+
+/// The compositing order: `--order`, back to front by default; from a pipe, the order its
+/// file order gives (refused for a view whose sheets do not run along z, or an `--order` against
+/// it).
+fn compositing_order(
+    args: &Inputs,
+    voxels: &Voxels,
+    frame: &FrameSetup,
+) -> Result<Order, CliError> {
+    Ok(match voxels {
+        Voxels::Stdin { .. } => {
+            if frame.sheet_axis != 2 {
+                return Err(CliError::input(format!(
+                    "standard input delivers z-slices in file order, but this view's sheets run along {}: \
+                     only views looking within 45° of the z axis work from a pipe (for example --view 0,0,0, \
+                     --view 180,0,0 or --view 30,20,0); stream a file to render any view",
+                    ["x", "y", "z"][frame.sheet_axis]
+                )));
+            }
+            let needed = frame.order_for_ascending();
+            if let Some(asked) = args.order.map(Order::from) {
+                if asked != needed {
+                    return Err(CliError::input(format!(
+                        "from a pipe this view composites {needed:?} (file order runs {} the viewer); drop --order",
+                        if frame.ascending_recedes { "away from" } else { "toward" }
+                    )));
+                }
+            }
+            needed
+        }
+        _ => args.order.map_or(Order::BackToFront, Order::from),
     })
 }
 
