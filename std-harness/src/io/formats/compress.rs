@@ -116,6 +116,18 @@ impl std::io::Write for Capped {
 /// Decodes an `.xz` stream (what VTK's `vtkLZMADataCompressor` writes: liblzma's "easy" encoder,
 /// CRC-64 check) into exactly `expected` bytes. Output past `expected` stops the decoder at once.
 pub fn unxz(bytes: &[u8], expected: usize) -> Result<Vec<u8>, String> {
+    // lzma-rs 0.3.0 computes a stream footer's index size as (backward_size + 1) << 2 in u32
+    // (src/decode/xz.rs:52), which overflows (a panic where overflow checks are on) for the
+    // backward size 2³² − 1: a 16 GiB index no real file has. A footer is CRC32, backward size,
+    // two flag bytes and the magic "YZ"; any run of four 0xFF bytes two bytes before a "YZ" is
+    // refused as corrupt before the decoder sees it (in compressed payload the pattern has odds
+    // of 2⁻⁴⁸ per byte).
+    if bytes
+        .windows(8)
+        .any(|w| w[..4] == [0xff; 4] && w[6..] == *b"YZ")
+    {
+        return Err("corrupt LZMA data: an XZ stream footer declares a 16 GiB index".into());
+    }
     let mut sink = Capped {
         out: Vec::new(),
         limit: expected,
@@ -139,4 +151,21 @@ pub fn unxz(bytes: &[u8], expected: usize) -> Result<Vec<u8>, String> {
         ));
     }
     Ok(sink.out)
+}
+
+#[cfg(test)]
+mod xz_footer_tests {
+    /// A fuzzed stream (found by `tests/fuzz` `compressors`) whose footer declares backward size
+    /// 2³² − 1: refused with a typed error, not a panic in the decoder.
+    #[test]
+    fn a_footer_with_the_largest_backward_size_is_refused() {
+        let mut bytes = vec![
+            0xfd, b'7', b'z', b'X', b'Z', 0, 0, 4, 0xe6, 0xd6, 0xb4, 0x46,
+        ];
+        bytes.extend_from_slice(&[0, 0, 0, 0, 0, 0, 0, 0]);
+        bytes.extend_from_slice(&[0xf0, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0x5f, 0x2d]);
+        bytes.extend_from_slice(b"YZ");
+        let e = super::unxz(&bytes, 16).expect_err("refused");
+        assert!(e.contains("corrupt LZMA data"), "{e}");
+    }
 }
