@@ -476,29 +476,33 @@ fn parse_dims(s: &str) -> Result<[usize; 3], String> {
     Ok(out)
 }
 
+impl GammaArg {
+    /// The image module's curve.
+    pub fn curve(self) -> crate::io::image::Gamma {
+        match self {
+            GammaArg::Linear => crate::io::image::Gamma::Linear,
+            GammaArg::Srgb => crate::io::image::Gamma::Srgb,
+        }
+    }
+}
+
+impl Background {
+    /// The image file, if it names one.
+    pub fn file(&self) -> Option<&std::path::Path> {
+        match self {
+            Background::Image(p) => Some(p),
+            _ => None,
+        }
+    }
+}
+
 impl RenderArgs {
     /// How a PNG output is written: `--background transparent`, `--gamma`, `--depth`.
     pub fn png_style(&self) -> crate::io::image::PngStyle {
         crate::io::image::PngStyle {
             alpha: self.background == Background::Transparent,
-            gamma: self.gamma_curve(),
+            gamma: self.gamma.curve(),
             sixteen: self.depth == 16,
-        }
-    }
-
-    /// `--gamma` as the image module's curve.
-    pub fn gamma_curve(&self) -> crate::io::image::Gamma {
-        match self.gamma {
-            GammaArg::Linear => crate::io::image::Gamma::Linear,
-            GammaArg::Srgb => crate::io::image::Gamma::Srgb,
-        }
-    }
-
-    /// The background image file, if `--background` names one.
-    pub fn background_file(&self) -> Option<&std::path::Path> {
-        match &self.background {
-            Background::Image(p) => Some(p),
-            _ => None,
         }
     }
 
@@ -510,7 +514,7 @@ impl RenderArgs {
             self.volume.as_deref(),
             self.stream.as_deref(),
             self.tf.as_deref().map(std::path::Path::new),
-            self.background_file(),
+            self.background.file(),
             self.footprint.table_file.as_deref(),
         ];
         for path in named.into_iter().flatten() {

@@ -344,24 +344,6 @@ impl From<&RenderArgs> for Inputs {
     }
 }
 
-impl Inputs {
-    /// `--gamma` as the image module's curve.
-    pub fn gamma_curve(&self) -> crate::io::image::Gamma {
-        match self.gamma {
-            GammaArg::Linear => crate::io::image::Gamma::Linear,
-            GammaArg::Srgb => crate::io::image::Gamma::Srgb,
-        }
-    }
-
-    /// The background image file, if `--background` names one.
-    pub fn background_file(&self) -> Option<&std::path::Path> {
-        match &self.background {
-            Background::Image(p) => Some(p),
-            _ => None,
-        }
-    }
-}
-
 /// `base` turned `degrees` of azimuth further about the volume's vertical axis: `--view`'s
 /// azimuth plus `degrees`, or a `--view-matrix` V as V · Ry(degrees) (the same turn). What
 /// `render --orbit` and `bench --orbit` step by.

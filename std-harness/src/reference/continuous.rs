@@ -41,58 +41,15 @@
 //! the eye through each pixel centre (perspective).
 
 use super::field::Field;
-pub use super::field::Model;
+pub use super::field::{Absorption, ContinuousScene, Model, Reconstruction, DEFAULT_CAP};
 use crate::CliError;
 use footprint::frame::FrameSetup;
-use footprint::shade::Shader;
-use footprint::Kernel;
 use glam::{DMat3, DVec3};
 
 /// Two successive refinements closer than this (PSNR between them, dB) count as converged.
 pub const CONVERGED_DB: f64 = 60.0;
 /// The most halvings of the step.
 pub const MAX_HALVINGS: usize = 6;
-
-/// How the continuous field is reconstructed from the voxels.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Reconstruction {
-    /// The renderer's kernel (Gaussian only).
-    Kernel,
-    /// Trilinear interpolation of the pre-classified voxels.
-    Trilinear,
-}
-
-impl Reconstruction {
-    /// The name `--reconstruction` and the JSON use.
-    pub fn name(self) -> &'static str {
-        match self {
-            Reconstruction::Kernel => "kernel",
-            Reconstruction::Trilinear => "trilinear",
-        }
-    }
-}
-
-/// Which quantity the field reconstructs between voxels (see the module docs): the core's
-/// model, so the reference and both slicings read the same field.
-pub use footprint::render::Absorption;
-
-/// What the continuous reference renders.
-pub struct ContinuousScene<'a> {
-    pub frame: &'a FrameSetup,
-    pub kernel: &'a Kernel,
-    pub shader: Shader<'a>,
-    pub background: Option<&'a [[f32; 4]]>,
-    pub reconstruction: Reconstruction,
-    /// Pre-classified in an absorption model, or post-classified ([`super::field`]).
-    pub model: Model,
-    /// The least transmittance per world unit a voxel keeps in the extinction model (its opacity
-    /// is capped at 1 − `cap`): [`DEFAULT_CAP`], the renderer's. The opacity model has no cap and
-    /// ignores it (`tests/continuous.rs` moves it from 10⁻⁴ to 10⁻⁹ and checks that).
-    pub cap: f64,
-}
-
-/// [`ContinuousScene::cap`] as the renderer takes it: 1 − `SlabVoxel::MAX_UNIT_ALPHA` = 10⁻⁶.
-pub const DEFAULT_CAP: f64 = 1e-6;
 
 /// The converged image and how it converged.
 pub struct Continuous {

@@ -15,12 +15,53 @@
 //!   nothing is extrapolated past its faces); a NaN value is a missing sample (weight zero) and a
 //!   sample whose weights are all missing is transparent.
 
-use super::continuous::{Absorption, ContinuousScene, Reconstruction};
 use crate::CliError;
+use footprint::frame::FrameSetup;
 use footprint::render::{gradient, SheetWindow};
 use footprint::shade::{Lighting, Shader};
 use footprint::Kernel;
 use glam::{DVec3, Vec3};
+
+/// How the continuous field is reconstructed from the voxels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Reconstruction {
+    /// The renderer's kernel (Gaussian only).
+    Kernel,
+    /// Trilinear interpolation of the pre-classified voxels.
+    Trilinear,
+}
+
+impl Reconstruction {
+    /// The name `--reconstruction` and the JSON use.
+    pub fn name(self) -> &'static str {
+        match self {
+            Reconstruction::Kernel => "kernel",
+            Reconstruction::Trilinear => "trilinear",
+        }
+    }
+}
+
+/// Which quantity the field reconstructs between voxels (see [`super::continuous`]): the core's
+/// model, so the reference and both slicings read the same field.
+pub use footprint::render::Absorption;
+
+/// What the continuous reference renders.
+pub struct ContinuousScene<'a> {
+    pub frame: &'a FrameSetup,
+    pub kernel: &'a Kernel,
+    pub shader: Shader<'a>,
+    pub background: Option<&'a [[f32; 4]]>,
+    pub reconstruction: Reconstruction,
+    /// Pre-classified in an absorption model, or post-classified ([`super::field`]).
+    pub model: Model,
+    /// The least transmittance per world unit a voxel keeps in the extinction model (its opacity
+    /// is capped at 1 − `cap`): [`DEFAULT_CAP`], the renderer's. The opacity model has no cap and
+    /// ignores it (`tests/continuous.rs` moves it from 10⁻⁴ to 10⁻⁹ and checks that).
+    pub cap: f64,
+}
+
+/// [`ContinuousScene::cap`] as the renderer takes it: 1 − `SlabVoxel::MAX_UNIT_ALPHA` = 10⁻⁶.
+pub const DEFAULT_CAP: f64 = 1e-6;
 
 /// Voxels per block side of the empty-space map.
 const BLOCK: usize = 8;

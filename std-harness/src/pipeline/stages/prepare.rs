@@ -521,8 +521,9 @@ pub fn prepare_as_asked(args: &Inputs) -> Result<Prepared, CliError> {
         other => other,
     };
     let background_out: Option<Arc<[[f32; 4]]>> = args
-        .background_file()
-        .map(|p| load_background(p, args.size, args.gamma_curve()))
+        .background
+        .file()
+        .map(|p| load_background(p, args.size, args.gamma.curve()))
         .transpose()?
         .map(Into::into);
     let background = at_frame(background_out.as_ref(), args.size, supersample);
