@@ -59,8 +59,10 @@ use crate::splat::{
 mod fill;
 mod row;
 mod small;
+pub(crate) mod walk;
 
 pub use fill::StencilFill;
+use walk::{corner_rows, SpanWalk};
 
 /// Largest number of phases per pixel the harness uses ([`phases_for`] lowers it for
 /// footprints wider than [`NARROW_SIDE`]).
@@ -265,7 +267,6 @@ pub struct Stencils<'a, S: ?Sized> {
     /// Offset of the per-cell row ranges in `data`.
     ranges: usize,
     side: usize,
-    reach: i64,
     phases: usize,
     /// The longest stored row run, pixels (0 when every run is empty).
     run_width: usize,
@@ -340,53 +341,42 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
         // corner stencils is non-zero (blended footprints: the pixels a splat visits), or where
         // all four are (edged ones: the pixels it blends); first > last when there are none.
         let wide = plan.edged;
-        let mut run_width = 0;
         let weights = &*weights;
         let nonzero = |stencil: usize, my: usize| {
             nonzero_run(&weights[stencil * cells + my * side..][..side])
         };
-        for (c, cell) in spans.chunks_exact_mut(side).enumerate() {
-            let corners = cell_corners(c, phases);
-            for (my, packed) in cell.iter_mut().enumerate() {
-                let (mut first, mut last) = (side, 0);
-                if wide {
-                    // Non-zero in all four: inside each corner's run, and no zero within (a
-                    // support row is one interval, but a table can hold a zero inside it).
-                    let (mut lo, mut hi) = (0, side - 1);
-                    let mut any = true;
-                    for &c in &corners {
-                        match nonzero(c, my) {
-                            Some((f, l)) => (lo, hi) = (lo.max(f), hi.min(l)),
-                            None => any = false,
-                        }
-                    }
-                    if any && lo <= hi {
-                        let row = |c: usize| &weights[c * cells + my * side..][lo..=hi];
-                        if corners.iter().all(|&c| row(c).iter().all(|&w| w != 0.0)) {
-                            (first, last) = (lo, hi);
-                        }
-                    }
-                } else {
-                    for (f, l) in corners.iter().filter_map(|&s| nonzero(s, my)) {
-                        first = first.min(f);
-                        last = last.max(l);
-                    }
-                }
-                // B ≤ 129: both fit 16 bits, and the pattern (exponent field ≤ 1) is never a NaN, so
-                // it survives being stored and read as an f32 unchanged.
-                *packed = f32::from_bits(first as u32 | (last as u32) << 16);
-                if first <= last {
-                    run_width = run_width.max(last - first + 1);
+        let run = |corners: [usize; 4], my: usize| {
+            if !wide {
+                return corners
+                    .iter()
+                    .filter_map(|&s| nonzero(s, my))
+                    .fold((side, 0), |(f, l), (a, b)| (f.min(a), l.max(b)));
+            }
+            // Non-zero in all four: inside each corner's run, and no zero within (a support row
+            // is one interval, but a table can hold a zero inside it).
+            let (mut lo, mut hi) = (0, side - 1);
+            for &c in &corners {
+                match nonzero(c, my) {
+                    Some((f, l)) => (lo, hi) = (lo.max(f), hi.min(l)),
+                    None => return (side, 0),
                 }
             }
-        }
+            let row = |c: usize| &weights[c * cells + my * side..][lo..=hi];
+            if lo <= hi && corners.iter().all(|&c| row(c).iter().all(|&w| w != 0.0)) {
+                (lo, hi)
+            } else {
+                (side, 0)
+            }
+        };
+        // Kept as the bits of an f32: the pattern (exponent field ≤ 1) is never a NaN, so it
+        // survives being stored and read as an f32 unchanged.
+        let run_width = walk::pack_runs(spans, side, phases, run, f32::from_bits);
         Ok(Stencils {
             sampler,
             wide,
             data: &buffer[..len],
             ranges,
             side,
-            reach,
             phases,
             run_width,
             phase_shift: phases.is_power_of_two().then(|| phases.trailing_zeros()),
@@ -420,7 +410,6 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
         if !(center[0].is_finite() && center[1].is_finite()) {
             return Err(BufferError::NonFiniteCenter);
         }
-        let (w, h) = (image.width() as i64, image.height() as i64);
         let p = self.phases;
         // With P = 2^s phases the centre scaled by P, T = c·P, is exact, and one floor j = ⌊T⌋
         // gives both the pixel (j >> s) and the phase cell (j mod P), and the fraction T − j is
@@ -436,20 +425,17 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
             Some((s, _, j)) => (j[0] >> s, j[1] >> s),
             None => (floor_i64(center[0]), floor_i64(center[1])),
         };
-        let (x0, y0) = (ix - self.reach, iy - self.reach);
-        let b = self.side as i64;
         let mut stats = SplatStats::default();
-        if x0 + b <= 0 || y0 + b <= 0 || x0 >= w || y0 >= h {
+        let Some(walk) = SpanWalk::new([ix, iy], self.side, image.width(), image.height()) else {
             return Ok(stats);
-        }
-        let inside = x0 >= 0 && y0 >= 0 && x0 + b <= w && y0 + b <= h;
+        };
         let phase = |c: f32, i: i64| {
             let t = (c - i as f32) * p as f32;
             let k = (t.max(0.0) as usize).min(p - 1);
             (k, (t - k as f32).clamp(0.0, 1.0))
         };
         let ((ka, fx), (kb, fy)) = match scaled {
-            Some((_, t, j)) if inside => {
+            Some((_, t, j)) if walk.inside => {
                 let cell =
                     |t: f32, j: i64| ((j as usize) & (p - 1), (t - j as f32).clamp(0.0, 1.0));
                 (cell(t[0], j[0]), cell(t[1], j[1]))
@@ -458,109 +444,72 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
         };
         let side = self.side;
         let corners = corner_offsets(ka, kb, p, side * side);
-        let (w00, w10, w01, w11) = (
+        let blend = [
             (1.0 - fx) * (1.0 - fy),
             fx * (1.0 - fy),
             (1.0 - fx) * fy,
             fx * fy,
-        );
+        ];
         let spans = &self.data[self.ranges + (kb * p + ka) * side..][..side];
-        // A row's stored run, as absolute pixel columns (first > last when empty).
-        let run = |span: &f32| {
-            let bits = span.to_bits();
-            (x0 + i64::from(bits & 0xffff), x0 + i64::from(bits >> 16))
-        };
-        // Rows of the box inside the image.
-        let (my0, my1) = ((-y0).max(0) as usize, (h - y0).min(b) as usize);
         let stride = image.stride();
+        let w = image.width() as i64;
         let data = image.data_mut();
-        let mut weights = [0.0f32; MAX_STENCIL_SIDE];
-        let wide = self.wide;
-        if !wide {
+        if !self.wide {
             // A box wholly inside the image whose runs are at most 15 px: windows of a fixed
             // width, no clipping.
-            if inside {
-                let (at, blend) = ((x0 as usize, y0 as usize), [w00, w10, w01, w11]);
-                let small = (corners, blend, spans, at);
+            if walk.inside {
+                let small = (corners, blend, spans, (walk.x0 as usize, walk.y0 as usize));
                 if let Some(stats) = self.splat_small(small, value, data, stride, &mut touched) {
                     return Ok(stats);
                 }
             }
             // Blended: weight and deposit in one pass over the stored runs.
-            for (my, span) in spans.iter().enumerate().take(my1).skip(my0) {
-                let (first, last) = run(span);
-                let (lo, hi) = (first.max(0), last.min(w - 1));
-                if lo > hi {
+            for row in walk.rows(spans, f32::to_bits) {
+                let Some(c) = walk.clip(row.my, row.first, row.last) else {
                     continue;
-                }
-                let (m0, n) = ((lo - x0) as usize, (hi - lo + 1) as usize);
-                let r = my * side + m0;
-                let [s00, s10, s01, s11] = corners;
-                // Four slices of length n, written out so the compiler sees their lengths and
-                // the loop below indexes them without checks (an array of slices measured 22 %
-                // slower on the walnut).
-                let (r00, r10, r01, r11) = (
-                    &self.data[s00 + r..][..n],
-                    &self.data[s10 + r..][..n],
-                    &self.data[s01 + r..][..n],
-                    &self.data[s11 + r..][..n],
-                );
-                let y = (y0 + my as i64) as usize;
-                let start = y * stride + lo as usize;
+                };
+                let rows = corner_rows(self.data, corners, c.entry, c.n);
+                let start = row.y * stride + c.lo;
                 // Clipped to the image, so the range is inside the buffer ImageMut checked.
-                let px = &mut data[start..start + n];
-                let rows = (r00, r10, r01, r11);
-                stats.pixels_updated += row::blend_row([w00, w10, w01, w11], rows, value, px);
-                stats.pixels_visited += n as u32;
-                touched(y, lo as usize, hi as usize);
+                let px = &mut data[start..start + c.n];
+                stats.pixels_updated += row::blend_row(blend, rows, value, px);
+                stats.pixels_visited += c.n as u32;
+                touched(row.y, c.lo, c.hi);
             }
             return Ok(stats);
         }
-        for (my, span) in spans.iter().enumerate().take(my1).skip(my0) {
-            let y = y0 + my as i64;
-            let qy = y as f32 + 0.5 - center[1];
-            let (first, last) = run(span);
-            // Wide: the pixel centres inside the support (as the table walk), blended where all
+        let [w00, w10, w01, w11] = blend;
+        let mut weights = [0.0f32; MAX_STENCIL_SIDE];
+        for row in walk.rows(spans, f32::to_bits) {
+            let qy = row.y as f32 + 0.5 - center[1];
+            // Edged: the pixel centres inside the support (as the table walk), blended where all
             // four corners are non-zero and read from the sampler at the edge.
             let Some(span) = row_pixels(self.sampler.footprint(), center[0], qy) else {
                 continue;
             };
-            let blend = (first.max(span.0), last.min(span.1));
             let (lo, hi) = (span.0.max(0), span.1.min(w - 1));
             if lo > hi {
                 continue;
             }
             let n = (hi - lo + 1) as usize;
             let ws = &mut weights[..n];
-            let (b0, b1) = (blend.0.max(lo), blend.1.min(hi));
-            if b0 <= b1 {
-                let (m0, nb) = ((b0 - x0) as usize, (b1 - b0 + 1) as usize);
-                let r = my * side + m0;
-                let [s00, s10, s01, s11] = corners;
-                let (r00, r10, r01, r11) = (
-                    &self.data[s00 + r..][..nb],
-                    &self.data[s10 + r..][..nb],
-                    &self.data[s01 + r..][..nb],
-                    &self.data[s11 + r..][..nb],
-                );
+            // The blended part: the stored run inside the support, clipped to the image.
+            let blended = walk.clip(row.my, row.first.max(lo), row.last.min(hi));
+            if let Some(c) = blended {
+                let (r00, r10, r01, r11) = corner_rows(self.data, corners, c.entry, c.n);
                 // The row's weights first (a loop the compiler vectorises), then the deposit.
-                let out = &mut ws[(b0 - lo) as usize..][..nb];
+                let out = &mut ws[c.lo - lo as usize..][..c.n];
                 for (k, wt) in out.iter_mut().enumerate() {
                     *wt = w00 * r00[k] + w10 * r10[k] + w01 * r01[k] + w11 * r11[k];
                 }
             }
             // The edge pixels outside the blended run.
-            let (e0, e1) = if b0 <= b1 {
-                (b0 - lo, b1 - lo + 1)
-            } else {
-                (0, 0)
-            };
+            let (e0, e1) = blended.map_or((0, 0), |c| (c.lo as i64 - lo, c.hi as i64 - lo + 1));
             for k in (0..e0).chain(e1..n as i64) {
                 let q = [(lo + k) as f32 + 0.5 - center[0], qy];
                 ws[k as usize] = self.sampler.weight(q);
             }
-            let y = y as usize;
-            let start = y * stride + lo as usize;
+            let start = row.y * stride + lo as usize;
             // Clipped to the image, so the range is inside the buffer ImageMut checked.
             let px = &mut data[start..start + n];
             for (d, &wt) in px.iter_mut().zip(ws.iter()) {
@@ -568,7 +517,7 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
                 stats.pixels_updated += u32::from(wt != 0.0);
             }
             stats.pixels_visited += n as u32;
-            touched(y, lo as usize, hi as usize);
+            touched(row.y, lo as usize, hi as usize);
         }
         Ok(stats)
     }

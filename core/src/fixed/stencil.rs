@@ -33,8 +33,9 @@
 
 use super::{is_grey, FixedTable, POS_FRAC};
 use crate::splat::{BufferError, ImageMut, SplatStats};
+use crate::stencil::walk::{self, corner_rows, SpanWalk};
 use crate::stencil::{
-    cell_corners, corner_offsets, nonzero_run, MAX_STENCIL_FLOATS, MAX_STENCIL_SIDE, NARROW_SIDE,
+    corner_offsets, nonzero_run, MAX_STENCIL_FLOATS, MAX_STENCIL_SIDE, NARROW_SIDE,
 };
 
 const HALF_POS: i64 = 1 << (POS_FRAC - 1);
@@ -96,7 +97,6 @@ pub struct FixedStencils<'a, const M: usize> {
     data: &'a [i32],
     ranges: usize,
     side: usize,
-    reach: i64,
     phases: usize,
     /// Box side above [`NARROW_SIDE`]: blended only inside all four corners' support.
     wide: bool,
@@ -224,28 +224,22 @@ impl<'a, const M: usize> FixedStencils<'a, M> {
         let nonzero = |stencil: usize, my: usize| {
             nonzero_run(&weights[stencil * cells + my * side..][..side])
         };
-        for (c, cell) in spans.chunks_exact_mut(side).enumerate() {
-            let corners = cell_corners(c, phases);
-            for (my, packed) in cell.iter_mut().enumerate() {
-                let (mut first, mut last) = (side, 0);
-                let rows = if wide {
-                    my.saturating_sub(1)..(my + 2).min(side)
-                } else {
-                    my..my + 1
-                };
-                for r in rows {
-                    for (f, l) in corners.iter().filter_map(|&s| nonzero(s, r)) {
-                        first = first.min(f);
-                        last = last.max(l);
-                    }
-                }
-                if wide && first <= last {
-                    (first, last) = (first.saturating_sub(1), (last + 1).min(side - 1));
-                }
-                // B ≤ 129: both fit 16 bits.
-                *packed = (first | last << 16) as i32;
+        let run = |corners: [usize; 4], my: usize| {
+            let rows = if wide {
+                my.saturating_sub(1)..(my + 2).min(side)
+            } else {
+                my..my + 1
+            };
+            let (first, last) = rows
+                .flat_map(|r| corners.iter().filter_map(move |&s| nonzero(s, r)))
+                .fold((side, 0), |(f, l), (a, b)| (f.min(a), l.max(b)));
+            if wide && first <= last {
+                (first.saturating_sub(1), (last + 1).min(side - 1))
+            } else {
+                (first, last)
             }
-        }
+        };
+        walk::pack_runs(spans, side, phases, run, |bits| bits as i32);
         let entries = |e: &[i32]| e.iter().map(|w| i64::from(*w).abs()).max().unwrap_or(0);
         let mut max_weight = entries(weights) + 1;
         if wide {
@@ -255,7 +249,6 @@ impl<'a, const M: usize> FixedStencils<'a, M> {
             data: &buffer[..len],
             ranges,
             side,
-            reach,
             phases,
             wide,
             table,
@@ -361,14 +354,11 @@ impl<'a, const M: usize> FixedStencils<'a, M> {
         acc: &mut ImageMut<'_, [i64; 4]>,
         mut touched: impl FnMut(usize, usize, usize),
     ) -> SplatStats {
-        let (w, h) = (acc.width() as i64, acc.height() as i64);
         let (ix, iy) = (center[0] >> POS_FRAC, center[1] >> POS_FRAC);
-        let (x0, y0) = (ix - self.reach, iy - self.reach);
-        let b = self.side as i64;
         let mut stats = SplatStats::default();
-        if x0 + b <= 0 || y0 + b <= 0 || x0 >= w || y0 >= h {
+        let Some(walk) = SpanWalk::new([ix, iy], self.side, acc.width(), acc.height()) else {
             return stats;
-        }
+        };
         let p = self.phases;
         // Phase cell k and the Q8 fraction within it.
         let phase = |c: i64, i: i64| {
@@ -388,38 +378,22 @@ impl<'a, const M: usize> FixedStencils<'a, M> {
         );
         let v = value.map(i64::from);
         let spans = &self.data[self.ranges + (kb * p + ka) * side..][..side];
-        let (my0, my1) = ((-y0).max(0) as usize, (h - y0).min(b) as usize);
         let stride = acc.stride();
         let data = acc.data_mut();
-        for (my, &span) in spans.iter().enumerate().take(my1).skip(my0) {
-            let bits = span as u32;
-            let (first, last) = (x0 + i64::from(bits & 0xffff), x0 + i64::from(bits >> 16));
-            let (lo, hi) = (first.max(0), last.min(w - 1));
-            if lo > hi {
+        for row in walk.rows(spans, |s| s as u32) {
+            let Some(clip) = walk.clip(row.my, row.first, row.last) else {
                 continue;
-            }
-            let (m0, n) = ((lo - x0) as usize, (hi - lo + 1) as usize);
-            let r = my * side + m0;
-            let [s00, s10, s01, s11] = corners;
-            // Four slices of length n, written out so the compiler sees their lengths and
-            // the loop below indexes them without checks (an array of slices measured 22 %
-            // slower on the walnut).
-            let (r00, r10, r01, r11) = (
-                &self.data[s00 + r..][..n],
-                &self.data[s10 + r..][..n],
-                &self.data[s01 + r..][..n],
-                &self.data[s11 + r..][..n],
-            );
-            let y = (y0 + my as i64) as usize;
-            let start = y * stride + lo as usize;
+            };
+            let (r00, r10, r01, r11) = corner_rows(self.data, corners, clip.entry, clip.n);
+            let start = row.y * stride + clip.lo;
             // Clipped to the image, so the range is inside the buffer ImageMut checked.
-            let px = &mut data[start..start + n];
+            let px = &mut data[start..start + clip.n];
             let mut updated = 0u32;
             // A wide footprint's edge pixel, weighted as the walk weights it.
             let exact = |k: usize| {
                 let q = [
-                    ((lo + k as i64) << POS_FRAC) + HALF_POS - center[0],
-                    (((y0 + my as i64) << POS_FRAC) + HALF_POS) - center[1],
+                    (((clip.lo + k) as i64) << POS_FRAC) + HALF_POS - center[0],
+                    ((row.y as i64) << POS_FRAC) + HALF_POS - center[1],
                 ];
                 self.table.weight(&self.table.cursor(q))
             };
@@ -458,9 +432,9 @@ impl<'a, const M: usize> FixedStencils<'a, M> {
                 }
                 updated += u32::from(wt != 0);
             }
-            stats.pixels_visited += n as u32;
+            stats.pixels_visited += clip.n as u32;
             stats.pixels_updated += updated;
-            touched(y, lo as usize, hi as usize);
+            touched(row.y, clip.lo, clip.hi);
         }
         stats
     }
@@ -489,7 +463,6 @@ mod tests {
                 data: &[],
                 ranges: 0,
                 side,
-                reach: (side / 2) as i64,
                 phases: 1,
                 wide: false,
                 table: &table,
