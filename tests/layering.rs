@@ -394,6 +394,76 @@ fn files_stay_readable() {
     assert!(long.is_empty(), "{}", long.join("\n"));
 }
 
+/// Longest function in the harness, lines from its `fn` line to its closing brace (issue 41: a
+/// function a reader takes in whole).
+const MAX_FN_LINES: usize = 120;
+
+/// The functions of `text` longer than `max` lines, as `name (lines, from line L)`. A function
+/// starts at a line whose code begins with `fn` (after `pub`, `pub(…)`, `const`, `unsafe`) and
+/// ends at the first later line that is its indentation followed by `}` (rustfmt's layout).
+fn long_functions(text: &str, max: usize) -> Vec<String> {
+    let lines: Vec<&str> = text.lines().collect();
+    let mut long = Vec::new();
+    for (i, line) in lines.iter().enumerate() {
+        let code = line.trim_start();
+        let indent = &line[..line.len() - code.len()];
+        let mut rest = code;
+        for prefix in ["pub(crate) ", "pub(super) ", "pub ", "const ", "unsafe "] {
+            rest = rest.strip_prefix(prefix).unwrap_or(rest);
+        }
+        let Some(sig) = rest.strip_prefix("fn ") else {
+            continue;
+        };
+        let name: String = sig.chars().take_while(|&c| is_ident(c)).collect();
+        // The body opens where the signature ends with `{`; a `;` first is a declaration.
+        let Some(open) = (i..lines.len()).find(|&j| {
+            let l = lines[j].trim_end();
+            l.ends_with('{') || l.ends_with(';')
+        }) else {
+            continue;
+        };
+        if lines[open].trim_end().ends_with(';') {
+            continue;
+        }
+        let close = format!("{indent}}}");
+        if lines[open].trim_end().ends_with("{}") || lines[open] == close {
+            continue;
+        }
+        if let Some(end) = (open + 1..lines.len()).find(|&j| lines[j] == close) {
+            let n = end - i + 1;
+            if n > max {
+                long.push(format!("{name} ({n} lines, from line {})", i + 1));
+            }
+        }
+    }
+    long
+}
+
+#[test]
+fn harness_functions_stay_readable() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut files = Vec::new();
+    rs_files(&root.join("std-harness/src"), &mut files);
+    let mut long = Vec::new();
+    for f in files {
+        let text = std::fs::read_to_string(&f).expect("readable file");
+        for l in long_functions(&text, MAX_FN_LINES) {
+            long.push(format!("{}: {l}", f.display()));
+        }
+    }
+    assert!(long.is_empty(), "over {MAX_FN_LINES} lines:\n{}", long.join("\n"));
+}
+
+#[test]
+fn the_function_measure_sees_a_long_function() {
+    let body = "    let x = 1;\n".repeat(5);
+    let text = format!("pub fn a(\n    x: u8,\n) -> u8 {{\n{body}}}\n\nfn b() {{}}\nfn c();\n");
+    assert_eq!(long_functions(&text, 8), ["a (9 lines, from line 1)"]);
+    assert!(long_functions(&text, 9).is_empty());
+    let nested = format!("impl A {{\n    fn m(&self) {{\n{body}    }}\n}}\n");
+    assert_eq!(long_functions(&nested, 6), ["m (7 lines, from line 2)"]);
+}
+
 /// The core's layers, bottom up: a module imports only modules of lower layers (issue 41: no
 /// circle and no upward import in either crate). Within a folder module, files that name each
 /// other through `super::` form no circle either.

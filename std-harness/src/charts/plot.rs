@@ -67,19 +67,7 @@ where
 {
     root.fill(&WHITE).map_err(plot_err)?;
     let (plot, side) = root.split_horizontally(root.dim_in_pixel().0 * 72 / 100);
-    // Against the sheet reference: the paper's sheets only (image slabs are another method, not
-    // an approximation of that reference). Against the continuous integral: every row.
-    let db = |r: &Measured| if truth { r.continuous_db } else { r.psnr_db };
-    let on_front = |r: &Measured| if truth { r.pareto_continuous } else { r.pareto };
-    let finite: Vec<Measured> = rows
-        .iter()
-        .filter(|r| db(r).is_finite() && (truth || r.config.slab().is_none()))
-        .map(|r| Measured {
-            psnr_db: db(r),
-            pareto: on_front(r),
-            ..r.clone()
-        })
-        .collect();
+    let finite = charted(rows, truth);
     let finite: Vec<&Measured> = finite.iter().collect();
     let (t0, t1) = finite.iter().fold((f64::MAX, 0.0f64), |(a, b), r| {
         (a.min(r.min_s), b.max(r.max_s))
@@ -171,7 +159,37 @@ where
         .label_font(("sans-serif", 13))
         .draw()
         .map_err(plot_err)?;
-    // The side panel: the key and the frontier's members.
+    draw_key(&side, &front)?;
+    root.present().map_err(plot_err)?;
+    Ok(())
+}
+
+/// The rows a trade-off chart plots, with `psnr_db` and `pareto` set to the chart's figure:
+/// against the sheet reference (`truth` false) the paper's sheets only (image slabs are another
+/// method, not an approximation of that reference); against the continuous integral every row.
+/// Rows without a finite figure are left out.
+fn charted(rows: &[Measured], truth: bool) -> Vec<Measured> {
+    let db = |r: &Measured| if truth { r.continuous_db } else { r.psnr_db };
+    let on_front = |r: &Measured| if truth { r.pareto_continuous } else { r.pareto };
+    rows.iter()
+        .filter(|r| db(r).is_finite() && (truth || r.config.slab().is_none()))
+        .map(|r| Measured {
+            psnr_db: db(r),
+            pareto: on_front(r),
+            ..r.clone()
+        })
+        .collect()
+}
+
+/// The trade-off chart's side panel: the key and the frontier's members, fastest first.
+fn draw_key<DB: DrawingBackend>(
+    side: &DrawingArea<DB, Shift>,
+    front: &[&Measured],
+) -> Result<(), CliError>
+where
+    DB::ErrorType: 'static,
+{
+    let ms = |s: f64| s * 1e3;
     let mut lines = vec![
         "Labels: table size N.".to_string(),
         "Filled: bilinear lookup;".to_string(),
@@ -179,7 +197,7 @@ where
         String::new(),
         "Pareto frontier (fastest first):".to_string(),
     ];
-    for r in &front {
+    for r in front {
         lines.push(match r.config.slab() {
             Some(t) => format!("image slabs {t}"),
             None => format!(
@@ -200,7 +218,6 @@ where
         ))
         .map_err(plot_err)?;
     }
-    root.present().map_err(plot_err)?;
     Ok(())
 }
 

@@ -9,6 +9,7 @@ use crate::pipeline::quality::config::Config;
 use crate::pipeline::quality::model as quality;
 use crate::CliError;
 use clap::Args;
+use std::path::Path;
 
 #[derive(Args, Debug, Clone)]
 pub struct ChartArgs {
@@ -84,62 +85,81 @@ pub fn run(args: &ChartArgs) -> Result<(), CliError> {
             n.to_string_lossy().into_owned()
         });
     if args.refine_only {
-        let rows = refine::sweep(&base, args.refine_reference, args.runs)?;
-        io::write_atomic(&dir.join("refine.csv"), refine::csv(&rows).as_bytes())?;
-        let title = format!(
-            "built-in scene {n}^3 at {}x{}, against {r}^3: --refine, {} thread(s)",
-            base.size.0,
-            base.size.1,
-            base.thread_count(),
-            n = base.scene_size,
-            r = args.refine_reference,
-        );
-        refine::write_chart(&dir, &rows, &title)?;
-        for r in &rows {
-            crate::say!(
-                "refine {}: {} samples, {:.4} s ({:.2}x unrefined), {:.2} dB ({:+.2} dB)",
-                refine::label(r),
-                r.samples,
-                r.median_s,
-                r.median_s / rows[0].median_s,
-                r.psnr_db,
-                r.psnr_db - rows[0].psnr_db
-            );
+        refine_chart(&dir, &base, args)?;
+    } else {
+        if !args.no_lod {
+            lod_chart(&dir, &base, &name, args.runs)?;
         }
-        crate::say!("wrote {}", dir.display());
-        return Ok(());
-    }
-    if !args.no_lod {
-        let (rows, auto) = lod::sweep(&base, args.runs)?;
-        io::write_atomic(&dir.join("lod.csv"), lod::csv(&rows, auto).as_bytes())?;
-        let title = format!(
-            "{name}, {}x{}: levels of detail, {} thread(s)",
-            base.size.0,
-            base.size.1,
-            base.thread_count()
-        );
-        lod::write_chart(&dir, &rows, auto, &title)?;
-        for r in &rows {
-            crate::say!(
-                "lod {}: {:?}, {:.4} s ({:.1}x level 0), {:.2} dB against level 0{}",
-                r.level,
-                r.dims,
-                r.median_s,
-                rows[0].median_s / r.median_s,
-                r.psnr_db,
-                if r.level == auto { " (auto)" } else { "" }
-            );
-        }
-        if args.lod_only {
-            crate::say!("wrote {}", dir.display());
-            return Ok(());
+        if !args.lod_only {
+            tradeoff_chart(&dir, &base, &name, args.runs)?;
+            if !args.no_stability {
+                stability_chart(&dir, &base, args)?;
+            }
         }
     }
-    let prepared = prepare(&base)?;
+    crate::say!("wrote {}", dir.display());
+    Ok(())
+}
+
+/// The refinement sweep: refine.csv and its chart.
+fn refine_chart(dir: &Path, base: &RenderArgs, args: &ChartArgs) -> Result<(), CliError> {
+    let rows = refine::sweep(base, args.refine_reference, args.runs)?;
+    io::write_atomic(&dir.join("refine.csv"), refine::csv(&rows).as_bytes())?;
+    let title = format!(
+        "built-in scene {n}^3 at {}x{}, against {r}^3: --refine, {} thread(s)",
+        base.size.0,
+        base.size.1,
+        base.thread_count(),
+        n = base.scene_size,
+        r = args.refine_reference,
+    );
+    refine::write_chart(dir, &rows, &title)?;
+    for r in &rows {
+        crate::say!(
+            "refine {}: {} samples, {:.4} s ({:.2}x unrefined), {:.2} dB ({:+.2} dB)",
+            refine::label(r),
+            r.samples,
+            r.median_s,
+            r.median_s / rows[0].median_s,
+            r.psnr_db,
+            r.psnr_db - rows[0].psnr_db
+        );
+    }
+    Ok(())
+}
+
+/// The levels-of-detail sweep: lod.csv and its chart.
+fn lod_chart(dir: &Path, base: &RenderArgs, name: &str, runs: usize) -> Result<(), CliError> {
+    let (rows, auto) = lod::sweep(base, runs)?;
+    io::write_atomic(&dir.join("lod.csv"), lod::csv(&rows, auto).as_bytes())?;
+    let title = format!(
+        "{name}, {}x{}: levels of detail, {} thread(s)",
+        base.size.0,
+        base.size.1,
+        base.thread_count()
+    );
+    lod::write_chart(dir, &rows, auto, &title)?;
+    for r in &rows {
+        crate::say!(
+            "lod {}: {:?}, {:.4} s ({:.1}x level 0), {:.2} dB against level 0{}",
+            r.level,
+            r.dims,
+            r.median_s,
+            rows[0].median_s / r.median_s,
+            r.psnr_db,
+            if r.level == auto { " (auto)" } else { "" }
+        );
+    }
+    Ok(())
+}
+
+/// The trade-off sweep over every configuration: tradeoff.csv, its chart and both frontiers.
+fn tradeoff_chart(dir: &Path, base: &RenderArgs, name: &str, runs: usize) -> Result<(), CliError> {
+    let prepared = prepare(base)?;
     let mut configs = Config::for_frame(&prepared.frame);
     configs.extend(Config::slabs(&prepared.frame, &prepared.kernel));
     drop(prepared);
-    let rows = sweep::sweep(&base, &configs, args.runs)?;
+    let rows = sweep::sweep(base, &configs, runs)?;
     io::write_atomic(&dir.join("tradeoff.csv"), sweep::csv(&rows).as_bytes())?;
     let title = format!(
         "{name}, {}x{}: frame time against error ({} backend)",
@@ -147,7 +167,7 @@ pub fn run(args: &ChartArgs) -> Result<(), CliError> {
         base.size.1,
         footprint::math::BACKEND
     );
-    plot::write_tradeoff(&dir, &rows, &title)?;
+    plot::write_tradeoff(dir, &rows, &title)?;
     print_frontier("Pareto frontier:", &rows, |r| r.pareto, |r| r.psnr_db);
     print_frontier(
         "Pareto frontier against the continuous integral:",
@@ -155,54 +175,55 @@ pub fn run(args: &ChartArgs) -> Result<(), CliError> {
         |r| r.pareto_continuous,
         |r| r.continuous_db,
     );
-    if !args.no_stability {
-        let curves = stability::stability();
-        io::write_atomic(
-            &dir.join("stability.csv"),
-            stability::stability_csv(&curves).as_bytes(),
-        )?;
-        let pop = if args.no_popping {
-            None
-        } else {
-            let mut a = base.clone();
-            a.size = args.popping_size;
-            // A scene the sweep cannot render (a footprint-model kernel has no continuous
-            // reference or slabs; a perspective view no slabs) charts without panel (d).
-            match popping::popping(&a, crate::io::progress::sheets("popping")) {
-                Ok(pop) => {
-                    io::write_atomic(&dir.join("popping.csv"), pop.csv().as_bytes())?;
-                    for (k, name) in popping::NAMES.iter().enumerate() {
-                        let (db, az) = pop.worst(k);
-                        crate::say!(
-                            "popping: {name:<21} largest change {db:.2} dB (PSNR) at {az:.1}°"
-                        );
-                    }
-                    Some(pop)
+    Ok(())
+}
+
+/// The stability sweeps (rotation, anisotropy, footprint size) and, unless `--no-popping`, the
+/// popping sweep: stability.csv, popping.csv and their chart.
+fn stability_chart(dir: &Path, base: &RenderArgs, args: &ChartArgs) -> Result<(), CliError> {
+    let curves = stability::stability();
+    io::write_atomic(
+        &dir.join("stability.csv"),
+        stability::stability_csv(&curves).as_bytes(),
+    )?;
+    let pop = if args.no_popping {
+        None
+    } else {
+        let mut a = base.clone();
+        a.size = args.popping_size;
+        // A scene the sweep cannot render (a footprint-model kernel has no continuous
+        // reference or slabs; a perspective view no slabs) charts without panel (d).
+        match popping::popping(&a, crate::io::progress::sheets("popping")) {
+            Ok(pop) => {
+                io::write_atomic(&dir.join("popping.csv"), pop.csv().as_bytes())?;
+                for (k, name) in popping::NAMES.iter().enumerate() {
+                    let (db, az) = pop.worst(k);
+                    crate::say!("popping: {name:<21} largest change {db:.2} dB (PSNR) at {az:.1}°");
                 }
-                Err(e) => {
-                    crate::warn!("the popping panel (d) is left out: {e}");
-                    None
-                }
+                Some(pop)
             }
-        };
-        plot::write_stability(&dir, &curves, pop.as_ref())?;
-        for (panel, set) in ["rotation", "anisotropy", "footprint size"]
-            .iter()
-            .zip(&curves)
-        {
-            for c in set {
-                let worst = c.points.iter().filter_map(|p| p.1).fold(0.0f64, f64::max);
-                let fails = c.points.iter().filter(|p| p.1.is_none()).count();
-                crate::say!(
-                    "stability {panel}: {:<24} worst {:.2e}, {} failed",
-                    c.name,
-                    worst,
-                    fails
-                );
+            Err(e) => {
+                crate::warn!("the popping panel (d) is left out: {e}");
+                None
             }
         }
+    };
+    plot::write_stability(dir, &curves, pop.as_ref())?;
+    for (panel, set) in ["rotation", "anisotropy", "footprint size"]
+        .iter()
+        .zip(&curves)
+    {
+        for c in set {
+            let worst = c.points.iter().filter_map(|p| p.1).fold(0.0f64, f64::max);
+            let fails = c.points.iter().filter(|p| p.1.is_none()).count();
+            crate::say!(
+                "stability {panel}: {:<24} worst {:.2e}, {} failed",
+                c.name,
+                worst,
+                fails
+            );
+        }
     }
-    crate::say!("wrote {}", dir.display());
     Ok(())
 }
 

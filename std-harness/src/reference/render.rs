@@ -11,6 +11,7 @@ use footprint::lod::Coloured;
 use footprint::render::{gradient, Absorption, SheetWindow};
 use footprint::shade::{Lighting, Shader};
 use footprint::Kernel;
+use glam::{DMat3, DVec3};
 
 /// What the reference renders: the core's frame and shading, the kernel, the compositing order
 /// and the background (as in the core renderer).
@@ -34,145 +35,48 @@ pub fn render_reference(
     mut sheet: impl FnMut(usize, &mut [Coloured]),
     mut progress: impl FnMut(usize, usize),
 ) -> Result<Vec<[f64; 4]>, CliError> {
-    let ReferenceScene {
-        frame,
-        kernel,
-        min_radius_px,
-        shader,
-        order,
-        background,
-        absorption,
-    } = *scene;
-    let g2s = frame.grid_to_screen.as_dmat3();
-    let fp = ReferenceFootprint::new(kernel, &g2s, f64::from(min_radius_px))?;
+    let splat = SheetSplat::new(scene)?;
+    let frame = scene.frame;
     let (w, h) = (frame.size[0], frame.size[1]);
     let n = w * h;
-    let bg: Vec<[f64; 4]> = match background {
+    let bg: Vec<[f64; 4]> = match scene.background {
         Some(b) => b.iter().map(|p| p.map(f64::from)).collect(),
         None => vec![[0.0; 4]; n],
     };
+    let order = scene.order;
     let mut image = if order == Order::BackToFront {
         bg.clone()
     } else {
         vec![[0.0; 4]; n]
     };
     let mut accum = vec![[0.0f64; 4]; n];
-    let lighting = Lighting::new(frame);
-    let (len, na, nb) = frame.sheet_shape();
+    let (len, _, _) = frame.sheet_shape();
     let count = frame.sheet_count();
-    let (k, (a, b)) = (frame.sheet_axis, frame.in_sheet);
-    let origin = frame.origin.as_dvec3();
-    let (ck, ca, cb) = (g2s.col(k), g2s.col(a), g2s.col(b));
-    let area = f64::from(frame.cell_area);
-    let camera = frame.camera();
-    let min_r = f64::from(min_radius_px);
-    let failed = std::sync::Mutex::new(false);
     let blank = Coloured::default();
     let mut bufs = [vec![blank; len], vec![blank; len], vec![blank; len]];
-    let load = |s: usize,
-                buf: &mut Vec<Coloured>,
-                sheet: &mut dyn FnMut(usize, &mut [Coloured])| sheet(s, buf);
     for step in 0..count {
         let s = frame.sheet_at(order, step);
         // Sheets s−1, s, s+1 (read directly: the reference does not need to stream).
         let have_lo = s > 0;
         let have_hi = s + 1 < count;
         if have_lo {
-            load(s - 1, &mut bufs[0], &mut sheet);
+            sheet(s - 1, &mut bufs[0]);
         }
-        load(s, &mut bufs[1], &mut sheet);
+        sheet(s, &mut bufs[1]);
         if have_hi {
-            load(s + 1, &mut bufs[2], &mut sheet);
+            sheet(s + 1, &mut bufs[2]);
         }
         let window = SheetWindow {
             lower: have_lo.then_some(&bufs[0][..]),
             current: &bufs[1][..],
             upper: have_hi.then_some(&bufs[2][..]),
         };
-        // The image's rows are split between threads; each shades every voxel (cheap) and
-        // evaluates footprints only on its own rows (the expensive part), so the sum is the same
-        // as a single pass.
-        let threads = std::thread::available_parallelism()
-            .map_or(1, |n| n.get())
-            .clamp(1, 8);
-        let band = h.div_ceil(threads);
-        let failed = &failed;
-        std::thread::scope(|scope| {
-            for (t, chunk) in accum.chunks_mut(band * w).enumerate() {
-                let window = &window;
-                let fp = &fp;
-                let lighting = &lighting;
-                crate::threads::spawn(scope, move || {
-                    let rows = t * band..(t * band + chunk.len() / w);
-                    let first = rows.start * w;
-                    for v in 0..nb {
-                        for u in 0..na {
-                            let sample = window.current[v * na + u];
-                            let rgba = shader.shade_coloured(
-                                lighting,
-                                None,
-                                sample.value,
-                                sample.colour,
-                                || gradient(frame, window, u, v),
-                                frame.grid_index(s, u, v),
-                                frame.dims,
-                            );
-                            if !(rgba[3] > 0.0) {
-                                continue;
-                            }
-                            let mut add = |i: usize, c: &[f64; 4], wt: f64| {
-                                let px = &mut chunk[i - first];
-                                for ch in 0..4 {
-                                    px[ch] += c[ch] * wt;
-                                }
-                            };
-                            if let Some(cam) = camera {
-                                let idx = frame.grid_index(s, u, v).map(|i| i as f64);
-                                let Ok(pv) = PerspectiveVoxel::new(frame, cam, kernel, min_r, idx)
-                                else {
-                                    *failed.lock().expect("no panics hold it") = true;
-                                    continue;
-                                };
-                                let Some(value) = absorption.voxel_value(rgba) else {
-                                    continue;
-                                };
-                                let scale = match absorption {
-                                    Absorption::Opacity => {
-                                        let a = f64::from(rgba[3]);
-                                        if a < 1.0 && pv.exponent != 1.0 {
-                                            (1.0 - (1.0 - a).powf(pv.exponent)) / a
-                                        } else {
-                                            1.0
-                                        }
-                                    }
-                                    // Optical depth is linear in the distance along the ray.
-                                    Absorption::Extinction => pv.exponent,
-                                };
-                                let c = value.map(|x| f64::from(x) * scale);
-                                pv.for_each_weight(w, rows.clone(), |i, wt| add(i, &c, wt));
-                                continue;
-                            }
-                            let p = origin + ck * s as f64 + ca * u as f64 + cb * v as f64;
-                            let Some(value) = absorption.voxel_value(rgba) else {
-                                continue;
-                            };
-                            let c = value.map(|x| f64::from(x) * area);
-                            fp.for_each_weight([p.x, p.y], w, rows.clone(), |i, wt| add(i, &c, wt));
-                        }
-                    }
-                });
-            }
-        });
-        if *failed.lock().expect("no panics hold it") {
-            return Err(CliError::input(
-                "the reference could not project a voxel (behind the eye or not finite)",
-            ));
-        }
+        splat.sheet(s, &window, &mut accum)?;
         for (acc, img) in accum.iter_mut().zip(image.iter_mut()) {
             if *acc == [0.0; 4] {
                 continue;
             }
-            let src = match absorption {
+            let src = match scene.absorption {
                 Absorption::Opacity => acc.map(|x| x.clamp(0.0, 1.0)),
                 Absorption::Extinction => extinction_layer64(*acc),
             };
@@ -190,6 +94,150 @@ pub fn render_reference(
         }
     }
     Ok(image)
+}
+
+/// One view's splatting of a sheet into the f64 accumulation image: the scene, the exact
+/// footprint and what every voxel of the view shares.
+struct SheetSplat<'a> {
+    scene: ReferenceScene<'a>,
+    fp: ReferenceFootprint,
+    lighting: Lighting,
+    /// Grid to screen (pixels per grid step), in f64.
+    g2s: DMat3,
+    origin: DVec3,
+    /// Pixels per grid step squared: a voxel's footprint integrates to this.
+    area: f64,
+}
+
+impl<'a> SheetSplat<'a> {
+    fn new(scene: &ReferenceScene<'a>) -> Result<Self, CliError> {
+        let frame = scene.frame;
+        let g2s = frame.grid_to_screen.as_dmat3();
+        let fp = ReferenceFootprint::new(scene.kernel, &g2s, f64::from(scene.min_radius_px))?;
+        Ok(SheetSplat {
+            scene: *scene,
+            fp,
+            lighting: Lighting::new(frame),
+            g2s,
+            origin: frame.origin.as_dvec3(),
+            area: f64::from(frame.cell_area),
+        })
+    }
+
+    /// Adds sheet `s` (the middle of `window`) to `accum`. The image's rows are split between
+    /// threads; each shades every voxel (cheap) and evaluates footprints only on its own rows
+    /// (the expensive part), so the sum is the same as a single pass.
+    fn sheet(
+        &self,
+        s: usize,
+        window: &SheetWindow<'_, Coloured>,
+        accum: &mut [[f64; 4]],
+    ) -> Result<(), CliError> {
+        let frame = self.scene.frame;
+        let (w, h) = (frame.size[0], frame.size[1]);
+        let (_, na, nb) = frame.sheet_shape();
+        let threads = std::thread::available_parallelism()
+            .map_or(1, |n| n.get())
+            .clamp(1, 8);
+        let band = h.div_ceil(threads);
+        let failed = std::sync::Mutex::new(false);
+        std::thread::scope(|scope| {
+            for (t, chunk) in accum.chunks_mut(band * w).enumerate() {
+                let failed = &failed;
+                crate::threads::spawn(scope, move || {
+                    let rows = t * band..(t * band + chunk.len() / w);
+                    for v in 0..nb {
+                        for u in 0..na {
+                            if self.voxel(s, [u, v], window, rows.clone(), chunk).is_err() {
+                                *failed.lock().expect("no panics hold it") = true;
+                            }
+                        }
+                    }
+                });
+            }
+        });
+        if *failed.lock().expect("no panics hold it") {
+            return Err(CliError::input(
+                "the reference could not project a voxel (behind the eye or not finite)",
+            ));
+        }
+        Ok(())
+    }
+
+    /// Shades voxel (u, v) of sheet `s` and adds its footprint to `chunk`, image rows `rows`;
+    /// `Err` when a perspective view cannot project it.
+    fn voxel(
+        &self,
+        s: usize,
+        [u, v]: [usize; 2],
+        window: &SheetWindow<'_, Coloured>,
+        rows: std::ops::Range<usize>,
+        chunk: &mut [[f64; 4]],
+    ) -> Result<(), ()> {
+        let ReferenceScene {
+            frame,
+            kernel,
+            min_radius_px,
+            shader,
+            absorption,
+            ..
+        } = self.scene;
+        let na = frame.sheet_shape().1;
+        let sample = window.current[v * na + u];
+        let rgba = shader.shade_coloured(
+            &self.lighting,
+            None,
+            sample.value,
+            sample.colour,
+            || gradient(frame, window, u, v),
+            frame.grid_index(s, u, v),
+            frame.dims,
+        );
+        if !(rgba[3] > 0.0) {
+            return Ok(());
+        }
+        let w = frame.size[0];
+        let first = rows.start * w;
+        let mut add = |i: usize, c: &[f64; 4], wt: f64| {
+            let px = &mut chunk[i - first];
+            for ch in 0..4 {
+                px[ch] += c[ch] * wt;
+            }
+        };
+        if let Some(cam) = frame.camera() {
+            let idx = frame.grid_index(s, u, v).map(|i| i as f64);
+            let min_r = f64::from(min_radius_px);
+            let pv = PerspectiveVoxel::new(frame, cam, kernel, min_r, idx).map_err(|_| ())?;
+            let Some(value) = absorption.voxel_value(rgba) else {
+                return Ok(());
+            };
+            let scale = match absorption {
+                Absorption::Opacity => {
+                    let a = f64::from(rgba[3]);
+                    if a < 1.0 && pv.exponent != 1.0 {
+                        (1.0 - (1.0 - a).powf(pv.exponent)) / a
+                    } else {
+                        1.0
+                    }
+                }
+                // Optical depth is linear in the distance along the ray.
+                Absorption::Extinction => pv.exponent,
+            };
+            let c = value.map(|x| f64::from(x) * scale);
+            pv.for_each_weight(w, rows, |i, wt| add(i, &c, wt));
+            return Ok(());
+        }
+        let (k, (a, b)) = (frame.sheet_axis, frame.in_sheet);
+        let g = &self.g2s;
+        let p = self.origin + g.col(k) * s as f64 + g.col(a) * u as f64 + g.col(b) * v as f64;
+        let Some(value) = absorption.voxel_value(rgba) else {
+            return Ok(());
+        };
+        let c = value.map(|x| f64::from(x) * self.area);
+        self.fp
+            .for_each_weight([p.x, p.y], w, rows, |i, wt| add(i, &c, wt));
+        Ok(())
+    }
 }
 
 /// An extinction sheet's [E, τ] as a premultiplied layer, in f64: α = 1 − e^(−τ), colour E·α/τ.

@@ -32,41 +32,8 @@ fn is_true(v: &str) -> bool {
 
 /// Parses a MetaImage header from the start of `bytes` (up to and including `ElementDataFile`).
 pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
-    let mut at = 0;
-    let mut fields: Vec<(String, String)> = Vec::new();
-    while at < bytes.len() {
-        let end = bytes[at..]
-            .iter()
-            .position(|&b| b == b'\n')
-            .map_or(bytes.len(), |p| at + p);
-        let line = std::str::from_utf8(&bytes[at..end])
-            .map_err(|_| "header is not text".to_string())?
-            .trim();
-        at = (end + 1).min(bytes.len());
-        if line.is_empty() {
-            continue;
-        }
-        let (k, v) = line.split_once('=').ok_or_else(|| {
-            format!(
-                "malformed header line '{}'",
-                line.chars().take(60).collect::<String>()
-            )
-        })?;
-        let key = k.trim().to_string();
-        fields.push((key.clone(), v.trim().to_string()));
-        if key == "ElementDataFile" {
-            break;
-        }
-        if fields.len() > 200 {
-            return Err("header has no ElementDataFile".into());
-        }
-    }
-    let get = |keys: &[&str]| {
-        fields
-            .iter()
-            .find(|(k, _)| keys.contains(&k.as_str()))
-            .map(|(_, v)| v.as_str())
-    };
+    let (fields, header_len) = Fields::read(bytes)?;
+    let get = |keys: &[&str]| fields.get(keys);
     let need = |k: &str| get(&[k]).ok_or_else(|| format!("missing header field '{k}'"));
     if let Some(t) = get(&["ObjectType"]) {
         if t != "Image" {
@@ -79,18 +46,7 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
     let ds = need("DimSize")?;
     let d: Vec<usize> = numbers(ds, 3, "DimSize")?;
     let dims = [d[0], d[1], d[2]];
-    let tyname = need("ElementType")?;
-    let ty = match tyname {
-        "MET_UCHAR" => SampleType::U8,
-        "MET_CHAR" => SampleType::I8,
-        "MET_USHORT" => SampleType::U16,
-        "MET_SHORT" => SampleType::I16,
-        "MET_UINT" => SampleType::U32,
-        "MET_INT" => SampleType::I32,
-        "MET_FLOAT" => SampleType::F32,
-        "MET_DOUBLE" => SampleType::F64,
-        o => return Err(format!("ElementType: '{o}' is not supported")),
-    };
+    let ty = element_type(need("ElementType")?)?;
     byte_len(dims, ty)?;
     // Several components per voxel lie interleaved in the data (RGB, a vector field): read as
     // scalars they would render a wrong image, so they are refused, as VTI and legacy VTK
@@ -104,28 +60,7 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
             ));
         }
     }
-    let spacing = match get(&["ElementSpacing", "ElementSize"]) {
-        Some(s) => {
-            let v: Vec<f32> = numbers(s, 3, "ElementSpacing")?;
-            [v[0], v[1], v[2]]
-        }
-        None => [1.0; 3],
-    };
-    check_spacing(spacing)?;
-    let directions = match get(&["TransformMatrix", "Rotation", "Orientation"]) {
-        Some(s) => {
-            let v: Vec<f32> = numbers(s, 9, "TransformMatrix")?;
-            let mut d = AXIS_ALIGNED;
-            for (i, row) in d.iter_mut().enumerate() {
-                let r = [v[3 * i], v[3 * i + 1], v[3 * i + 2]];
-                *row = super::axis_step(r)
-                    .ok_or_else(|| format!("TransformMatrix: row {i} is zero"))?
-                    .1;
-            }
-            d
-        }
-        None => AXIS_ALIGNED,
-    };
+    let (spacing, directions) = fields.orientation()?;
     let big_endian = get(&["ElementByteOrderMSB", "BinaryDataByteOrderMSB"]).is_some_and(is_true);
     if get(&["BinaryData"]).is_some_and(|v| !is_true(v)) {
         return Err("BinaryData = False (ASCII MetaImage) is not supported".into());
@@ -138,8 +73,7 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
     if header_size < -1 || (header_size == -1 && compressed) {
         return Err(format!("HeaderSize: {header_size} is not allowed here"));
     }
-    let file = need("ElementDataFile")?;
-    let data_file = match file {
+    let data_file = match need("ElementDataFile")? {
         "LOCAL" => None,
         f if f.starts_with("LIST") || f.contains('%') => {
             return Err("ElementDataFile: lists and patterns are not supported".into())
@@ -155,8 +89,99 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
         compressed,
         data_file,
         header_size,
-        header_len: at,
+        header_len,
     })
+}
+
+/// The sample type an `ElementType` names.
+fn element_type(name: &str) -> Result<SampleType, String> {
+    Ok(match name {
+        "MET_UCHAR" => SampleType::U8,
+        "MET_CHAR" => SampleType::I8,
+        "MET_USHORT" => SampleType::U16,
+        "MET_SHORT" => SampleType::I16,
+        "MET_UINT" => SampleType::U32,
+        "MET_INT" => SampleType::I32,
+        "MET_FLOAT" => SampleType::F32,
+        "MET_DOUBLE" => SampleType::F64,
+        o => return Err(format!("ElementType: '{o}' is not supported")),
+    })
+}
+
+/// A header's `Key = value` fields, in file order.
+struct Fields(Vec<(String, String)>);
+
+impl Fields {
+    /// The fields at the start of `bytes`, up to and including `ElementDataFile` (at most 200),
+    /// and the bytes of header text they take (where LOCAL data start).
+    fn read(bytes: &[u8]) -> Result<(Self, usize), String> {
+        let mut at = 0;
+        let mut fields: Vec<(String, String)> = Vec::new();
+        while at < bytes.len() {
+            let end = bytes[at..]
+                .iter()
+                .position(|&b| b == b'\n')
+                .map_or(bytes.len(), |p| at + p);
+            let line = std::str::from_utf8(&bytes[at..end])
+                .map_err(|_| "header is not text".to_string())?
+                .trim();
+            at = (end + 1).min(bytes.len());
+            if line.is_empty() {
+                continue;
+            }
+            let (k, v) = line.split_once('=').ok_or_else(|| {
+                format!(
+                    "malformed header line '{}'",
+                    line.chars().take(60).collect::<String>()
+                )
+            })?;
+            let key = k.trim().to_string();
+            fields.push((key.clone(), v.trim().to_string()));
+            if key == "ElementDataFile" {
+                break;
+            }
+            if fields.len() > 200 {
+                return Err("header has no ElementDataFile".into());
+            }
+        }
+        Ok((Fields(fields), at))
+    }
+
+    /// The first field with one of these keys.
+    fn get(&self, keys: &[&str]) -> Option<&str> {
+        self.0
+            .iter()
+            .find(|(k, _)| keys.contains(&k.as_str()))
+            .map(|(_, v)| v.as_str())
+    }
+
+    /// `ElementSpacing` (or `ElementSize`; default 1) and the axis directions, row i of
+    /// `TransformMatrix` (or `Rotation`, `Orientation`) grid axis i's.
+    fn orientation(&self) -> Result<([f32; 3], [[f32; 3]; 3]), String> {
+        let spacing = match self.get(&["ElementSpacing", "ElementSize"]) {
+            Some(s) => {
+                let v: Vec<f32> = numbers(s, 3, "ElementSpacing")?;
+                [v[0], v[1], v[2]]
+            }
+            None => [1.0; 3],
+        };
+        check_spacing(spacing)?;
+        let directions = match self.get(&["TransformMatrix", "Rotation", "Orientation"]) {
+            Some(s) => {
+                let v: Vec<f32> = numbers(s, 9, "TransformMatrix")?;
+                let mut d = AXIS_ALIGNED;
+                for (i, row) in d.iter_mut().enumerate() {
+                    let r = [v[3 * i], v[3 * i + 1], v[3 * i + 2]];
+                    *row = super::axis_step(r)
+                        .ok_or_else(|| format!("TransformMatrix: row {i} is zero"))?
+                        .1;
+                }
+                d
+            }
+            None => AXIS_ALIGNED,
+        };
+        Ok((spacing, directions))
+    }
 }
 
 /// Loads a MetaImage volume.

@@ -119,104 +119,20 @@ pub fn parse_header(b: &[u8]) -> Result<Header, String> {
             if len == HEADER_LEN { 1 } else { 2 }
         ));
     }
-    let l = if len == HEADER_LEN { &NIFTI1 } else { &NIFTI2 };
-    let bytes = |o: usize, n: usize| {
-        let mut a = [0u8; 8];
-        a[..n].copy_from_slice(&b[o..o + n]);
-        if big_endian {
-            a[..n].reverse();
-        }
-        a
+    let f = Fields {
+        b,
+        big_endian,
+        l: if len == HEADER_LEN { &NIFTI1 } else { &NIFTI2 },
     };
-    let i16_at = |o: usize| i16::from_le_bytes(bytes(o, 2)[..2].try_into().expect("2"));
-    let i32_at = |o: usize| i32::from_le_bytes(bytes(o, 4)[..4].try_into().expect("4"));
-    let i64_at = |o: usize| i64::from_le_bytes(bytes(o, 8));
-    let f32_at = |o: usize| f32::from_le_bytes(bytes(o, 4)[..4].try_into().expect("4"));
-    let f64_at = |o: usize| f64::from_le_bytes(bytes(o, 8));
-    // An integer field: `dim[i]` and the form codes are i16 in NIfTI-1, i64 / i32 in NIfTI-2.
-    let dim = |i: usize| {
-        if l.wide {
-            i64_at(l.dim + 8 * i)
-        } else {
-            i64::from(i16_at(l.dim + 2 * i))
-        }
-    };
-    let code = |o: usize| {
-        if l.wide {
-            i64::from(i32_at(o))
-        } else {
-            i64::from(i16_at(o))
-        }
-    };
-    // A real field, kept in f64 (NIfTI-2's width), narrowed where the renderer needs f32.
-    let real = |o: usize, i: usize| {
-        if l.wide {
-            f64_at(o + 8 * i)
-        } else {
-            f64::from(f32_at(o + 4 * i))
-        }
-    };
-    let magic = &b[l.magic..l.magic + 4];
-    let (version, pair) = match magic {
-        b"n+1\0" if !l.wide => (1, false),
-        b"ni1\0" if !l.wide => (1, true),
-        b"n+2\0" if l.wide => (2, false),
-        b"ni2\0" if l.wide => (2, true),
-        // Analyze 7.5 (NIfTI-1's ancestor): no magic; always a pair.
-        [0, 0, 0, 0] if !l.wide => (0, true),
-        _ => {
-            return Err(format!(
-                "magic {:?} is not {} (single file) or {} (pair)",
-                String::from_utf8_lossy(magic).trim_end_matches('\0'),
-                if l.wide { "n+2" } else { "n+1" },
-                if l.wide { "ni2" } else { "ni1" },
-            ))
-        }
-    };
-    let ndim = dim(0);
-    if !(3..=7).contains(&ndim) {
-        return Err(format!("dim[0] = {ndim}: expected a 3D volume"));
-    }
-    let mut dims = [0usize; 3];
-    for (a, d) in dims.iter_mut().enumerate() {
-        let v = dim(a + 1);
-        *d = usize::try_from(v)
-            .ok()
-            .filter(|&v| v > 0)
-            .ok_or_else(|| format!("dim[{}] = {v} is not positive", a + 1))?;
-    }
-    for a in 4..=ndim as usize {
-        if dim(a) > 1 {
-            return Err(format!(
-                "dim[{a}] = {}: only 3D volumes are supported",
-                dim(a)
-            ));
-        }
-    }
-    let datatype = i16_at(l.datatype);
-    let ty = match datatype {
-        2 => SampleType::U8,
-        4 => SampleType::I16,
-        8 => SampleType::I32,
-        16 => SampleType::F32,
-        64 => SampleType::F64,
-        256 => SampleType::I8,
-        512 => SampleType::U16,
-        768 => SampleType::U32,
-        o => return Err(format!("datatype {o} is not supported")),
-    };
-    if i16_at(l.bitpix) as usize != 8 * ty.size() {
-        return Err(format!(
-            "bitpix {} does not match datatype {datatype}",
-            i16_at(l.bitpix)
-        ));
-    }
+    let (version, pair) = f.version()?;
+    let dims = f.dims()?;
+    let ty = f.sample_type()?;
     byte_len(dims, ty)?;
-    let pixdim = [1, 2, 3].map(|i| real(l.pixdim, i).abs() as f32);
+    let l = f.l;
     let vox = if l.wide {
-        i64_at(l.vox_offset) as f64
+        f.i64_at(l.vox_offset) as f64
     } else {
-        real(l.vox_offset, 0)
+        f.real(l.vox_offset, 0)
     };
     // A single file's samples follow the header; a pair's `.img` holds only samples (offset 0
     // in practice, any whole number allowed).
@@ -224,32 +140,192 @@ pub fn parse_header(b: &[u8]) -> Result<Header, String> {
     if !(vox >= min as f64 && vox.fract() == 0.0 && vox < 1e9) {
         return Err(format!("vox_offset {vox} is not a whole number ≥ {min}"));
     }
-    let (slope, inter) = (real(l.slope, 0) as f32, real(l.inter, 0) as f32);
+    let (slope, inter) = (f.real(l.slope, 0) as f32, f.real(l.inter, 0) as f32);
     let scale =
         (slope.is_finite() && inter.is_finite() && slope != 0.0 && (slope, inter) != (1.0, 0.0))
             .then_some((slope, inter));
     // Analyze headers keep other fields where NIfTI has its form codes: orientation is ignored.
-    let (qform, sform) = if version == 0 {
-        (0, 0)
+    let (spacing, directions) = if version == 0 {
+        (f.pixdim(), AXIS_ALIGNED)
     } else {
-        (code(l.qform), code(l.sform))
+        f.orientation()?
     };
-    let (spacing, directions) = if sform > 0 {
-        // srow_x, srow_y, srow_z: four reals each; column j of the 3×3 part is axis j's step.
-        let m = |r: usize, c: usize| real(l.srow, 4 * r + c) as f32;
-        let mut spacing = [0.0f32; 3];
-        let mut d = AXIS_ALIGNED;
-        for c in 0..3 {
-            let v = [m(0, c), m(1, c), m(2, c)];
-            (spacing[c], d[c]) = super::axis_step(v)
-                .ok_or_else(|| format!("sform column {c} is zero or not finite"))?;
+    check_spacing(spacing)?;
+    Ok(Header {
+        version,
+        pair,
+        dims,
+        spacing,
+        directions,
+        ty,
+        big_endian,
+        vox_offset: vox as usize,
+        scale,
+    })
+}
+
+/// A header's fields, read in its byte order at its version's offsets and widths.
+struct Fields<'a> {
+    b: &'a [u8],
+    big_endian: bool,
+    l: &'static Layout,
+}
+
+impl Fields<'_> {
+    /// `n` ≤ 8 bytes at `o`, little-endian first.
+    fn bytes(&self, o: usize, n: usize) -> [u8; 8] {
+        let mut a = [0u8; 8];
+        a[..n].copy_from_slice(&self.b[o..o + n]);
+        if self.big_endian {
+            a[..n].reverse();
         }
-        (spacing, d)
-    } else if qform > 0 {
-        // As nifti1_io's nifti_quatern_to_mat44 (in f64): a = √(1 − b² − c² − d²), except where
-        // that is below 10⁻⁷, when (b, c, d) is normalised and a = 0 (a 180° rotation), so a
-        // quaternion written a little past unit length still gives a rotation.
-        let [mut qb, mut qc, mut qd] = [0, 1, 2].map(|k| real(l.quatern, k));
+        a
+    }
+
+    fn i16_at(&self, o: usize) -> i16 {
+        let [a, b, ..] = self.bytes(o, 2);
+        i16::from_le_bytes([a, b])
+    }
+
+    fn i32_at(&self, o: usize) -> i32 {
+        let [a, b, c, d, ..] = self.bytes(o, 4);
+        i32::from_le_bytes([a, b, c, d])
+    }
+
+    fn i64_at(&self, o: usize) -> i64 {
+        i64::from_le_bytes(self.bytes(o, 8))
+    }
+
+    /// `dim[i]`: i16 in NIfTI-1, i64 in NIfTI-2.
+    fn dim(&self, i: usize) -> i64 {
+        if self.l.wide {
+            self.i64_at(self.l.dim + 8 * i)
+        } else {
+            i64::from(self.i16_at(self.l.dim + 2 * i))
+        }
+    }
+
+    /// A form code: i16 in NIfTI-1, i32 in NIfTI-2.
+    fn code(&self, o: usize) -> i64 {
+        if self.l.wide {
+            i64::from(self.i32_at(o))
+        } else {
+            i64::from(self.i16_at(o))
+        }
+    }
+
+    /// Real `i` of the array at `o`, kept in f64 (NIfTI-2's width), narrowed where the renderer
+    /// needs f32.
+    fn real(&self, o: usize, i: usize) -> f64 {
+        if self.l.wide {
+            f64::from_le_bytes(self.bytes(o + 8 * i, 8))
+        } else {
+            let [a, b, c, d, ..] = self.bytes(o + 4 * i, 4);
+            f64::from(f32::from_le_bytes([a, b, c, d]))
+        }
+    }
+
+    /// (version, pair) from the magic: 1 or 2, or 0 for Analyze 7.5 (no magic, always a pair).
+    fn version(&self) -> Result<(u8, bool), String> {
+        let (l, b) = (self.l, self.b);
+        let magic = &b[l.magic..l.magic + 4];
+        Ok(match magic {
+            b"n+1\0" if !l.wide => (1, false),
+            b"ni1\0" if !l.wide => (1, true),
+            b"n+2\0" if l.wide => (2, false),
+            b"ni2\0" if l.wide => (2, true),
+            [0, 0, 0, 0] if !l.wide => (0, true),
+            _ => {
+                return Err(format!(
+                    "magic {:?} is not {} (single file) or {} (pair)",
+                    String::from_utf8_lossy(magic).trim_end_matches('\0'),
+                    if l.wide { "n+2" } else { "n+1" },
+                    if l.wide { "ni2" } else { "ni1" },
+                ))
+            }
+        })
+    }
+
+    /// The three dimensions (a 3D volume: any further ones 1).
+    fn dims(&self) -> Result<[usize; 3], String> {
+        let ndim = self.dim(0);
+        if !(3..=7).contains(&ndim) {
+            return Err(format!("dim[0] = {ndim}: expected a 3D volume"));
+        }
+        let mut dims = [0usize; 3];
+        for (a, d) in dims.iter_mut().enumerate() {
+            let v = self.dim(a + 1);
+            *d = usize::try_from(v)
+                .ok()
+                .filter(|&v| v > 0)
+                .ok_or_else(|| format!("dim[{}] = {v} is not positive", a + 1))?;
+        }
+        for a in 4..=ndim as usize {
+            if self.dim(a) > 1 {
+                return Err(format!(
+                    "dim[{a}] = {}: only 3D volumes are supported",
+                    self.dim(a)
+                ));
+            }
+        }
+        Ok(dims)
+    }
+
+    /// The sample type `datatype` names, checked against `bitpix`.
+    fn sample_type(&self) -> Result<SampleType, String> {
+        let datatype = self.i16_at(self.l.datatype);
+        let ty = match datatype {
+            2 => SampleType::U8,
+            4 => SampleType::I16,
+            8 => SampleType::I32,
+            16 => SampleType::F32,
+            64 => SampleType::F64,
+            256 => SampleType::I8,
+            512 => SampleType::U16,
+            768 => SampleType::U32,
+            o => return Err(format!("datatype {o} is not supported")),
+        };
+        let bitpix = self.i16_at(self.l.bitpix);
+        if bitpix as usize != 8 * ty.size() {
+            return Err(format!(
+                "bitpix {bitpix} does not match datatype {datatype}"
+            ));
+        }
+        Ok(ty)
+    }
+
+    /// `pixdim[1..=3]`, as magnitudes.
+    fn pixdim(&self) -> [f32; 3] {
+        [1, 2, 3].map(|i| self.real(self.l.pixdim, i).abs() as f32)
+    }
+
+    /// Spacing and axis directions: from the sform if `sform_code` > 0, else the qform if
+    /// `qform_code` > 0, else `pixdim` along the axes.
+    fn orientation(&self) -> Result<([f32; 3], [[f32; 3]; 3]), String> {
+        let l = self.l;
+        if self.code(l.sform) > 0 {
+            // srow_x, srow_y, srow_z: four reals each; column j of the 3×3 part is axis j's step.
+            let m = |r: usize, c: usize| self.real(l.srow, 4 * r + c) as f32;
+            let mut spacing = [0.0f32; 3];
+            let mut d = AXIS_ALIGNED;
+            for c in 0..3 {
+                let v = [m(0, c), m(1, c), m(2, c)];
+                (spacing[c], d[c]) = super::axis_step(v)
+                    .ok_or_else(|| format!("sform column {c} is zero or not finite"))?;
+            }
+            Ok((spacing, d))
+        } else if self.code(l.qform) > 0 {
+            Ok((self.pixdim(), self.quaternion()?))
+        } else {
+            Ok((self.pixdim(), AXIS_ALIGNED))
+        }
+    }
+
+    /// The qform's axis directions. As nifti1_io's nifti_quatern_to_mat44 (in f64): a = √(1 −
+    /// b² − c² − d²), except where that is below 10⁻⁷, when (b, c, d) is normalised and a = 0 (a
+    /// 180° rotation), so a quaternion written a little past unit length still gives a rotation.
+    fn quaternion(&self) -> Result<[[f32; 3]; 3], String> {
+        let [mut qb, mut qc, mut qd] = [0, 1, 2].map(|k| self.real(self.l.quatern, k));
         let norm2 = qb * qb + qc * qc + qd * qd;
         if !norm2.is_finite() {
             return Err("qform quaternion (quatern_b, c, d) is not finite".into());
@@ -261,7 +337,11 @@ pub fn parse_header(b: &[u8]) -> Result<Header, String> {
         } else {
             (1.0 - norm2).sqrt()
         };
-        let qfac = if real(l.pixdim, 0) < 0.0 { -1.0 } else { 1.0 };
+        let qfac = if self.real(self.l.pixdim, 0) < 0.0 {
+            -1.0
+        } else {
+            1.0
+        };
         let r = [
             [
                 qa * qa + qb * qb - qc * qc - qd * qd,
@@ -280,22 +360,8 @@ pub fn parse_header(b: &[u8]) -> Result<Header, String> {
             ],
         ];
         let col = |c: usize, s: f64| [0, 1, 2].map(|i| (r[i][c] * s) as f32);
-        (pixdim, [col(0, 1.0), col(1, 1.0), col(2, qfac)])
-    } else {
-        (pixdim, AXIS_ALIGNED)
-    };
-    check_spacing(spacing)?;
-    Ok(Header {
-        version,
-        pair,
-        dims,
-        spacing,
-        directions,
-        ty,
-        big_endian,
-        vox_offset: vox as usize,
-        scale,
-    })
+        Ok([col(0, 1.0), col(1, 1.0), col(2, qfac)])
+    }
 }
 
 /// The header and the image of a pair named by either (`.hdr`, `.hdr.gz`, `.img`, `.img.gz`, in

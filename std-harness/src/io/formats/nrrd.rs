@@ -56,83 +56,24 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
     if !(bytes.len() >= 8 && bytes.starts_with(b"NRRD000") && (b'1'..=b'5').contains(&bytes[7])) {
         return Err("not an NRRD file (expected magic NRRD0001 to NRRD0005)".into());
     }
-    let mut at = 0;
-    let mut fields: Vec<(String, String)> = Vec::new();
-    let mut first = true;
-    loop {
-        let end = bytes[at..].iter().position(|&b| b == b'\n').map(|p| at + p);
-        let line_bytes = &bytes[at..end.unwrap_or(bytes.len())];
-        at = end.map_or(bytes.len(), |e| e + 1);
-        let line = std::str::from_utf8(line_bytes).map_err(|_| "header is not text".to_string())?;
-        let line = line.trim_end_matches('\r');
-        if first {
-            first = false;
-        } else if line.is_empty() {
-            break;
-        } else if !line.starts_with('#') {
-            if let Some((k, v)) = line.split_once(": ") {
-                fields.push((k.trim().to_ascii_lowercase(), v.trim().to_string()));
-            } else if !line.contains(":=") {
-                return Err(format!(
-                    "malformed header line '{}'",
-                    line.chars().take(60).collect::<String>()
-                ));
-            }
-        }
-        if end.is_none() {
-            break;
-        }
-    }
-    let get = |keys: &[&str]| {
-        fields
-            .iter()
-            .find(|(k, _)| keys.contains(&k.as_str()))
-            .map(|(_, v)| v.as_str())
-    };
-    let need = |k: &str| get(&[k]).ok_or_else(|| format!("missing header field '{k}'"));
-    let tyname = need("type")?;
+    let (fields, header_len) = Fields::read(bytes)?;
+    let tyname = fields.need("type")?;
     let ty = SampleType::parse(tyname)
         .ok_or_else(|| format!("type: '{tyname}' is not a supported sample type"))?;
-    let dimension = need("dimension")?;
+    let dimension = fields.need("dimension")?;
     if dimension.trim() != "3" {
         return Err(format!("dimension: expected 3, found '{dimension}'"));
     }
-    let sizes = need("sizes")?;
+    let sizes = fields.need("sizes")?;
     let dims: Vec<usize> = numbers(sizes, 3, "sizes")?;
     let dims = [dims[0], dims[1], dims[2]];
     byte_len(dims, ty)?;
-    let (spacing, directions) = if let Some(sd) = get(&["space directions"]) {
-        // Three vectors "(x,y,z)", separated by spaces.
-        let parts: Vec<&str> = sd
-            .split(')')
-            .map(str::trim)
-            .filter(|p| !p.is_empty())
-            .collect();
-        if parts.len() != 3 {
-            return Err(format!(
-                "space directions: expected 3 vectors, found '{sd}'"
-            ));
-        }
-        let mut spacing = [0.0f32; 3];
-        let mut dirs = AXIS_ALIGNED;
-        for (c, p) in parts.iter().enumerate() {
-            let v = vector(&format!("{p})"))
-                .ok_or_else(|| format!("space directions: '{p})' is not a 3-vector"))?;
-            (spacing[c], dirs[c]) = super::axis_step(v)
-                .ok_or_else(|| format!("space directions: vector {} has zero length", c + 1))?;
-        }
-        (spacing, dirs)
-    } else if let Some(s) = get(&["spacings"]) {
-        let v: Vec<f32> = numbers(s, 3, "spacings")?;
-        ([v[0], v[1], v[2]], AXIS_ALIGNED)
-    } else {
-        ([1.0; 3], AXIS_ALIGNED)
-    };
+    let (spacing, directions) = fields.orientation()?;
     check_spacing(spacing)?;
-    if let Some(o) = get(&["space origin"]) {
+    if let Some(o) = fields.get(&["space origin"]) {
         vector(o).ok_or_else(|| format!("space origin: '{o}' is not a 3-vector"))?;
     }
-    let enc = need("encoding")?;
+    let enc = fields.need("encoding")?;
     let encoding = match enc {
         "raw" => Encoding::Raw,
         "gzip" | "gz" => Encoding::Gzip,
@@ -143,7 +84,7 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
             ))
         }
     };
-    let big_endian = match get(&["endian"]) {
+    let big_endian = match fields.get(&["endian"]) {
         Some("big") => true,
         Some("little") => false,
         None if ty.size() == 1 || encoding == Encoding::Ascii => false,
@@ -154,23 +95,16 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
         }
         Some(other) => return Err(format!("endian: expected little or big, found '{other}'")),
     };
-    let number = |keys: &[&str], name: &str| -> Result<i64, String> {
-        get(keys).map_or(Ok(0), |v| {
-            v.trim()
-                .parse()
-                .map_err(|_| format!("{name}: '{v}' is not a whole number"))
-        })
-    };
-    let byte_skip = number(&["byte skip", "byteskip"], "byte skip")?;
+    let byte_skip = fields.number(&["byte skip", "byteskip"], "byte skip")?;
     if byte_skip < -1 || (byte_skip == -1 && encoding != Encoding::Raw) {
         return Err(format!(
             "byte skip: {byte_skip} is not allowed with {enc} encoding"
         ));
     }
-    let line_skip = number(&["line skip", "lineskip"], "line skip")?;
+    let line_skip = fields.number(&["line skip", "lineskip"], "line skip")?;
     let line_skip =
         usize::try_from(line_skip).map_err(|_| format!("line skip: {line_skip} is negative"))?;
-    let data_file = get(&["data file", "datafile"]).map(str::to_string);
+    let data_file = fields.get(&["data file", "datafile"]).map(str::to_string);
     if data_file
         .as_deref()
         .is_some_and(|d| d.starts_with("LIST") || d.contains('%'))
@@ -187,8 +121,101 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
         data_file,
         line_skip,
         byte_skip,
-        header_len: at,
+        header_len,
     })
+}
+
+/// A header's `key: value` fields, keys in lower case, in file order.
+struct Fields(Vec<(String, String)>);
+
+impl Fields {
+    /// The fields of the header at the start of `bytes` (after the magic line, up to the blank
+    /// line that ends it) and the header's length in bytes, that line included.
+    fn read(bytes: &[u8]) -> Result<(Self, usize), String> {
+        let mut at = 0;
+        let mut fields = Vec::new();
+        let mut first = true;
+        loop {
+            let end = bytes[at..].iter().position(|&b| b == b'\n').map(|p| at + p);
+            let line_bytes = &bytes[at..end.unwrap_or(bytes.len())];
+            at = end.map_or(bytes.len(), |e| e + 1);
+            let line =
+                std::str::from_utf8(line_bytes).map_err(|_| "header is not text".to_string())?;
+            let line = line.trim_end_matches('\r');
+            if first {
+                first = false;
+            } else if line.is_empty() {
+                break;
+            } else if !line.starts_with('#') {
+                if let Some((k, v)) = line.split_once(": ") {
+                    fields.push((k.trim().to_ascii_lowercase(), v.trim().to_string()));
+                } else if !line.contains(":=") {
+                    return Err(format!(
+                        "malformed header line '{}'",
+                        line.chars().take(60).collect::<String>()
+                    ));
+                }
+            }
+            if end.is_none() {
+                break;
+            }
+        }
+        Ok((Fields(fields), at))
+    }
+
+    /// The first field with one of these keys.
+    fn get(&self, keys: &[&str]) -> Option<&str> {
+        self.0
+            .iter()
+            .find(|(k, _)| keys.contains(&k.as_str()))
+            .map(|(_, v)| v.as_str())
+    }
+
+    /// Field `k`, which must be there.
+    fn need(&self, k: &str) -> Result<&str, String> {
+        self.get(&[k])
+            .ok_or_else(|| format!("missing header field '{k}'"))
+    }
+
+    /// A whole-number field (0 if absent).
+    fn number(&self, keys: &[&str], name: &str) -> Result<i64, String> {
+        self.get(keys).map_or(Ok(0), |v| {
+            v.trim()
+                .parse()
+                .map_err(|_| format!("{name}: '{v}' is not a whole number"))
+        })
+    }
+
+    /// Spacing and axis directions: from `space directions` (three vectors "(x,y,z)",
+    /// separated by spaces), else `spacings` along the axes, else unit spacing.
+    fn orientation(&self) -> Result<([f32; 3], [[f32; 3]; 3]), String> {
+        if let Some(sd) = self.get(&["space directions"]) {
+            let parts: Vec<&str> = sd
+                .split(')')
+                .map(str::trim)
+                .filter(|p| !p.is_empty())
+                .collect();
+            if parts.len() != 3 {
+                return Err(format!(
+                    "space directions: expected 3 vectors, found '{sd}'"
+                ));
+            }
+            let mut spacing = [0.0f32; 3];
+            let mut dirs = AXIS_ALIGNED;
+            for (c, p) in parts.iter().enumerate() {
+                let v = vector(&format!("{p})"))
+                    .ok_or_else(|| format!("space directions: '{p})' is not a 3-vector"))?;
+                (spacing[c], dirs[c]) = super::axis_step(v)
+                    .ok_or_else(|| format!("space directions: vector {} has zero length", c + 1))?;
+            }
+            Ok((spacing, dirs))
+        } else if let Some(s) = self.get(&["spacings"]) {
+            let v: Vec<f32> = numbers(s, 3, "spacings")?;
+            Ok(([v[0], v[1], v[2]], AXIS_ALIGNED))
+        } else {
+            Ok(([1.0; 3], AXIS_ALIGNED))
+        }
+    }
 }
 
 /// Longest run of bytes `line skip` may pass over, in all (16 MiB): a data file without line

@@ -195,6 +195,36 @@ pub fn parse_header_array<'a>(
     if root.tag_name().name() != "VTKFile" || root.attribute("type") != Some("ImageData") {
         return Err("not a VTK XML ImageData file (VTKFile type=\"ImageData\")".into());
     }
+    let (big_endian, header64, compressor) = encoding(root)?;
+    let image = root
+        .children()
+        .find(|n| n.has_tag_name("ImageData"))
+        .ok_or("no ImageData element")?;
+    let (dims, spacing, directions) = geometry(image)?;
+    let (ty, format) = data_array(choose_array(image, array)?)?;
+    byte_len(dims, ty)?;
+    if matches!(format, Format::Appended { .. }) && appended.is_none() {
+        return Err("appended DataArray but no AppendedData section".into());
+    }
+    Ok((
+        Header {
+            dims,
+            spacing,
+            directions,
+            ty,
+            big_endian,
+            header64,
+            compressor,
+            format,
+        },
+        appended,
+    ))
+}
+
+type Node<'a, 'input> = roxmltree::Node<'a, 'input>;
+
+/// The `VTKFile` element's byte order (big-endian?), header width (64-bit?) and compressor.
+fn encoding(root: Node<'_, '_>) -> Result<(bool, bool, Compressor), String> {
     let big_endian = match root.attribute("byte_order") {
         Some("BigEndian") => true,
         Some("LittleEndian") | None => false,
@@ -221,10 +251,14 @@ pub fn parse_header_array<'a>(
             ))
         }
     };
-    let image = root
-        .children()
-        .find(|n| n.has_tag_name("ImageData"))
-        .ok_or("no ImageData element")?;
+    Ok((big_endian, header64, compressor))
+}
+
+/// Dimensions, spacing and axis directions.
+type Geometry = ([usize; 3], [f32; 3], [[f32; 3]; 3]);
+
+/// The `ImageData` element's dimensions (from `WholeExtent`), spacing and axis directions.
+fn geometry(image: Node<'_, '_>) -> Result<Geometry, String> {
     let extent: Vec<i64> = numbers(
         image
             .attribute("WholeExtent")
@@ -265,6 +299,15 @@ pub fn parse_header_array<'a>(
         }
         None => AXIS_ALIGNED,
     };
+    Ok((dims, spacing, directions))
+}
+
+/// The one piece's point-data array named `array`, else the `Scalars` attribute's, else the
+/// first.
+fn choose_array<'a, 'input>(
+    image: Node<'a, 'input>,
+    array: Option<&str>,
+) -> Result<Node<'a, 'input>, String> {
     let pieces: Vec<_> = image
         .children()
         .filter(|n| n.has_tag_name("Piece"))
@@ -287,18 +330,20 @@ pub fn parse_header_array<'a>(
             .collect::<Vec<_>>()
             .join(", ")
     };
-    let array = match (array, point_data.attribute("Scalars")) {
-        (Some(name), _) => arrays
-            .iter()
-            .find(|a| a.attribute("Name") == Some(name))
+    let named = |name: &str| arrays.iter().find(|a| a.attribute("Name") == Some(name));
+    let found = match (array, point_data.attribute("Scalars")) {
+        (Some(name), _) => named(name)
             .ok_or_else(|| format!("no point-data array '{name}' (the file has: {})", names()))?,
-        (None, Some(name)) => arrays
-            .iter()
-            .find(|a| a.attribute("Name") == Some(name))
+        (None, Some(name)) => named(name)
             .or(arrays.first())
             .ok_or("PointData has no scalar DataArray")?,
         (None, None) => arrays.first().ok_or("PointData has no scalar DataArray")?,
     };
+    Ok(*found)
+}
+
+/// A `DataArray`'s sample type and where its values are.
+fn data_array(array: Node<'_, '_>) -> Result<(SampleType, Format), String> {
     let comps = array.attribute("NumberOfComponents").unwrap_or("1");
     if comps != "1" {
         return Err(format!(
@@ -317,11 +362,10 @@ pub fn parse_header_array<'a>(
         "Float64" => SampleType::F64,
         o => return Err(format!("DataArray type '{o}' is not supported")),
     };
-    byte_len(dims, ty)?;
-    let text = array.text().unwrap_or("").as_bytes().to_vec();
+    let text = || array.text().unwrap_or("").as_bytes().to_vec();
     let format = match array.attribute("format").unwrap_or("ascii") {
-        "ascii" => Format::Ascii(text),
-        "binary" => Format::Binary(text),
+        "ascii" => Format::Ascii(text()),
+        "binary" => Format::Binary(text()),
         "appended" => {
             let off = array
                 .attribute("offset")
@@ -339,22 +383,7 @@ pub fn parse_header_array<'a>(
             ))
         }
     };
-    if matches!(format, Format::Appended { .. }) && appended.is_none() {
-        return Err("appended DataArray but no AppendedData section".into());
-    }
-    Ok((
-        Header {
-            dims,
-            spacing,
-            directions,
-            ty,
-            big_endian,
-            header64,
-            compressor,
-            format,
-        },
-        appended,
-    ))
+    Ok((ty, format))
 }
 
 /// Reads header words (UInt32 or UInt64) from `b` at word index `i`.

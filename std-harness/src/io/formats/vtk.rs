@@ -219,7 +219,20 @@ struct Found {
 /// (see the module documentation).
 pub fn parse(bytes: &[u8], array: Option<&str>) -> Result<Header, String> {
     let mut w = Words { b: bytes, pos: 0 };
-    // Line 1: the version line; line 2: the title, whatever it holds.
+    let mut scan = Scan {
+        binary: preamble(&mut w)?,
+        ..Scan::default()
+    };
+    while let Some(word) = w.word() {
+        scan.keyword(&mut w, word)?;
+    }
+    scan.header(array)
+}
+
+/// Lines 1 and 2 (the version line, then the title, whatever it holds) and the `ASCII` or
+/// `BINARY` word after them: whether the data are binary.
+fn preamble(w: &mut Words<'_>) -> Result<bool, String> {
+    let bytes = w.b;
     let first_end = bytes
         .iter()
         .position(|&c| c == b'\n')
@@ -234,29 +247,36 @@ pub fn parse(bytes: &[u8], array: Option<&str>) -> Result<Header, String> {
     }
     w.pos = (first_end + 1).min(bytes.len());
     w.skip_line();
-    let mode = w.word().unwrap_or("");
-    let binary = match mode.to_ascii_uppercase().as_str() {
-        "ASCII" => false,
-        "BINARY" => true,
-        o => {
-            return Err(format!(
-                "after the title: expected ASCII or BINARY, found '{o}'"
-            ))
-        }
-    };
-    let (mut dims, mut spacing, mut dataset) = (None, None, None);
-    // Where the point data's arrays are, and how many values each tuple of a section has.
-    let mut found: Vec<Found> = Vec::new();
-    let mut section: Option<(bool, usize)> = None; // (point data?, tuples)
-    let mut chosen: Option<usize> = None;
-    let points = |dims: Option<[usize; 3]>| -> Result<usize, String> {
-        let d = dims.ok_or("POINT_DATA before DIMENSIONS")?;
-        Ok(d[0] * d[1] * d[2])
-    };
-    while let Some(word) = w.word() {
+    match w.word().unwrap_or("").to_ascii_uppercase().as_str() {
+        "ASCII" => Ok(false),
+        "BINARY" => Ok(true),
+        o => Err(format!(
+            "after the title: expected ASCII or BINARY, found '{o}'"
+        )),
+    }
+}
+
+/// What the keywords read so far declared.
+#[derive(Default)]
+struct Scan {
+    binary: bool,
+    dims: Option<[usize; 3]>,
+    spacing: Option<[f32; 3]>,
+    dataset: Option<String>,
+    /// The point data's arrays, in file order.
+    found: Vec<Found>,
+    /// The current section: (point data?, tuples).
+    section: Option<(bool, usize)>,
+    /// The first point-data `SCALARS` (VTK's active scalars), an index into `found`.
+    chosen: Option<usize>,
+}
+
+impl Scan {
+    /// Reads what follows keyword `word`.
+    fn keyword(&mut self, w: &mut Words<'_>, word: &str) -> Result<(), String> {
         let key = word.to_ascii_uppercase();
         match key.as_str() {
-            "DATASET" => dataset = Some(w.need("DATASET")?.to_ascii_uppercase()),
+            "DATASET" => self.dataset = Some(w.need("DATASET")?.to_ascii_uppercase()),
             "DIMENSIONS" => {
                 let v = w.numbers(3, "DIMENSIONS")?;
                 if v.iter()
@@ -266,11 +286,11 @@ pub fn parse(bytes: &[u8], array: Option<&str>) -> Result<Header, String> {
                 }
                 let d = [v[0] as usize, v[1] as usize, v[2] as usize];
                 byte_len(d, SampleType::U8)?;
-                dims = Some(d);
+                self.dims = Some(d);
             }
             "SPACING" | "ASPECT_RATIO" => {
                 let v = w.numbers(3, &key)?;
-                spacing = Some([v[0] as f32, v[1] as f32, v[2] as f32]);
+                self.spacing = Some([v[0] as f32, v[1] as f32, v[2] as f32]);
             }
             "ORIGIN" => {
                 w.numbers(3, "ORIGIN")?;
@@ -278,41 +298,18 @@ pub fn parse(bytes: &[u8], array: Option<&str>) -> Result<Header, String> {
             "POINT_DATA" | "CELL_DATA" => {
                 let n = w.count(&key)?;
                 let point = key == "POINT_DATA";
-                if point && n != points(dims)? {
-                    return Err(format!(
-                        "POINT_DATA: expected {} (the DIMENSIONS' product), found {n}",
-                        points(dims)?
-                    ));
-                }
-                section = Some((point, n));
-            }
-            "FIELD" => {
-                // Dataset field data (before any section) have their own tuple counts.
-                w.need("FIELD name")?;
-                let arrays = w.count("FIELD array count")?;
-                for _ in 0..arrays {
-                    let name = w.need("FIELD array name")?.to_string();
-                    let comps = w.count(&format!("FIELD array {name}: components"))?;
-                    let tuples = w.count(&format!("FIELD array {name}: tuples"))?;
-                    let ty = w.need(&format!("FIELD array {name}: type"))?.to_string();
-                    let size = type_size(&ty).ok_or_else(|| {
-                        format!("FIELD array {name}: type '{ty}' is not a VTK type")
-                    })?;
-                    let values = comps
-                        .checked_mul(tuples)
-                        .ok_or_else(|| format!("FIELD array {name}: too many values"))?;
-                    let start = w.skip_values(values, size, binary, &name)?;
-                    w.skip_metadata();
-                    if matches!(section, Some((true, n)) if n == tuples) {
-                        found.push(Found {
-                            name,
-                            ty,
-                            components: comps,
-                            start,
-                        });
+                if point {
+                    let d = self.dims.ok_or("POINT_DATA before DIMENSIONS")?;
+                    let points = d[0] * d[1] * d[2];
+                    if n != points {
+                        return Err(format!(
+                            "POINT_DATA: expected {points} (the DIMENSIONS' product), found {n}"
+                        ));
                     }
                 }
+                self.section = Some((point, n));
             }
+            "FIELD" => self.field(w)?,
             "SCALARS"
             | "COLOR_SCALARS"
             | "VECTORS"
@@ -322,146 +319,192 @@ pub fn parse(bytes: &[u8], array: Option<&str>) -> Result<Header, String> {
             | "TENSORS6"
             | "GLOBAL_IDS"
             | "PEDIGREE_IDS"
-            | "LOOKUP_TABLE" => {
-                let Some((point, tuples)) = section else {
-                    return Err(format!("{key} before POINT_DATA or CELL_DATA"));
-                };
-                let name = w.need(&key)?.to_string();
-                let (ty, comps, size) = match key.as_str() {
-                    "SCALARS" => {
-                        let ty = w.need("SCALARS type")?.to_string();
-                        // Optional components, then the required LOOKUP_TABLE name.
-                        let mut next = w.need("SCALARS: LOOKUP_TABLE")?;
-                        let mut comps = 1;
-                        if !next.eq_ignore_ascii_case("LOOKUP_TABLE") {
-                            comps = next
-                                .parse()
-                                .ok()
-                                .filter(|c| (1..=4).contains(c))
-                                .ok_or_else(|| {
-                                    format!("SCALARS {name}: '{next}' is not 1 to 4 components")
-                                })?;
-                            next = w.need("SCALARS: LOOKUP_TABLE")?;
-                        }
-                        if !next.eq_ignore_ascii_case("LOOKUP_TABLE") {
-                            return Err(format!(
-                                "SCALARS {name}: missing LOOKUP_TABLE after SCALARS, found '{next}'"
-                            ));
-                        }
-                        w.need("LOOKUP_TABLE name")?;
-                        if ty.eq_ignore_ascii_case("bit") && binary {
-                            // Packed eight to a byte; not renderable, but passed over.
-                            let bytes = (tuples * comps).div_ceil(8);
-                            w.skip_values(bytes, 1, true, &name)?;
-                            w.skip_metadata();
-                            continue;
-                        }
-                        let size = type_size(&ty).ok_or_else(|| {
-                            format!("SCALARS {name}: type '{ty}' is not a VTK type")
-                        })?;
-                        (ty, comps, size)
-                    }
-                    "COLOR_SCALARS" => {
-                        let c = w.count("COLOR_SCALARS components")?;
-                        ("unsigned_char".to_string(), c, 1)
-                    }
-                    "LOOKUP_TABLE" => {
-                        // A standalone table: size entries of RGBA.
-                        let n = w.count("LOOKUP_TABLE size")?;
-                        w.skip_values(n.saturating_mul(4), 1, binary, &name)?;
-                        continue;
-                    }
-                    "TEXTURE_COORDINATES" => {
-                        let c = w.count("TEXTURE_COORDINATES dimension")?;
-                        let ty = w.need("TEXTURE_COORDINATES type")?.to_string();
-                        let size = type_size(&ty).ok_or_else(|| format!("{name}: type '{ty}'"))?;
-                        (ty, c, size)
-                    }
-                    _ => {
-                        let ty = w.need(&format!("{key} type"))?.to_string();
-                        let size = type_size(&ty).ok_or_else(|| {
-                            format!("{key} {name}: type '{ty}' is not a VTK type")
-                        })?;
-                        let c = match key.as_str() {
-                            "VECTORS" | "NORMALS" => 3,
-                            "TENSORS" => 9,
-                            "TENSORS6" => 6,
-                            _ => 1,
-                        };
-                        (ty, c, size)
-                    }
-                };
-                let values = tuples
-                    .checked_mul(comps)
-                    .ok_or_else(|| format!("{key} {name}: too many values"))?;
-                let start = w.skip_values(values, size, binary, &name)?;
-                w.skip_metadata();
-                if point && key == "SCALARS" {
-                    if chosen.is_none() {
-                        chosen = Some(found.len());
-                    }
-                    found.push(Found {
-                        name,
-                        ty,
-                        components: comps,
-                        start,
-                    });
-                }
-            }
+            | "LOOKUP_TABLE" => self.attribute(w, &key)?,
             "METADATA" => w.metadata_body(),
-            _ => {
-                return Err(format!("unexpected '{word}' (not a legacy VTK keyword)"));
+            _ => return Err(format!("unexpected '{word}' (not a legacy VTK keyword)")),
+        }
+        Ok(())
+    }
+
+    /// A `FIELD name count` and its arrays (dataset field data, before any section, have
+    /// their own tuple counts: only arrays of the point data's count are candidates).
+    fn field(&mut self, w: &mut Words<'_>) -> Result<(), String> {
+        w.need("FIELD name")?;
+        let arrays = w.count("FIELD array count")?;
+        for _ in 0..arrays {
+            let name = w.need("FIELD array name")?.to_string();
+            let comps = w.count(&format!("FIELD array {name}: components"))?;
+            let tuples = w.count(&format!("FIELD array {name}: tuples"))?;
+            let ty = w.need(&format!("FIELD array {name}: type"))?.to_string();
+            let size = type_size(&ty)
+                .ok_or_else(|| format!("FIELD array {name}: type '{ty}' is not a VTK type"))?;
+            let values = comps
+                .checked_mul(tuples)
+                .ok_or_else(|| format!("FIELD array {name}: too many values"))?;
+            let start = w.skip_values(values, size, self.binary, &name)?;
+            w.skip_metadata();
+            if matches!(self.section, Some((true, n)) if n == tuples) {
+                self.found.push(Found {
+                    name,
+                    ty,
+                    components: comps,
+                    start,
+                });
             }
         }
+        Ok(())
     }
-    if dataset.as_deref() != Some("STRUCTURED_POINTS") {
+
+    /// A section's attribute (`key` read): its values passed over, a point-data `SCALARS`
+    /// kept as a candidate.
+    fn attribute(&mut self, w: &mut Words<'_>, key: &str) -> Result<(), String> {
+        let Some((point, tuples)) = self.section else {
+            return Err(format!("{key} before POINT_DATA or CELL_DATA"));
+        };
+        let name = w.need(key)?.to_string();
+        let binary = self.binary;
+        let (ty, comps, size) = match key {
+            "SCALARS" => match scalars_type(w, &name, tuples, binary)? {
+                Some(t) => t,
+                None => return Ok(()),
+            },
+            "COLOR_SCALARS" => {
+                let c = w.count("COLOR_SCALARS components")?;
+                ("unsigned_char".to_string(), c, 1)
+            }
+            "LOOKUP_TABLE" => {
+                // A standalone table: size entries of RGBA.
+                let n = w.count("LOOKUP_TABLE size")?;
+                w.skip_values(n.saturating_mul(4), 1, binary, &name)?;
+                return Ok(());
+            }
+            "TEXTURE_COORDINATES" => {
+                let c = w.count("TEXTURE_COORDINATES dimension")?;
+                let ty = w.need("TEXTURE_COORDINATES type")?.to_string();
+                let size = type_size(&ty).ok_or_else(|| format!("{name}: type '{ty}'"))?;
+                (ty, c, size)
+            }
+            _ => {
+                let ty = w.need(&format!("{key} type"))?.to_string();
+                let size = type_size(&ty)
+                    .ok_or_else(|| format!("{key} {name}: type '{ty}' is not a VTK type"))?;
+                let c = match key {
+                    "VECTORS" | "NORMALS" => 3,
+                    "TENSORS" => 9,
+                    "TENSORS6" => 6,
+                    _ => 1,
+                };
+                (ty, c, size)
+            }
+        };
+        let values = tuples
+            .checked_mul(comps)
+            .ok_or_else(|| format!("{key} {name}: too many values"))?;
+        let start = w.skip_values(values, size, binary, &name)?;
+        w.skip_metadata();
+        if point && key == "SCALARS" {
+            self.chosen.get_or_insert(self.found.len());
+            self.found.push(Found {
+                name,
+                ty,
+                components: comps,
+                start,
+            });
+        }
+        Ok(())
+    }
+
+    /// The header of the array `array` names, or of the default one.
+    fn header(self, array: Option<&str>) -> Result<Header, String> {
+        if self.dataset.as_deref() != Some("STRUCTURED_POINTS") {
+            return Err(format!(
+                "DATASET: expected STRUCTURED_POINTS, found {}",
+                self.dataset.as_deref().unwrap_or("none")
+            ));
+        }
+        let dims = self.dims.ok_or("missing DIMENSIONS")?;
+        let found = &self.found;
+        let list: Vec<String> = found
+            .iter()
+            .map(|f| format!("{} ({} × {})", f.name, f.ty, f.components))
+            .collect();
+        let pick = match array {
+            Some(name) => found.iter().position(|f| f.name == name).ok_or_else(|| {
+                format!(
+                    "no point-data array '{name}' (the file has: {})",
+                    if list.is_empty() {
+                        "none".to_string()
+                    } else {
+                        list.join(", ")
+                    }
+                )
+            })?,
+            None => self
+                .chosen
+                .or_else(|| found.iter().position(|f| f.components == 1))
+                .ok_or("missing SCALARS: no single-component point-data array")?,
+        };
+        let f = &found[pick];
+        if f.components != 1 {
+            return Err(format!(
+                "array '{}' has {} components (only 1 is supported; the file has: {})",
+                f.name,
+                f.components,
+                list.join(", ")
+            ));
+        }
+        let ty = sample_type(&f.ty)
+            .ok_or_else(|| format!("array '{}': type '{}' is not supported", f.name, f.ty))?;
+        let spacing = self.spacing.unwrap_or([1.0; 3]);
+        check_spacing(spacing)?;
+        Ok(Header {
+            dims,
+            spacing,
+            ty,
+            binary: self.binary,
+            name: f.name.clone(),
+            data_start: f.start,
+            arrays: list,
+        })
+    }
+}
+
+/// After `SCALARS name`: the type, optional components and the required `LOOKUP_TABLE name`;
+/// (type, components, bytes per value), or `None` for packed bits (not renderable: passed
+/// over here).
+fn scalars_type(
+    w: &mut Words<'_>,
+    name: &str,
+    tuples: usize,
+    binary: bool,
+) -> Result<Option<(String, usize, usize)>, String> {
+    let ty = w.need("SCALARS type")?.to_string();
+    let mut next = w.need("SCALARS: LOOKUP_TABLE")?;
+    let mut comps = 1;
+    if !next.eq_ignore_ascii_case("LOOKUP_TABLE") {
+        comps = next
+            .parse()
+            .ok()
+            .filter(|c| (1..=4).contains(c))
+            .ok_or_else(|| format!("SCALARS {name}: '{next}' is not 1 to 4 components"))?;
+        next = w.need("SCALARS: LOOKUP_TABLE")?;
+    }
+    if !next.eq_ignore_ascii_case("LOOKUP_TABLE") {
         return Err(format!(
-            "DATASET: expected STRUCTURED_POINTS, found {}",
-            dataset.as_deref().unwrap_or("none")
+            "SCALARS {name}: missing LOOKUP_TABLE after SCALARS, found '{next}'"
         ));
     }
-    let dims = dims.ok_or("missing DIMENSIONS")?;
-    let list: Vec<String> = found
-        .iter()
-        .map(|f| format!("{} ({} × {})", f.name, f.ty, f.components))
-        .collect();
-    let pick = match array {
-        Some(name) => found.iter().position(|f| f.name == name).ok_or_else(|| {
-            format!(
-                "no point-data array '{name}' (the file has: {})",
-                if list.is_empty() {
-                    "none".to_string()
-                } else {
-                    list.join(", ")
-                }
-            )
-        })?,
-        None => chosen
-            .or_else(|| found.iter().position(|f| f.components == 1))
-            .ok_or("missing SCALARS: no single-component point-data array")?,
-    };
-    let f = &found[pick];
-    if f.components != 1 {
-        return Err(format!(
-            "array '{}' has {} components (only 1 is supported; the file has: {})",
-            f.name,
-            f.components,
-            list.join(", ")
-        ));
+    w.need("LOOKUP_TABLE name")?;
+    if ty.eq_ignore_ascii_case("bit") && binary {
+        // Packed eight to a byte.
+        let bytes = (tuples * comps).div_ceil(8);
+        w.skip_values(bytes, 1, true, name)?;
+        w.skip_metadata();
+        return Ok(None);
     }
-    let ty = sample_type(&f.ty)
-        .ok_or_else(|| format!("array '{}': type '{}' is not supported", f.name, f.ty))?;
-    let spacing = spacing.unwrap_or([1.0; 3]);
-    check_spacing(spacing)?;
-    Ok(Header {
-        dims,
-        spacing,
-        ty,
-        binary,
-        name: f.name.clone(),
-        data_start: f.start,
-        arrays: list,
-    })
+    let size =
+        type_size(&ty).ok_or_else(|| format!("SCALARS {name}: type '{ty}' is not a VTK type"))?;
+    Ok(Some((ty, comps, size)))
 }
 
 /// Parses the header of a legacy `.vtk` file, choosing the default array.

@@ -28,16 +28,17 @@ use crate::pipeline::stages::supersample::to_output;
 use crate::plan::{End, Plan};
 use crate::CliError;
 use footprint::composite::RowSpan;
+use footprint::frame::FrameSetup;
 use footprint::refine::{factor_for, RefinedAxis};
 use footprint::render::{
     key_spacings, rate_index, sheet_map, spacing_key, FloatPath, RefineTables, RefinedGrid,
-    RenderBuffers, ScaledFootprint, SheetRenderer, SPACING_KEYS,
+    RenderBuffers, RenderStats, ScaledFootprint, SheetRenderer, SPACING_KEYS,
 };
 use footprint::shade::{Lighting, Shader, Shading, OPACITY_TABLE_LEN};
 use footprint::splat::{BufferError, ImageMut, Pixel, SplatStats, Splatter};
 use footprint::stencil::{self, Stencils};
 use footprint::Sampler;
-use footprint::{Footprint, ViewTable};
+use footprint::{Footprint, GenericTable, Lookup, ViewTable};
 use std::time::Instant;
 
 /// Samples that must share a border spacing for its scaled footprint to be resampled into a
@@ -221,7 +222,6 @@ fn refined_at<const N: usize>(
     start: Instant,
     classify: f64,
 ) -> Result<CoreFrame, CliError> {
-    let volume = p.volume().expect("checked");
     let f = &p.frame;
     let axis = |a: usize| {
         RefinedAxis::new(a, f.dims[a], &refinement.factors[a])
@@ -230,176 +230,221 @@ fn refined_at<const N: usize>(
     let grid = RefinedGrid {
         axes: [axis(0)?, axis(1)?, axis(2)?],
     };
+    let t0 = Instant::now();
+    let generic = plan.table.generic::<N>(&p.kernel)?;
     let lookup = plan.table.lookup;
-    let threads = plan.threads;
-    let dims = volume.dims;
-    let value = |[i, j, k]: [usize; 3]| volume.value(i + dims[0] * (j + dims[1] * k));
-    {
-        let t0 = Instant::now();
-        let generic = plan.table.generic::<N>(&p.kernel)?;
-        let footprint_for = |m: &glam::Mat3| {
-            Footprint::with_sheet_axis(&p.kernel, m, p.options, f.sheet_axis)
-                .map_err(|e| CliError::input(format!("--refine: a local spacing's footprint: {e}")))
-        };
-        let (k, (a, b)) = (f.sheet_axis, f.in_sheet);
-        let map = sheet_map(f);
-        // Refined footprints are many and small: their stencils get at most REFINE_PHASES
-        // phases per pixel (a 1/16-px placement), which keeps building them cheap.
-        let phases = plan.phases.min(REFINE_PHASES);
-        // Samples per spacing key (see the core's `spacing_key`).
-        let bins = |axis: usize| {
-            let mut c = [0usize; 9];
-            let _ = grid.axes[axis].for_each::<()>(true, |s| {
-                c[spacing_key(s.spacing, [1.0; 2], 1.0) % 9] += 1;
-                Ok(())
-            });
-            c
-        };
-        let (ca, cb) = (bins(a), bins(b));
-        let mut cz = [0usize; 3];
-        let _ = grid.axes[k].for_each::<()>(true, |s| {
-            cz[spacing_key([1.0; 2], [1.0; 2], s.width()) / 81] += 1;
+    // Refined footprints are many and small: their stencils get at most REFINE_PHASES
+    // phases per pixel (a 1/16-px placement), which keeps building them cheap.
+    let phases = plan.phases.min(REFINE_PHASES);
+    let keys = spacing_keys(&grid, f);
+    let rate_tables = rate_tables::<N>(p, &refinement, &keys, &generic, lookup)?;
+    let base = &*rate_tables.iter().find(|(r, _)| *r == 2).expect("built").1;
+    let rates = [0, 1, 2, 3, 4].map(|r| {
+        rate_tables
+            .iter()
+            .find(|(j, _)| *j == r)
+            .map_or(base, |t| &*t.1)
+    });
+    let (mut exact_tables, mut scaled) = key_tables(p, &keys, rates, &generic, lookup, phases)?;
+    let mut splatters: Vec<Option<Exact<'_, N>>> = (0..SPACING_KEYS).map(|_| None).collect();
+    for (key, table, buffer) in exact_tables.iter_mut() {
+        splatters[*key] = Some(if buffer.is_empty() {
+            Exact::Table(&**table)
+        } else {
+            Exact::Stencils(Stencils::build(&**table, phases, buffer)?)
+        });
+    }
+    for (key, fp, buffer) in scaled.iter_mut() {
+        splatters[*key] = Some(Exact::Scaled(Stencils::build(&*fp, phases, buffer)?));
+    }
+    let tables = RefineTables {
+        rates,
+        splatters: &splatters,
+    };
+    let table_secs = t0.elapsed().as_secs_f64();
+    let (image, stats, phases) = refined_bands(p, plan.threads, &grid, &tables)?;
+    let image = to_output(image, p.out_size(), p.supersample);
+    Ok(CoreFrame {
+        image,
+        stats,
+        seconds: start.elapsed().as_secs_f64(),
+        phases: Phases {
+            classify,
+            tables: table_secs,
+            ..phases
+        },
+        threads: plan.threads.clamp(1, f.size[1]),
+        visible: None,
+        refine: Some(refinement),
+    })
+}
+
+/// The spacing keys (the core's `spacing_key`) the refined grid's samples have, with how many
+/// samples have each.
+fn spacing_keys(grid: &RefinedGrid, f: &FrameSetup) -> Vec<(usize, usize)> {
+    let (k, (a, b)) = (f.sheet_axis, f.in_sheet);
+    let bins = |axis: usize| {
+        let mut c = [0usize; 9];
+        let _ = grid.axes[axis].for_each::<()>(true, |s| {
+            c[spacing_key(s.spacing, [1.0; 2], 1.0) % 9] += 1;
             Ok(())
         });
-        let keys: Vec<(usize, usize)> = (0..SPACING_KEYS)
-            .map(|key| (key, ca[key % 9] * cb[(key / 9) % 9] * cz[key / 81]))
-            .filter(|&(_, n)| n > 0)
-            .collect();
-        let symmetric = |key: usize| {
-            let (sa, sb, _) = key_spacings(key);
-            sa[0] == sa[1] && sb[0] == sb[1]
-        };
-        // Rate tables: those some sample's scaled footprint reads.
-        let mut needed = rates_needed(&refinement, k, (a, b));
-        for &(key, _) in keys.iter().filter(|&&(key, _)| !symmetric(key)) {
-            let (sa, sb, w) = key_spacings(key);
-            needed[rate_index(sa, sb, w)] = true;
-        }
-        let mut rate_tables = Vec::with_capacity(5);
-        for (r, rho) in RefineTables::<ViewTable<N>, Exact<'_, N>>::RATES
-            .into_iter()
-            .enumerate()
-        {
-            if rho != 1.0 && !needed[r] {
-                continue;
-            }
-            let mut m = f.grid_to_screen;
-            *m.col_mut(k) *= rho;
-            let fp = if rho == 1.0 {
-                f.footprint
-            } else {
-                footprint_for(&m)?
-            };
-            rate_tables.push((
-                r,
-                Box::new(ViewTable::<N>::build(&fp, &generic, lookup, lookup)),
-            ));
-        }
-        let base = &*rate_tables.iter().find(|(r, _)| *r == 2).expect("built").1;
-        let rates = [0, 1, 2, 3, 4].map(|r| {
-            rate_tables
-                .iter()
-                .find(|(j, _)| *j == r)
-                .map_or(base, |t| &*t.1)
-        });
-        // Per key: a symmetric spacing's exact footprint, or the scaled rate footprint.
-        let mut exact_tables = Vec::new();
-        let mut scaled = Vec::new();
-        for &(key, n) in &keys {
-            let (sa, sb, w) = key_spacings(key);
-            if symmetric(key) {
-                let mut sigma = [1.0f32; 3];
-                (sigma[a], sigma[b], sigma[k]) = (sa[0], sb[0], w);
-                let m = f.grid_to_screen * glam::Mat3::from_diagonal(glam::Vec3::from_array(sigma));
-                let table = Box::new(ViewTable::<N>::build(
-                    &footprint_for(&m)?,
-                    &generic,
-                    lookup,
-                    lookup,
-                ));
-                let len = stencil_len(table.footprint(), n, phases);
-                exact_tables.push((key, table, vec![0.0f32; len.unwrap_or(0)]));
-            } else if let Some(fp) =
-                ScaledFootprint::new(rates[rate_index(sa, sb, w)], map, [sa, sb])
-            {
-                // A scaled footprint's read costs about twice a table's: half the samples' worth
-                // for stencils; else, shared by a few samples, its own table (the row walk).
-                if let Some(len) = stencil_len(fp.footprint(), n / 2, phases) {
-                    scaled.push((key, fp, vec![0.0f32; len]));
-                } else if n >= RESAMPLE_SAMPLES {
-                    let mut t = Box::new(ViewTable::<N>::zeroed(*fp.footprint()));
-                    t.resample_into(&fp, lookup);
-                    exact_tables.push((key, t, Vec::new()));
-                }
-            }
-        }
-        let mut splatters: Vec<Option<Exact<'_, N>>> = (0..SPACING_KEYS).map(|_| None).collect();
-        for (key, table, buffer) in exact_tables.iter_mut() {
-            splatters[*key] = Some(if buffer.is_empty() {
-                Exact::Table(&**table)
-            } else {
-                Exact::Stencils(Stencils::build(&**table, phases, buffer)?)
-            });
-        }
-        for (key, fp, buffer) in scaled.iter_mut() {
-            splatters[*key] = Some(Exact::Scaled(Stencils::build(&*fp, phases, buffer)?));
-        }
-        let tables = RefineTables {
-            rates,
-            splatters: &splatters,
-        };
-        let table_secs = t0.elapsed().as_secs_f64();
-        let (image, stats, phases) = on_bands(
-            crate::io::try_filled(f.size[0] * f.size[1], [0.0f32; 4], "the image")?,
-            f.size,
-            equal_bands(f.size[1], threads),
-            p.background.as_deref(),
-            |rows, image, bg| {
-                let n = f.size[0] * rows.len();
-                let mut acc = crate::io::try_filled(n, [0.0f32; 4], "a band's sheet accumulator")?;
-                let mut spans = vec![RowSpan::EMPTY; rows.len()];
-                let mut opacity = vec![0.0f32; OPACITY_TABLE_LEN];
-                let mut scratch = crate::io::try_filled(
-                    2 * f.sheet_shape().0,
-                    0.0f32,
-                    "refinement scratch sheets",
-                )?;
-                let buffers = RenderBuffers {
-                    accumulator: &mut acc,
-                    image,
-                    rows: &mut spans,
-                };
-                let path = FloatPath::new(tables.rates[2]).with_absorption(p.absorption);
-                let mut r =
-                    SheetRenderer::with_band(f, path, p.shader(), p.order, buffers, bg, rows)?
-                        .with_opacity_table(&mut opacity)?;
-                let t = Instant::now();
-                r.render_refined(&grid, &tables, value, &mut scratch)?;
-                let splat = t.elapsed().as_secs_f64();
-                Ok((
-                    r.finish(),
-                    Phases {
-                        splat,
-                        ..Phases::default()
-                    },
-                ))
-            },
-        )?;
-        let image = to_output(image, p.out_size(), p.supersample);
-        Ok(CoreFrame {
-            image,
-            stats,
-            seconds: start.elapsed().as_secs_f64(),
-            phases: Phases {
-                classify,
-                tables: table_secs,
-                ..phases
-            },
-            threads: threads.clamp(1, f.size[1]),
-            visible: None,
-            refine: Some(refinement),
-        })
+        c
+    };
+    let (ca, cb) = (bins(a), bins(b));
+    let mut cz = [0usize; 3];
+    let _ = grid.axes[k].for_each::<()>(true, |s| {
+        cz[spacing_key([1.0; 2], [1.0; 2], s.width()) / 81] += 1;
+        Ok(())
+    });
+    (0..SPACING_KEYS)
+        .map(|key| (key, ca[key % 9] * cb[(key / 9) % 9] * cz[key / 81]))
+        .filter(|&(_, n)| n > 0)
+        .collect()
+}
+
+/// Whether spacing `key` is symmetric (each in-sheet axis's two spacings equal): its samples
+/// get an exact footprint of their own.
+fn symmetric(key: usize) -> bool {
+    let (sa, sb, _) = key_spacings(key);
+    sa[0] == sa[1] && sb[0] == sb[1]
+}
+
+/// The footprint of a local grid-to-screen matrix `m`.
+fn local_footprint(p: &Prepared, m: &glam::Mat3) -> Result<Footprint, CliError> {
+    Footprint::with_sheet_axis(&p.kernel, m, p.options, p.frame.sheet_axis)
+        .map_err(|e| CliError::input(format!("--refine: a local spacing's footprint: {e}")))
+}
+
+/// The view tables of the rates ([`RefineTables::RATES`]) some sample's scaled footprint reads,
+/// by rate index; rate 1 (index 2) always.
+fn rate_tables<const N: usize>(
+    p: &Prepared,
+    refinement: &Refinement,
+    keys: &[(usize, usize)],
+    generic: &GenericTable<N>,
+    lookup: Lookup,
+) -> Result<Vec<(usize, Box<ViewTable<N>>)>, CliError> {
+    let f = &p.frame;
+    let (k, (a, b)) = (f.sheet_axis, f.in_sheet);
+    let mut needed = rates_needed(refinement, k, (a, b));
+    for &(key, _) in keys.iter().filter(|&&(key, _)| !symmetric(key)) {
+        let (sa, sb, w) = key_spacings(key);
+        needed[rate_index(sa, sb, w)] = true;
     }
+    let mut rate_tables = Vec::with_capacity(5);
+    for (r, rho) in RefineTables::<ViewTable<N>, Exact<'_, N>>::RATES
+        .into_iter()
+        .enumerate()
+    {
+        if rho != 1.0 && !needed[r] {
+            continue;
+        }
+        let mut m = f.grid_to_screen;
+        *m.col_mut(k) *= rho;
+        let fp = if rho == 1.0 {
+            f.footprint
+        } else {
+            local_footprint(p, &m)?
+        };
+        let table = ViewTable::<N>::build(&fp, generic, lookup, lookup);
+        rate_tables.push((r, Box::new(table)));
+    }
+    Ok(rate_tables)
+}
+
+/// Per spacing key, its footprint and stencil storage: (key, a symmetric spacing's exact table
+/// or a border spacing's resampled one, stencil floats (empty: walk the table)), and (key, a
+/// border spacing's scaled footprint, its stencil floats).
+type KeyTables<'r, const N: usize> = (
+    Vec<(usize, Box<ViewTable<N>>, Vec<f32>)>,
+    Vec<(usize, ScaledFootprint<'r, ViewTable<N>>, Vec<f32>)>,
+);
+
+/// The footprints of `keys` (see [`KeyTables`]); a border spacing neither shared enough for
+/// stencils nor for a table of its own gets none (its samples read the rate tables).
+fn key_tables<'r, const N: usize>(
+    p: &Prepared,
+    keys: &[(usize, usize)],
+    rates: [&'r ViewTable<N>; 5],
+    generic: &GenericTable<N>,
+    lookup: Lookup,
+    phases: usize,
+) -> Result<KeyTables<'r, N>, CliError> {
+    let f = &p.frame;
+    let (k, (a, b)) = (f.sheet_axis, f.in_sheet);
+    let map = sheet_map(f);
+    let mut exact_tables = Vec::new();
+    let mut scaled = Vec::new();
+    for &(key, n) in keys {
+        let (sa, sb, w) = key_spacings(key);
+        if symmetric(key) {
+            let mut sigma = [1.0f32; 3];
+            (sigma[a], sigma[b], sigma[k]) = (sa[0], sb[0], w);
+            let m = f.grid_to_screen * glam::Mat3::from_diagonal(glam::Vec3::from_array(sigma));
+            let fp = local_footprint(p, &m)?;
+            let table = Box::new(ViewTable::<N>::build(&fp, generic, lookup, lookup));
+            let len = stencil_len(table.footprint(), n, phases);
+            exact_tables.push((key, table, vec![0.0f32; len.unwrap_or(0)]));
+        } else if let Some(fp) = ScaledFootprint::new(rates[rate_index(sa, sb, w)], map, [sa, sb]) {
+            // A scaled footprint's read costs about twice a table's: half the samples' worth
+            // for stencils; else, shared by a few samples, its own table (the row walk).
+            if let Some(len) = stencil_len(fp.footprint(), n / 2, phases) {
+                scaled.push((key, fp, vec![0.0f32; len]));
+            } else if n >= RESAMPLE_SAMPLES {
+                let mut t = Box::new(ViewTable::<N>::zeroed(*fp.footprint()));
+                t.resample_into(&fp, lookup);
+                exact_tables.push((key, t, Vec::new()));
+            }
+        }
+    }
+    Ok((exact_tables, scaled))
+}
+
+/// Renders the refined grid through `tables` on `threads` bands of rows: the image (render
+/// size), the counts and the phases' seconds.
+fn refined_bands<const N: usize>(
+    p: &Prepared,
+    threads: usize,
+    grid: &RefinedGrid,
+    tables: &RefineTables<'_, ViewTable<N>, Exact<'_, N>>,
+) -> Result<(Vec<[f32; 4]>, RenderStats, Phases), CliError> {
+    let f = &p.frame;
+    let volume = p.volume().expect("checked");
+    let dims = volume.dims;
+    let value = |[i, j, k]: [usize; 3]| volume.value(i + dims[0] * (j + dims[1] * k));
+    on_bands(
+        crate::io::try_filled(f.size[0] * f.size[1], [0.0f32; 4], "the image")?,
+        f.size,
+        equal_bands(f.size[1], threads),
+        p.background.as_deref(),
+        |rows, image, bg| {
+            let n = f.size[0] * rows.len();
+            let mut acc = crate::io::try_filled(n, [0.0f32; 4], "a band's sheet accumulator")?;
+            let mut spans = vec![RowSpan::EMPTY; rows.len()];
+            let mut opacity = vec![0.0f32; OPACITY_TABLE_LEN];
+            let mut scratch =
+                crate::io::try_filled(2 * f.sheet_shape().0, 0.0f32, "refinement scratch sheets")?;
+            let buffers = RenderBuffers {
+                accumulator: &mut acc,
+                image,
+                rows: &mut spans,
+            };
+            let path = FloatPath::new(tables.rates[2]).with_absorption(p.absorption);
+            let mut r = SheetRenderer::with_band(f, path, p.shader(), p.order, buffers, bg, rows)?
+                .with_opacity_table(&mut opacity)?;
+            let t = Instant::now();
+            r.render_refined(grid, tables, value, &mut scratch)?;
+            let splat = t.elapsed().as_secs_f64();
+            Ok((
+                r.finish(),
+                Phases {
+                    splat,
+                    ..Phases::default()
+                },
+            ))
+        },
+    )
 }
 
 /// One spacing's footprint: a symmetric spacing's exact footprint (its phase stencils, or its
