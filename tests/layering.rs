@@ -451,7 +451,11 @@ fn harness_functions_stay_readable() {
             long.push(format!("{}: {l}", f.display()));
         }
     }
-    assert!(long.is_empty(), "over {MAX_FN_LINES} lines:\n{}", long.join("\n"));
+    assert!(
+        long.is_empty(),
+        "over {MAX_FN_LINES} lines:\n{}",
+        long.join("\n")
+    );
 }
 
 #[test]

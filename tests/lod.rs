@@ -320,3 +320,43 @@ fn render_and_verify_write_the_same_image() {
         assert!(a == b, "render and verify differ with {flags:?}");
     }
 }
+
+/// Every rule the flags alone decide is the plan's (issue 41): refused by `plan` before anything
+/// is loaded (the volume named here does not exist, so a rule checked later would report the
+/// missing file instead).
+#[test]
+fn the_plan_refuses_what_the_flags_decide_before_loading() {
+    let missing = "/nonexistent/volume.nhdr";
+    let cases: [(&[&str], &str); 9] = [
+        (
+            &["--lod", "1", "--supersample", "2"],
+            "--lod 1 and --supersample 2",
+        ),
+        (&["--lod", "2", "--perspective", "30"], "--lod 2"),
+        (&["--lod", "1", "--refine", "0.1"], "--refine adds samples"),
+        (
+            &["--subsample", "2", "--perspective", "30"],
+            "orthographic views only",
+        ),
+        (&["--subsample", "2", "--supersample", "3"], "supersampled"),
+        (&["--subsample", "2", "--lod", "1"], "coarser level"),
+        (&["--refine", "0.1"], "in memory"),
+        (&["--slicing", "image"], "drop --stream"),
+        (&["--quality", "40", "--lod", "1"], "streamed volume"),
+    ];
+    for (k, (flags, says)) in cases.iter().enumerate() {
+        // The last three are rules of a streamed volume.
+        let source: &[&str] = if k >= 6 {
+            &["--stream", missing, "--dims", "8,8,8", "--type", "uint8"]
+        } else {
+            &[missing]
+        };
+        let a = parse_args(&[source, &["--size", "32x32"], *flags].concat()).unwrap();
+        let e = plan(&a).expect_err("refused by the plan").to_string();
+        assert!(e.contains(says), "{flags:?}: {e}");
+        assert!(!e.contains("nonexistent"), "{flags:?}: {e}");
+    }
+    // And the same combinations in memory, or without the clash, plan.
+    let ok = parse_args(&[missing, "--lod", "1", "--subsample", "auto"]).unwrap();
+    assert!(plan(&ok).is_ok());
+}

@@ -467,8 +467,9 @@ fn image_slicing_refusals_say_why() {
         let mut a = vec!["--slicing", "image", "--size", "32x32"];
         a.extend_from_slice(extra);
         let args = parse_args(&a).unwrap();
-        let err = prepare(&args)
-            .and_then(|p| render_frame(&p, &plan(&args).unwrap(), &mut FrameCache::default()))
+        // As `render` does: the plan first (it refuses a stream), then the frame.
+        let err = plan(&args)
+            .and_then(|pl| render_frame(&prepare(&args)?, &pl, &mut FrameCache::default()))
             .map(|_| ())
             .unwrap_err();
         assert!(err.message.contains(says), "{extra:?}: {}", err.message);

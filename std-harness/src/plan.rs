@@ -1,9 +1,11 @@
 //! The render plan (issue 41): what draws a frame, resolved once from the command line.
 //!
 //! [`plan`] turns `render`'s flags into a typed [`Plan`] and holds every compatibility rule that
-//! the flags alone decide (the rules that need the volume or the frame, such as a stream refused
-//! by slabs or a subsampling factor too large for the footprints, stay where those are known, each
-//! once). The pipeline renders `(&Prepared, &Plan)` ([`crate::pipeline::render_frame`]); `verify`,
+//! the flags alone decide, before anything is loaded: between end points, precision and model,
+//! with a streamed volume, and between the resolution decorators ([`check_levels`], which the
+//! pipeline also applies to [`Inputs`] built in code). The rules that need the volume or the
+//! frame (a subsampling factor too large for the footprints, a supersampling the minimum radius
+//! asks for, a view a pipe cannot feed) stay where those are known. The pipeline renders `(&Prepared, &Plan)` ([`crate::pipeline::render_frame`]); `verify`,
 //! `bench`, `chart` and `--quality` build or derive plans ([`Plan::with_precision`],
 //! [`crate::pipeline::quality::config::Config::plan`]) instead of rewriting flags, so `verify` renders the
 //! plan `render` would, defaults included.
@@ -193,6 +195,10 @@ pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
         }
         _ => {}
     }
+    if args.stream.is_some() {
+        streamed_rules(&end, args)?;
+    }
+    check_levels(&Inputs::from(args))?;
     let extinction = Absorption::from(args.absorption) == Absorption::Extinction;
     if extinction && matches!(end, End::Sheets(_) | End::Refined { .. }) {
         // (Perspective sheets place each voxel's optical depth along its own ray: `PerVoxel`.)
@@ -221,6 +227,22 @@ pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
                 &format!("--subsample {s}"),
                 "--refine adds samples for magnified volumes; subsampling removes pixels: drop one",
             );
+        }
+        // An explicit factor where the flags already rule subsampling out (`auto` then means
+        // 1; the frame decides the rest: `pipeline::stages::subsample::factor`).
+        let blocked = if s == "auto" {
+            None
+        } else if args.perspective.is_some() {
+            Some("orthographic views only (a perspective view's footprints vary per voxel)")
+        } else if matches!(args.supersample, Supersample::Fixed(2..)) {
+            Some("the frame is supersampled (--supersample): give one of them")
+        } else if matches!(args.lod, Lod::Level(1..)) {
+            Some("the volume renders at a coarser level of detail (--lod); give --lod 0 or auto")
+        } else {
+            None
+        };
+        if let Some(why) = blocked {
+            return refuse(&format!("--subsample {s}"), why);
         }
     }
     Ok(Plan {
@@ -251,6 +273,67 @@ impl From<Lookup> for LookupArg {
             Lookup::Bilinear => LookupArg::Bilinear,
         }
     }
+}
+
+/// The rules a streamed volume (`--stream`: read once, a few sheets at a time) adds to `end`.
+fn streamed_rules(end: &End, args: &RenderArgs) -> Result<(), CliError> {
+    let refuse = |flag: &str, why: &str| Err(CliError::input(format!("{flag}: {why}")));
+    match end {
+        End::Refined { .. } => refuse("--refine", "the volume must be in memory (drop --stream)"),
+        End::Slabs { .. } => refuse(
+            "--slicing image",
+            "a slab of an oblique view crosses every sheet, so it cannot be fed from a few \
+             streamed sheets: drop --stream (the volume is loaded) or use --slicing object",
+        ),
+        _ => match (args.quality, args.lod) {
+            (Some(_), Lod::Level(n @ 1..)) => Err(quality_level_of_stream(n)),
+            _ => Ok(()),
+        },
+    }
+}
+
+/// `--quality` with `--lod N` (N ≥ 1) of a streamed volume: refused.
+pub fn quality_level_of_stream(n: u32) -> CliError {
+    CliError::input(format!(
+        "--quality measures level {n}'s error against full resolution, which a streamed volume \
+         (read once) cannot give: load it (a volume argument instead of --stream) or drop --lod \
+         {n} (level 0)"
+    ))
+}
+
+/// The rules between the resolution decorators that the inputs decide before any frame: an
+/// explicit level of detail (`--lod N`, N ≥ 1) is refused with a perspective view, with
+/// `--refine` (which refines full resolution) and with `--supersample K` (K ≥ 2: both would act
+/// on one frame). [`plan`] applies them to the flags; the pipeline's `setup_frame` to every
+/// [`Inputs`], including those built in code.
+pub fn check_levels(inputs: &Inputs) -> Result<(), CliError> {
+    let Lod::Level(n @ 1..) = inputs.lod else {
+        return Ok(());
+    };
+    if inputs.perspective.is_some() {
+        return Err(no_level_in_perspective(n));
+    }
+    if inputs.refine {
+        return Err(CliError::input(format!(
+            "--refine adds samples to full resolution; --lod {n} removes them: give --lod 0 or \
+             auto"
+        )));
+    }
+    if let Supersample::Fixed(k @ 2..) = inputs.supersample {
+        return Err(CliError::input(format!(
+            "--lod {n} and --supersample {k} would both act on one frame (a coarser level seen \
+             at k x the size): give one of them (--lod 0, or --supersample 1 or auto)"
+        )));
+    }
+    Ok(())
+}
+
+/// `--lod N` (N ≥ 1) with `--perspective`: refused (levels are for orthographic views).
+pub fn no_level_in_perspective(n: u32) -> CliError {
+    CliError::input(format!(
+        "--lod {n}: {}; use --lod 0 or auto with --perspective",
+        footprint::lod::LodError::Perspective
+    ))
 }
 
 /// What a render loads and how it sees it, resolved from the command line: the volume and its

@@ -104,17 +104,13 @@ fn choose_sheets(
     };
     if p0.volume().is_none() {
         if let Some(n @ 1..) = explicit {
-            return Err(CliError::input(format!(
-                "--quality measures level {n}'s error against full resolution, which a streamed \
-                 volume (read once) cannot give: load it (a volume argument instead of --stream) \
-                 or drop --lod {n} (level 0)"
-            )));
+            return Err(crate::plan::quality_level_of_stream(n));
         }
         let c = choose(&p0, target)?;
         return Ok((p0, c));
     }
     if let (Some(n @ 1..), Some(_)) = (explicit, p0.frame.camera()) {
-        return Err(crate::pipeline::stages::prepare::no_level_in_perspective(n));
+        return Err(crate::plan::no_level_in_perspective(n));
     }
     let levels = candidate_levels(&p0, explicit);
     if levels.is_empty() {

@@ -11,12 +11,12 @@ use super::load::{load_background, load_voxels, Loaded, Voxels};
 use super::supersample;
 use crate::args::Lod;
 use crate::io::volume::Volume;
-use crate::plan::Inputs;
 use crate::plan::Plan;
+use crate::plan::{check_levels, Inputs};
 use crate::{tf, CliError};
 use footprint::frame::{FrameSetup, Order};
 use footprint::geometry::FootprintOptions;
-use footprint::lod::{level_frame, level_kernel, LodError};
+use footprint::lod::{level_frame, level_kernel};
 use footprint::shade::{Phong, Shader, Shading, TransferFunction};
 use footprint::{Grid, Kernel, View};
 use std::sync::Arc;
@@ -307,32 +307,18 @@ pub fn setup_frame(
     kernel: &Kernel,
     options: FootprintOptions,
 ) -> Result<(FrameSetup, usize, u32), CliError> {
+    check_levels(args)?;
     let view = view_for(args, dims, grid)?;
     let size = [args.size.0, args.size.1];
     if let Some(fovy) = args.perspective {
-        if let Lod::Level(n @ 1..) = args.lod {
-            return Err(no_level_in_perspective(n));
-        }
         let (frame, k) = perspective_frame(args, fovy, &view, dims, grid, kernel, options)?;
         return Ok((frame, k, 0));
     }
     let fine = FrameSetup::new(dims, grid, &view, kernel, options, size)?;
-    if let (true, Lod::Level(n @ 1..)) = (args.refine, args.lod) {
-        return Err(CliError::input(format!(
-            "--refine adds samples to full resolution; --lod {n} removes them: give --lod 0 or \
-             auto"
-        )));
-    }
     let fixed_k = match args.supersample {
         crate::args::Supersample::Fixed(k @ 2..) => Some(k),
         _ => None,
     };
-    if let (Some(k), Lod::Level(n @ 1..)) = (fixed_k, args.lod) {
-        return Err(CliError::input(format!(
-            "--lod {n} and --supersample {k} would both act on one frame (a coarser level seen \
-             at k x the size): give one of them (--lod 0, or --supersample 1 or auto)"
-        )));
-    }
     let level = match (args.refine, fixed_k) {
         // Refinement is for magnified volumes: it always starts from full resolution; so does
         // a frame supersampled on request.
@@ -358,14 +344,6 @@ pub fn setup_frame(
         .map_err(|e| CliError::input(format!("view: {e}")))?;
     let fine = FrameSetup::new(dims, grid, &view, kernel, options, size.map(|n| n * k))?;
     Ok((at_level(&fine, &view)?, k, level))
-}
-
-/// Why `--lod n` (n ≥ 1) cannot render with `--perspective`.
-pub fn no_level_in_perspective(n: u32) -> CliError {
-    CliError::input(format!(
-        "--lod {n}: {}; use --lod 0 or auto with --perspective",
-        LodError::Perspective
-    ))
 }
 
 /// The perspective frame of `--perspective FOVY`: `view`'s rotation (its scale dropped), the eye
