@@ -4,7 +4,7 @@
 //! `TransformMatrix` (row i is grid axis i's direction). `ElementNumberOfChannels` other than 1
 //! (interleaved components) is refused.
 
-use super::{compress, numbers};
+use super::{compress, numbers, Fields};
 use crate::io::volume::{at, byte_len, check_spacing, decode, SampleType, Volume, AXIS_ALIGNED};
 use crate::CliError;
 use std::path::{Path, PathBuf};
@@ -32,9 +32,9 @@ fn is_true(v: &str) -> bool {
 
 /// Parses a MetaImage header from the start of `bytes` (up to and including `ElementDataFile`).
 pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
-    let (fields, header_len) = Fields::read(bytes)?;
+    let (fields, header_len) = read_fields(bytes)?;
     let get = |keys: &[&str]| fields.get(keys);
-    let need = |k: &str| get(&[k]).ok_or_else(|| format!("missing header field '{k}'"));
+    let need = |k: &str| fields.need(k);
     if let Some(t) = get(&["ObjectType"]) {
         if t != "Image" {
             return Err(format!("ObjectType: expected Image, found '{t}'"));
@@ -60,7 +60,7 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
             ));
         }
     }
-    let (spacing, directions) = fields.orientation()?;
+    let (spacing, directions) = orientation(&fields)?;
     let big_endian = get(&["ElementByteOrderMSB", "BinaryDataByteOrderMSB"]).is_some_and(is_true);
     if get(&["BinaryData"]).is_some_and(|v| !is_true(v)) {
         return Err("BinaryData = False (ASCII MetaImage) is not supported".into());
@@ -108,80 +108,67 @@ fn element_type(name: &str) -> Result<SampleType, String> {
     })
 }
 
-/// A header's `Key = value` fields, in file order.
-struct Fields(Vec<(String, String)>);
-
-impl Fields {
-    /// The fields at the start of `bytes`, up to and including `ElementDataFile` (at most 200),
-    /// and the bytes of header text they take (where LOCAL data start).
-    fn read(bytes: &[u8]) -> Result<(Self, usize), String> {
-        let mut at = 0;
-        let mut fields: Vec<(String, String)> = Vec::new();
-        while at < bytes.len() {
-            let end = bytes[at..]
-                .iter()
-                .position(|&b| b == b'\n')
-                .map_or(bytes.len(), |p| at + p);
-            let line = std::str::from_utf8(&bytes[at..end])
-                .map_err(|_| "header is not text".to_string())?
-                .trim();
-            at = (end + 1).min(bytes.len());
-            if line.is_empty() {
-                continue;
-            }
-            let (k, v) = line.split_once('=').ok_or_else(|| {
-                format!(
-                    "malformed header line '{}'",
-                    line.chars().take(60).collect::<String>()
-                )
-            })?;
-            let key = k.trim().to_string();
-            fields.push((key.clone(), v.trim().to_string()));
-            if key == "ElementDataFile" {
-                break;
-            }
-            if fields.len() > 200 {
-                return Err("header has no ElementDataFile".into());
-            }
-        }
-        Ok((Fields(fields), at))
-    }
-
-    /// The first field with one of these keys.
-    fn get(&self, keys: &[&str]) -> Option<&str> {
-        self.0
+/// The fields at the start of `bytes`, up to and including `ElementDataFile` (at most 200),
+/// and the bytes of header text they take (where LOCAL data start).
+fn read_fields(bytes: &[u8]) -> Result<(Fields, usize), String> {
+    let mut at = 0;
+    let mut fields: Vec<(String, String)> = Vec::new();
+    while at < bytes.len() {
+        let end = bytes[at..]
             .iter()
-            .find(|(k, _)| keys.contains(&k.as_str()))
-            .map(|(_, v)| v.as_str())
+            .position(|&b| b == b'\n')
+            .map_or(bytes.len(), |p| at + p);
+        let line = std::str::from_utf8(&bytes[at..end])
+            .map_err(|_| "header is not text".to_string())?
+            .trim();
+        at = (end + 1).min(bytes.len());
+        if line.is_empty() {
+            continue;
+        }
+        let (k, v) = line.split_once('=').ok_or_else(|| {
+            format!(
+                "malformed header line '{}'",
+                line.chars().take(60).collect::<String>()
+            )
+        })?;
+        let key = k.trim().to_string();
+        fields.push((key.clone(), v.trim().to_string()));
+        if key == "ElementDataFile" {
+            break;
+        }
+        if fields.len() > 200 {
+            return Err("header has no ElementDataFile".into());
+        }
     }
+    Ok((Fields(fields), at))
+}
 
-    /// `ElementSpacing` (or `ElementSize`; default 1) and the axis directions, row i of
-    /// `TransformMatrix` (or `Rotation`, `Orientation`) grid axis i's.
-    fn orientation(&self) -> Result<([f32; 3], [[f32; 3]; 3]), String> {
-        let spacing = match self.get(&["ElementSpacing", "ElementSize"]) {
-            Some(s) => {
-                let v: Vec<f32> = numbers(s, 3, "ElementSpacing")?;
-                [v[0], v[1], v[2]]
+/// `ElementSpacing` (or `ElementSize`; default 1) and the axis directions, row i of
+/// `TransformMatrix` (or `Rotation`, `Orientation`) grid axis i's.
+fn orientation(fields: &Fields) -> Result<([f32; 3], [[f32; 3]; 3]), String> {
+    let spacing = match fields.get(&["ElementSpacing", "ElementSize"]) {
+        Some(s) => {
+            let v: Vec<f32> = numbers(s, 3, "ElementSpacing")?;
+            [v[0], v[1], v[2]]
+        }
+        None => [1.0; 3],
+    };
+    check_spacing(spacing)?;
+    let directions = match fields.get(&["TransformMatrix", "Rotation", "Orientation"]) {
+        Some(s) => {
+            let v: Vec<f32> = numbers(s, 9, "TransformMatrix")?;
+            let mut d = AXIS_ALIGNED;
+            for (i, row) in d.iter_mut().enumerate() {
+                let r = [v[3 * i], v[3 * i + 1], v[3 * i + 2]];
+                *row = super::axis_step(r)
+                    .ok_or_else(|| format!("TransformMatrix: row {i} is zero"))?
+                    .1;
             }
-            None => [1.0; 3],
-        };
-        check_spacing(spacing)?;
-        let directions = match self.get(&["TransformMatrix", "Rotation", "Orientation"]) {
-            Some(s) => {
-                let v: Vec<f32> = numbers(s, 9, "TransformMatrix")?;
-                let mut d = AXIS_ALIGNED;
-                for (i, row) in d.iter_mut().enumerate() {
-                    let r = [v[3 * i], v[3 * i + 1], v[3 * i + 2]];
-                    *row = super::axis_step(r)
-                        .ok_or_else(|| format!("TransformMatrix: row {i} is zero"))?
-                        .1;
-                }
-                d
-            }
-            None => AXIS_ALIGNED,
-        };
-        Ok((spacing, directions))
-    }
+            d
+        }
+        None => AXIS_ALIGNED,
+    };
+    Ok((spacing, directions))
 }
 
 /// Loads a MetaImage volume.

@@ -37,6 +37,26 @@ pub fn numbers<T: std::str::FromStr>(s: &str, n: usize, what: &str) -> Result<Ve
     Ok(v)
 }
 
+/// A text header's key–value fields in file order (NRRD's `key: value` lines, keys in lower case;
+/// MetaImage's `Key = value`): the first field with a key wins.
+pub struct Fields(pub Vec<(String, String)>);
+
+impl Fields {
+    /// The first field with one of these keys.
+    pub fn get(&self, keys: &[&str]) -> Option<&str> {
+        self.0
+            .iter()
+            .find(|(k, _)| keys.contains(&k.as_str()))
+            .map(|(_, v)| v.as_str())
+    }
+
+    /// Field `k`, which must be there.
+    pub fn need(&self, k: &str) -> Result<&str, String> {
+        self.get(&[k])
+            .ok_or_else(|| format!("missing header field '{k}'"))
+    }
+}
+
 /// What streaming needs from an uncompressed file's header: where its samples are, and the grid.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Streamable {

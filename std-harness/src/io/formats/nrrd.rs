@@ -7,7 +7,7 @@
 //! `byteskip` (−1 for raw: the data are the file's last bytes). `#` comments and `key:=value`
 //! pairs are ignored; other fields (`kinds`, `centers`, `space`, …) are accepted and ignored.
 
-use super::{compress, numbers};
+use super::{compress, numbers, Fields};
 use crate::io::volume::{
     at, byte_len, check_spacing, decode, decode_ascii, SampleType, Volume, AXIS_ALIGNED,
 };
@@ -56,7 +56,7 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
     if !(bytes.len() >= 8 && bytes.starts_with(b"NRRD000") && (b'1'..=b'5').contains(&bytes[7])) {
         return Err("not an NRRD file (expected magic NRRD0001 to NRRD0005)".into());
     }
-    let (fields, header_len) = Fields::read(bytes)?;
+    let (fields, header_len) = read_fields(bytes)?;
     let tyname = fields.need("type")?;
     let ty = SampleType::parse(tyname)
         .ok_or_else(|| format!("type: '{tyname}' is not a supported sample type"))?;
@@ -68,7 +68,7 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
     let dims: Vec<usize> = numbers(sizes, 3, "sizes")?;
     let dims = [dims[0], dims[1], dims[2]];
     byte_len(dims, ty)?;
-    let (spacing, directions) = fields.orientation()?;
+    let (spacing, directions) = orientation(&fields)?;
     check_spacing(spacing)?;
     if let Some(o) = fields.get(&["space origin"]) {
         vector(o).ok_or_else(|| format!("space origin: '{o}' is not a 3-vector"))?;
@@ -95,13 +95,13 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
         }
         Some(other) => return Err(format!("endian: expected little or big, found '{other}'")),
     };
-    let byte_skip = fields.number(&["byte skip", "byteskip"], "byte skip")?;
+    let byte_skip = number(&fields, &["byte skip", "byteskip"], "byte skip")?;
     if byte_skip < -1 || (byte_skip == -1 && encoding != Encoding::Raw) {
         return Err(format!(
             "byte skip: {byte_skip} is not allowed with {enc} encoding"
         ));
     }
-    let line_skip = fields.number(&["line skip", "lineskip"], "line skip")?;
+    let line_skip = number(&fields, &["line skip", "lineskip"], "line skip")?;
     let line_skip =
         usize::try_from(line_skip).map_err(|_| format!("line skip: {line_skip} is negative"))?;
     let data_file = fields.get(&["data file", "datafile"]).map(str::to_string);
@@ -125,96 +125,76 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
     })
 }
 
-/// A header's `key: value` fields, keys in lower case, in file order.
-struct Fields(Vec<(String, String)>);
-
-impl Fields {
-    /// The fields of the header at the start of `bytes` (after the magic line, up to the blank
-    /// line that ends it) and the header's length in bytes, that line included.
-    fn read(bytes: &[u8]) -> Result<(Self, usize), String> {
-        let mut at = 0;
-        let mut fields = Vec::new();
-        let mut first = true;
-        loop {
-            let end = bytes[at..].iter().position(|&b| b == b'\n').map(|p| at + p);
-            let line_bytes = &bytes[at..end.unwrap_or(bytes.len())];
-            at = end.map_or(bytes.len(), |e| e + 1);
-            let line =
-                std::str::from_utf8(line_bytes).map_err(|_| "header is not text".to_string())?;
-            let line = line.trim_end_matches('\r');
-            if first {
-                first = false;
-            } else if line.is_empty() {
-                break;
-            } else if !line.starts_with('#') {
-                if let Some((k, v)) = line.split_once(": ") {
-                    fields.push((k.trim().to_ascii_lowercase(), v.trim().to_string()));
-                } else if !line.contains(":=") {
-                    return Err(format!(
-                        "malformed header line '{}'",
-                        line.chars().take(60).collect::<String>()
-                    ));
-                }
-            }
-            if end.is_none() {
-                break;
-            }
-        }
-        Ok((Fields(fields), at))
-    }
-
-    /// The first field with one of these keys.
-    fn get(&self, keys: &[&str]) -> Option<&str> {
-        self.0
-            .iter()
-            .find(|(k, _)| keys.contains(&k.as_str()))
-            .map(|(_, v)| v.as_str())
-    }
-
-    /// Field `k`, which must be there.
-    fn need(&self, k: &str) -> Result<&str, String> {
-        self.get(&[k])
-            .ok_or_else(|| format!("missing header field '{k}'"))
-    }
-
-    /// A whole-number field (0 if absent).
-    fn number(&self, keys: &[&str], name: &str) -> Result<i64, String> {
-        self.get(keys).map_or(Ok(0), |v| {
-            v.trim()
-                .parse()
-                .map_err(|_| format!("{name}: '{v}' is not a whole number"))
-        })
-    }
-
-    /// Spacing and axis directions: from `space directions` (three vectors "(x,y,z)",
-    /// separated by spaces), else `spacings` along the axes, else unit spacing.
-    fn orientation(&self) -> Result<([f32; 3], [[f32; 3]; 3]), String> {
-        if let Some(sd) = self.get(&["space directions"]) {
-            let parts: Vec<&str> = sd
-                .split(')')
-                .map(str::trim)
-                .filter(|p| !p.is_empty())
-                .collect();
-            if parts.len() != 3 {
+/// The fields of the header at the start of `bytes` (after the magic line, up to the blank
+/// line that ends it) and the header's length in bytes, that line included.
+fn read_fields(bytes: &[u8]) -> Result<(Fields, usize), String> {
+    let mut at = 0;
+    let mut fields = Vec::new();
+    let mut first = true;
+    loop {
+        let end = bytes[at..].iter().position(|&b| b == b'\n').map(|p| at + p);
+        let line_bytes = &bytes[at..end.unwrap_or(bytes.len())];
+        at = end.map_or(bytes.len(), |e| e + 1);
+        let line = std::str::from_utf8(line_bytes).map_err(|_| "header is not text".to_string())?;
+        let line = line.trim_end_matches('\r');
+        if first {
+            first = false;
+        } else if line.is_empty() {
+            break;
+        } else if !line.starts_with('#') {
+            if let Some((k, v)) = line.split_once(": ") {
+                fields.push((k.trim().to_ascii_lowercase(), v.trim().to_string()));
+            } else if !line.contains(":=") {
                 return Err(format!(
-                    "space directions: expected 3 vectors, found '{sd}'"
+                    "malformed header line '{}'",
+                    line.chars().take(60).collect::<String>()
                 ));
             }
-            let mut spacing = [0.0f32; 3];
-            let mut dirs = AXIS_ALIGNED;
-            for (c, p) in parts.iter().enumerate() {
-                let v = vector(&format!("{p})"))
-                    .ok_or_else(|| format!("space directions: '{p})' is not a 3-vector"))?;
-                (spacing[c], dirs[c]) = super::axis_step(v)
-                    .ok_or_else(|| format!("space directions: vector {} has zero length", c + 1))?;
-            }
-            Ok((spacing, dirs))
-        } else if let Some(s) = self.get(&["spacings"]) {
-            let v: Vec<f32> = numbers(s, 3, "spacings")?;
-            Ok(([v[0], v[1], v[2]], AXIS_ALIGNED))
-        } else {
-            Ok(([1.0; 3], AXIS_ALIGNED))
         }
+        if end.is_none() {
+            break;
+        }
+    }
+    Ok((Fields(fields), at))
+}
+
+/// A whole-number field (0 if absent).
+fn number(fields: &Fields, keys: &[&str], name: &str) -> Result<i64, String> {
+    fields.get(keys).map_or(Ok(0), |v| {
+        v.trim()
+            .parse()
+            .map_err(|_| format!("{name}: '{v}' is not a whole number"))
+    })
+}
+
+/// Spacing and axis directions: from `space directions` (three vectors "(x,y,z)",
+/// separated by spaces), else `spacings` along the axes, else unit spacing.
+fn orientation(fields: &Fields) -> Result<([f32; 3], [[f32; 3]; 3]), String> {
+    if let Some(sd) = fields.get(&["space directions"]) {
+        let parts: Vec<&str> = sd
+            .split(')')
+            .map(str::trim)
+            .filter(|p| !p.is_empty())
+            .collect();
+        if parts.len() != 3 {
+            return Err(format!(
+                "space directions: expected 3 vectors, found '{sd}'"
+            ));
+        }
+        let mut spacing = [0.0f32; 3];
+        let mut dirs = AXIS_ALIGNED;
+        for (c, p) in parts.iter().enumerate() {
+            let v = vector(&format!("{p})"))
+                .ok_or_else(|| format!("space directions: '{p})' is not a 3-vector"))?;
+            (spacing[c], dirs[c]) = super::axis_step(v)
+                .ok_or_else(|| format!("space directions: vector {} has zero length", c + 1))?;
+        }
+        Ok((spacing, dirs))
+    } else if let Some(s) = fields.get(&["spacings"]) {
+        let v: Vec<f32> = numbers(s, 3, "spacings")?;
+        Ok(([v[0], v[1], v[2]], AXIS_ALIGNED))
+    } else {
+        Ok(([1.0; 3], AXIS_ALIGNED))
     }
 }
 

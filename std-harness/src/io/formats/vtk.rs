@@ -215,6 +215,17 @@ struct Found {
     start: usize,
 }
 
+impl Found {
+    fn new(name: String, ty: String, components: usize, start: usize) -> Self {
+        Found {
+            name,
+            ty,
+            components,
+            start,
+        }
+    }
+}
+
 /// Parses a legacy `.vtk` file and locates the array to render: `array` by name, or the default
 /// (see the module documentation).
 pub fn parse(bytes: &[u8], array: Option<&str>) -> Result<Header, String> {
@@ -344,12 +355,7 @@ impl Scan {
             let start = w.skip_values(values, size, self.binary, &name)?;
             w.skip_metadata();
             if matches!(self.section, Some((true, n)) if n == tuples) {
-                self.found.push(Found {
-                    name,
-                    ty,
-                    components: comps,
-                    start,
-                });
+                self.found.push(Found::new(name, ty, comps, start));
             }
         }
         Ok(())
@@ -404,12 +410,7 @@ impl Scan {
         w.skip_metadata();
         if point && key == "SCALARS" {
             self.chosen.get_or_insert(self.found.len());
-            self.found.push(Found {
-                name,
-                ty,
-                components: comps,
-                start,
-            });
+            self.found.push(Found::new(name, ty, comps, start));
         }
         Ok(())
     }
