@@ -5,6 +5,8 @@
 #  2. the firmware renders it on QEMU mps2-an385 (Cortex-M3, no FPU) and mps2-an386 (Cortex-M4F)
 #     and prints the same checksum, its painted-stack high-water mark, static RAM and flash, and
 #     its image, which the host checks (CRC) and compares with its float render (PSNR);
+#  2a. each firmware sends its bands as RGB565 rows through the core's embedded-graphics adaptor
+#     into a framebuffer-less display that keeps their CRC, equal to the host's for the same rows;
 #  2b. on QEMU microbit (Cortex-M0, nRF51822 memory map: 256 KiB flash, 16 KiB RAM) it renders
 #     48×48 in bands, with the host's checksum for that size, in 16 KiB: statics + stack;
 #  3. the fixed path's splat and compositing contain no float (object-code audit on M3, M4F and
@@ -35,6 +37,10 @@ echo "$out"
 host_release=$(grep '^fixed checksum' <<<"$out")
 host_microbit=$(sed -n 's/^microbit fixed checksum //p' <<<"$out")
 [ -n "$host_microbit" ] || fail "the host printed no micro:bit checksum"
+# The rows a display is sent (RGB565 through the core's embedded-graphics adaptor), per size.
+host_rgb565=$(sed -n 's/^rgb565 crc \(0x[0-9a-f]*\) .*/\1/p' <<<"$out")
+host_rgb565_microbit=$(sed -n 's/^microbit rgb565 crc \(0x[0-9a-f]*\) .*/\1/p' <<<"$out")
+[ -n "$host_rgb565" ] && [ -n "$host_rgb565_microbit" ] || fail "the host printed no rgb565 CRC"
 [ "$host_debug" = "$host_release" ] || fail "host debug ($host_debug) and release ($host_release) differ"
 # The checksum is pinned: a change to the fixed path's output is a reviewed decision (update
 # expected-checksum.txt in the same commit), never an accident.
@@ -77,6 +83,9 @@ for spec in "thumbv7m-none-eabi mps2-an385 cortex-m3 M3" "thumbv7em-none-eabihf 
   sum=$(grep '^fixed checksum' <<<"$out") || fail "$name printed no checksum"
   [ "$sum" = "$host_debug" ] || fail "$name: '$sum', host: '$host_debug'"
   echo "$name fixed: $sum (= host)"
+  shown=$(sed -n 's/^rgb565 crc \(0x[0-9a-f]*\) .*/\1/p' <<<"$out")
+  [ "$shown" = "$host_rgb565" ] || fail "$name: the display was sent rgb565 crc '$shown', host: '$host_rgb565'"
+  echo "$name display rows: rgb565 crc $shown (= host)"
   printf '%s\n' "$out" > "target/$name.log"
   compare "$name" "target/$name.log"
   python3 elf_check.py float-audit "$elf"
@@ -111,6 +120,9 @@ grep -v '^row ' <<<"$out"
 printf '%s\n' "$out" > target/microbit.log
 sum=$(sed -n 's/^fixed checksum //p' <<<"$out")
 [ "$sum" = "$host_microbit" ] || fail "micro:bit: checksum '$sum', host: '$host_microbit'"
+shown=$(sed -n 's/^rgb565 crc \(0x[0-9a-f]*\) .*/\1/p' <<<"$out")
+[ "$shown" = "$host_rgb565_microbit" ] \
+  || fail "micro:bit: the display was sent rgb565 crc '$shown', host: '$host_rgb565_microbit'"
 ram=$(field 'static RAM' "$out"); stack=$(field 'stack high-water' "$out"); flash=$(field flash "$out")
 read -r w h < <(sed -n 's/^image \([0-9]*\) \([0-9]*\)$/\1 \2/p' <<<"$out")
 [ -n "$ram" ] && [ -n "$stack" ] && [ -n "$flash" ] && [ -n "$w" ] || fail "micro:bit: missing figures"

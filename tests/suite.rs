@@ -6,6 +6,7 @@ mod bad_input;
 mod classify;
 mod continuous;
 mod degenerate;
+mod display;
 mod ellipse_geometry;
 mod fixed_point;
 mod flat_field;

@@ -14,8 +14,21 @@
 //!
 //! Every value is clamped to [0, 1] (NaN → 0) and rounded half away from zero. Alpha stays linear
 //! (coverage, not a colour).
+//!
+//! A band leaves the renderer as rows: [`band_rows`] encodes each row to RGB565 in a one-row
+//! buffer and hands it to a [`RowSink`] (with the `embedded-graphics` feature, `DisplaySink`
+//! writes it into any `DrawTarget` of that ecosystem); [`rgb565_q24`] encodes the
+//! fixed path's pixels without floating point.
 
 use crate::math;
+
+#[cfg(feature = "embedded-graphics")]
+mod display;
+mod rows;
+
+#[cfg(feature = "embedded-graphics")]
+pub use display::DisplaySink;
+pub use rows::{band_rows, rgb565_q24, RowError, RowFn, RowSink};
 
 /// sRGB encoding of one linear channel, clamped to [0, 1]; NaN gives 0.
 #[inline]

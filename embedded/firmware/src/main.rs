@@ -6,6 +6,7 @@
 //! image W H
 //! row Y RRRRRRRRGGGGGGGGBBBBBBBBAAAAAAAA…   (W pixels, Q24 hex; one line per row)
 //! fixed checksum 0x…      (equal to `footprint-scene-host`'s, bit for bit)
+//! rgb565 crc 0x… (N pixels …)   the rows a display was sent (equal to the host's)
 //! stack high-water N bytes (painted stack)
 //! static RAM N bytes (.data + .bss)
 //! flash N bytes (.text + .rodata + .data image)
@@ -23,6 +24,7 @@ use cortex_m::peripheral::{syst::SystClkSource, SYST};
 use cortex_m_rt::{entry, exception};
 use cortex_m_semihosting::{debug, hio, hprintln};
 use footprint::composite::RowSpan;
+use footprint_scene::display::{send_band, CrcDisplay};
 use footprint_scene::N;
 
 /// Image side, pixels.
@@ -77,8 +79,13 @@ fn main() -> ! {
     );
     let data_load = core::ptr::addr_of!(__sidata) as usize;
     let ok = match result {
-        Ok(report) => {
+        Ok((report, (display_crc, drawn))) => {
             hprintln!("{} checksum 0x{:08x}", PATH, report.checksum);
+            hprintln!(
+                "rgb565 crc 0x{:08x} ({} pixels through the embedded-graphics adaptor)",
+                display_crc,
+                drawn
+            );
             hprintln!(
                 "scene: {}x{} in {} bands of {} rows, {} sheets, {} voxels splatted, {} pixel updates",
                 SIDE,
@@ -97,7 +104,10 @@ fn main() -> ! {
         }
     };
     match instructions(frame_ticks, calibration) {
-        Some(n) => hprintln!("frame instructions {} (printing the image excluded)", n),
+        Some(n) => hprintln!(
+            "frame instructions {} (the rows sent to the display included, printing the image excluded)",
+            n
+        ),
         None => hprintln!("frame instructions unknown (no clock: run QEMU with -icount)"),
     }
     hprintln!("stack high-water {} bytes", high_water);
@@ -217,7 +227,7 @@ fn print_rows(first: usize, pixels: &[[u32; 4]]) {
 /// The fixed-point render, from `static` buffers.
 #[cfg(not(feature = "float"))]
 #[inline(never)]
-fn render() -> Result<footprint_scene::Report, footprint::Error> {
+fn render() -> Result<(footprint_scene::Report, (u32, usize)), footprint::Error> {
     use footprint::fixed::FixedTable;
     static mut TABLE: FixedTable<N> = FixedTable::zeroed();
     static mut LUT: [[u32; 4]; 256] = [[0; 4]; 256];
@@ -235,13 +245,20 @@ fn render() -> Result<footprint_scene::Report, footprint::Error> {
             rows: &mut *core::ptr::addr_of_mut!(ROWS),
         }
     };
-    footprint_scene::render_fixed(SIDE, b, emit)
+    let mut display = CrcDisplay::new(SIDE);
+    let mut row = [0u16; SIDE];
+    let report = footprint_scene::render_fixed(SIDE, b, |first, px| {
+        emit(first, px);
+        // Whole rows of SIDE pixels into a row of SIDE: cannot fail.
+        let _ = send_band(first, SIDE, px, &mut row, &mut display);
+    })?;
+    Ok((report, display.finish()))
 }
 
 /// The float render, from `static` buffers.
 #[cfg(feature = "float")]
 #[inline(never)]
-fn render() -> Result<footprint_scene::Report, footprint::Error> {
+fn render() -> Result<(footprint_scene::Report, (u32, usize)), footprint::Error> {
     use footprint::ViewTable;
     static mut TABLE: ViewTable<N> = ViewTable::zeroed(footprint::Footprint::EMPTY);
     static mut ACC: [[f32; 4]; BAND_PIXELS] = [[0.0; 4]; BAND_PIXELS];
@@ -256,16 +273,20 @@ fn render() -> Result<footprint_scene::Report, footprint::Error> {
             rows: &mut *core::ptr::addr_of_mut!(ROWS),
         }
     };
-    footprint_scene::render_float(SIDE, b, |first, px| {
-        // A row at a time, quantised to Q24 for printing.
+    let mut display = CrcDisplay::new(SIDE);
+    let mut out = [0u16; SIDE];
+    let report = footprint_scene::render_float(SIDE, b, |first, px| {
+        // A row at a time, quantised to Q24 for printing and the display.
         for (r, row) in px.chunks(SIDE).enumerate() {
             let mut q = [[0u32; 4]; SIDE];
             for (o, c) in q.iter_mut().zip(row) {
                 *o = footprint::fixed::quantise(*c);
             }
             emit(first + r, &q);
+            let _ = send_band(first + r, SIDE, &q, &mut out, &mut display);
         }
-    })
+    })?;
+    Ok((report, display.finish()))
 }
 
 /// Fills the free RAM between the statics and (a margin below) the current stack pointer with

@@ -14,6 +14,7 @@
 use footprint::composite::RowSpan;
 use footprint::fixed::FixedTable;
 use footprint::ViewTable;
+use footprint_scene::display::{send_band, CrcDisplay};
 use footprint_scene::{render_fixed, render_float, FixedBuffers, FloatBuffers, Report};
 use footprint_scene::{SIDE, SIDE_MICROBIT};
 use std::process::ExitCode;
@@ -75,6 +76,18 @@ fn checksums(threads: usize) -> Result<(), String> {
         fixed_image(SIDE_MICROBIT, SIDE_MICROBIT)?.0.checksum
     );
     println!("float checksum 0x{:08x} (informational)", float.checksum);
+    for (name, side) in [("", SIDE), ("microbit ", SIDE_MICROBIT)] {
+        // The whole image as one band through the same adaptor the firmware sends its bands
+        // through: bands change neither the rows nor their order.
+        let image = fixed_image(side, side)?.1;
+        let mut display = CrcDisplay::new(side);
+        send_band(0, side, &image, &mut vec![0; side], &mut display)
+            .map_err(|e| format!("rows to the display: {e}"))?;
+        let (crc, drawn) = display.finish();
+        println!(
+            "{name}rgb565 crc 0x{crc:08x} ({drawn} pixels through the embedded-graphics adaptor)"
+        );
+    }
     Ok(())
 }
 

@@ -29,6 +29,8 @@ use footprint::table::Crc32;
 use footprint::{GenericTable, Grid, Kernel, Lookup, View, ViewTable};
 use glam::{Mat3, Vec3};
 
+pub mod display;
+
 /// Voxels along each axis.
 pub const DIM: usize = 32;
 /// Image width and height on the MPS2 boards and the host, pixels.
