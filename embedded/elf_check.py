@@ -124,7 +124,13 @@ def stack_bound(elf, chain, budget):
             sizes[f.strip()] = int(m.group(2), 0)
 
     def find(fragment):
-        found = [n for n in funcs if n == fragment] or [n for n in funcs if fragment in n]
+        # Exact, else the one name ending with it (a function, not the closures and generic
+        # instances named after it), else the one containing it.
+        found = (
+            [n for n in funcs if n == fragment]
+            or [n for n in funcs if n.endswith(fragment)]
+            or [n for n in funcs if fragment in n]
+        )
         if len(found) != 1:
             sys.exit(f"stack-bound: {len(found)} functions match '{fragment}': {found[:5]}")
         return found[0]

@@ -81,12 +81,8 @@ impl<const M: usize> FixedTable<M> {
         if u0.abs() > ONE_POS || u1.abs() > ONE_POS {
             return 0;
         }
-        if !self.separable {
-            // |u|² ≤ 1 in Q32: (u >> 8) ≤ 2¹⁶, so the squares fit easily.
-            let (a, b) = (u0 >> 8, u1 >> 8);
-            if a * a + b * b > 1 << 32 {
-                return 0;
-            }
+        if !self.separable && !inside_disc(u0, u1) {
+            return 0;
         }
         let last = ((M - 1) as i64) << POS_FRAC;
         let [tx, ty] = c.t;
@@ -105,11 +101,11 @@ impl<const M: usize> FixedTable<M> {
                 // Fractions in Q16 (0 … 2¹⁶ inclusive at the last node).
                 let fx = (tx - ((col as i64) << POS_FRAC)) >> (POS_FRAC - 16);
                 let fy = (ty - ((row as i64) << POS_FRAC)) >> (POS_FRAC - 16);
-                let lerp = |a: i64, b: i64, f: i64| a + (((b - a) * f + (1 << 15)) >> 16);
                 let (r0, r1) = (&self.data[row], &self.data[row + 1]);
-                let top = lerp(i64::from(r0[col]), i64::from(r0[col + 1]), fx);
-                let bottom = lerp(i64::from(r1[col]), i64::from(r1[col + 1]), fx);
-                lerp(top, bottom, fy)
+                let (fx, fy) = (fx as u32, fy as u32);
+                let top = lerp(r0[col], r0[col + 1], fx);
+                let bottom = lerp(r1[col], r1[col + 1], fx);
+                i64::from(lerp(top, bottom, fy))
             }
         }
     }
@@ -136,6 +132,70 @@ impl<const M: usize> FixedTable<M> {
             }
         }
     }
+}
+
+/// Whether unit coordinates (u0, u1) (Q24, each within ±1) lie in the unit disc: (u0 >> 8)² +
+/// (u1 >> 8)² ≤ 2³² (Q32), exactly, with 32-bit multiplies: each |u >> 8| ≤ 2¹⁶, whose square is
+/// below 2³² except at 2¹⁶ itself (the square 2³², handled without multiplying), and the sum of
+/// two squares is taken in `u64` (an add, not a multiply on a 32-bit core).
+/// On a 64-bit core, in 64-bit multiplies (the same answer; see [`lerp`] on why).
+#[inline]
+fn inside_disc(u0: i64, u1: i64) -> bool {
+    if cfg!(target_pointer_width = "64") {
+        let (a, b) = (u0 >> 8, u1 >> 8);
+        a * a + b * b <= 1 << 32
+    } else {
+        inside_disc_narrow(u0, u1)
+    }
+}
+
+/// [`inside_disc`] in 32-bit multiplies (see there).
+#[inline]
+fn inside_disc_narrow(u0: i64, u1: i64) -> bool {
+    let square = |u: i64| {
+        let m = (u >> 8).unsigned_abs();
+        if m >= 1 << 16 {
+            1 << 32 // m = 2¹⁶ exactly: |u| ≤ 2²⁴ was checked.
+        } else {
+            u64::from((m as u32) * (m as u32))
+        }
+    };
+    square(u0) + square(u1) <= 1 << 32
+}
+
+/// a + round((b − a) · f / 2¹⁶) for entries |a|, |b| ≤ 2²⁸ ([`super::MAX_ENTRY_FRAC`]: every
+/// table entry, and every lerp of entries, obeys it) and f in Q16 (0 … 2¹⁶): bit for bit
+/// `a + (((b − a) · f + 2¹⁵) >> 16)` in `i64`, in 32-bit arithmetic. With d = b − a =
+/// d_hi · 2¹⁶ + d_lo (d_lo = d mod 2¹⁶ ≥ 0), d · f + 2¹⁵ = d_hi · f · 2¹⁶ + (d_lo · f + 2¹⁵), and
+/// the floor of that over 2¹⁶ is d_hi · f + ⌊(d_lo · f + 2¹⁵) / 2¹⁶⌋ because the second part is
+/// not negative; |d_hi · f| ≤ 2¹³ · 2¹⁶ and d_lo · f + 2¹⁵ < 2³² fit 32 bits. A core without a
+/// 64-bit multiply (Cortex-M0: `__aeabi_lmul`, a library call) pays three 32-bit ones instead.
+#[inline]
+fn lerp(a: i32, b: i32, f: u32) -> i32 {
+    // A 64-bit core multiplies in 64 bits at no extra cost, and the narrow form's extra steps
+    // measured slower there (host table walk, headsq 512², one thread: 300 → 350 ms).
+    if cfg!(target_pointer_width = "64") {
+        lerp_wide(a, b, f)
+    } else {
+        lerp_narrow(a, b, f)
+    }
+}
+
+/// [`lerp`] in `i64`, as written.
+#[inline]
+fn lerp_wide(a: i32, b: i32, f: u32) -> i32 {
+    let (a, b, f) = (i64::from(a), i64::from(b), i64::from(f));
+    (a + (((b - a) * f + (1 << 15)) >> 16)) as i32
+}
+
+/// [`lerp`] in 32-bit arithmetic (see there).
+#[inline]
+fn lerp_narrow(a: i32, b: i32, f: u32) -> i32 {
+    debug_assert!(a.unsigned_abs() <= 1 << 28 && b.unsigned_abs() <= 1 << 28 && f <= 1 << 16);
+    let d = b.wrapping_sub(a);
+    let (hi, lo) = (d >> 16, (d & 0xffff) as u32);
+    a.wrapping_add(hi.wrapping_mul(f as i32))
+        .wrapping_add(((lo * f + (1 << 15)) >> 16) as i32)
 }
 
 /// Spreads `value` (premultiplied RGBA, Q24) of a voxel projected to `center` (Q24 px, absolute)
@@ -167,9 +227,22 @@ pub fn splat<const M: usize>(
     {
         v[0] = (v[0] as f32 * 1.0001) as i64;
     }
+    // A renormalised footprint's weights, kept from the summing pass for the deposit when its
+    // box fits (entries are i32, so every weight is).
+    let mut kept = [0i32; KEPT_WEIGHTS];
+    let whole = (ys, xs);
+    let box_width = xs.1 - xs.0 + 1;
+    let keep = table.renorm != 0 && box_width * (ys.1 - ys.0 + 1) <= KEPT_WEIGHTS as i64;
     if table.renorm != 0 {
         let mut sum = 0i64;
-        table.for_each(center, ys, xs, |_, _, w| sum += w);
+        let mut k = 0;
+        table.for_each(center, ys, xs, |_, _, w| {
+            sum += w;
+            if keep {
+                kept[k] = w as i32;
+                k += 1;
+            }
+        });
         if sum <= 0 {
             return deposit_whole(table, center, &v, acc, touched);
         }
@@ -185,7 +258,7 @@ pub fn splat<const M: usize>(
     }
     let data = acc.data_mut();
     let mut row = (-1i64, 0i64, 0i64);
-    table.for_each(center, ys, xs, |x, y, weight| {
+    let mut deposit = |x: i64, y: i64, weight: i64| {
         stats.pixels_visited += 1;
         if weight == 0 {
             return;
@@ -203,13 +276,29 @@ pub fn splat<const M: usize>(
             *a = a.saturating_add(c * weight);
         }
         stats.pixels_updated += 1;
-    });
+    };
+    if keep {
+        // The same pixels, in the same order, with the weights the summing pass computed.
+        let ((y0, _), (x0, _)) = whole;
+        for y in ys.0..=ys.1 {
+            let at = ((y - y0) * box_width) as usize;
+            for x in xs.0..=xs.1 {
+                deposit(x, y, i64::from(kept[at + (x - x0) as usize]));
+            }
+        }
+    } else {
+        table.for_each(center, ys, xs, deposit);
+    }
     if row.0 >= 0 {
         touched(row.0 as usize, row.1 as usize, row.2 as usize);
     }
     stats
 }
 
+/// Most weights a renormalised splat keeps from its summing pass: 9 × 9, the largest box of a
+/// renormalised footprint (both half-extents at most [`crate::geometry::RENORMALISE_BELOW_PX`] =
+/// 4 px, so at most 9 pixel centres per row and column), 324 bytes of stack.
+const KEPT_WEIGHTS: usize = 81;
 /// `x · c / s` rounded (s > 0), capped at [`MAX_RENORM_VALUE`]: a Q24 value scaled by the cell
 /// area C = round(area · 2^f) over the footprint's sum S. In 64 bits when x·c + s/2 fits (always
 /// for values up to 2²⁴ and C up to 2³⁸), else in 128 bits; both give the same quotient (integer
@@ -247,5 +336,77 @@ fn deposit_whole<const M: usize>(
     SplatStats {
         pixels_visited: 1,
         pixels_updated: 1,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{inside_disc_narrow as inside_disc, lerp_narrow as lerp};
+
+    /// The 32-bit disc test is the 64-bit one at every point of a lattice over ±1 and along the
+    /// circle's edge.
+    #[test]
+    fn the_32_bit_disc_test_is_the_64_bit_one() {
+        let wide = |u0: i64, u1: i64| {
+            let (a, b) = (u0 >> 8, u1 >> 8);
+            a * a + b * b <= 1 << 32
+        };
+        let one = 1i64 << 24;
+        let mut pts = std::vec::Vec::new();
+        for i in -64..=64 {
+            for j in -64..=64 {
+                pts.push((i * one / 64, j * one / 64));
+            }
+        }
+        for k in 0..=4096i64 {
+            // Along the edge: u1 = ⌊√(1 − u0²)⌋ and its neighbours (Q24).
+            let u0 = k * one / 4096;
+            let r = (one * one - u0 * u0).isqrt();
+            for d in -300..=300 {
+                pts.push((u0, r + d));
+                pts.push((-u0, -(r + d)));
+            }
+        }
+        pts.extend([
+            (one, 0),
+            (0, one),
+            (-one, -one),
+            (one, 255),
+            (one, 256),
+            (one, -256),
+        ]);
+        for (u0, u1) in pts {
+            if u0.abs() <= one && u1.abs() <= one {
+                assert_eq!(inside_disc(u0, u1), wide(u0, u1), "{u0} {u1}");
+            }
+        }
+    }
+
+    /// The 32-bit lerp is the 64-bit one, bit for bit, over the entries' whole range: every
+    /// fraction against edge and random pairs.
+    #[test]
+    fn the_32_bit_lerp_is_the_64_bit_one() {
+        let wide = |a: i32, b: i32, f: u32| {
+            let (a, b, f) = (i64::from(a), i64::from(b), i64::from(f));
+            a + (((b - a) * f + (1 << 15)) >> 16)
+        };
+        let m = 1i32 << 28;
+        let mut pairs = std::vec![(m, -m), (-m, m), (0, m), (m, 0), (-m, 0), (0, 0), (1, -1)];
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        for _ in 0..2000 {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            let r = |s: u64| (s % (2 * m as u64 + 1)) as i64 - i64::from(m);
+            pairs.push((r(seed) as i32, r(seed >> 20) as i32));
+        }
+        for (a, b) in pairs {
+            for f in (0..=1u32 << 16)
+                .step_by(7)
+                .chain([1 << 16, 1, 32767, 32768, 32769])
+            {
+                assert_eq!(i64::from(lerp(a, b, f)), wide(a, b, f), "{a} {b} {f}");
+            }
+        }
     }
 }
