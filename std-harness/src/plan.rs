@@ -233,11 +233,11 @@ pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
         let blocked = if s == "auto" {
             None
         } else if args.perspective.is_some() {
-            Some("orthographic views only (a perspective view's footprints vary per voxel)")
+            Some(SUBSAMPLE_NOT_PERSPECTIVE)
         } else if matches!(args.supersample, Supersample::Fixed(2..)) {
             Some("the frame is supersampled (--supersample): give one of them")
         } else if matches!(args.lod, Lod::Level(1..)) {
-            Some("the volume renders at a coarser level of detail (--lod); give --lod 0 or auto")
+            Some(SUBSAMPLE_NOT_AT_A_LEVEL)
         } else {
             None
         };
@@ -274,6 +274,16 @@ impl From<Lookup> for LookupArg {
         }
     }
 }
+
+/// Why `--subsample` is refused with a perspective view: here from the flags, and in
+/// `pipeline::stages::subsample::factor` for a frame built in code.
+pub const SUBSAMPLE_NOT_PERSPECTIVE: &str =
+    "orthographic views only (a perspective view's footprints vary per voxel)";
+
+/// Why `--subsample` is refused at a coarser level of detail (the flags' `--lod N` here, `auto`'s
+/// choice in `pipeline::stages::subsample::factor`).
+pub const SUBSAMPLE_NOT_AT_A_LEVEL: &str =
+    "the volume renders at a coarser level of detail (--lod); give --lod 0 or auto";
 
 /// The rules a streamed volume (`--stream`: read once, a few sheets at a time) adds to `end`.
 fn streamed_rules(end: &End, args: &RenderArgs) -> Result<(), CliError> {

@@ -135,10 +135,8 @@ impl<const M: usize> FixedTable<M> {
 }
 
 /// Whether unit coordinates (u0, u1) (Q24, each within ±1) lie in the unit disc: (u0 >> 8)² +
-/// (u1 >> 8)² ≤ 2³² (Q32), exactly, with 32-bit multiplies: each |u >> 8| ≤ 2¹⁶, whose square is
-/// below 2³² except at 2¹⁶ itself (the square 2³², handled without multiplying), and the sum of
-/// two squares is taken in `u64` (an add, not a multiply on a 32-bit core).
-/// On a 64-bit core, in 64-bit multiplies (the same answer; see [`lerp`] on why).
+/// (u1 >> 8)² ≤ 2³² (Q32). On a 64-bit core in 64-bit multiplies, on others in 32-bit ones
+/// ([`inside_disc_narrow`]): the same answer (see [`lerp`] on why both).
 #[inline]
 fn inside_disc(u0: i64, u1: i64) -> bool {
     if cfg!(target_pointer_width = "64") {
@@ -149,7 +147,9 @@ fn inside_disc(u0: i64, u1: i64) -> bool {
     }
 }
 
-/// [`inside_disc`] in 32-bit multiplies (see there).
+/// [`inside_disc`] in 32-bit multiplies, exactly: each |u >> 8| ≤ 2¹⁶, whose square is below 2³²
+/// except at 2¹⁶ itself (the square 2³², handled without multiplying), and the sum of two squares
+/// is taken in `u64` (an add, not a multiply on a 32-bit core).
 #[inline]
 fn inside_disc_narrow(u0: i64, u1: i64) -> bool {
     let square = |u: i64| {
@@ -164,8 +164,9 @@ fn inside_disc_narrow(u0: i64, u1: i64) -> bool {
 }
 
 /// a + round((b − a) · f / 2¹⁶) for entries |a|, |b| ≤ 2²⁸ ([`super::MAX_ENTRY_FRAC`]: every
-/// table entry, and every lerp of entries, obeys it) and f in Q16 (0 … 2¹⁶): bit for bit
-/// `a + (((b − a) · f + 2¹⁵) >> 16)` in `i64`, in 32-bit arithmetic. With d = b − a =
+/// table entry, and every lerp of entries, obeys it) and f in Q16 (0 … 2¹⁶), as
+/// `a + (((b − a) · f + 2¹⁵) >> 16)` in `i64` ([`lerp_wide`]) on a 64-bit core, and bit for bit
+/// the same in 32-bit arithmetic ([`lerp_narrow`]) on others. With d = b − a =
 /// d_hi · 2¹⁶ + d_lo (d_lo = d mod 2¹⁶ ≥ 0), d · f + 2¹⁵ = d_hi · f · 2¹⁶ + (d_lo · f + 2¹⁵), and
 /// the floor of that over 2¹⁶ is d_hi · f + ⌊(d_lo · f + 2¹⁵) / 2¹⁶⌋ because the second part is
 /// not negative; |d_hi · f| ≤ 2¹³ · 2¹⁶ and d_lo · f + 2¹⁵ < 2³² fit 32 bits. A core without a

@@ -74,7 +74,7 @@ pub fn factor(
     };
     let refined = matches!(plan.end, End::Refined { .. });
     let blocked = if frame.camera().is_some() {
-        Some("orthographic views only (a perspective view's footprints vary per voxel)")
+        Some(crate::plan::SUBSAMPLE_NOT_PERSPECTIVE)
     } else if refined {
         Some("--refine adds samples for magnified volumes; subsampling removes pixels: drop one")
     } else if supersample > 1 {
@@ -83,7 +83,7 @@ pub fn factor(
              --min-radius)",
         )
     } else if level > 0 {
-        Some("the volume renders at a coarser level of detail (--lod); give --lod 0 or auto")
+        Some(crate::plan::SUBSAMPLE_NOT_AT_A_LEVEL)
     } else {
         None
     };
