@@ -1,7 +1,13 @@
 #!/usr/bin/env bash
 # Everything the embedded demo must show, in one run (CI calls it; it works locally too):
-#  1. the host renders the scene (debug, and release on 4 threads) to one fixed-point checksum,
-#     the one pinned in expected-checksum.txt;
+#  0. every board runs the compact fixed path (footprint::fixed::compact) on an orbit of 4
+#     frames: per frame its checksum (equal to the host's, bit for bit) and instructions; the
+#     first frame's image, RAM, stack and flash, and its PSNR against the host's float render;
+#     boards: mps2-an385 (M3) and mps2-an386 (M4F) at 64², micro:bit (M0, 16 KiB) at 48²,
+#     stm32vldiscovery (STM32F100, M3, 8 KiB) at 32²;
+#  1. the host renders the scene (debug, and release on 4 threads) to one Q24 fixed-point
+#     checksum and one compact checksum, the ones pinned in expected-checksum.txt; the Q24 path
+#     still runs on the M3 (`--features q24`) to the same bits;
 #  2. the firmware renders it on QEMU mps2-an385 (Cortex-M3, no FPU) and mps2-an386 (Cortex-M4F)
 #     and prints the same checksum, its painted-stack high-water mark, static RAM and flash, and
 #     its image, which the host checks (CRC) and compares with its float render (PSNR);
@@ -20,7 +26,8 @@
 set -euo pipefail
 cd "$(dirname "$0")"
 
-STACK_BUDGET=4096
+# The compact path's per-view stencil set-up keeps one box of float weights on the stack.
+STACK_BUDGET=4608
 # -icount shift=0: the virtual clock advances 1 ns per instruction, so the firmware's SysTick
 # count (calibrated against a loop of known length) is an instruction count, the same every run.
 QEMU_FLAGS=(-nographic -icount shift=0 -semihosting-config enable=on,target=native)
@@ -31,22 +38,22 @@ echo "== host"
 # (Not `tee /dev/stderr`: reopening stderr truncates it when it is a log file.)
 out=$(cargo run -q -p footprint-scene-host)
 echo "$out"
-host_debug=$(grep '^fixed checksum' <<<"$out")
+host_debug=$(grep -E '^(fixed|compact) checksum' <<<"$out" | sed 's/ (.*//')
 out=$(cargo run -q --release -p footprint-scene-host -- --threads 4)
 echo "$out"
-host_release=$(grep '^fixed checksum' <<<"$out")
-host_microbit=$(sed -n 's/^microbit fixed checksum //p' <<<"$out")
-[ -n "$host_microbit" ] || fail "the host printed no micro:bit checksum"
-# The rows a display is sent (RGB565 through the core's embedded-graphics adaptor), per size.
-host_rgb565=$(sed -n 's/^rgb565 crc \(0x[0-9a-f]*\) .*/\1/p' <<<"$out")
-host_rgb565_microbit=$(sed -n 's/^microbit rgb565 crc \(0x[0-9a-f]*\) .*/\1/p' <<<"$out")
-[ -n "$host_rgb565" ] && [ -n "$host_rgb565_microbit" ] || fail "the host printed no rgb565 CRC"
+host_release=$(grep -E '^(fixed|compact) checksum' <<<"$out" | sed 's/ (.*//')
 [ "$host_debug" = "$host_release" ] || fail "host debug ($host_debug) and release ($host_release) differ"
-# The checksum is pinned: a change to the fixed path's output is a reviewed decision (update
+# The checksums are pinned: a change to either fixed path's output is a reviewed decision (update
 # expected-checksum.txt in the same commit), never an accident.
 expected=$(cat expected-checksum.txt)
 [ "$host_debug" = "$expected" ] || fail "host '$host_debug', expected-checksum.txt '$expected'"
-echo "host fixed checksum equals expected-checksum.txt"
+echo "host checksums equal expected-checksum.txt"
+host_q24=$(grep '^fixed checksum' <<<"$out")
+host_q24_rgb565=$(sed -n 's/^rgb565 crc \(0x[0-9a-f]*\) .*/\1/p' <<<"$out")
+# host_value PREFIX KEY, host_orbit PREFIX: the host's value of "PREFIXKEY 0x…" ("", "microbit ", "stm32 ").
+host_out=$out
+host_value() { sed -n "s/^$1$2 \(0x[0-9a-f]*\).*/\1/p" <<<"$host_out"; }
+host_orbit() { sed -n "s/^$1orbit checksums //p" <<<"$host_out"; }
 
 # run MACHINE CPU ELF: prints the firmware's output, fails on a non-zero exit or a timeout
 # (CPU "-": the machine's own).
@@ -65,93 +72,100 @@ compare() {
     || fail "$1: the printed image does not match the host's"
 }
 
-# field NAME OUTPUT: the N of a firmware's "NAME N bytes" line; instr OUTPUT: its instructions
-# per frame.
+# field NAME OUTPUT: the N of a firmware's "NAME N bytes" line; instr OUTPUT: its first frame's
+# instructions; frames OUTPUT: each frame's checksum, and instructions.
 field() { sed -n "s/^$1 \([0-9]*\) bytes/\1/p" <<<"$2"; }
 instr() { sed -n 's/^frame instructions \([0-9]*\).*/\1/p' <<<"$1"; }
+frame_sums() { sed -n 's/^frame [0-9]* checksum \(0x[0-9a-f]*\) .*/\1/p' <<<"$1" | paste -sd' '; }
+frame_instr() { sed -n 's/^frame [0-9]* checksum 0x[0-9a-f]* instructions \([0-9]*\)/\1/p' <<<"$1" | paste -sd' '; }
+# stack_bound TARGET DIR FEATURES: the worst-case stack of the render chain (the compiler's stack
+# sizes), printed; the bound in $bound.
+stack_bound() {
+  RUSTC_BOOTSTRAP=1 RUSTFLAGS="-Z emit-stack-sizes ${LINK[*]}" \
+    cargo build -q --release -p footprint-firmware --target "$1" --target-dir "$2" $3
+  # The render's worst case plus the frames of its callers from the reset handler (main's own
+  # printing goes through core::fmt's indirect calls and is not bounded; it runs after the
+  # high-water mark is taken).
+  local b
+  b=$(python3 elf_check.py stack-bound "$2/$1/release/footprint-firmware" \
+    "__stext>main>___cortex_m_rt_main>footprint_firmware6render" "$STACK_BUDGET")
+  echo "$b"
+  bound=$(sed -n 's/^stack-bound: worst case from [^:]*: \([0-9]*\) bytes.*/\1/p' <<<"$b")
+}
 
 report=target/embedded-report.txt
 mkdir -p target
 : > "$report"
-for spec in "thumbv7m-none-eabi mps2-an385 cortex-m3 M3" "thumbv7em-none-eabihf mps2-an386 cortex-m4 M4F"; do
-  read -r target machine cpu name <<<"$spec"
-  echo "== $name fixed ($target on $machine)"
-  cargo build -q --release -p footprint-firmware --target "$target"
-  elf=target/$target/release/footprint-firmware
+# board NAME TARGET MACHINE CPU RAM PREFIX FEATURES: the compact firmware on one board.
+board() {
+  local name=$1 target=$2 machine=$3 cpu=$4 ram=$5 prefix=$6 features=$7
+  local dir=target/board-$name
+  echo "== $name compact ($target on $machine)"
+  cargo build -q --release -p footprint-firmware --target "$target" --target-dir "$dir" $features
+  local elf=$dir/$target/release/footprint-firmware
+  local out
   out=$(run "$machine" "$cpu" "$elf")
   grep -v '^row ' <<<"$out"
-  sum=$(grep '^fixed checksum' <<<"$out") || fail "$name printed no checksum"
-  [ "$sum" = "$host_debug" ] || fail "$name: '$sum', host: '$host_debug'"
-  echo "$name fixed: $sum (= host)"
-  shown=$(sed -n 's/^rgb565 crc \(0x[0-9a-f]*\) .*/\1/p' <<<"$out")
-  [ "$shown" = "$host_rgb565" ] || fail "$name: the display was sent rgb565 crc '$shown', host: '$host_rgb565'"
-  echo "$name display rows: rgb565 crc $shown (= host)"
   printf '%s\n' "$out" > "target/$name.log"
-  compare "$name" "target/$name.log"
+  local sum shown sums want
+  sum=$(sed -n 's/^compact checksum //p' <<<"$out")
+  [ -n "$sum" ] && [ "$sum" = "$(host_value "$prefix" 'compact checksum')" ] \
+    || fail "$name: compact checksum '$sum', host: '$(host_value "$prefix" 'compact checksum')'"
+  sums=$(frame_sums "$out"); want=$(host_orbit "$prefix")
+  [ -n "$sums" ] && [ "$sums" = "$want" ] || fail "$name: orbit checksums '$sums', host: '$want'"
+  shown=$(sed -n 's/^rgb565 crc \(0x[0-9a-f]*\) .*/\1/p' <<<"$out")
+  [ "$shown" = "$(host_value "$prefix" 'compact rgb565 crc')" ] \
+    || fail "$name: the display was sent rgb565 crc '$shown', host: '$(host_value "$prefix" 'compact rgb565 crc')'"
+  local cmp_out psnr
+  cmp_out=$(compare "$name" "target/$name.log")
+  echo "$cmp_out"
+  psnr=$(sed -n 's/.*psnr_vs_float \([0-9.]*\) dB.*/\1/p' <<<"$cmp_out")
+  python3 -c "import sys; sys.exit(0 if float('$psnr') >= 40 else 1)" || fail "$name: PSNR $psnr dB < 40"
   python3 elf_check.py float-audit "$elf"
-
+  local statics stack flash
+  statics=$(field 'static RAM' "$out"); stack=$(field 'stack high-water' "$out"); flash=$(field flash "$out")
+  [ -n "$statics" ] && [ -n "$stack" ] && [ -n "$flash" ] || fail "$name: missing figures"
+  [ $((statics + stack)) -le "$ram" ] || fail "$name: static RAM $statics + stack $stack > $ram"
   echo "== $name stack bound"
-  RUSTC_BOOTSTRAP=1 RUSTFLAGS="-Z emit-stack-sizes ${LINK[*]}" \
-    cargo build -q --release -p footprint-firmware --target "$target" --target-dir target/stack
-  # The render's worst case plus the frames of its callers from the reset handler (main's own
-  # printing goes through core::fmt's indirect calls and is not bounded; it runs after the
-  # high-water mark is taken).
-  bound_out=$(python3 elf_check.py stack-bound "target/stack/$target/release/footprint-firmware" \
-    "__stext>main>___cortex_m_rt_main>footprint_firmware6render" "$STACK_BUDGET")
-  echo "$bound_out"
-  bound=$(sed -n 's/^stack-bound: worst case from [^:]*: \([0-9]*\) bytes.*/\1/p' <<<"$bound_out")
-  used=$(sed -n 's/^stack high-water \([0-9]*\) bytes/\1/p' <<<"$out")
-  [ -n "$bound" ] && [ -n "$used" ] || fail "$name: no stack figures"
-  [ "$used" -le "$bound" ] || fail "$name: painted stack $used exceeds the computed bound $bound"
+  stack_bound "$target" "target/stack-$name" "$features"
+  [ -n "$bound" ] && [ "$stack" -le "$bound" ] || fail "$name: painted stack $stack exceeds the computed bound $bound"
+  local ins
+  ins=$(frame_instr "$out")
+  echo "$name compact: orbit instructions/frame $ins; static RAM $statics + stack $stack (bound $bound) of $ram B; flash $flash B; checksum $sum; psnr_vs_float $psnr dB" >>"$report"
+}
 
-  echo "== $name float"
-  cargo build -q --release -p footprint-firmware --features float --target "$target" --target-dir target/float
-  fout=$(run "$machine" "$cpu" "target/float/$target/release/footprint-firmware")
-  grep -v '^row ' <<<"$fout"
-  echo "$name fixed: stack $used (bound $bound), static RAM $(field 'static RAM' "$out"), flash $(field flash "$out"), instructions/frame $(instr "$out")" >>"$report"
-  echo "$name float: stack $(field 'stack high-water' "$fout"), static RAM $(field 'static RAM' "$fout"), flash $(field flash "$fout"), instructions/frame $(instr "$fout")" >>"$report"
-done
-
-echo "== micro:bit fixed (thumbv6m-none-eabi on microbit: Cortex-M0, 16 KiB RAM)"
-cargo build -q --release -p footprint-firmware --target thumbv6m-none-eabi
-elf=target/thumbv6m-none-eabi/release/footprint-firmware
-out=$(run microbit - "$elf")
-grep -v '^row ' <<<"$out"
-printf '%s\n' "$out" > target/microbit.log
-sum=$(sed -n 's/^fixed checksum //p' <<<"$out")
-[ "$sum" = "$host_microbit" ] || fail "micro:bit: checksum '$sum', host: '$host_microbit'"
-shown=$(sed -n 's/^rgb565 crc \(0x[0-9a-f]*\) .*/\1/p' <<<"$out")
-[ "$shown" = "$host_rgb565_microbit" ] \
-  || fail "micro:bit: the display was sent rgb565 crc '$shown', host: '$host_rgb565_microbit'"
-ram=$(field 'static RAM' "$out"); stack=$(field 'stack high-water' "$out"); flash=$(field flash "$out")
-read -r w h < <(sed -n 's/^image \([0-9]*\) \([0-9]*\)$/\1 \2/p' <<<"$out")
-[ -n "$ram" ] && [ -n "$stack" ] && [ -n "$flash" ] && [ -n "$w" ] || fail "micro:bit: missing figures"
-cmp_out=$(compare microbit target/microbit.log)
-psnr=$(sed -n 's/.*psnr_vs_float \([0-9.]*\) dB.*/\1/p' <<<"$cmp_out")
-echo "microbit: image ${w}x${h}, ram $ram B, stack $stack B, flash $flash B, checksum $sum, psnr_vs_float $psnr dB"
-[ "$w" -ge 48 ] && [ "$h" -ge 48 ] || fail "micro:bit: image ${w}x${h} is smaller than 48x48"
-[ $((ram + stack)) -le 16384 ] || fail "micro:bit: static RAM $ram + stack $stack > 16384"
-python3 -c "import sys; sys.exit(0 if float('$psnr') >= 35 else 1)" || fail "micro:bit: PSNR $psnr dB < 35"
-# The README's pictures are these two: a change is a reviewed decision (copy them to docs/images).
+board M3 thumbv7m-none-eabi mps2-an385 cortex-m3 4194304 "" ""
+board M4F thumbv7em-none-eabihf mps2-an386 cortex-m4 4194304 "" ""
+board microbit thumbv6m-none-eabi microbit - 16384 "microbit " ""
+board STM32F100 thumbv7m-none-eabi stm32vldiscovery - 8192 "stm32 " "--features stm32f100"
+# The README's pictures are the micro:bit's: a change is a reviewed decision (copy them to
+# docs/images).
 for f in microbit host-float; do
   cmp -s "$images/microbit/$f.png" "../docs/images/microbit-$f.png" \
     || fail "docs/images/microbit-$f.png differs from $images/microbit/$f.png (copy it if intended)"
 done
-python3 elf_check.py float-audit "$elf"
-echo "== micro:bit stack bound"
-RUSTC_BOOTSTRAP=1 RUSTFLAGS="-Z emit-stack-sizes ${LINK[*]}" \
-  cargo build -q --release -p footprint-firmware --target thumbv6m-none-eabi --target-dir target/stack
-bound_out=$(python3 elf_check.py stack-bound "target/stack/thumbv6m-none-eabi/release/footprint-firmware" \
-  "__stext>main>___cortex_m_rt_main>footprint_firmware6render" "$STACK_BUDGET")
-echo "$bound_out"
-bound=$(sed -n 's/^stack-bound: worst case from [^:]*: \([0-9]*\) bytes.*/\1/p' <<<"$bound_out")
-[ -n "$bound" ] && [ "$stack" -le "$bound" ] || fail "micro:bit: painted stack $stack exceeds the computed bound $bound"
-echo "micro:bit fixed: stack $stack (bound $bound), static RAM $ram, flash $flash, instructions/frame $(instr "$out")" >>"$report"
-echo "== micro:bit float"
-cargo build -q --release -p footprint-firmware --features float --target thumbv6m-none-eabi --target-dir target/float
-fout=$(run microbit - "target/float/thumbv6m-none-eabi/release/footprint-firmware")
-grep -v '^row ' <<<"$fout"
-echo "micro:bit float: stack $(field 'stack high-water' "$fout"), static RAM $(field 'static RAM' "$fout"), flash $(field flash "$fout"), instructions/frame $(instr "$fout")" >>"$report"
+
+echo "== M3 Q24 fixed path (--features q24)"
+cargo build -q --release -p footprint-firmware --features q24 --target thumbv7m-none-eabi --target-dir target/q24
+out=$(run mps2-an385 cortex-m3 target/q24/thumbv7m-none-eabi/release/footprint-firmware)
+grep -v '^row ' <<<"$out"
+sum=$(grep '^fixed checksum' <<<"$out") || fail "Q24 printed no checksum"
+[ "$sum" = "$host_q24" ] || fail "Q24 on M3: '$sum', host: '$host_q24'"
+shown=$(sed -n 's/^rgb565 crc \(0x[0-9a-f]*\) .*/\1/p' <<<"$out")
+[ "$shown" = "$host_q24_rgb565" ] || fail "Q24 on M3: rgb565 crc '$shown', host: '$host_q24_rgb565'"
+printf '%s\n' "$out" > target/M3-q24.log
+compare M3-q24 target/M3-q24.log
+python3 elf_check.py float-audit target/q24/thumbv7m-none-eabi/release/footprint-firmware
+echo "M3 Q24 fixed: $sum (= host); static RAM $(field 'static RAM' "$out"), stack $(field 'stack high-water' "$out"), instructions/frame $(instr "$out")" >>"$report"
+
+for spec in "thumbv7m-none-eabi mps2-an385 cortex-m3 M3" "thumbv7em-none-eabihf mps2-an386 cortex-m4 M4F" "thumbv6m-none-eabi microbit - micro:bit"; do
+  read -r target machine cpu name <<<"$spec"
+  echo "== $name float"
+  cargo build -q --release -p footprint-firmware --features float --target "$target" --target-dir target/float
+  fout=$(run "$machine" "$cpu" "target/float/$target/release/footprint-firmware")
+  grep -v '^row ' <<<"$fout"
+  echo "$name float: stack $(field 'stack high-water' "$fout"), static RAM $(field 'static RAM' "$fout"), flash $(field flash "$fout"), instructions/frame $(instr "$fout")" >>"$report"
+done
 
 echo "== the audit catches a planted float (--cfg footprint_audit_plant)"
 RUSTFLAGS="--cfg footprint_audit_plant ${LINK[*]}" \

@@ -24,7 +24,7 @@ TOOLS = os.path.join(
     subprocess.run(["rustc", "--print", "sysroot"], capture_output=True, text=True, check=True).stdout.strip(),
     "lib", "rustlib", "x86_64-unknown-linux-gnu", "bin")
 
-FIXED_PATH = ("5fixed5splat5splat", "5fixed9composite")
+FIXED_PATH = ("5fixed5splat5splat", "5fixed9composite", "7compact15CompactStencils5splat", "7compact13composite_row")
 SOFT_FLOAT = re.compile(r"__aeabi_[fd]|__(add|sub|mul|div|neg)[sdt]f3|__(eq|ne|lt|le|gt|ge|unord|cmp)[sdt]f2"
                         r"|__(extend|trunc)[sdt]f|__fix(uns)?[sdt]f|__float(un)?[sdt]i[sdt]f|__powi[sdt]f2")
 VFP = re.compile(r"^v\S*\.(f32|f64)|^vmov\b.*\b[sd]\d+|^vldr|^vstr|^vpush|^vpop|^vcvt")

@@ -66,6 +66,7 @@
 //! fused multiply-add: Rust never contracts) and the software `libm`, so the same inputs give
 //! the same bytes on x86-64, Cortex-M4F and Cortex-M3, in debug and release.
 
+pub mod compact;
 pub mod composite;
 pub mod splat;
 pub mod stencil;

@@ -22,7 +22,30 @@ struct BandTest {
     reach: f32,
     top: f32,
     bottom: f32,
+    /// The row ranges in integers, where they fit: per row v the range of u is [lo + v·step,
+    /// hi + v·step] (Q32 voxels), so a row costs an integer multiply and no float (a core
+    /// without an FPU pays a library call per float operation).
+    fixed: Option<RowLine>,
 }
+
+/// The u range of sheet row v, [lo + v·step, hi + v·step], in Q32 voxels, lo widened down and
+/// hi up by [`ROW_MARGIN`] against the rounding of the float set-up and of the steps.
+#[derive(Clone, Copy)]
+struct RowLine {
+    lo: i64,
+    hi: i64,
+    step: i64,
+}
+
+/// Fraction bits of [`RowLine`].
+const ROW_FRAC: u32 = 32;
+/// Widening of each end of a [`RowLine`]: 2⁻⁸ voxel, far above the rounding (f32 set-up to
+/// within 2⁻²⁰ of the value for the |values| ≤ 2¹² it takes; Q32 steps, off by 2⁻³³ each, over
+/// at most 2¹⁶ rows).
+const ROW_MARGIN: i64 = 1 << (ROW_FRAC - 8);
+/// Largest |value| (voxels) a [`RowLine`] takes, and most rows: beyond, rows use floats.
+const ROW_LIMIT: f32 = 4096.0;
+const ROW_MAX_ROWS: usize = 1 << 16;
 
 impl BandReach {
     pub(super) fn new(f: &FrameSetup, band: (usize, usize), index: usize) -> Self {
@@ -33,16 +56,17 @@ impl BandReach {
         }
         let cols = f.grid_to_screen;
         let (ia, ib) = f.in_sheet;
-        BandReach {
-            test: Some(BandTest {
-                y_sheet: f.origin.y + cols.col(f.sheet_axis).y * index as f32,
-                ya: cols.col(ia).y,
-                yb: cols.col(ib).y,
-                reach: f.footprint.half_extent[1] + 2.0,
-                top: band.0 as f32,
-                bottom: (band.0 + band.1) as f32,
-            }),
-        }
+        let mut t = BandTest {
+            y_sheet: f.origin.y + cols.col(f.sheet_axis).y * index as f32,
+            ya: cols.col(ia).y,
+            yb: cols.col(ib).y,
+            reach: f.footprint.half_extent[1] + 2.0,
+            top: band.0 as f32,
+            bottom: (band.0 + band.1) as f32,
+            fixed: None,
+        };
+        t.fixed = t.line(f.sheet_shape().2);
+        BandReach { test: Some(t) }
     }
 
     /// The voxels `u` of sheet row `v` (of `na`) that may reach the band: a superset of those
@@ -52,6 +76,18 @@ impl BandReach {
         let Some(t) = &self.test else {
             return 0..na;
         };
+        if let Some(l) = t.fixed {
+            // |v·step| < 2¹⁶ · 2¹² · 2³² = 2⁶⁰ (checked in `line`).
+            let shift = v as i64 * l.step;
+            let (lo, hi) = (l.lo + shift, l.hi + shift);
+            let n = na as i64;
+            if hi < -(1i64 << ROW_FRAC) || lo > n << ROW_FRAC {
+                return 0..0;
+            }
+            let first = (lo.max(0) >> ROW_FRAC) as usize;
+            let last = ((hi.clamp(0, n << ROW_FRAC) >> ROW_FRAC) as usize + 2).min(na);
+            return first.saturating_sub(1)..last;
+        }
         let c = t.y_sheet + t.yb * v as f32;
         let (lo, hi) = (t.top - t.reach - c, t.bottom + t.reach - c);
         // c + ya·u must lie in [lo + c, hi + c], i.e. ya·u in [lo, hi].
@@ -75,6 +111,19 @@ impl BandReach {
         first.saturating_sub(1)..last
     }
 
+    /// Whether voxel `u` of row `v` (of `na` voxels) passes the float per-row test (the
+    /// reference `row`'s integer lines are checked against in the tests).
+    #[cfg(test)]
+    fn row_float(&self, v: usize, na: usize) -> core::ops::Range<usize> {
+        let Some(t) = &self.test else {
+            return 0..na;
+        };
+        let fixed = BandReach {
+            test: Some(BandTest { fixed: None, ..*t }),
+        };
+        fixed.row(v, na)
+    }
+
     pub(super) fn may_reach(&self, u: usize, v: usize) -> bool {
         match &self.test {
             None => true,
@@ -83,6 +132,38 @@ impl BandReach {
                 !(y + t.reach < t.top || y - t.reach > t.bottom)
             }
         }
+    }
+}
+
+impl BandTest {
+    /// The integer form of [`BandReach::row`] for sheets of `nb` rows, where every value fits
+    /// (see [`ROW_LIMIT`]); `None` keeps the float rows.
+    fn line(&self, nb: usize) -> Option<RowLine> {
+        let (lo, hi) = (
+            self.top - self.reach - self.y_sheet,
+            self.bottom + self.reach - self.y_sheet,
+        );
+        // A level row is all or nothing: the float branch handles it.
+        if !(math::abs(self.ya) > 1e-6) || nb > ROW_MAX_ROWS {
+            return None;
+        }
+        let (a, b) = (lo / self.ya, hi / self.ya);
+        let (a, b) = if a <= b { (a, b) } else { (b, a) };
+        let step = -self.yb / self.ya;
+        let fits = |x: f32| math::abs(x) <= ROW_LIMIT;
+        if !(fits(a) && fits(b) && fits(step)) {
+            return None;
+        }
+        let q = |x: f32| {
+            // Exact in two parts: the whole voxels, then the fraction (|x| ≤ 2¹²).
+            let whole = math::floor(x);
+            ((whole as i64) << ROW_FRAC) + ((x - whole) * (1u64 << ROW_FRAC) as f32) as i64
+        };
+        Some(RowLine {
+            lo: q(a) - ROW_MARGIN,
+            hi: q(b) + ROW_MARGIN,
+            step: q(step),
+        })
     }
 }
 
@@ -154,6 +235,13 @@ mod tests {
                     let r = BandReach::new(&f, band, s);
                     for v in 0..nb {
                         let range = r.row(v, na);
+                        // The integer rows hold the float rows' voxels.
+                        let float = r.row_float(v, na);
+                        assert!(
+                            float.is_empty()
+                                || (range.start <= float.start && range.end >= float.end),
+                            "view {a}, band {band:?}, sheet {s}, row {v}: {range:?} inside {float:?}"
+                        );
                         skipped += na - range.len();
                         for u in 0..na {
                             if r.may_reach(u, v) {

@@ -35,7 +35,7 @@ mod visible;
 pub use absorption::Absorption;
 pub use error::RenderError;
 pub use perspective::PerVoxel;
-pub use precision::{FixedPath, FloatPath, Precision, VoxelSplat};
+pub use precision::{CompactPath, FixedPath, FloatPath, Precision, VoxelSplat};
 pub use refined::{key_spacings, rate_index, spacing_key, RefineTables, RefinedGrid, SPACING_KEYS};
 pub use scaled::{sheet_map, splat_scaled, ScaledFootprint};
 pub use shade_cache::{ShadeCacheEntry, SHADE_CACHE_LEN};

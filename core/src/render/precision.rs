@@ -5,6 +5,7 @@
 use super::absorption::{extinction_layer, Absorption};
 use super::RenderError;
 use crate::composite::{clamp_unit, over};
+use crate::fixed::compact::{self, CompactPlacement, CompactStencils};
 use crate::fixed::stencil::FixedStencils;
 use crate::fixed::{self, FixedError, FixedTable, Placement};
 use crate::frame::{FrameSetup, Order};
@@ -348,5 +349,71 @@ impl<const M: usize> Precision for FixedPath<'_, M> {
 
     fn over_row(&self, front: &mut [[u32; 4]], back: &[[u32; 4]]) {
         fixed::composite::over_row(front, back);
+    }
+}
+
+/// Compact fixed-point accumulation for small cores ([`crate::fixed::compact`]): Q15 values and
+/// image, `i32` accumulator, Q16 placement and one phase stencil per voxel; every per-voxel and
+/// per-pixel operation a 32-bit integer one.
+#[derive(Clone, Copy, Debug)]
+pub struct CompactPath<'a> {
+    stencils: CompactStencils<'a>,
+    place: CompactPlacement,
+}
+
+impl<'a> CompactPath<'a> {
+    /// The compact path for `frame` through `stencils` (built for this frame). Refused for a
+    /// perspective frame and when the volume lands outside the Q16 screen range.
+    pub fn new(
+        frame: &FrameSetup,
+        stencils: CompactStencils<'a>,
+    ) -> Result<Self, compact::CompactError> {
+        Ok(CompactPath {
+            stencils,
+            place: CompactPlacement::new(frame)?,
+        })
+    }
+}
+
+impl Precision for CompactPath<'_> {
+    type Value = [u16; 4];
+    type Acc = [i32; 4];
+    type Pixel = [u16; 4];
+    const ACC_ZERO: [i32; 4] = [0; 4];
+    const CLEAR: [u16; 4] = [0; 4];
+
+    #[inline]
+    fn value(&self, rgba: [f32; 4]) -> [u16; 4] {
+        compact::quantise_value(rgba)
+    }
+
+    #[inline]
+    fn is_transparent(value: &[u16; 4]) -> bool {
+        value[3] == 0
+    }
+
+    #[inline]
+    fn splat(
+        &self,
+        _: &FrameSetup,
+        sheet: usize,
+        (u, v): (usize, usize),
+        row0: usize,
+        value: &[u16; 4],
+        acc: &mut ImageMut<'_, [i32; 4]>,
+        touched: impl FnMut(usize, usize, usize),
+    ) -> Result<SplatStats, RenderError> {
+        let mut center = self.place.at(sheet, u, v);
+        // row0 < 2¹⁴ (the image size was checked at set-up).
+        center[1] -= (row0 as i32) << compact::POS_FRAC;
+        Ok(self.stencils.splat(center, value, acc, touched))
+    }
+
+    fn composite_row(&self, acc: &mut [[i32; 4]], image: &mut [[u16; 4]], order: Order) {
+        compact::composite_row(acc, image, self.stencils.frac_bits(), order);
+    }
+
+    fn over_row(&self, front: &mut [[u16; 4]], back: &[[u16; 4]]) {
+        compact::over_row(front, back);
     }
 }

@@ -1,20 +1,26 @@
 //! The embedded demo scene ([`footprint_scene`]) on a Cortex-M under QEMU, every buffer `static`,
-//! no heap. Renders band by band (the volume streamed once per band), prints each finished band,
-//! then its figures, over semihosting, and exits with the render's status:
+//! no heap. Renders an orbit of [`FRAMES`] frames (the view turned
+//! [`footprint_scene::ORBIT_STEP_DEG`] each frame) on the compact fixed path, band by band (the
+//! volume streamed once per band), printing the first frame's bands, then each frame's figures,
+//! over semihosting, and exits with the render's status:
 //!
 //! ```text
 //! image W H
-//! row Y RRRRRRRRGGGGGGGGBBBBBBBBAAAAAAAA…   (W pixels, Q24 hex; one line per row)
-//! fixed checksum 0x…      (equal to `footprint-scene-host`'s, bit for bit)
-//! rgb565 crc 0x… (N pixels …)   the rows a display was sent (equal to the host's)
+//! row Y RRRRRRRRGGGGGGGGBBBBBBBBAAAAAAAA…   (frame 0: W pixels, Q24 hex; one line per row)
+//! frame K checksum 0x… instructions N       (per orbit frame; checksums equal to the host's)
+//! compact checksum 0x…    (frame 0; equal to `footprint-scene-host`'s, bit for bit)
+//! rgb565 crc 0x… (N pixels …)   frame 0's rows as a display was sent them (equal to the host's)
 //! stack high-water N bytes (painted stack)
 //! static RAM N bytes (.data + .bss)
 //! flash N bytes (.text + .rodata + .data image)
 //! ```
 //!
-//! The board follows the target: Cortex-M0 (`thumbv6m-none-eabi`) is the BBC micro:bit (16 KiB
-//! of RAM: a 48×48 image in bands of [`BAND`] rows), anything else QEMU's MPS2 boards (64×64).
-//! Build with `--features float` for the float path instead (its checksum is informational).
+//! The board follows the target and features: Cortex-M0 (`thumbv6m-none-eabi`) is the BBC
+//! micro:bit (16 KiB of RAM: 48×48 in bands of [`BAND`] rows); `--features stm32f100` the
+//! STM32VLDISCOVERY's STM32F100 (Cortex-M3, 8 KiB of RAM: 32×32); anything else QEMU's MPS2
+//! boards (64×64, one band). Build with `--features q24` for the Q24 fixed path (one frame,
+//! bit-exact with the host's `footprint render --fixed`), or `--features float` for the float
+//! path (its checksum is informational).
 #![no_std]
 #![no_main]
 
@@ -24,23 +30,49 @@ use cortex_m::peripheral::{syst::SystClkSource, SYST};
 use cortex_m_rt::{entry, exception};
 use cortex_m_semihosting::{debug, hio, hprintln};
 use footprint::composite::RowSpan;
-use footprint_scene::display::{send_band, CrcDisplay};
-use footprint_scene::N;
+#[cfg(any(feature = "q24", feature = "float"))]
+use footprint_scene::display::send_band;
+#[cfg(not(any(feature = "q24", feature = "float")))]
+use footprint_scene::display::send_band_q15;
+use footprint_scene::display::CrcDisplay;
 
 /// Image side, pixels.
 #[cfg(microbit)]
 const SIDE: usize = footprint_scene::SIDE_MICROBIT;
 /// Image side, pixels.
-#[cfg(not(microbit))]
+#[cfg(stm32f100)]
+const SIDE: usize = footprint_scene::SIDE_STM32;
+/// Image side, pixels.
+#[cfg(not(any(microbit, stm32f100)))]
 const SIDE: usize = footprint_scene::SIDE;
-/// Rows per band: the accumulator and working image hold this many rows.
-#[cfg(microbit)]
+/// Rows per band: the accumulator and working image hold this many rows (as many as the
+/// board's RAM leaves: README "Embedding").
+#[cfg(all(microbit, not(any(feature = "q24", feature = "float"))))]
+const BAND: usize = 5;
+/// Rows per band (the Q24 and float paths' wider pixels on the micro:bit).
+#[cfg(all(microbit, any(feature = "q24", feature = "float")))]
 const BAND: usize = 2;
-/// Rows per band: the accumulator and working image hold this many rows.
-#[cfg(not(microbit))]
-const BAND: usize = 8;
+/// Rows per band.
+#[cfg(stm32f100)]
+const BAND: usize = 3;
+/// Rows per band: the whole image on the 4 MiB MPS2 boards.
+#[cfg(not(any(microbit, stm32f100)))]
+const BAND: usize = SIDE;
+/// Frames of the orbit (the Q24 and float paths render one).
+#[cfg(not(any(feature = "q24", feature = "float")))]
+const FRAMES: usize = 4;
+/// Frames of the orbit (the Q24 and float paths render one).
+#[cfg(any(feature = "q24", feature = "float"))]
+const FRAMES: usize = 1;
 /// Pixels in a band.
 const BAND_PIXELS: usize = BAND * SIDE;
+
+/// Where the board's flash starts (its memory map's FLASH origin).
+#[cfg(stm32f100)]
+const FLASH_ORIGIN: usize = 0x0800_0000;
+/// Where the board's flash starts (its memory map's FLASH origin).
+#[cfg(not(stm32f100))]
+const FLASH_ORIGIN: usize = 0;
 
 /// The word the unused stack is painted with.
 const PAINT: u32 = 0xC0DE_F00D;
@@ -69,50 +101,83 @@ fn main() -> ! {
     };
     hprintln!("image {} {}", SIDE, SIDE);
     paint_stack(free_start);
-    let t0 = ticks();
-    let result = render();
-    let frame_ticks = ticks() - t0 - u64::from(EMIT_TICKS.load(Relaxed));
+    // Each frame's checksum and ticks, printed after the stack's high-water mark is taken
+    // (core::fmt's stack is not part of the render's bound).
+    let mut frames = [(0u32, 0u64); FRAMES];
+    let mut first = None;
+    let mut failed = None;
+    for (step, out) in frames.iter_mut().enumerate() {
+        EMIT_TICKS.store(0, Relaxed);
+        let t0 = ticks();
+        let result = render(step);
+        let spent = ticks() - t0 - u64::from(EMIT_TICKS.load(Relaxed));
+        match result {
+            Ok(r) => {
+                *out = (r.0.checksum, spent);
+                first.get_or_insert(r);
+            }
+            Err(e) => {
+                failed = Some(e);
+                break;
+            }
+        }
+    }
     let high_water = stack_high_water(free_start);
     let (data_start, data_end) = (
         core::ptr::addr_of_mut!(__sdata) as usize,
         core::ptr::addr_of_mut!(__edata) as usize,
     );
     let data_load = core::ptr::addr_of!(__sidata) as usize;
-    let ok = match result {
-        Ok((report, (display_crc, drawn))) => {
-            hprintln!("{} checksum 0x{:08x}", PATH, report.checksum);
-            hprintln!(
-                "rgb565 crc 0x{:08x} ({} pixels through the embedded-graphics adaptor)",
-                display_crc,
-                drawn
-            );
-            hprintln!(
-                "scene: {}x{} in {} bands of {} rows, {} sheets, {} voxels splatted, {} pixel updates",
-                SIDE,
-                SIDE,
-                report.bands,
-                BAND,
-                report.stats.sheets,
-                report.stats.voxels_splatted,
-                report.stats.pixel_updates
-            );
-            true
+    if let Some(e) = failed {
+        hprintln!("render failed: {}", e);
+    }
+    for (step, &(checksum, spent)) in frames.iter().enumerate() {
+        match instructions(spent, calibration) {
+            Some(n) => hprintln!(
+                "frame {} checksum 0x{:08x} instructions {}",
+                step,
+                checksum,
+                n
+            ),
+            None => hprintln!(
+                "frame {} checksum 0x{:08x} instructions unknown",
+                step,
+                checksum
+            ),
         }
-        Err(e) => {
-            hprintln!("render failed: {}", e);
-            false
-        }
-    };
-    match instructions(frame_ticks, calibration) {
+    }
+    let ok = failed.is_none();
+    if let Some((report, (display_crc, drawn))) = first {
+        hprintln!("{} checksum 0x{:08x}", PATH, report.checksum);
+        hprintln!(
+            "rgb565 crc 0x{:08x} ({} pixels through the embedded-graphics adaptor)",
+            display_crc,
+            drawn
+        );
+        hprintln!(
+            "scene: {}x{} in {} bands of {} rows, {} sheets, {} voxels splatted, {} pixel updates",
+            SIDE,
+            SIDE,
+            report.bands,
+            BAND,
+            report.stats.sheets,
+            report.stats.voxels_splatted,
+            report.stats.pixel_updates
+        );
+    }
+    match instructions(frames[0].1, calibration) {
         Some(n) => hprintln!(
-            "frame instructions {} (the rows sent to the display included, printing the image excluded)",
+            "frame instructions {} (frame 0, with the view-independent set-up; the rows sent to the display included, printing the image excluded)",
             n
         ),
         None => hprintln!("frame instructions unknown (no clock: run QEMU with -icount)"),
     }
     hprintln!("stack high-water {} bytes", high_water);
     hprintln!("static RAM {} bytes", free_start - data_start);
-    hprintln!("flash {} bytes", data_load + (data_end - data_start));
+    hprintln!(
+        "flash {} bytes",
+        data_load - FLASH_ORIGIN + (data_end - data_start)
+    );
     debug::exit(if ok {
         debug::EXIT_SUCCESS
     } else {
@@ -124,7 +189,9 @@ fn main() -> ! {
     }
 }
 
-#[cfg(not(feature = "float"))]
+#[cfg(not(any(feature = "q24", feature = "float")))]
+const PATH: &str = "compact";
+#[cfg(feature = "q24")]
 const PATH: &str = "fixed";
 #[cfg(feature = "float")]
 const PATH: &str = "float";
@@ -224,12 +291,64 @@ fn print_rows(first: usize, pixels: &[[u32; 4]]) {
     }
 }
 
-/// The fixed-point render, from `static` buffers.
-#[cfg(not(feature = "float"))]
+/// The compact fixed-point render of orbit frame `step`, from `static` buffers; the shading table
+/// (view-independent) is built by the first frame and reused. Frame 0's rows are printed.
+#[cfg(not(any(feature = "q24", feature = "float")))]
 #[inline(never)]
-fn render() -> Result<(footprint_scene::Report, (u32, usize)), footprint::Error> {
+fn render(step: usize) -> Result<(footprint_scene::Report, (u32, usize)), footprint::Error> {
+    const STENCILS: usize = footprint_scene::compact_stencil_len(SIDE);
+    static mut STENCIL: [i16; STENCILS] = [0; STENCILS];
+    static mut LUT: [[u16; 4]; 256] = [[0; 4]; 256];
+    static mut ACC: [[i32; 4]; BAND_PIXELS] = [[0; 4]; BAND_PIXELS];
+    static mut IMAGE: [[u16; 4]; BAND_PIXELS] = [[0; 4]; BAND_PIXELS];
+    static mut ROWS: [RowSpan; BAND] = [RowSpan::EMPTY; BAND];
+    // SAFETY: `render` is called from `main` only, one frame after another, with no interrupts
+    // that touch these: each `static mut` is borrowed mutably once per call, and every borrow
+    // ends when the call returns.
+    let (lut, b) = unsafe {
+        (
+            &mut *core::ptr::addr_of_mut!(LUT),
+            footprint_scene::CompactBuffers {
+                stencils: &mut *core::ptr::addr_of_mut!(STENCIL),
+                acc: &mut *core::ptr::addr_of_mut!(ACC),
+                image: &mut *core::ptr::addr_of_mut!(IMAGE),
+                rows: &mut *core::ptr::addr_of_mut!(ROWS),
+            },
+        )
+    };
+    if step == 0 {
+        footprint_scene::compact_lut(lut)?;
+    }
+    let mut display = CrcDisplay::new(SIDE);
+    let mut row = [0u16; SIDE];
+    let report = footprint_scene::render_compact(SIDE, step, lut, b, |first, px| {
+        if step == 0 {
+            emit_q15(first, px);
+        }
+        // Whole rows of SIDE pixels into a row of SIDE: cannot fail.
+        let _ = send_band_q15(first, SIDE, px, &mut row, &mut display);
+    })?;
+    Ok((report, display.finish()))
+}
+
+/// Prints Q15 band rows as Q24 (exact: a shift), a row at a time.
+#[cfg(not(any(feature = "q24", feature = "float")))]
+fn emit_q15(first: usize, pixels: &[[u16; 4]]) {
+    for (r, row) in pixels.chunks(SIDE).enumerate() {
+        let mut q = [[0u32; 4]; SIDE];
+        for (o, &p) in q.iter_mut().zip(row) {
+            *o = footprint::fixed::compact::to_q24(p);
+        }
+        emit(first + r, &q);
+    }
+}
+
+/// The Q24 fixed-point render, from `static` buffers (one frame).
+#[cfg(feature = "q24")]
+#[inline(never)]
+fn render(_step: usize) -> Result<(footprint_scene::Report, (u32, usize)), footprint::Error> {
     use footprint::fixed::FixedTable;
-    static mut TABLE: FixedTable<N> = FixedTable::zeroed();
+    static mut TABLE: FixedTable<{ footprint_scene::N }> = FixedTable::zeroed();
     static mut LUT: [[u32; 4]; 256] = [[0; 4]; 256];
     static mut ACC: [[i64; 4]; BAND_PIXELS] = [[0; 4]; BAND_PIXELS];
     static mut IMAGE: [[u32; 4]; BAND_PIXELS] = [[0; 4]; BAND_PIXELS];
@@ -255,12 +374,13 @@ fn render() -> Result<(footprint_scene::Report, (u32, usize)), footprint::Error>
     Ok((report, display.finish()))
 }
 
-/// The float render, from `static` buffers.
+/// The float render, from `static` buffers (one frame).
 #[cfg(feature = "float")]
 #[inline(never)]
-fn render() -> Result<(footprint_scene::Report, (u32, usize)), footprint::Error> {
+fn render(_step: usize) -> Result<(footprint_scene::Report, (u32, usize)), footprint::Error> {
     use footprint::ViewTable;
-    static mut TABLE: ViewTable<N> = ViewTable::zeroed(footprint::Footprint::EMPTY);
+    static mut TABLE: ViewTable<{ footprint_scene::N }> =
+        ViewTable::zeroed(footprint::Footprint::EMPTY);
     static mut ACC: [[f32; 4]; BAND_PIXELS] = [[0.0; 4]; BAND_PIXELS];
     static mut IMAGE: [[f32; 4]; BAND_PIXELS] = [[0.0; 4]; BAND_PIXELS];
     static mut ROWS: [RowSpan; BAND] = [RowSpan::EMPTY; BAND];

@@ -2,7 +2,8 @@
 //! its checksums, so CI can compare them (`fixed checksum 0x…` must match bit for bit).
 //!
 //! ```text
-//! footprint-scene-host [--threads N]     checksums: 64×64 (MPS2 boards), 48×48 (micro:bit)
+//! footprint-scene-host [--threads N]     checksums: 64×64 (MPS2 boards), 48×48 (micro:bit),
+//!                                        32×32 (STM32F100, compact only), and each orbit
 //! footprint-scene-host compare LOG DIR   the firmware's image (from its printed LOG) against
 //!                                        the host's float render: PNGs in DIR and the PSNR
 //! ```
@@ -14,9 +15,13 @@
 use footprint::composite::RowSpan;
 use footprint::fixed::FixedTable;
 use footprint::ViewTable;
-use footprint_scene::display::{send_band, CrcDisplay};
+use footprint_scene::display::{send_band, send_band_q15, CrcDisplay};
+use footprint_scene::{compact_lut, compact_stencil_len, render_compact, CompactBuffers};
 use footprint_scene::{render_fixed, render_float, FixedBuffers, FloatBuffers, Report};
-use footprint_scene::{SIDE, SIDE_MICROBIT};
+use footprint_scene::{SIDE, SIDE_MICROBIT, SIDE_STM32};
+
+/// Frames of the firmware's orbit (its `FRAMES`).
+const ORBIT_FRAMES: usize = 4;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
@@ -76,6 +81,48 @@ fn checksums(threads: usize) -> Result<(), String> {
         fixed_image(SIDE_MICROBIT, SIDE_MICROBIT)?.0.checksum
     );
     println!("float checksum 0x{:08x} (informational)", float.checksum);
+    // The compact path (what the firmware renders by default): each board's size, whole and
+    // in bands, and its orbit.
+    for (name, side) in [
+        ("", SIDE),
+        ("microbit ", SIDE_MICROBIT),
+        ("stm32 ", SIDE_STM32),
+    ] {
+        let (r, img) = compact_image(side, side, 0)?;
+        for band in [1, 2, 5] {
+            let banded = compact_image(side, band, 0)?.0.checksum;
+            if banded != r.checksum {
+                return Err(format!(
+                    "compact {side}x{side}: bands of {band} rows give 0x{banded:08x}, the whole image 0x{:08x}",
+                    r.checksum
+                ));
+            }
+        }
+        let (_, float) = float_image(side, side)?;
+        let q: Vec<[f32; 4]> = img
+            .iter()
+            .map(|&p| footprint::fixed::compact::to_f32(p))
+            .collect();
+        println!(
+            "{name}compact checksum 0x{:08x} ({side}x{side}, {} pixel updates, psnr_vs_float {:.2} dB)",
+            r.checksum,
+            r.stats.pixel_updates,
+            psnr(&q, &float)
+        );
+        let orbit = (0..ORBIT_FRAMES)
+            .map(|step| {
+                compact_image(side, side, step).map(|(r, _)| format!("0x{:08x}", r.checksum))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        println!("{name}orbit checksums {}", orbit.join(" "));
+        let mut display = CrcDisplay::new(side);
+        send_band_q15(0, side, &img, &mut vec![0; side], &mut display)
+            .map_err(|e| format!("rows to the display: {e}"))?;
+        let (crc, drawn) = display.finish();
+        println!(
+            "{name}compact rgb565 crc 0x{crc:08x} ({drawn} pixels through the embedded-graphics adaptor)"
+        );
+    }
     for (name, side) in [("", SIDE), ("microbit ", SIDE_MICROBIT)] {
         // The whole image as one band through the same adaptor the firmware sends its bands
         // through: bands change neither the rows nor their order.
@@ -109,6 +156,44 @@ fn fixed_image(side: usize, band: usize) -> Result<(Report, Vec<[u32; 4]>), Stri
     )
     .map_err(|e| format!("fixed render failed: {e}"))?;
     Ok((report, image))
+}
+
+/// The compact render of orbit frame `step` at `side`² in bands of `band` rows: its report and
+/// image (Q15 premultiplied RGBA, row-major).
+fn compact_image(side: usize, band: usize, step: usize) -> Result<(Report, Vec<[u16; 4]>), String> {
+    let band = band.min(side);
+    let mut lut = Box::new([[0u16; 4]; 256]);
+    compact_lut(&mut lut).map_err(|e| format!("compact shading table: {e}"))?;
+    let mut image = vec![[0u16; 4]; side * side];
+    let report = render_compact(
+        side,
+        step,
+        &lut,
+        CompactBuffers {
+            stencils: &mut vec![0; compact_stencil_len(side)],
+            acc: &mut vec![[0; 4]; band * side],
+            image: &mut vec![[0; 4]; band * side],
+            rows: &mut vec![RowSpan::EMPTY; band],
+        },
+        |first, px| image[first * side..first * side + px.len()].copy_from_slice(px),
+    )
+    .map_err(|e| format!("compact render failed: {e}"))?;
+    Ok((report, image))
+}
+
+/// PSNR (dB, RGB, peak 1) of `a` against `b`.
+fn psnr(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
+    let mse = a
+        .iter()
+        .zip(b)
+        .flat_map(|(x, y)| (0..3).map(move |c| f64::from(x[c] - y[c]).powi(2)))
+        .sum::<f64>()
+        / (3 * a.len()) as f64;
+    if mse > 0.0 {
+        10.0 * (1.0 / mse).log10()
+    } else {
+        f64::INFINITY
+    }
 }
 
 /// The float render at `side`² in bands of `band` rows: its report and image.
@@ -200,12 +285,29 @@ fn write_png(path: &std::path::Path, side: usize, rgb: &[[f64; 3]]) -> Result<()
 fn compare(log: &str, dir: &str) -> Result<(), String> {
     let text = std::fs::read_to_string(log).map_err(|e| format!("{log}: {e}"))?;
     let (side, target) = parse_dump(&text)?;
-    let crc = footprint::fixed::checksum(&target);
-    let (host, _) = fixed_image(side, side)?;
-    if crc != host.checksum {
+    // A compact firmware printed Q15 widened to Q24: its CRC is over the Q15 image.
+    let compact = text.lines().any(|l| l.starts_with("compact checksum"));
+    let (crc, host) = if compact {
+        let q15 = target
+            .iter()
+            .map(|p| {
+                let q = p.map(|c| (c >> 9) as u16);
+                (footprint::fixed::compact::to_q24(q) == *p)
+                    .then_some(q)
+                    .ok_or("a compact image pixel that is not Q15")
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let crc = footprint::fixed::compact::checksum(&q15);
+        (crc, compact_image(side, side, 0)?.0.checksum)
+    } else {
+        (
+            footprint::fixed::checksum(&target),
+            fixed_image(side, side)?.0.checksum,
+        )
+    };
+    if crc != host {
         return Err(format!(
-            "the printed image's CRC 0x{crc:08x} is not the host's fixed checksum 0x{:08x}",
-            host.checksum
+            "the printed image's CRC 0x{crc:08x} is not the host's checksum 0x{host:08x}"
         ));
     }
     let (_, float) = float_image(side, side)?;
@@ -231,6 +333,7 @@ fn compare(log: &str, dir: &str) -> Result<(), String> {
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     write_png(&dir.join("microbit.png"), side, &target_rgb)?;
     write_png(&dir.join("host-float.png"), side, &float_rgb)?;
-    println!("image {side}x{side}, crc 0x{crc:08x} (= host fixed), psnr_vs_float {psnr:.2} dB");
+    let path = if compact { "compact" } else { "fixed" };
+    println!("image {side}x{side}, crc 0x{crc:08x} (= host {path}), psnr_vs_float {psnr:.2} dB");
     Ok(())
 }

@@ -74,3 +74,17 @@ pub fn send_band(
     let mut sink = DisplaySink::new(display, Point::zero());
     band_rows(first, width, band, rgb565_q24, row, &mut sink)
 }
+
+/// [`send_band`] for a compact (Q15) band: each pixel widened to Q24 (exact) and encoded as
+/// [`send_band`] encodes it, so equal images send equal rows.
+pub fn send_band_q15(
+    first: usize,
+    width: usize,
+    band: &[[u16; 4]],
+    row: &mut [u16],
+    display: &mut CrcDisplay,
+) -> Result<(), RowError<Infallible>> {
+    let mut sink = DisplaySink::new(display, Point::zero());
+    let encode = |p: [u16; 4]| rgb565_q24(footprint::fixed::compact::to_q24(p));
+    band_rows(first, width, band, encode, row, &mut sink)
+}

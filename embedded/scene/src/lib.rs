@@ -19,12 +19,16 @@
 #![forbid(unsafe_code)]
 
 use footprint::composite::RowSpan;
+use footprint::fixed::compact::{self, CompactError, CompactStencils};
 use footprint::fixed::{self, FixedTable};
 use footprint::frame::{FrameSetup, Order};
 use footprint::geometry::FootprintOptions;
 use footprint::math;
-use footprint::render::{FixedPath, Precision, RenderBuffers, RenderStats, SheetRenderer};
+use footprint::render::{
+    CompactPath, FixedPath, Precision, RenderBuffers, RenderStats, SheetRenderer,
+};
 use footprint::shade::{Lighting, Shader, Shading, TransferFunction};
+use footprint::splat::Direct;
 use footprint::table::Crc32;
 use footprint::{GenericTable, Grid, Kernel, Lookup, View, ViewTable};
 use glam::{Mat3, Vec3};
@@ -37,6 +41,8 @@ pub const DIM: usize = 32;
 pub const SIDE: usize = 64;
 /// Image width and height on the micro:bit (16 KiB of RAM), pixels.
 pub const SIDE_MICROBIT: usize = 48;
+/// Image width and height on the STM32F100 (8 KiB of RAM), pixels.
+pub const SIDE_STM32: usize = 32;
 /// Generic and view table size (N×N nodes).
 pub const N: usize = 33;
 
@@ -65,16 +71,33 @@ pub fn sample(i: usize, j: usize, k: usize) -> u8 {
     if (700..900).contains(&r2) {
         (150 + ((i + 2 * j + 3 * k) % 16) * 6) as u8
     } else if r2 < 400 {
-        (255 - r2 * 200 / 400) as u8
+        // 255 − ⌊r2 · 200 / 400⌋, written as the shift it is (a Cortex-M0 has no divider).
+        (255 - r2 / 2) as u8
     } else {
         0
     }
 }
 
+/// Degrees the orbit turns the view (about the vertical axis) from one frame to the next.
+pub const ORBIT_STEP_DEG: f32 = 5.0;
+
 /// The view: V = zoom · Rx(20°) · Ry(30°) from the core's own `sin`/`cos` (the same bits on
 /// every target).
 pub fn view_matrix() -> Mat3 {
-    let (az, el, zoom) = (30.0f32.to_radians(), 20.0f32.to_radians(), 1.3f32);
+    view_matrix_at(SIDE, 0)
+}
+
+/// The view of orbit frame `step` at `side`² pixels: V = zoom · Rx(20°) · Ry(30° + step ·
+/// [`ORBIT_STEP_DEG`]), zoom 1.3 px per voxel from 48² up (the volume fits), scaled down with
+/// the image below that (32² on the 8 KiB board).
+pub fn view_matrix_at(side: usize, step: usize) -> Mat3 {
+    let turn = ORBIT_STEP_DEG * step as f32;
+    let zoom = if side >= SIDE_MICROBIT {
+        1.3f32
+    } else {
+        1.3 * side as f32 / SIDE_MICROBIT as f32
+    };
+    let (az, el) = ((30.0f32 + turn).to_radians(), 20.0f32.to_radians());
     let (sa, ca, se, ce) = (math::sin(az), math::cos(az), math::sin(el), math::cos(el));
     let ry = Mat3::from_cols(
         Vec3::new(ca, 0.0, -sa),
@@ -91,10 +114,15 @@ pub fn view_matrix() -> Mat3 {
 
 /// The frame of the scene at `side`×`side` pixels.
 pub fn frame(side: usize) -> Result<FrameSetup, footprint::Error> {
+    frame_at(side, 0)
+}
+
+/// The frame of orbit frame `step` at `side`×`side` pixels ([`view_matrix_at`]).
+pub fn frame_at(side: usize, step: usize) -> Result<FrameSetup, footprint::Error> {
     Ok(FrameSetup::new(
         [DIM; 3],
         &Grid::from_spacing([1.0; 3])?,
-        &View::new(view_matrix())?,
+        &View::new(view_matrix_at(side, step))?,
         &Kernel::PAPER_GAUSSIAN,
         FootprintOptions::default(),
         [side; 2],
@@ -267,4 +295,91 @@ pub fn render_float(
     render_bands(&f, path, shader, buffers, shade, emit, |c: f32, crc| {
         crc.update(&c.to_bits().to_le_bytes())
     })
+}
+
+/// Phases per pixel axis of the compact path's stencils at `side`²: 8 (a voxel moves at most
+/// 1/16 px), 4 below 48² (the 8 KiB board's 32², where the stencils must stay small).
+pub const fn phases_for(side: usize) -> usize {
+    if side >= SIDE_MICROBIT {
+        8
+    } else {
+        4
+    }
+}
+
+/// `i16`s the compact stencils need at `side`² (for sizing a `static`; checked at run time).
+pub const fn compact_stencil_len(side: usize) -> usize {
+    // The footprint's box is 5×5 at 48² and 64² (half-extent 2.1 px), 4×4 at 32²: 31 or 21
+    // `i16`s per phase (see footprint::fixed::compact).
+    let per = if side >= SIDE_MICROBIT { 31 } else { 21 };
+    phases_for(side) * phases_for(side) * per
+}
+
+/// Every buffer of a compact render, borrowed (bands as in [`FixedBuffers`]).
+pub struct CompactBuffers<'a> {
+    /// The view's phase stencils ([`compact_stencil_len`]).
+    pub stencils: &'a mut [i16],
+    /// Sheet accumulator for one band; all zero at the start (left all zero).
+    pub acc: &'a mut [[i32; 4]],
+    /// Working image for one band (Q15 premultiplied RGBA).
+    pub image: &'a mut [[u16; 4]],
+    /// Touched span per band row; its length is the band height.
+    pub rows: &'a mut [RowSpan],
+}
+
+/// The view-independent part of a compact render: the shaded value per sample value, Q15
+/// premultiplied RGBA (emission shading does not depend on the view, so an orbit builds it
+/// once).
+pub fn compact_lut(lut: &mut [[u16; 4]; 256]) -> Result<(), footprint::Error> {
+    let f = frame(SIDE)?;
+    let (shader, lighting) = (shader(), Lighting::new(&f));
+    for (v, entry) in lut.iter_mut().enumerate() {
+        let rgba = shader.shade(&lighting, v as f32, || Vec3::ZERO, [0; 3], f.dims);
+        *entry = compact::quantise_value(rgba);
+    }
+    Ok(())
+}
+
+/// Renders orbit frame `step` of the scene at `side`×`side` on the compact fixed path
+/// ([`footprint::fixed::compact`]), band by band, each voxel shaded through `lut`
+/// ([`compact_lut`]), handing each finished band to `emit(first_row, pixels)` (Q15
+/// premultiplied RGBA). Per view it builds only the stencils and the placement.
+#[inline(never)]
+pub fn render_compact(
+    side: usize,
+    step: usize,
+    lut: &[[u16; 4]; 256],
+    b: CompactBuffers<'_>,
+    emit: impl FnMut(usize, &[[u16; 4]]),
+) -> Result<Report, footprint::Error> {
+    let f = frame_at(side, step)?;
+    let sampler = Direct {
+        footprint: f.footprint,
+        table: &GENERIC,
+        lookup: Lookup::Bilinear,
+    };
+    let stencils = CompactStencils::build(&f, &sampler, phases_for(side), b.stencils)
+        .map_err(compact_error)?;
+    let path = CompactPath::new(&f, stencils).map_err(compact_error)?;
+    let buffers = (&mut *b.acc, &mut *b.image, &mut *b.rows);
+    render_bands(
+        &f,
+        path,
+        shader(),
+        buffers,
+        |x| lut[usize::from(x)],
+        emit,
+        |c: u16, crc| crc.update(&c.to_le_bytes()),
+    )
+}
+
+/// A compact-path refusal as the core's error (a buffer or a fixed-point range).
+fn compact_error(e: CompactError) -> footprint::Error {
+    match e {
+        CompactError::Buffer(b) => footprint::Error::Buffer(b),
+        CompactError::Fixed(f) => footprint::Error::Fixed(f),
+        _ => footprint::Error::Fixed(footprint::fixed::FixedError::Range {
+            what: "compact stencils (footprint box or phases)",
+        }),
+    }
 }

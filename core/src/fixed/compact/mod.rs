@@ -1,0 +1,313 @@
+//! Compact fixed point: a 32-bit integer path for small cores (Cortex-M0/M3/M4 class), where the
+//! Q24 path's `i64` accumulators, per-pixel table walk and per-voxel renormalising division are
+//! library calls and long sequences. Every per-voxel and per-pixel operation here is a 32-bit
+//! add, shift or multiply (which every Cortex-M has in one instruction), and a voxel's weights
+//! are read from a precomputed phase stencil, not computed. No floating point at splat or
+//! composite time (denied below and audited on the boards); the per-view set-up
+//! ([`CompactStencils::build`], [`CompactPlacement::new`]) is float.
+//!
+//! # Formats
+//! | quantity | type | format | range |
+//! |---|---|---|---|
+//! | voxel value (premultiplied RGBA channel) | `u16` | Q15: v / 2¹⁵ | 0 … [`ONE`] (clamped) |
+//! | stencil weight = footprint weight × cell area | `i16` | Q*W*, W ≤ [`MAX_WEIGHT_FRAC`] chosen per view | \|w\| < 2¹⁵ |
+//! | sheet accumulator channel | `i32` | Q(15 + W) | saturates at ±2³¹ |
+//! | working-image channel | `u16` | Q15, [`ONE`] = opacity 1 | saturates at 2¹⁶ − 1 |
+//! | screen positions | `i32` | Q16 pixels | ±2¹⁴ px (checked at set-up) |
+//!
+//! # Why this headroom is enough
+//! A product value × weight is below 2¹⁵ · 2¹⁵ = 2³⁰. A sheet's weights at one pixel sum to its
+//! flat-field value, 2^W · (1 + ripple) with W ≤ 14 and ripple ≤ 0.1 for the shipped kernels
+//! (`tests/flat_field.rs`), so opacity-1 voxels accumulate to about 2²⁹: a 4-fold headroom below
+//! 2³¹. Past it adds saturate (never wrap); `tests/compact.rs` drives a pixel into saturation.
+//! Compositing multiplies a Q15 channel (≤ 2¹⁶) by a Q15 transparency (≤ 2¹⁵) in `u32`.
+//!
+//! # Phases
+//! A voxel at Q16 position c = (i + φx, j + φy) (i, j whole pixels, φ in [0, 1)) takes the
+//! stencil of phase (⌊φx·P⌋, ⌊φy·P⌋), sampled at the phase cell's centre ((k + ½)/P): the voxel
+//! moves by at most 1/(2P) px. Each stencil holds the weights of the pixels whose centres lie
+//! within the footprint's box around that centre, and per row the run of pixels it touches.
+//! A renormalised footprint (see [`crate::geometry::RENORMALISE_BELOW_PX`]) has each stencil
+//! scaled to sum to exactly round(cell area · 2^W), the rounding remainder put on its largest
+//! weight, so no voxel needs a division; a stencil no pixel centre falls in puts the whole cell
+//! on the pixel containing the voxel, as the float path does.
+//!
+//! # Memory
+//! P² stencils of 1 + By·(Bx + 1) `i16`s ([`len_for`]), Bx, By the box's width and height in
+//! pixels (⌊2e⌋ + 1 for half-extent e). The demo scene's (e = 2.1 px, P = 8): 64 × 31 × 2 B =
+//! 3 968 B.
+//!
+//! # Rounding
+//! As in [`super`]: every shift rounds to nearest (half an LSB added first); opacity 1 is 2¹⁵,
+//! a power of two, so a transparent sheet leaves the image bit-identical.
+#![deny(clippy::float_arithmetic, clippy::disallowed_types)]
+
+mod setup;
+
+pub use setup::{box_for, len_for, quantise_value, to_f32};
+
+use super::FixedError;
+use crate::frame::Order;
+use crate::splat::{BufferError, ImageMut, SplatStats};
+
+/// Fraction bits of values and of the working image.
+pub const FRAC: u32 = 15;
+/// Opacity 1 (and colour 1): 2¹⁵.
+pub const ONE: u16 = 1 << FRAC;
+/// Fraction bits of screen positions.
+pub const POS_FRAC: u32 = 16;
+/// The largest weight fraction W: keeps a flat field of opacity 1 at 2²⁹ (see the module docs).
+pub const MAX_WEIGHT_FRAC: u32 = 14;
+/// The widest box a stencil holds, pixels per side (footprints of half-extent below 4.5 px; the
+/// set-up keeps one box of weights on the stack, so this bounds its stack too).
+pub const MAX_SIDE: usize = 9;
+/// The most phases per pixel axis.
+pub const MAX_PHASES: usize = 64;
+/// The largest screen coordinate a voxel may land on, pixels (so Q16 sums stay in `i32`).
+pub const MAX_SCREEN_PX: i32 = 1 << 14;
+
+/// Why a compact path cannot serve a view.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum CompactError {
+    /// A position, step or weight outside its format, or a perspective frame.
+    Fixed(FixedError),
+    /// The footprint's box is wider than [`MAX_SIDE`] pixels (render it with the Q24 path).
+    Wide {
+        /// The box side it would need, pixels.
+        side: usize,
+    },
+    /// `phases` is 0 or above [`MAX_PHASES`].
+    Phases {
+        /// The phases asked for.
+        phases: usize,
+    },
+    /// The caller's stencil buffer is shorter than [`len_for`].
+    Buffer(BufferError),
+}
+
+impl core::fmt::Display for CompactError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::Fixed(e) => e.fmt(f),
+            Self::Wide { side } => write!(
+                f,
+                "the footprint needs a {side}-pixel box; compact stencils hold at most {MAX_SIDE}"
+            ),
+            Self::Phases { phases } => {
+                write!(
+                    f,
+                    "compact stencils need 1 to {MAX_PHASES} phases, got {phases}"
+                )
+            }
+            Self::Buffer(e) => e.fmt(f),
+        }
+    }
+}
+
+impl core::error::Error for CompactError {}
+
+impl From<FixedError> for CompactError {
+    fn from(e: FixedError) -> Self {
+        Self::Fixed(e)
+    }
+}
+
+pub(crate) fn stencil_len(bx: usize, by: usize) -> usize {
+    1 + by * (bx + 1)
+}
+
+/// One view's phase stencils in caller storage (see the module docs for the layout).
+#[derive(Clone, Copy, Debug)]
+pub struct CompactStencils<'a> {
+    data: &'a [i16],
+    phases: u32,
+    bx: usize,
+    by: usize,
+    stride: usize,
+    frac: u32,
+}
+
+impl<'a> CompactStencils<'a> {
+    // `build`: see setup.rs (float, per view).
+
+    /// Weight fraction bits W (per view).
+    pub fn frac_bits(&self) -> u32 {
+        self.frac
+    }
+
+    /// Phases per pixel axis.
+    pub fn phases(&self) -> usize {
+        self.phases as usize
+    }
+
+    /// Box width and height, pixels.
+    pub fn box_size(&self) -> [usize; 2] {
+        [self.bx, self.by]
+    }
+
+    /// The stencil of phase cell (kx, ky): origin (box's first pixel relative to the voxel's)
+    /// and By rows of (first, end) run and Bx weights.
+    #[inline]
+    fn stencil(&self, kx: u32, ky: u32) -> &[i16] {
+        let k = (ky * self.phases + kx) as usize;
+        &self.data[k * self.stride..(k + 1) * self.stride]
+    }
+
+    /// Spreads `value` (Q15 premultiplied RGBA) of a voxel at `center` (Q16 px; y relative to
+    /// `acc`'s first row) into `acc` (Q(15 + W), saturating adds), calling `touched(y, x0, x1)`
+    /// for each row it updated. Not inlined, so the object-code audit (embedded/elf_check.py)
+    /// finds it by name.
+    #[inline(never)]
+    pub fn splat(
+        &self,
+        center: [i32; 2],
+        value: &[u16; 4],
+        acc: &mut ImageMut<'_, [i32; 4]>,
+        mut touched: impl FnMut(usize, usize, usize),
+    ) -> SplatStats {
+        #[cfg(footprint_audit_plant)]
+        let value = &[
+            (value[0] as f32 * 1.0001) as u16,
+            value[1],
+            value[2],
+            value[3],
+        ];
+        let pos = |c: i32| {
+            (
+                c >> POS_FRAC,
+                ((c & 0xffff) as u32 * self.phases) >> POS_FRAC,
+            )
+        };
+        let ((ix, kx), (iy, ky)) = (pos(center[0]), pos(center[1]));
+        let st = self.stencil(kx, ky);
+        let origin = st[0] as u16;
+        let x0 = ix + i32::from(origin as u8 as i8);
+        let y0 = iy + i32::from((origin >> 8) as u8 as i8);
+        let (w, h, stride) = (acc.width() as i32, acc.height() as i32, acc.stride());
+        let v = value.map(i32::from);
+        let data = acc.data_mut();
+        let mut stats = SplatStats::default();
+        let width = self.bx + 1;
+        for r in 0..self.by as i32 {
+            let y = y0 + r;
+            if y < 0 {
+                continue;
+            }
+            if y >= h {
+                break;
+            }
+            let row = &st[1 + r as usize * width..][..width];
+            let run = row[0] as u16;
+            let (lo, hi) = (i32::from(run & 0xff), i32::from(run >> 8));
+            let (xa, xb) = ((x0 + lo).max(0), (x0 + hi).min(w));
+            if xa >= xb {
+                continue;
+            }
+            let at = y as usize * stride;
+            let line = &mut data[at + xa as usize..at + xb as usize];
+            let weights = &row[1 + (xa - x0) as usize..];
+            for (px, &wt) in line.iter_mut().zip(weights) {
+                let wt = i32::from(wt);
+                for (a, c) in px.iter_mut().zip(&v) {
+                    *a = a.saturating_add(c * wt);
+                }
+            }
+            let n = (xb - xa) as u32;
+            stats.pixels_visited += n;
+            stats.pixels_updated += n;
+            touched(y as usize, xa as usize, xb as usize - 1);
+        }
+        stats
+    }
+}
+
+pub(crate) fn pack_origin(x: i32, y: i32) -> i16 {
+    // |first| ≤ MAX_SIDE: fits an i8 each.
+    ((x as i8 as u8 as u16) | ((y as i8 as u8 as u16) << 8)) as i16
+}
+
+pub(crate) fn pack_run(lo: usize, hi: usize) -> i16 {
+    (lo as u16 | ((hi as u16) << 8)) as i16
+}
+
+/// Where every voxel of a frame lands, Q16 px: voxel (u, v) of sheet s at `origin + s·sheet +
+/// u·along_a + v·along_b`, 32-bit integer sums (exact, the same on every target).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CompactPlacement {
+    origin: [i32; 2],
+    sheet: [i32; 2],
+    along_a: [i32; 2],
+    along_b: [i32; 2],
+}
+
+impl CompactPlacement {
+    // `new`: see setup.rs (float, per view).
+
+    /// Screen position of voxel (u, v) of sheet `sheet`, Q16 px.
+    #[inline]
+    pub fn at(&self, sheet: usize, u: usize, v: usize) -> [i32; 2] {
+        let (s, u, v) = (sheet as i32, u as i32, v as i32);
+        [0, 1]
+            .map(|i| self.origin[i] + s * self.sheet[i] + u * self.along_a[i] + v * self.along_b[i])
+    }
+}
+
+/// A Q15 pixel as Q24 ([`super::FRAC`]): exact.
+pub fn to_q24(p: [u16; 4]) -> [u32; 4] {
+    p.map(|c| u32::from(c) << (super::FRAC - FRAC))
+}
+
+/// An accumulated sheet pixel (Q(15 + W)) rounded to Q15 and clamped to [0, [`ONE`]].
+#[inline]
+pub fn resolve(acc: [i32; 4], frac: u32) -> [u16; 4] {
+    let half = (1i32 << frac) >> 1;
+    acc.map(|a| (a.saturating_add(half) >> frac).clamp(0, i32::from(ONE)) as u16)
+}
+
+/// `front over back` in Q15, rounded, saturating at 2¹⁶ − 1.
+#[inline]
+pub fn over(front: [u16; 4], back: [u16; 4]) -> [u16; 4] {
+    let t = u32::from(ONE.saturating_sub(front[3]));
+    let mut out = [0u16; 4];
+    for ((o, &f), &b) in out.iter_mut().zip(&front).zip(&back) {
+        let behind = (u32::from(b) * t + (1 << (FRAC - 1))) >> FRAC;
+        *o = (u32::from(f) + behind).min(u32::from(u16::MAX)) as u16;
+    }
+    out
+}
+
+/// Composites one accumulated sheet row into the image row (over back to front, under front to
+/// back) and clears the accumulator row. (Not inlined: audited by name, like the splat.)
+#[inline(never)]
+pub fn composite_row(acc: &mut [[i32; 4]], image: &mut [[u16; 4]], frac: u32, order: Order) {
+    for (a, px) in acc.iter_mut().zip(image.iter_mut()) {
+        let layer = resolve(*a, frac);
+        *a = [0; 4];
+        *px = match order {
+            Order::BackToFront => over(layer, *px),
+            Order::FrontToBack => over(*px, layer),
+        };
+    }
+}
+
+/// `front = front over back`, pixel by pixel.
+pub fn over_row(front: &mut [[u16; 4]], back: &[[u16; 4]]) {
+    for (f, &b) in front.iter_mut().zip(back) {
+        *f = over(*f, b);
+    }
+}
+
+/// CRC-32 of a Q15 image, each channel as two little-endian bytes, pixels in order.
+pub fn checksum(image: &[[u16; 4]]) -> u32 {
+    let mut crc = crate::table::Crc32::new();
+    for px in image {
+        for c in px {
+            crc.update(&c.to_le_bytes());
+        }
+    }
+    crc.finish()
+}
+
+#[cfg(test)]
+mod tests;
