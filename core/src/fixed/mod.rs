@@ -130,10 +130,18 @@ pub(crate) fn is_grey<T: PartialEq>(p: &[T; 4]) -> bool {
 /// CRC-32 of an image's channels, each as 4 little-endian bytes, row by row: the checksum the
 /// firmware and the host print for the same scene.
 pub fn checksum(image: &[[u32; 4]]) -> u32 {
+    channel_crc(image, |c, crc| crc.update(&c.to_le_bytes()))
+}
+
+/// CRC-32 of an image's channels in order, each written by `bytes` (both fixed formats' checksum).
+pub(crate) fn channel_crc<C: Copy>(
+    image: &[[C; 4]],
+    bytes: impl Fn(C, &mut crate::table::Crc32),
+) -> u32 {
     let mut crc = crate::table::Crc32::new();
     for px in image {
-        for c in px {
-            crc.update(&c.to_le_bytes());
+        for &c in px {
+            bytes(c, &mut crc);
         }
     }
     crc.finish()

@@ -300,13 +300,7 @@ pub fn over_row(front: &mut [[u16; 4]], back: &[[u16; 4]]) {
 
 /// CRC-32 of a Q15 image, each channel as two little-endian bytes, pixels in order.
 pub fn checksum(image: &[[u16; 4]]) -> u32 {
-    let mut crc = crate::table::Crc32::new();
-    for px in image {
-        for c in px {
-            crc.update(&c.to_le_bytes());
-        }
-    }
-    crc.finish()
+    super::channel_crc(image, |c, crc| crc.update(&c.to_le_bytes()))
 }
 
 #[cfg(test)]

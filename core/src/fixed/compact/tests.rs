@@ -11,6 +11,20 @@ use crate::{GenericTable, Grid, Kernel, Lookup, Sampler, View};
 use glam::Mat3;
 use std::vec;
 
+/// The paper Gaussian's generic table.
+fn gaussian() -> GenericTable<33> {
+    GenericTable::<33>::build(Kernel::PAPER_GAUSSIAN)
+}
+
+/// `frame`'s footprint read straight from `table`.
+fn direct<'a>(f: &FrameSetup, table: &'a GenericTable<33>) -> Direct<'a, 33> {
+    Direct {
+        footprint: f.footprint,
+        table,
+        lookup: Lookup::Bilinear,
+    }
+}
+
 fn frame(zoom: f32, az: f32) -> FrameSetup {
     let m = Mat3::from_rotation_x(0.35) * Mat3::from_rotation_y(az) * zoom;
     FrameSetup::new(
@@ -29,14 +43,10 @@ fn frame(zoom: f32, az: f32) -> FrameSetup {
 /// LSB of W; a renormalised voxel deposits exactly round(area · 2^W) per unit value.
 #[test]
 fn a_splat_is_the_footprint_at_its_phase() {
-    let table = GenericTable::<33>::build(Kernel::PAPER_GAUSSIAN);
+    let table = gaussian();
     for (zoom, az) in [(1.3, 0.5), (0.9, 1.1), (1.6, 2.0), (1.0, 0.0)] {
         let f = frame(zoom, az);
-        let sampler = Direct {
-            footprint: f.footprint,
-            table: &table,
-            lookup: Lookup::Bilinear,
-        };
+        let sampler = direct(&f, &table);
         let phases = 8;
         let mut buf = vec![0i16; len_for(&f, phases).unwrap()];
         let st = CompactStencils::build(&f, &sampler, phases, &mut buf).unwrap();
@@ -93,13 +103,9 @@ fn a_splat_is_the_footprint_at_its_phase() {
 /// Adds saturate at the `i32` limit instead of wrapping, and a resolved pixel clamps to one.
 #[test]
 fn sums_saturate_and_resolve_clamps() {
-    let table = GenericTable::<33>::build(Kernel::PAPER_GAUSSIAN);
+    let table = gaussian();
     let f = frame(1.3, 0.5);
-    let sampler = Direct {
-        footprint: f.footprint,
-        table: &table,
-        lookup: Lookup::Bilinear,
-    };
+    let sampler = direct(&f, &table);
     let mut buf = vec![0i16; len_for(&f, 4).unwrap()];
     let st = CompactStencils::build(&f, &sampler, 4, &mut buf).unwrap();
     let mut acc = vec![[0i32; 4]; 40 * 40];
@@ -132,13 +138,9 @@ fn over_is_exact_at_zero_and_one() {
 /// refusals.
 #[test]
 fn refusals_are_typed() {
-    let table = GenericTable::<33>::build(Kernel::PAPER_GAUSSIAN);
+    let table = gaussian();
     let f = frame(1.3, 0.5);
-    let sampler = Direct {
-        footprint: f.footprint,
-        table: &table,
-        lookup: Lookup::Bilinear,
-    };
+    let sampler = direct(&f, &table);
     assert!(matches!(len_for(&f, 0), Err(CompactError::Phases { .. })));
     let mut short = [0i16; 4];
     assert!(matches!(
