@@ -4,6 +4,7 @@
 //! `hostile.rs` stays its own executable: it runs its cases as child processes under limits.
 mod bad_input;
 mod classify;
+mod compact;
 mod continuous;
 mod degenerate;
 mod display;

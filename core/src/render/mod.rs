@@ -277,6 +277,7 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
             &mut self.stats,
             index,
             lengths,
+            |_| 0..usize::MAX,
             shade,
         )?;
         self.composite_sheet();
@@ -416,6 +417,31 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
         self.splat_and_composite(index, None, |_, u, v| shade(u, v))
     }
 
+    /// [`SheetRenderer::render_sheet_with`] where the caller knows which voxels can be
+    /// non-transparent: in sheet row `v`, only `u` in `occupied(v)` (a promise: the renderer
+    /// neither shades nor visits the others, so a source skips its empty runs in bulk). The image
+    /// is bit-identical to `render_sheet_with` when the promise holds.
+    pub fn render_sheet_rows_with(
+        &mut self,
+        index: usize,
+        occupied: impl Fn(usize) -> core::ops::Range<usize>,
+        shade: impl FnMut(usize, usize) -> P::Value,
+    ) -> Result<(), RenderError> {
+        Self::splat_sheet(
+            self.frame,
+            &self.path,
+            self.band,
+            &mut self.buffers,
+            &mut self.stats,
+            index,
+            [None, None, None],
+            occupied,
+            shade,
+        )?;
+        self.composite_sheet();
+        Ok(())
+    }
+
     /// [`SheetRenderer::splat_sheet`] of a sheet of `len` values (checked, if given), each
     /// `shade(path, u, v)`, then [`SheetRenderer::composite_sheet`].
     fn splat_and_composite(
@@ -433,6 +459,7 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
             &mut self.stats,
             index,
             [len, None, None],
+            |_| 0..usize::MAX,
             |u, v| shade(path, u, v),
         )?;
         self.composite_sheet();
@@ -440,8 +467,8 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
     }
 
     /// Checks sheet `index` and the given sheet `lengths`, then splats the value that
-    /// `shade(u, v)` gives for every voxel (skipping transparent ones, and in a band the voxels
-    /// that cannot reach it, without shading them).
+    /// `shade(u, v)` gives for every voxel of row v in `occupied(v)` (skipping transparent ones,
+    /// and in a band the voxels that cannot reach it, without shading them).
     #[allow(clippy::too_many_arguments)]
     fn splat_sheet(
         f: &FrameSetup,
@@ -451,6 +478,7 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
         stats: &mut RenderStats,
         index: usize,
         lengths: [Option<usize>; 3],
+        occupied: impl Fn(usize) -> core::ops::Range<usize>,
         mut shade: impl FnMut(usize, usize) -> P::Value,
     ) -> Result<(), RenderError> {
         let count = f.sheet_count();
@@ -465,7 +493,8 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
         let rows = &mut *buffers.rows;
         let reach = BandReach::new(f, band, index);
         for v in 0..nb {
-            for u in reach.row(v, na) {
+            let (reached, held) = (reach.row(v, na), occupied(v));
+            for u in reached.start.max(held.start)..reached.end.min(held.end) {
                 stats.voxels += 1;
                 let value = shade(u, v);
                 if P::is_transparent(&value) {

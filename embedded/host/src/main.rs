@@ -44,7 +44,37 @@ fn main() -> ExitCode {
     }
 }
 
+/// The scene's promise to the renderer ([`footprint_scene::occupied`]): every non-zero sample
+/// lies in its row's range, whichever axis the sheets and rows run along.
+fn check_occupied() -> Result<(), String> {
+    use footprint_scene::{occupied, sample, DIM};
+    for i in 0..DIM {
+        for j in 0..DIM {
+            for k in 0..DIM {
+                let nonzero = sample(i, j, k) != 0;
+                let held = [
+                    (i, j, k),
+                    (j, k, i),
+                    (k, i, j),
+                    (j, i, k),
+                    (i, k, j),
+                    (k, j, i),
+                ]
+                .iter()
+                .all(|&(s, v, u)| occupied(s, v).contains(&u));
+                if nonzero && !held {
+                    return Err(format!(
+                        "sample ({i}, {j}, {k}) is outside its row's occupied range"
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
 fn checksums(threads: usize) -> Result<(), String> {
+    check_occupied()?;
     let fixed = std::thread::scope(|s| {
         let handles: Vec<_> = (0..threads)
             .map(|_| s.spawn(|| fixed_image(SIDE, SIDE)))
