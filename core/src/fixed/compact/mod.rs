@@ -185,39 +185,40 @@ impl<'a> CompactStencils<'a> {
         let x0 = ix + i32::from(origin as u8 as i8);
         let y0 = iy + i32::from((origin >> 8) as u8 as i8);
         let (w, h, stride) = (acc.width() as i32, acc.height() as i32, acc.stride());
-        let v = value.map(i32::from);
-        let data = acc.data_mut();
+        // The box's rows inside `acc`, found once (a band holds a few of them).
+        let (r0, r1) = ((-y0).max(0), (h - y0).min(self.by as i32));
         let mut stats = SplatStats::default();
+        if r0 >= r1 {
+            return stats;
+        }
+        let [v0, v1, v2, v3] = value.map(i32::from);
+        let data = acc.data_mut();
         let width = self.bx + 1;
-        for r in 0..self.by as i32 {
-            let y = y0 + r;
-            if y < 0 {
-                continue;
-            }
-            if y >= h {
-                break;
-            }
-            let row = &st[1 + r as usize * width..][..width];
+        let mut rows = st[1 + r0 as usize * width..].chunks(width);
+        let mut n = 0u32;
+        for y in (y0 + r0) as usize..(y0 + r1) as usize {
+            let Some(row) = rows.next() else { break };
             let run = row[0] as u16;
             let (lo, hi) = (i32::from(run & 0xff), i32::from(run >> 8));
             let (xa, xb) = ((x0 + lo).max(0), (x0 + hi).min(w));
             if xa >= xb {
                 continue;
             }
-            let at = y as usize * stride;
+            let at = y * stride;
             let line = &mut data[at + xa as usize..at + xb as usize];
             let weights = &row[1 + (xa - x0) as usize..];
             for (px, &wt) in line.iter_mut().zip(weights) {
                 let wt = i32::from(wt);
-                for (a, c) in px.iter_mut().zip(&v) {
-                    *a = a.saturating_add(c * wt);
-                }
+                px[0] = px[0].saturating_add(v0 * wt);
+                px[1] = px[1].saturating_add(v1 * wt);
+                px[2] = px[2].saturating_add(v2 * wt);
+                px[3] = px[3].saturating_add(v3 * wt);
             }
-            let n = (xb - xa) as u32;
-            stats.pixels_visited += n;
-            stats.pixels_updated += n;
-            touched(y as usize, xa as usize, xb as usize - 1);
+            n += (xb - xa) as u32;
+            touched(y, xa as usize, xb as usize - 1);
         }
+        stats.pixels_visited = n;
+        stats.pixels_updated = n;
         stats
     }
 }
@@ -282,6 +283,10 @@ pub fn over(front: [u16; 4], back: [u16; 4]) -> [u16; 4] {
 #[inline(never)]
 pub fn composite_row(acc: &mut [[i32; 4]], image: &mut [[u16; 4]], frac: u32, order: Order) {
     for (a, px) in acc.iter_mut().zip(image.iter_mut()) {
+        // An empty layer composites to the pixel itself, exactly (over and under by nothing).
+        if (a[0] | a[1] | a[2] | a[3]) == 0 {
+            continue;
+        }
         let layer = resolve(*a, frac);
         *a = [0; 4];
         *px = match order {
