@@ -159,7 +159,7 @@ impl Crc32 {
         Crc32(!0)
     }
 
-    /// Feeds `bytes` (a byte at a time through [`CRC_TABLE`]: a load, a shift and two xors).
+    /// Feeds `bytes` (a byte at a time through a 256-entry table: a load, a shift and two xors).
     pub fn update(&mut self, bytes: &[u8]) {
         for &b in bytes {
             self.0 = (self.0 >> 8) ^ CRC_TABLE[((self.0 ^ u32::from(b)) & 0xff) as usize];
