@@ -66,15 +66,25 @@ impl<'a> CompactStencils<'a> {
             }));
         }
         let [bx, by] = box_for(frame)?;
+        let covering = covering_bound(frame)?;
+        // The largest |weight| that keeps every sum in `i32` (see `covering_bound`).
+        let cap = (65_535 / covering).min(32_767) as f32;
         // One sampling pass at the finest W; a stencil whose weights do not fit it restarts the
         // pass at the W its largest weight allows (W only falls, so this ends, and it ends at
         // the W of the view's largest weight).
         let mut frac = MAX_WEIGHT_FRAC;
         let frac = loop {
-            match fill(frame, sampler, phases, [bx, by], frac, &mut buffer[..len]) {
+            match fill(
+                frame,
+                sampler,
+                phases,
+                [bx, by],
+                (frac, cap),
+                &mut buffer[..len],
+            ) {
                 Ok(()) => break frac,
                 Err(Fill::Over(largest)) => {
-                    let lower = weight_frac(largest)?;
+                    let lower = weight_frac(largest, cap)?;
                     if lower >= frac {
                         return Err(FixedError::Range {
                             what: "stencil weight",
@@ -93,6 +103,7 @@ impl<'a> CompactStencils<'a> {
             by,
             stride: stencil_len(bx, by),
             frac,
+            covering,
         })
     }
 }
@@ -116,7 +127,7 @@ fn fill<S: crate::Sampler + ?Sized>(
     sampler: &S,
     phases: usize,
     [bx, by]: [usize; 2],
-    frac: u32,
+    (frac, cap): (u32, f32),
     out: &mut [i16],
 ) -> Result<(), Fill> {
     let fp = &frame.footprint;
@@ -144,7 +155,7 @@ fn fill<S: crate::Sampler + ?Sized>(
         let weights = &mut weights[..bx * by];
         if renormalise && !(sum > 0.0) {
             // No pixel centre in the support: the whole cell on the voxel's own pixel.
-            if area * scale >= 32767.0 {
+            if area * scale > cap {
                 return Err(Fill::Over(area));
             }
             out.fill(0);
@@ -158,7 +169,7 @@ fn fill<S: crate::Sampler + ?Sized>(
             weights.iter_mut().for_each(|w| *w *= s);
         }
         let largest = weights.iter().fold(0.0f32, |m, w| m.max(math::abs(*w)));
-        if largest * scale >= 32767.0 {
+        if largest * scale > cap {
             return Err(Fill::Over(largest));
         }
         out[0] = pack_origin(first[0], first[1]);
@@ -168,6 +179,15 @@ fn fill<S: crate::Sampler + ?Sized>(
         }
         if renormalise {
             spread_remainder(&mut q[..bx * by], quantise_i32(area * scale)?)?;
+        }
+        // Rounding (and the remainder) may push one weight past the cap: a lower W then.
+        let most = q[..bx * by]
+            .iter()
+            .map(|w| w.unsigned_abs())
+            .max()
+            .unwrap_or(0);
+        if f32::from(most) > cap {
+            return Err(Fill::Over(f32::from(most) / scale));
         }
         for y in 0..by {
             let row = &q[y * bx..(y + 1) * bx];
@@ -181,25 +201,49 @@ fn fill<S: crate::Sampler + ?Sized>(
     Ok(())
 }
 
-/// The largest W ≤ [`MAX_WEIGHT_FRAC`] with `largest` · 2^W < 2¹⁵.
-fn weight_frac(largest: f32) -> Result<u32, CompactError> {
-    if !largest.is_finite() {
-        return Err(FixedError::Range {
+/// The largest W ≤ [`MAX_WEIGHT_FRAC`] with `largest` · 2^W ≤ `cap`.
+fn weight_frac(largest: f32, cap: f32) -> Result<u32, CompactError> {
+    let range = || {
+        CompactError::Fixed(FixedError::Range {
             what: "stencil weight",
+        })
+    };
+    if !largest.is_finite() {
+        return Err(range());
+    }
+    let mut frac = MAX_WEIGHT_FRAC;
+    while largest * (1u32 << frac) as f32 > cap {
+        frac = frac.checked_sub(1).ok_or_else(range)?;
+    }
+    Ok(frac)
+}
+
+/// The most voxels of one sheet whose stencils can cover one pixel, N: the bound behind the
+/// plain adds (see [`super`], "Why the sums cannot overflow").
+///
+/// A stencil covers the pixels whose centres lie within the footprint's half-extents e of its
+/// phase centre, which is within half a pixel of the voxel's Q16 position c (a whole-cell
+/// stencil covers only the pixel holding c). So a pixel centre p is covered only by voxels with
+/// |p − c| ≤ e + ½ per axis: lattice points c = o + u·a + v·b in a (2eₓ + 1) × (2e_y + 1)
+/// rectangle. Each such point's cell {c + s·a + t·b : s, t ∈ [0, 1)} lies in the rectangle
+/// widened by |aₓ| + |bₓ| and |a_y| + |b_y|, and the cells are disjoint with area |det(a, b)|,
+/// so N ≤ (2eₓ + 1 + |aₓ| + |bₓ|)(2e_y + 1 + |a_y| + |b_y|) / |det|, rounded up with a margin
+/// for the float set-up and the Q16 steps.
+pub(super) fn covering_bound(frame: &FrameSetup) -> Result<u32, CompactError> {
+    let m = frame.grid_to_screen;
+    let (a, b) = (m.col(frame.in_sheet.0), m.col(frame.in_sheet.1));
+    let e = frame.footprint.half_extent;
+    let wx = 2.0 * e[0] + 1.0 + math::abs(a.x) + math::abs(b.x);
+    let wy = 2.0 * e[1] + 1.0 + math::abs(a.y) + math::abs(b.y);
+    let det = math::abs(a.x * b.y - a.y * b.x);
+    let n = wx * wy / (det * 0.999) + 1.0;
+    if !(1.0..65_536.0).contains(&n) {
+        return Err(FixedError::Range {
+            what: "voxels over one pixel",
         }
         .into());
     }
-    let mut frac = MAX_WEIGHT_FRAC;
-    while largest * (1u32 << frac) as f32 >= 32767.0 {
-        if frac == 0 {
-            return Err(FixedError::Range {
-                what: "stencil weight",
-            }
-            .into());
-        }
-        frac -= 1;
-    }
-    Ok(frac)
+    Ok(n as u32)
 }
 
 fn quantise_i32(x: f32) -> Result<i32, CompactError> {
