@@ -13,10 +13,11 @@
 #     its image, which the host checks (CRC) and compares with its float render (PSNR);
 #  2a. each firmware sends its bands as RGB565 rows through the core's embedded-graphics adaptor
 #     into a framebuffer-less display that keeps their CRC, equal to the host's for the same rows;
-#  2b. on QEMU microbit (Cortex-M0, nRF51822 memory map: 256 KiB flash, 16 KiB RAM) it renders
-#     48×48 in bands, with the host's checksum for that size, in 16 KiB: statics + stack;
-#  3. the fixed path's splat and compositing contain no float (object-code audit on M3, M4F and
-#     the micro:bit's M0), and the audit catches a planted float multiply;
+#  2b. on QEMU microbit (Cortex-M0, nRF51822 memory map: 256 KiB flash, 16 KiB RAM) and
+#     stm32vldiscovery (8 KiB RAM) it renders 48×48 and 32×32 in bands, with the host's
+#     checksums for those sizes, within each board's RAM: statics + stack;
+#  3. the fixed paths' splat and compositing contain no float (object-code audit on every
+#     board's build), and the audit catches a planted float multiply;
 #  4. the worst-case stack from the compiler's stack sizes fits STACK_BUDGET and bounds what the
 #     painted stack measured;
 #  5. the float build's figures, and every build's instructions per frame under -icount, for the

@@ -314,6 +314,23 @@ impl FrameSetup {
         self.origin + self.grid_to_screen * Vec3::from_array(index)
     }
 
+    /// Screen positions (px, and depth) of the volume's eight corner voxel centres, by the
+    /// affine map ([`FrameSetup::affine_position`]): corner `c` takes the last index on axis `i`
+    /// where bit `i` of `c` is set. The fixed-point placements check their range on these.
+    pub fn voxel_corners(&self) -> [Vec3; 8] {
+        let last = self.dims.map(|n| n.saturating_sub(1) as f32);
+        core::array::from_fn(|corner| {
+            let index = core::array::from_fn(|axis| {
+                if corner & (1 << axis) != 0 {
+                    last[axis]
+                } else {
+                    0.0
+                }
+            });
+            self.affine_position(index)
+        })
+    }
+
     /// Number of sheets (voxels along the sheet axis).
     pub fn sheet_count(&self) -> usize {
         self.dims[self.sheet_axis]

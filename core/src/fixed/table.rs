@@ -240,14 +240,7 @@ impl Placement {
     /// 2³⁰ px from the image origin.
     pub fn new(frame: &FrameSetup) -> Result<Self, FixedError> {
         let m = frame.grid_to_screen;
-        let d = frame.dims.map(|n| (n - 1) as f32);
-        for corner in 0..8 {
-            let mut p = frame.origin;
-            for (axis, &len) in d.iter().enumerate() {
-                if corner & (1 << axis) != 0 {
-                    p += m.col(axis) * len;
-                }
-            }
+        for p in frame.voxel_corners() {
             q24(p.x, "volume corner on screen")?;
             q24(p.y, "volume corner on screen")?;
         }

@@ -111,17 +111,17 @@ impl BandReach {
         first.saturating_sub(1)..last
     }
 
-    /// Whether voxel `u` of row `v` (of `na` voxels) passes the float per-row test (the
-    /// reference `row`'s integer lines are checked against in the tests).
+    /// [`BandReach::row`] computed in floats, as before the integer lines (the reference the
+    /// tests hold those lines to).
     #[cfg(test)]
     fn row_float(&self, v: usize, na: usize) -> core::ops::Range<usize> {
         let Some(t) = &self.test else {
             return 0..na;
         };
-        let fixed = BandReach {
+        let float = BandReach {
             test: Some(BandTest { fixed: None, ..*t }),
         };
-        fixed.row(v, na)
+        float.row(v, na)
     }
 
     pub(super) fn may_reach(&self, u: usize, v: usize) -> bool {

@@ -112,15 +112,16 @@ fn checksums(threads: usize) -> Result<(), String> {
     );
     println!("float checksum 0x{:08x} (informational)", float.checksum);
     // The compact path (what the firmware renders by default): each board's size, whole and
-    // in bands, and its orbit.
+    // in bands, and its orbit, all through one shading table (it is view-independent).
+    let lut = compact_shading()?;
     for (name, side) in [
         ("", SIDE),
         ("microbit ", SIDE_MICROBIT),
         ("stm32 ", SIDE_STM32),
     ] {
-        let (r, img) = compact_image(side, side, 0)?;
+        let (r, img) = compact_image(&lut, side, side, 0)?;
         for band in [1, 2, 5] {
-            let banded = compact_image(side, band, 0)?.0.checksum;
+            let banded = compact_image(&lut, side, band, 0)?.0.checksum;
             if banded != r.checksum {
                 return Err(format!(
                     "compact {side}x{side}: bands of {band} rows give 0x{banded:08x}, the whole image 0x{:08x}",
@@ -128,10 +129,11 @@ fn checksums(threads: usize) -> Result<(), String> {
                 ));
             }
         }
-        let (_, float) = float_image(side, side)?;
-        let q: Vec<[f32; 4]> = img
+        let rgb = |c: [f32; 4]| [0, 1, 2].map(|i| f64::from(c[i]));
+        let float: Vec<[f64; 3]> = float_image(side, side)?.1.into_iter().map(rgb).collect();
+        let q: Vec<[f64; 3]> = img
             .iter()
-            .map(|&p| footprint::fixed::compact::to_f32(p))
+            .map(|&p| rgb(footprint::fixed::compact::to_f32(p)))
             .collect();
         println!(
             "{name}compact checksum 0x{:08x} ({side}x{side}, {} pixel updates, psnr_vs_float {:.2} dB)",
@@ -139,11 +141,12 @@ fn checksums(threads: usize) -> Result<(), String> {
             r.stats.pixel_updates,
             psnr(&q, &float)
         );
-        let orbit = (0..ORBIT_FRAMES)
-            .map(|step| {
-                compact_image(side, side, step).map(|(r, _)| format!("0x{:08x}", r.checksum))
-            })
-            .collect::<Result<Vec<_>, _>>()?;
+        // Frame 0 is the render above; the later frames turn the view.
+        let mut orbit = vec![r.checksum];
+        for step in 1..ORBIT_FRAMES {
+            orbit.push(compact_image(&lut, side, side, step)?.0.checksum);
+        }
+        let orbit: Vec<String> = orbit.iter().map(|c| format!("0x{c:08x}")).collect();
         println!("{name}orbit checksums {}", orbit.join(" "));
         let mut display = CrcDisplay::new(side);
         send_band_q15(0, side, &img, &mut vec![0; side], &mut display)
@@ -188,17 +191,27 @@ fn fixed_image(side: usize, band: usize) -> Result<(Report, Vec<[u32; 4]>), Stri
     Ok((report, image))
 }
 
-/// The compact render of orbit frame `step` at `side`² in bands of `band` rows: its report and
-/// image (Q15 premultiplied RGBA, row-major).
-fn compact_image(side: usize, band: usize, step: usize) -> Result<(Report, Vec<[u16; 4]>), String> {
-    let band = band.min(side);
+/// The compact path's shading table ([`compact_lut`]).
+fn compact_shading() -> Result<Box<[[u16; 4]; 256]>, String> {
     let mut lut = Box::new([[0u16; 4]; 256]);
     compact_lut(&mut lut).map_err(|e| format!("compact shading table: {e}"))?;
+    Ok(lut)
+}
+
+/// The compact render of orbit frame `step` at `side`² in bands of `band` rows, shaded through
+/// `lut`: its report and image (Q15 premultiplied RGBA, row-major).
+fn compact_image(
+    lut: &[[u16; 4]; 256],
+    side: usize,
+    band: usize,
+    step: usize,
+) -> Result<(Report, Vec<[u16; 4]>), String> {
+    let band = band.min(side);
     let mut image = vec![[0u16; 4]; side * side];
     let report = render_compact(
         side,
         step,
-        &lut,
+        lut,
         CompactBuffers {
             stencils: &mut vec![0; compact_stencil_len(side)],
             acc: &mut vec![[0; 4]; band * side],
@@ -211,12 +224,13 @@ fn compact_image(side: usize, band: usize, step: usize) -> Result<(Report, Vec<[
     Ok((report, image))
 }
 
-/// PSNR (dB, RGB, peak 1) of `a` against `b`.
-fn psnr(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
+/// PSNR (dB, peak 1) of `a` against `b`, over every R, G and B value.
+fn psnr(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
     let mse = a
         .iter()
-        .zip(b)
-        .flat_map(|(x, y)| (0..3).map(move |c| f64::from(x[c] - y[c]).powi(2)))
+        .flatten()
+        .zip(b.iter().flatten())
+        .map(|(x, y)| (x - y) * (x - y))
         .sum::<f64>()
         / (3 * a.len()) as f64;
     if mse > 0.0 {
@@ -328,7 +342,12 @@ fn compare(log: &str, dir: &str) -> Result<(), String> {
             })
             .collect::<Result<Vec<_>, _>>()?;
         let crc = footprint::fixed::compact::checksum(&q15);
-        (crc, compact_image(side, side, 0)?.0.checksum)
+        (
+            crc,
+            compact_image(&*compact_shading()?, side, side, 0)?
+                .0
+                .checksum,
+        )
     } else {
         (
             footprint::fixed::checksum(&target),
@@ -347,18 +366,7 @@ fn compare(log: &str, dir: &str) -> Result<(), String> {
         .map(|&c| to_rgb(footprint::fixed::to_f32(c)))
         .collect();
     let float_rgb: Vec<[f64; 3]> = float.iter().map(|&c| to_rgb(c)).collect();
-    let mse = target_rgb
-        .iter()
-        .flatten()
-        .zip(float_rgb.iter().flatten())
-        .map(|(a, b)| (a - b) * (a - b))
-        .sum::<f64>()
-        / (3 * side * side) as f64;
-    let psnr = if mse > 0.0 {
-        10.0 * (1.0 / mse).log10()
-    } else {
-        f64::INFINITY
-    };
+    let psnr = psnr(&target_rgb, &float_rgb);
     let dir = std::path::Path::new(dir);
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     write_png(&dir.join("microbit.png"), side, &target_rgb)?;

@@ -292,14 +292,7 @@ impl CompactPlacement {
             return Err(FixedError::Range { what: "image size" }.into());
         }
         let m = frame.grid_to_screen;
-        let d = frame.dims.map(|n| n.saturating_sub(1) as f32);
-        for corner in 0..8 {
-            let mut p = frame.origin;
-            for (axis, &len) in d.iter().enumerate() {
-                if corner & (1 << axis) != 0 {
-                    p += m.col(axis) * len;
-                }
-            }
+        for p in frame.voxel_corners() {
             if !(math::abs(p.x) < limit && math::abs(p.y) < limit) {
                 return Err(FixedError::Range {
                     what: "volume corner on screen",
