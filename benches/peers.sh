@@ -86,6 +86,8 @@ csv=docs/perf/peers.csv
 echo "volume,rep,renderer,threads,accum,first_ms,median_ms" > "$csv"
 acsv=docs/perf/subsample.csv
 echo "volume,subsample,factor,psnr_f64_db,psnr_continuous_db" > "$acsv"
+pcsv=docs/perf/post.csv
+echo "volume,slab,value_subsample,post_db,pre_db,vtk_db,vtk_trilinear_db,post_trilinear_db" > "$pcsv"
 fcsv=docs/perf/floor.csv
 echo "volume,rep,pixel,pixel_updates,composites,voxels,sheets,box_px,accumulate_ms,composite_ms,floor_ms" > "$fcsv"
 for spec in "${volumes[@]}"; do
@@ -122,7 +124,36 @@ PY
     "$fp" verify "$raw" --dims "$nx,$ny,$nz" --type u8 --spacing "$sx,$sy,$sz" --window "$lo,$hi" --tf grey \
       --size 512x512 --view-matrix "$vm" --subsample "$sub" --reference continuous --json "$work/v.json" >/dev/null
     "$py" -c "import json; j=json.load(open('$work/v.json')); print(f'$name,$sub,{int(j[\"subsample\"])},{j[\"overall\"][\"psnr_db\"]:.2f},{j[\"continuous\"][\"psnr_db\"]:.2f}')" >> "$acsv"
+    [ "$sub" = 1 ] && cp "$work/v.json" "$work/v1.json"
   done
+  # Post-classification (issue 47): Footprint's post-classified default and its pre-classified
+  # default against the post-classified integral (the kernel's reconstruction, the default, and
+  # trilinear, VTK's own), and VTK's image (from its first run above) against the same integrals.
+  for recon in kernel trilinear; do
+    "$fp" verify "$raw" --dims "$nx,$ny,$nz" --type u8 --spacing "$sx,$sy,$sz" --window "$lo,$hi" --tf grey \
+      --size 512x512 --view-matrix "$vm" --classification post --reference continuous --reconstruction "$recon" \
+      --json "$work/post-$recon.json" --reference-out "$work/out/post-ref-$name-$recon.pfm" >/dev/null
+  done
+  "$py" - "$work" "$name" "$pcsv" <<'PY'
+import json, sys, numpy as np
+work, name, out = sys.argv[1:]
+def pfm(path):
+    with open(path, "rb") as f:
+        assert f.readline().strip() == b"PF"
+        w, h = map(int, f.readline().split())
+        scale = float(f.readline())
+        a = np.frombuffer(f.read(), "<f4" if scale < 0 else ">f4").reshape(h, w, 3)
+    return a[::-1]  # PFM rows run bottom to top
+def psnr(a, b):
+    return 10 * np.log10(1 / max(1e-20, float(((a - b) ** 2).mean())))
+vtk = np.fromfile(f"{work}/out/vtk-{name}.rgba.f32.raw", np.float32).reshape(512, 512, 4)[..., :3]
+k, t = (json.load(open(f"{work}/post-{r}.json")) for r in ("kernel", "trilinear"))
+ref = {r: pfm(f"{work}/out/post-ref-{name}-{r}.pfm") for r in ("kernel", "trilinear")}
+pre = json.load(open(f"{work}/v1.json"))["continuous"]["models"]["post-classified"]
+row = [name, f"{k['slab']:.2g}", str(int(k["value_subsample"])), k["continuous"]["psnr_db"], pre,
+       psnr(vtk, ref["kernel"]), psnr(vtk, ref["trilinear"]), t["continuous"]["psnr_db"]]
+open(out, "a").write(",".join(str(x) if isinstance(x, str) else f"{x:.2f}" for x in row) + "\n")
+PY
   "$work/vp_bench" "$raw" "$nx" "$ny" "$nz" "$sx" "$sy" "$sz" 512 512 30 20 "$lo" "$hi" 3 "$work/out/vp-$name" classified grey >/dev/null
   "$py" - "$work/out" "$name" "docs/images/peers-$name.png" <<'PY'
 import sys, numpy as np
@@ -141,6 +172,9 @@ PY
       label=$acc; [ "$sub" = auto ] && label=$acc-subsample
       "$py" -c "import json,sys; j=json.load(open('$work/b.json')); print(f'$name,$rep,footprint,$th,$label,{j[\"first_ms\"]:.3f},{j[\"median_ms\"]:.3f}')" >> "$csv"
     done
+    # Post-classified (issue 47), one thread: beside VTK's ray caster, which post-classifies.
+    "$fp" bench "${common[@]}" --threads 1 --classification post --json "$work/b.json" >/dev/null
+    "$py" -c "import json,sys; j=json.load(open('$work/b.json')); print(f'$name,$rep,footprint,1,float-post,{j[\"first_ms\"]:.3f},{j[\"median_ms\"]:.3f}')" >> "$csv"
     for th in 1 2; do
       vtk "$th"
       "$py" -c "import json; j=json.load(open('$work/out/vtk-$name.json'))['seconds']; print(f'$name,$rep,vtk,$th,-,{j[\"warmup_total\"]*1e3:.3f},{j[\"frame\"][\"median\"]*1e3:.3f}')" >> "$csv"
@@ -188,5 +222,5 @@ PY
 done
 
 echo "== docs/performance.md"
-"$py" "$root/benches/peers_report.py" "$csv" "$scsv" docs/performance.md docs/charts/perf-scaling "$acsv" "$fcsv"
+"$py" "$root/benches/peers_report.py" "$csv" "$scsv" docs/performance.md docs/charts/perf-scaling "$acsv" "$fcsv" "$pcsv"
 echo "wrote docs/performance.md, docs/perf/*.csv, docs/charts/perf-scaling.{svg,png}, docs/images/peers-*.png"

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Writes docs/performance.md and the scaling chart from the CSVs benches/peers.sh measured.
 
-usage: peers_report.py PEERS.csv SCALING.csv OUT.md CHART_STEM [SUBSAMPLE.csv [FLOOR.csv]]
+usage: peers_report.py PEERS.csv SCALING.csv OUT.md CHART_STEM [SUBSAMPLE.csv [FLOOR.csv [POST.csv]]]
 Every ratio is of medians over the repetitions, all measured alternately in one session.
 """
 import csv
@@ -20,6 +20,7 @@ import matplotlib.ticker  # noqa: E402,F401
 peers_csv, scaling_csv, out_md, stem = sys.argv[1:5]
 sub_csv = sys.argv[5] if len(sys.argv) > 5 else None
 floor_csv = sys.argv[6] if len(sys.argv) > 6 else None
+post_csv = sys.argv[7] if len(sys.argv) > 7 else None
 rows = list(csv.DictReader(open(peers_csv)))
 volumes = list(dict.fromkeys(r["volume"] for r in rows))
 
@@ -113,6 +114,33 @@ if any(r["accum"] == "float-subsample" for r in rows):
         f64s = f"{float(full['psnr_f64_db']):.1f} → {float(a['psnr_f64_db']):.1f} dB" if a and full else "–"
         cont = f"{float(full['psnr_continuous_db']):.2f} → {float(a['psnr_continuous_db']):.2f} dB" if a and full else "–"
         lines.append(f"| {v} | {s_} | {f1:.1f} ms | {r1:.1f} ms | {r2:.1f} ms | {t1 / f1:.2f}× | {r1 / vp:.1f}× | {r1 / r2:.2f}× | {f64s} | {cont} |")
+
+prows = {r["volume"]: r for r in csv.DictReader(open(post_csv))} if post_csv else {}
+if any(r["accum"] == "float-post" for r in rows):
+    lines += [
+        "",
+        "## Post-classification (`--classification post`)",
+        "",
+        "Values and gradients splatted into image-aligned slabs, classified per pixel (README, "
+        "\"Post-classification\"), at its defaults (slab and value subsampling in the table), one thread, "
+        "in the same repetitions as VTK above. Accuracy against the post-classified continuous integral "
+        "(`footprint verify --classification post --reference continuous`, one ray per pixel centre) with "
+        "the kernel's reconstruction (the default model) and with trilinear reconstruction (VTK's own); "
+        "*pre* is Footprint's pre-classified default against the same integral; VTK's image (its "
+        "`rgba.f32.raw`) is compared with the reference's PFM. Data: `docs/perf/post.csv`.",
+        "",
+        "| volume | slab, spacings | values at 1/s | post fresh, 1 thread | post re-render, 1 thread | VTK 1 thread | VTK ÷ post re-render [≥ 2] | post vs integral (kernel / trilinear) | pre vs integral | VTK vs integral (kernel / trilinear) |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for v in volumes:
+        p1, q1 = med(v, "footprint", 1, "float-post", "first_ms"), med(v, "footprint", 1, "float-post", "median_ms")
+        t1, _, _ = peer_times(v)
+        a = prows.get(v)
+        acc_ = (f"{a['post_db']} / {a['post_trilinear_db']} dB", f"{a['pre_db']} dB",
+                f"{a['vtk_db']} / {a['vtk_trilinear_db']} dB") if a else ("–", "–", "–")
+        slab, vs = (a["slab"], a["value_subsample"]) if a else ("?", "?")
+        lines.append(f"| {v} | {slab} | {vs} | {p1:.1f} ms | {q1:.1f} ms | {t1:.1f} ms | {t1 / q1:.2f}× | "
+                     f"{acc_[0]} | {acc_[1]} | {acc_[2]} |")
 
 frows = list(csv.DictReader(open(floor_csv))) if floor_csv else []
 if frows:

@@ -24,6 +24,7 @@ mod newcomer;
 mod outputs;
 mod paraview_presets;
 mod perspective;
+mod post;
 mod quality_continuous;
 mod quality_lod;
 mod real_writers;

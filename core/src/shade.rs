@@ -113,6 +113,15 @@ impl Lighting {
             ..Lighting::new(frame)
         }
     }
+
+    /// The same light with the opacity correction α' = 1 − (1 − α)^`exponent` (a layer
+    /// `exponent` reference distances deep; one: no correction).
+    pub fn with_opacity_exponent(self, exponent: f32) -> Self {
+        Lighting {
+            opacity_exponent: exponent,
+            ..self
+        }
+    }
 }
 
 impl Shader<'_> {

@@ -23,8 +23,8 @@
 //! and never act on one frame together (`pipeline::stages::prepare::setup_frame`).
 
 use crate::args::{
-    AccumArg, Background, FootprintArgs, GammaArg, Lod, LookupArg, MethodArg, OrderArg,
-    QualityReferenceArg, RenderArgs, SlicingArg, Supersample,
+    AccumArg, Background, ClassificationArg, FootprintArgs, GammaArg, Lod, LookupArg, MethodArg,
+    OrderArg, QualityReferenceArg, RenderArgs, SlicingArg, Supersample,
 };
 use crate::CliError;
 use footprint::render::Absorption;
@@ -49,6 +49,14 @@ pub enum End {
     Slabs {
         /// Voxel spacings along the ray.
         thickness: f32,
+    },
+    /// Post-classified image-aligned slabs `thickness` smallest grid spacings thick (float):
+    /// values reconstructed, then classified per pixel (`--classification post`).
+    Post {
+        /// Voxel spacings along the ray.
+        thickness: f32,
+        /// The values' subsampling (`--value-subsample`).
+        values: Supersample,
     },
     /// Sheets on a grid refined wherever samples differ by more than `threshold` (float, robust
     /// method, orthographic, volume in memory); `sheets` also refines across sheets.
@@ -142,10 +150,18 @@ impl Plan {
         }
     }
 
+    /// The name `--classification` and the JSON use: `post` for post-classified slabs.
+    pub fn classification(&self) -> &'static str {
+        match self.end {
+            End::Post { .. } => "post",
+            _ => "pre",
+        }
+    }
+
     /// The name `--slicing` and the JSON use: `image` for slabs, `object` otherwise.
     pub fn slicing(&self) -> &'static str {
         match self.end {
-            End::Slabs { .. } => "image",
+            End::Slabs { .. } | End::Post { .. } => "image",
             _ => "object",
         }
     }
@@ -158,7 +174,11 @@ pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
         AccumArg::Float => Precision::Float,
         AccumArg::Fixed => Precision::Fixed,
     };
-    let end = match (fa.method, args.refine, args.slicing) {
+    if args.classification == ClassificationArg::Post {
+        return post_plan(args, precision);
+    }
+    let slicing = args.slicing.unwrap_or(SlicingArg::Object);
+    let end = match (fa.method, args.refine, slicing) {
         (MethodArg::Reference, _, _) => End::Reference,
         (_, Some(threshold), _) => End::Refined {
             threshold,
@@ -174,7 +194,7 @@ pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
         End::Refined { .. } if precision == Precision::Fixed => {
             return refuse("--refine", "float accumulation only (drop --accum fixed)")
         }
-        End::Refined { .. } if args.slicing == SlicingArg::Image => {
+        End::Refined { .. } if slicing == SlicingArg::Image => {
             return refuse("--refine", "the paper's sheets only (drop --slicing image)")
         }
         End::Refined { .. } if args.perspective.is_some() => {
@@ -264,6 +284,84 @@ pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
             reference: args.quality_reference,
         }),
     })
+}
+
+/// `--classification post`'s plan: post-classified slabs, after the rules that the flags alone
+/// decide (what image slicing needs, and what post-classification cannot be combined with).
+fn post_plan(args: &RenderArgs, precision: Precision) -> Result<Plan, CliError> {
+    let refuse = |flag: &str, why: &str| {
+        Err(CliError::input(format!(
+            "--classification post with {flag}: {why}"
+        )))
+    };
+    let fa = &args.footprint;
+    if precision == Precision::Fixed {
+        return refuse(
+            "--accum fixed",
+            "there is no fixed-point post-classification (each slab sample is divided by its \
+             weight and shaded per pixel): use --accum float",
+        );
+    }
+    if fa.method == MethodArg::Reference {
+        return refuse(
+            "--method reference",
+            "the f64 sheet reference is pre-classified: compare against --reference continuous",
+        );
+    }
+    if args.refine.is_some() {
+        return refuse("--refine", "refinement refines the paper's sheets only");
+    }
+    if args.slicing == Some(SlicingArg::Object) {
+        return refuse(
+            "--slicing object",
+            "post-classification renders image-aligned slabs (drop --slicing)",
+        );
+    }
+    if args.perspective.is_some() {
+        return refuse(
+            "--perspective",
+            "image-aligned slabs are orthographic only (drop --perspective)",
+        );
+    }
+    if args.stream.is_some() {
+        return refuse(
+            "--stream",
+            "a slab of an oblique view crosses every sheet, so it cannot be fed from a few \
+             streamed sheets: drop --stream (the volume is loaded)",
+        );
+    }
+    if Absorption::from(args.absorption) == Absorption::Extinction {
+        return refuse(
+            "--absorption extinction",
+            "post-classification composites each sample's opacity over its step, as ray casters \
+             do (drop --absorption)",
+        );
+    }
+    if let Lod::Level(n @ 1..) = args.lod {
+        return refuse(
+            &format!("--lod {n}"),
+            "a coarser level carries pre-classified colours; post-classification reconstructs \
+             the values at full resolution (give --lod 0 or auto)",
+        );
+    }
+    if args.quality.is_some() {
+        return refuse(
+            "--quality",
+            "--quality chooses among pre-classified methods; give --slab-post instead",
+        );
+    }
+    let mut plan = plan(&RenderArgs {
+        classification: ClassificationArg::Pre,
+        slicing: Some(SlicingArg::Image),
+        ..args.clone()
+    })?;
+    plan.end = End::Post {
+        thickness: args
+            .slab_post
+            .unwrap_or_else(|| crate::args::default_post_slab(&args.shading)),
+        values: args.value_subsample,
+    };
+    Ok(plan)
 }
 
 impl From<Lookup> for LookupArg {
@@ -428,9 +526,19 @@ impl From<&RenderArgs> for Inputs {
             depth: a.depth,
             footprint: a.footprint.clone(),
             absorption: a.absorption.into(),
-            order: a.order,
+            // Post-classification composites front to back unless told: opaque pixels then take
+            // nothing more (exact), where back to front must classify every slab.
+            order: match (a.classification, a.order) {
+                (ClassificationArg::Post, None) => Some(crate::args::OrderArg::FrontToBack),
+                (_, order) => order,
+            },
             supersample: a.supersample,
-            lod: a.lod,
+            // Post-classification reconstructs the values at full resolution (a coarser level
+            // carries pre-classified colours): `auto` means level 0 there.
+            lod: match (a.classification, a.lod) {
+                (ClassificationArg::Post, Lod::Auto) => Lod::Level(0),
+                (_, lod) => lod,
+            },
             refine: a.refine.is_some(),
             quality: a.quality.is_some(),
         }

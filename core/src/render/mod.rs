@@ -24,6 +24,7 @@ pub mod absorption;
 mod band;
 mod error;
 mod perspective;
+pub mod post;
 mod precision;
 mod refined;
 mod scaled;
@@ -35,6 +36,10 @@ mod visible;
 pub use absorption::Absorption;
 pub use error::RenderError;
 pub use perspective::PerVoxel;
+pub use post::{
+    Classify, PostBuffers, PostRenderer, PostSample, PostSetup, PostVoxel, ShadedLayers,
+    WeightTable,
+};
 pub use precision::{CompactPath, FixedPath, FloatPath, Precision, VoxelSplat};
 pub use refined::{key_spacings, rate_index, spacing_key, RefineTables, RefinedGrid, SPACING_KEYS};
 pub use scaled::{sheet_map, splat_scaled, ScaledFootprint};

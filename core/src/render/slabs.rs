@@ -94,6 +94,11 @@ pub enum SlabError {
     Perspective,
     /// The view or grid is singular or not finite.
     Singular,
+    /// Value subsampling outside 1..=64 ([`super::post::PostSetup::with_value_scale`]).
+    ValueScale {
+        /// The factor given.
+        scale: usize,
+    },
 }
 
 impl fmt::Display for SlabError {
@@ -118,6 +123,7 @@ impl fmt::Display for SlabError {
                  use --slicing object)",
             ),
             Self::Singular => f.write_str("the view or grid is singular"),
+            Self::ValueScale { scale } => write!(f, "value subsampling {scale} is outside 1..=64"),
         }
     }
 }
@@ -161,26 +167,26 @@ impl SlabVoxel {
 /// One orthographic frame's slab geometry (see the module docs for the derivation).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SlabSetup {
-    size: [usize; 2],
+    pub(super) size: [usize; 2],
     /// ρ² = qxx·dx² + 2·qxy·dx·dy + qyy·dy².
-    q: [f32; 3],
+    pub(super) q: [f32; 3],
     /// z* = shear[0]·dx + shear[1]·dy.
-    shear: [f32; 2],
+    pub(super) shear: [f32; 2],
     /// |d| / R: chord units per pixel of depth.
-    kappa: f32,
+    pub(super) kappa: f32,
     /// Half extents of the ρ² < 1 ellipse, pixels.
-    half: [f32; 2],
+    pub(super) half: [f32; 2],
     /// Depth half-extent of the kernel, pixels.
-    z_reach: f32,
+    pub(super) z_reach: f32,
     /// Front of slab 0 and the slab thickness, pixels of depth.
-    z0: f32,
-    thickness: f32,
-    count: usize,
+    pub(super) z0: f32,
+    pub(super) thickness: f32,
+    pub(super) count: usize,
     /// |G·d| / (|d|·R²): a section's weight per unit of table difference.
-    scale: f32,
+    pub(super) scale: f32,
     /// The model the slabs composite, and a slab's chord along the ray, world units.
-    absorption: Absorption,
-    chord: f32,
+    pub(super) absorption: Absorption,
+    pub(super) chord: f32,
 }
 
 impl SlabSetup {
@@ -329,7 +335,7 @@ impl SlabSetup {
 /// The pixels (or rows) of 0..`n` whose centres lie in [lo, hi] (screen pixels), the splat's own
 /// rule ([`pixel_range`]).
 #[inline]
-fn centres_within(lo: f32, hi: f32, n: usize) -> core::ops::Range<usize> {
+pub(super) fn centres_within(lo: f32, hi: f32, n: usize) -> core::ops::Range<usize> {
     let (a, b) = pixel_range(lo, hi);
     let a = a.clamp(0, n as i64) as usize;
     let b = (b + 1).clamp(0, n as i64) as usize;

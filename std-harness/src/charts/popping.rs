@@ -65,7 +65,7 @@ pub fn popping(
             .into_iter()
             .enumerate()
         {
-            args.slicing = slicing;
+            args.slicing = Some(slicing);
             let plan = crate::plan::plan(&args)?.with_precision(crate::plan::Precision::Float);
             let f = render_frame(&p, &plan, &mut caches[k])?;
             out.truth_db[k].push(compare(&f.image, &truth.image).1.psnr_db);

@@ -36,10 +36,21 @@ pub fn describe(p: &Prepared, args: &Inputs, plan: &Plan) -> Json {
         .arr_f64("window", &p.window.map(f64::from))
         .str("sheet_axis", ["i", "j", "k"][f.sheet_axis])
         .str("slicing", plan.slicing())
+        .str("classification", plan.classification())
         .num(
             "slab",
             match plan.end {
-                End::Slabs { thickness } => f64::from(thickness),
+                End::Slabs { thickness } | End::Post { thickness, .. } => f64::from(thickness),
+                _ => f64::NAN,
+            },
+        )
+        .num(
+            "value_subsample",
+            match plan.end {
+                End::Post { thickness, values } => {
+                    crate::pipeline::ends::post::value_scale(p, thickness, values)
+                        .map_or(f64::NAN, |s| s as f64)
+                }
                 _ => f64::NAN,
             },
         )

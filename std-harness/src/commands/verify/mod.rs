@@ -13,8 +13,8 @@ use crate::metrics::{compare, ErrorStats};
 use crate::pipeline::ends::continuous::{continuous_models, ModelFigures};
 use crate::pipeline::quality::{choose::apply_quality, field::prepare_field, model::Choice};
 use crate::pipeline::{prepare, render_core, render_ref, Prepared};
-use crate::plan::{plan, Inputs, Plan, Precision};
-use crate::reference::continuous::Continuous;
+use crate::plan::{plan, End, Inputs, Plan, Precision};
+use crate::reference::continuous::{Continuous, Model};
 use crate::CliError;
 use clap::Args;
 use footprint::render::RenderStats;
@@ -173,8 +173,12 @@ fn measure(args: &VerifyArgs, r: &RenderArgs) -> Result<Measured, CliError> {
                 _ => None,
             };
             let over = fine.as_ref().unwrap_or(&p);
-            let (recon, absorption) = (args.reconstruction.into(), p.absorption);
-            let (integral, seconds, models) = continuous_models(over, recon, absorption, &core)?;
+            let model = match plan.end {
+                End::Post { .. } => Model::Post,
+                _ => Model::Pre(p.absorption),
+            };
+            let recon = args.reconstruction.into();
+            let (integral, seconds, models) = continuous_models(over, recon, model, &core)?;
             let (_, error) = compare(&core, &integral.image);
             Some(AgainstContinuous {
                 integral,

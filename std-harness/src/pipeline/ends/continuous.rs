@@ -54,19 +54,19 @@ pub fn render_continuous_ref(
 /// PSNR (RGB, dB) against each continuous model, the chosen one first.
 pub type ModelFigures = Vec<(Model, f64)>;
 
-/// The continuous reference of `p` with `absorption` (as [`render_continuous_model`]) and, for
-/// context, `core`'s PSNR (RGB, dB) against each model, the chosen one first, then the other
-/// absorption model and post-classification (values reconstructed, then classified: what ray
-/// casters compute): the models differ by more than a renderer's error on opaque data, so the
-/// figure means little without its model.
+/// The continuous reference of `p` in `chosen_model` (pre-classified in an absorption model, as
+/// [`render_continuous_model`], or post-classified) and, for context, `core`'s PSNR (RGB, dB)
+/// against each model, the chosen one first, then the others (both absorption models and
+/// post-classification: values reconstructed, then classified, what ray casters compute): the
+/// models differ by more than a renderer's error on opaque data, so the figure means little
+/// without its model.
 pub fn continuous_models(
     p: &Prepared,
     reconstruction: Reconstruction,
-    absorption: Absorption,
+    chosen_model: Model,
     core: &[[f32; 4]],
 ) -> Result<(Continuous, f64, ModelFigures), CliError> {
-    let (chosen, secs) = render_continuous_model(p, reconstruction, absorption)?;
-    let chosen_model = Model::Pre(absorption);
+    let (chosen, secs) = render_continuous_as(p, reconstruction, chosen_model, DEFAULT_CAP)?;
     let mut figures = vec![(
         chosen_model,
         crate::metrics::compare(core, &chosen.image).1.psnr_db,

@@ -69,6 +69,9 @@ pub fn render_frame(
             super::refine::render_refined(p, plan, threshold, sheets)
         }
         End::Slabs { thickness } => super::slabs::render_slabs(p, thickness, plan.threads, cache),
+        End::Post { thickness, values } => {
+            super::post::render_post(p, thickness, values, plan.threads, cache)
+        }
         End::Sheets(precision) => render_sheets(p, plan, precision, cache),
         End::Reference => Err(CliError::input(
             "the f64 reference is not a core render: use render_ref (--method reference)",

@@ -156,7 +156,10 @@ fn slab_voxels(
 
 /// A stable counting sort of `keys` (each below `count`): the positions in key order, and where
 /// each key's run starts (`count + 1` entries).
-fn buckets(keys: impl Iterator<Item = usize> + Clone, count: usize) -> (Vec<usize>, Vec<usize>) {
+pub(crate) fn buckets(
+    keys: impl Iterator<Item = usize> + Clone,
+    count: usize,
+) -> (Vec<usize>, Vec<usize>) {
     let mut starts = vec![0usize; count + 1];
     for k in keys.clone() {
         starts[k + 1] += 1;

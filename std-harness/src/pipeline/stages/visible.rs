@@ -149,6 +149,16 @@ pub enum Visible<'a> {
     OnTheFly(&'a Volume),
 }
 
+/// The voxels a post-classified frame splats (`--classification post`: made by
+/// `pipeline::ends::post`), view-independent: grid index, value and world gradient (zero where
+/// the shading needs none), in grid order (x fastest).
+#[derive(Debug, Default)]
+pub struct PostSamples {
+    pub index: Vec<[u32; 3]>,
+    pub value: Vec<f32>,
+    pub gradient: Vec<[f32; 3]>,
+}
+
 /// Per-volume state kept across frames of one volume, transfer function and shading: the visible
 /// lists of each sheet axis met so far, and the bands' clear accumulators ([`Spares`]). A caller
 /// that changes the transfer function, window or shading must start a new cache.
@@ -160,6 +170,8 @@ pub struct FrameCache {
     /// The lists' budget in bytes, where not [`list_budget`]'s.
     budget: Option<usize>,
     spares: Spares,
+    /// The voxels post-classified frames splat (`--classification post`), once made.
+    pub post: Option<PostSamples>,
 }
 
 impl FrameCache {
@@ -198,6 +210,10 @@ impl FrameCache {
 
     /// The lists' budget this cache applies to a volume: [`list_budget`]'s, or the one it was
     /// made with.
+    pub fn list_budget_for(&self, volume: &Volume) -> usize {
+        self.budget_for(volume)
+    }
+
     fn budget_for(&self, volume: &Volume) -> usize {
         self.budget.unwrap_or_else(|| list_budget(volume))
     }

@@ -1,0 +1,66 @@
+//! The flags that choose the continuous model a frame renders and is measured against:
+//! `--classification`, `--absorption`, `--reconstruction`, and `--slab-post`'s default.
+
+/// `--reconstruction`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ReconstructionArg {
+    Kernel,
+    Trilinear,
+}
+
+impl From<ReconstructionArg> for crate::reference::continuous::Reconstruction {
+    fn from(a: ReconstructionArg) -> Self {
+        match a {
+            ReconstructionArg::Kernel => Self::Kernel,
+            ReconstructionArg::Trilinear => Self::Trilinear,
+        }
+    }
+}
+
+/// `--slab-post`'s default for `shading`, voxel spacings: the step that keeps the midpoint
+/// rule's error against the post-classified integral under the 44 dB target with a margin on the
+/// shared volumes (docs/post-classification.md): 0.7 for emission, 0.4 where gradients light the
+/// samples (the lit colour varies faster along a ray than the value does).
+pub fn default_post_slab(shading: &str) -> f32 {
+    if shading == "emission" {
+        0.7
+    } else {
+        0.4
+    }
+}
+
+/// `--classification`: shade the samples, then reconstruct (the paper's `pre`), or reconstruct
+/// the values, then classify (`post`; `footprint::render::post`).
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum ClassificationArg {
+    #[default]
+    Pre,
+    Post,
+}
+
+impl ClassificationArg {
+    /// The name the flag and the JSON use.
+    pub fn name(self) -> &'static str {
+        match self {
+            ClassificationArg::Pre => "pre",
+            ClassificationArg::Post => "post",
+        }
+    }
+}
+
+/// `--absorption`: the continuous model both slicings render and the continuous reference
+/// integrates (`footprint::render::absorption`).
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AbsorptionArg {
+    Opacity,
+    Extinction,
+}
+
+impl From<AbsorptionArg> for footprint::render::Absorption {
+    fn from(a: AbsorptionArg) -> Self {
+        match a {
+            AbsorptionArg::Extinction => Self::Extinction,
+            AbsorptionArg::Opacity => Self::Opacity,
+        }
+    }
+}

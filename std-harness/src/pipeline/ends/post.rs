@@ -1,0 +1,440 @@
+//! `--classification post`: the core's post-classified slabs (`footprint::render::post`) over a
+//! volume in memory, on several cores.
+//!
+//! 1. **Which voxels.** A sample is a convex combination of the voxels within a kernel radius R
+//!    of it, so it can only be visible if one of those is: its value above the shader's
+//!    [`transparent_at_or_below`](footprint::shade::Shader::transparent_at_or_below). Every voxel
+//!    such a sample reads lies less than 2R (grid steps) from that voxel, so the frame splats the
+//!    finite voxels less than 2R from a visible-valued one (an exact Euclidean distance transform
+//!    of the visible mask): every sample that can be seen has all of its weights, exactly as the
+//!    continuous model reads them, and samples short of weights are at or below the transparent
+//!    value either way. The voxels, their values and world gradients (the renderer's central
+//!    differences) are kept across frames in the [`FrameCache`], as the visible lists are.
+//! 2. **Per frame** they are placed on screen and sorted by the slab each reaches first in
+//!    compositing order, then by image row (counting sorts: the order does not depend on the
+//!    thread count); each thread owns a band of image rows and walks the slabs in that order, splatting
+//!    the voxels that enter at each slab, then classifying and compositing it.
+//!
+//! **Memory.** 28 bytes per kept voxel (grid index, value, gradient) and 36 per frame (its
+//! [`PostVoxel`] and first slab); per band a ring of slab accumulators of 20 bytes per pixel.
+//! A streamed volume is refused (an oblique slab crosses every sheet), as are fixed-point
+//! accumulation and colour-carrying levels of detail (their colours are pre-classified).
+
+use crate::args::Supersample;
+use crate::pipeline::stages::bands::{equal_bands, on_bands, CoreFrame, Phases};
+use crate::pipeline::stages::prepare::Prepared;
+use crate::pipeline::stages::supersample::to_output;
+use crate::pipeline::stages::visible::{FrameCache, PostSamples};
+use crate::CliError;
+use footprint::composite::RowSpan;
+use footprint::frame::Order;
+use footprint::render::post::{MAX_VALUE_SCALE, WEIGHT_NODES};
+use footprint::render::{
+    gradient, PostBuffers, PostRenderer, PostSetup, PostVoxel, RenderStats, ShadedLayers,
+    SheetWindow, WeightTable,
+};
+use footprint::shade::OPACITY_TABLE_LEN;
+use std::time::Instant;
+
+/// Bytes [`PostSamples`] keeps per voxel.
+const BYTES_PER_SAMPLE: usize = 28;
+
+/// Renders one frame of `p` post-classified, with slabs `thickness` voxel spacings thick, on
+/// `threads` bands.
+pub fn render_post(
+    p: &Prepared,
+    thickness: f32,
+    values: Supersample,
+    threads: usize,
+    cache: &mut FrameCache,
+) -> Result<CoreFrame, CliError> {
+    let refuse = |why: &str| CliError::input(format!("{}: --classification post: {why}", p.name));
+    let volume = p.volume().ok_or_else(|| {
+        refuse(
+            "a slab of an oblique view crosses every sheet, so it cannot be fed from a few \
+             streamed sheets: drop --stream (the volume is loaded)",
+        )
+    })?;
+    if volume.is_coloured() {
+        return Err(refuse(&format!(
+            "level {} of this volume carries pre-classified colours: give --lod 0",
+            p.level
+        )));
+    }
+    let setup =
+        PostSetup::new(&p.frame, &p.kernel, thickness).map_err(|e| refuse(&e.to_string()))?;
+    let scale = scale_for(&setup, values);
+    let setup = setup
+        .with_value_scale(scale)
+        .map_err(|e| refuse(&e.to_string()))?;
+    let start = Instant::now();
+    let weights =
+        Box::new(WeightTable::<WEIGHT_NODES>::new(&p.kernel).map_err(|e| refuse(&e.to_string()))?);
+    let mut opacity = vec![0.0f32; OPACITY_TABLE_LEN];
+    let classify = ShadedLayers::new(&p.frame, &setup, p.shader(), &mut opacity)
+        .map_err(|e| refuse(&e.to_string()))?;
+    let tables = start.elapsed().as_secs_f64();
+
+    let t0 = Instant::now();
+    let fresh = cache.post.is_none();
+    if fresh {
+        cache.post = Some(post_samples(p, volume, cache.list_budget_for(volume))?);
+    }
+    let samples = cache.post.as_ref().expect("just made");
+    let classify_samples = t0.elapsed().as_secs_f64();
+    let t1 = Instant::now();
+    let voxels = place(p, &setup, samples)?;
+    let classify_time = classify_samples + t1.elapsed().as_secs_f64();
+
+    let (setup, weights, classify, sv) = (&setup, &*weights, &classify, &voxels);
+    let [w, h] = p.frame.size;
+    let (image, mut stats, band_phases) = on_bands(
+        crate::io::try_filled(w * h, [0.0f32; 4], "the image")?,
+        p.frame.size,
+        equal_bands(h, threads),
+        p.background.as_deref(),
+        |rows, band, bg| render_band(p, setup, weights, classify, sv, bg, band, rows),
+    )?;
+    stats.voxels = voxels.voxels.len() as u64;
+    let phases = Phases {
+        classify: classify_time,
+        tables,
+        ..band_phases
+    };
+    let image = to_output(image, p.out_size(), p.supersample);
+    Ok(CoreFrame {
+        image,
+        stats,
+        seconds: start.elapsed().as_secs_f64(),
+        phases,
+        threads: threads.clamp(1, p.frame.size[1]),
+        visible: Some(voxels.voxels.len()),
+        refine: None,
+    })
+}
+
+/// `--value-subsample auto`'s bound: the kernel's shorter semi-axis, in value pixels, stays at or
+/// above this (docs/post-classification.md measures the error it costs).
+pub const AUTO_VALUE_RADIUS: f32 = 3.0;
+
+/// The largest value scale (at most [`MAX_VALUE_SCALE`]) that keeps the kernel's shorter
+/// semi-axis at least [`AUTO_VALUE_RADIUS`] value pixels; 1 where it is narrower.
+pub fn auto_value_scale(setup: &PostSetup) -> usize {
+    let s = (setup.kernel_radius_px() / AUTO_VALUE_RADIUS).floor();
+    if s >= 1.0 {
+        (s as usize).min(MAX_VALUE_SCALE)
+    } else {
+        1
+    }
+}
+
+/// The value scale `values` asks for on `setup`'s frame.
+fn scale_for(setup: &PostSetup, values: Supersample) -> usize {
+    match values {
+        Supersample::Fixed(s) => s,
+        Supersample::Auto => auto_value_scale(setup),
+    }
+}
+
+/// The value scale a post-classified frame of `p` with slabs `thickness` thick renders at
+/// (`None` where the slabs cannot be set up: the render says why).
+pub fn value_scale(p: &Prepared, thickness: f32, values: Supersample) -> Option<usize> {
+    let setup = PostSetup::new(&p.frame, &p.kernel, thickness).ok()?;
+    Some(scale_for(&setup, values))
+}
+
+/// The finite voxels less than 2R grid steps from a visible-valued one (see the module docs).
+fn post_samples(
+    p: &Prepared,
+    volume: &crate::io::volume::Volume,
+    budget: usize,
+) -> Result<PostSamples, CliError> {
+    let f = &p.frame;
+    let dims = f.dims;
+    let n: usize = dims.iter().product();
+    let shader = p.shader();
+    let clear = shader.transparent_at_or_below();
+    let needs_gradient = shader.shading.needs_gradient();
+    let (len, na, nb) = f.sheet_shape();
+    let axis = f.sheet_axis;
+    let grid = |s: usize, u: usize, v: usize| {
+        let i = f.grid_index(s, u, v);
+        (i[2] * dims[1] + i[1]) * dims[0] + i[0]
+    };
+    // The visible mask, then its dilation.
+    let mut mask = crate::io::try_filled(n, false, "the post-classification mask")?;
+    let mut sheet = vec![0.0f32; len];
+    for s in 0..f.sheet_count() {
+        volume.sheet_into(axis, s, &mut sheet);
+        for v in 0..nb {
+            for u in 0..na {
+                // NaN compares false: missing, not visible.
+                if sheet[v * na + u] > clear {
+                    mask[grid(s, u, v)] = true;
+                }
+            }
+        }
+    }
+    dilate(&mut mask, dims, 2.0 * p.kernel.spread());
+    let count = mask.iter().filter(|&&m| m).count();
+    if count.saturating_mul(BYTES_PER_SAMPLE) > budget {
+        return Err(CliError::input(format!(
+            "{}: --classification post keeps the {count} voxels near visible values in memory \
+             ({BYTES_PER_SAMPLE} bytes each), more than {} MiB: render a coarser level (--lod) or \
+             narrow the transfer function",
+            p.name,
+            budget >> 20
+        )));
+    }
+    let mut out = PostSamples::default();
+    let reserve = |e: std::collections::TryReserveError| {
+        CliError::input(format!(
+            "cannot allocate the post-classified voxel list: {e}"
+        ))
+    };
+    out.index.try_reserve_exact(count).map_err(reserve)?;
+    out.value.try_reserve_exact(count).map_err(reserve)?;
+    out.gradient.try_reserve_exact(count).map_err(reserve)?;
+    let mut bufs = [vec![0.0f32; len], vec![0.0f32; len], vec![0.0f32; len]];
+    let last = f.sheet_count() - 1;
+    for s in 0..=last {
+        if s > 0 {
+            volume.sheet_into(axis, s - 1, &mut bufs[0]);
+        }
+        volume.sheet_into(axis, s, &mut bufs[1]);
+        if s < last {
+            volume.sheet_into(axis, s + 1, &mut bufs[2]);
+        }
+        let window = SheetWindow {
+            lower: (s > 0).then_some(&bufs[0][..]),
+            current: &bufs[1][..],
+            upper: (s < last).then_some(&bufs[2][..]),
+        };
+        for v in 0..nb {
+            for u in 0..na {
+                let value = window.current[v * na + u];
+                if !mask[grid(s, u, v)] || !value.is_finite() {
+                    continue;
+                }
+                let g = if needs_gradient {
+                    gradient(f, &window, u, v).to_array()
+                } else {
+                    [0.0; 3]
+                };
+                out.index.push(f.grid_index(s, u, v).map(|c| c as u32));
+                out.value.push(value);
+                out.gradient.push(g);
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Keeps the cells of `mask` whose Euclidean distance to a set cell (in grid steps) is below
+/// `reach`: the squared distance transform of Felzenszwalb and Huttenlocher (2012), one exact
+/// pass of lower envelopes of parabolas per axis.
+fn dilate(mask: &mut [bool], dims: [usize; 3], reach: f32) {
+    const FAR: f32 = 1e20;
+    let mut d: Vec<f32> = mask.iter().map(|&m| if m { 0.0 } else { FAR }).collect();
+    let stride = [1, dims[0], dims[0] * dims[1]];
+    let n = dims.iter().copied().max().unwrap_or(0);
+    let (mut f, mut out, mut v, mut z) = (
+        vec![0.0f32; n],
+        vec![0.0f32; n],
+        vec![0usize; n],
+        vec![0.0f32; n + 1],
+    );
+    for a in 0..3 {
+        let (o1, o2) = ((a + 1) % 3, (a + 2) % 3);
+        let len = dims[a];
+        for j in 0..dims[o2] {
+            for i in 0..dims[o1] {
+                let base = i * stride[o1] + j * stride[o2];
+                for (k, fk) in f[..len].iter_mut().enumerate() {
+                    *fk = d[base + k * stride[a]];
+                }
+                envelope(&f[..len], &mut out[..len], &mut v, &mut z);
+                for (k, o) in out[..len].iter().enumerate() {
+                    d[base + k * stride[a]] = *o;
+                }
+            }
+        }
+    }
+    let r2 = reach * reach;
+    for (m, dist) in mask.iter_mut().zip(&d) {
+        *m = *dist < r2;
+    }
+}
+
+/// `out[p]` = min over q of (p − q)² + f[q] over the sites with f[q] below [`dilate`]'s FAR (FAR
+/// where there are none): the lower envelope of the parabolas rooted at the sites; `v` and `z`
+/// are scratch of at least `f.len()` (+1) entries.
+fn envelope(f: &[f32], out: &mut [f32], v: &mut [usize], z: &mut [f32]) {
+    const FAR: f32 = 1e20;
+    let cross = |q: usize, p: usize| {
+        let (q2, p2) = ((q * q) as f32, (p * p) as f32);
+        ((f[q] + q2) - (f[p] + p2)) / (2.0 * (q as f32 - p as f32))
+    };
+    let mut sites = (0..f.len()).filter(|&q| f[q] < FAR);
+    let Some(first) = sites.next() else {
+        out.fill(FAR);
+        return;
+    };
+    let mut k = 0;
+    v[0] = first;
+    z[0] = f32::NEG_INFINITY;
+    z[1] = f32::INFINITY;
+    for q in sites {
+        let mut s = cross(q, v[k]);
+        while k > 0 && s <= z[k] {
+            k -= 1;
+            s = cross(q, v[k]);
+        }
+        k += 1;
+        v[k] = q;
+        z[k] = s;
+        z[k + 1] = f32::INFINITY;
+    }
+    k = 0;
+    for (p, o) in out.iter_mut().enumerate() {
+        while z[k + 1] < p as f32 {
+            k += 1;
+        }
+        let dq = p as f32 - v[k] as f32;
+        *o = dq * dq + f[v[k]];
+    }
+}
+
+/// A frame's voxels on screen, grouped by the compositing step at which each enters (its first
+/// slab front to back, its last back to front), by image row within a step, in grid order within
+/// a row (a stable sort: the same order for any thread count).
+struct Placed {
+    voxels: Vec<PostVoxel>,
+    starts: Vec<usize>,
+}
+
+fn place(p: &Prepared, setup: &PostSetup, s: &PostSamples) -> Result<Placed, CliError> {
+    let f = &p.frame;
+    let slabs = setup.slabs();
+    let count = slabs.slab_count();
+    let n = s.value.len();
+    let mut voxels = Vec::new();
+    let mut keys = Vec::new();
+    voxels
+        .try_reserve_exact(n)
+        .and_then(|_| keys.try_reserve_exact(n))
+        .map_err(|_| CliError::input("cannot allocate the post-classified frame's voxels"))?;
+    // Within a slab, by image row: consecutive voxels then touch the same accumulator rows,
+    // which stay in cache (a whole frame's ring of accumulators does not).
+    let rows = f.size[1] + 1;
+    for k in 0..n {
+        let position = f.affine_position(s.index[k].map(|c| c as f32)).to_array();
+        let (first, last) = slabs.slabs_of(position[2]);
+        let step = match p.order {
+            Order::FrontToBack => first,
+            Order::BackToFront => count - 1 - last,
+        };
+        let row = position[1].clamp(0.0, (rows - 1) as f32) as usize;
+        keys.push(step * rows + row);
+        voxels.push(PostVoxel {
+            position,
+            value: s.value[k],
+            gradient: s.gradient[k],
+        });
+    }
+    let (order, starts) = super::slabs::buckets(keys.iter().copied(), count * rows);
+    Ok(Placed {
+        voxels: order.into_iter().map(|i| voxels[i]).collect(),
+        starts: starts.into_iter().step_by(rows).collect(),
+    })
+}
+
+/// One band: every slab in compositing order, its entering voxels splatted, then classified and
+/// composited.
+#[allow(clippy::too_many_arguments)]
+fn render_band(
+    p: &Prepared,
+    setup: &PostSetup,
+    weights: &WeightTable<WEIGHT_NODES>,
+    classify: &ShadedLayers<'_>,
+    sv: &Placed,
+    background: Option<&[[f32; 4]]>,
+    image: &mut [[f32; 4]],
+    rows: std::ops::Range<usize>,
+) -> Result<(RenderStats, Phases), CliError> {
+    let slabs = setup.slabs();
+    let ring = setup.ring();
+    let vr = setup.value_rows(rows.clone());
+    let n = setup.value_size()[0] * vr.len();
+    let mut acc = crate::io::try_filled(ring.saturating_mul(n), [0.0f32; 5], "a band's slabs")?;
+    let mut spans = vec![RowSpan::EMPTY; ring * vr.len()];
+    let buffers = PostBuffers {
+        accumulators: &mut acc,
+        image,
+        rows: &mut spans,
+    };
+    // Whether a voxel reaches the band's value rows (a conservative test at image scale: the
+    // renderer clips exactly).
+    let s = setup.value_scale();
+    let (ya, yb) = (vr.start * s, (vr.end * s).min(p.frame.size[1]));
+    let reaches = |v: &PostVoxel| {
+        let r = slabs.rows_of(v.position[1]);
+        r.start < yb + s && r.end + s > ya
+    };
+    let mut renderer = PostRenderer::with_band(
+        setup,
+        weights,
+        classify,
+        p.order,
+        buffers,
+        background,
+        rows.clone(),
+    )?;
+    let mut phases = Phases::default();
+    for k in 0..slabs.slab_count() {
+        let t0 = Instant::now();
+        for v in &sv.voxels[sv.starts[k]..sv.starts[k + 1]] {
+            if reaches(v) {
+                renderer.splat_voxel(v)?;
+            }
+        }
+        let t1 = Instant::now();
+        renderer.composite_next();
+        phases.splat += (t1 - t0).as_secs_f64();
+        phases.composite += t1.elapsed().as_secs_f64();
+    }
+    Ok((renderer.finish(), phases))
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn dilation_is_the_euclidean_distance_below_the_reach() {
+        let dims = [9usize, 7, 6];
+        let n = dims.iter().product::<usize>();
+        let set = [(1usize, 1usize, 1usize), (7, 5, 4), (4, 0, 5)];
+        let mut mask = vec![false; n];
+        for &(x, y, z) in &set {
+            mask[(z * dims[1] + y) * dims[0] + x] = true;
+        }
+        for reach in [0.5f32, 1.0, 2.3, 3.2] {
+            let mut m = mask.clone();
+            super::dilate(&mut m, dims, reach);
+            for z in 0..dims[2] {
+                for y in 0..dims[1] {
+                    for x in 0..dims[0] {
+                        let d2 = set
+                            .iter()
+                            .map(|&(a, b, c)| {
+                                let d = |p: usize, q: usize| (p as f32 - q as f32).powi(2);
+                                d(x, a) + d(y, b) + d(z, c)
+                            })
+                            .fold(f32::INFINITY, f32::min);
+                        let got = m[(z * dims[1] + y) * dims[0] + x];
+                        assert_eq!(got, d2 < reach * reach, "({x},{y},{z}) reach {reach}");
+                    }
+                }
+            }
+        }
+    }
+}
