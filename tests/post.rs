@@ -461,4 +461,11 @@ fn post_classification_refuses_what_it_cannot_do() {
             .expect_err(&format!("{extra:?} is refused"));
         assert!(err.to_string().contains(says), "{extra:?}: {err}");
     }
+    // Post's own flags without post: refused, not ignored.
+    for extra in [["--slab-post", "0.5"], ["--value-subsample", "2"]] {
+        let mut a = vec!["--size", "32x32"];
+        a.extend_from_slice(&extra);
+        let err = plan(&parse_args(&a).unwrap()).expect_err("refused");
+        assert!(err.to_string().contains("--classification post"), "{err}");
+    }
 }

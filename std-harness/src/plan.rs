@@ -177,6 +177,12 @@ pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
     if args.classification == ClassificationArg::Post {
         return post_plan(args, precision);
     }
+    if args.slab_post.is_some() || args.value_subsample != Supersample::Auto {
+        return Err(CliError::input(
+            "--slab-post and --value-subsample set up post-classified slabs: add \
+             --classification post (or drop them)",
+        ));
+    }
     let slicing = args.slicing.unwrap_or(SlicingArg::Object);
     let end = match (fa.method, args.refine, slicing) {
         (MethodArg::Reference, _, _) => End::Reference,
@@ -353,6 +359,8 @@ fn post_plan(args: &RenderArgs, precision: Precision) -> Result<Plan, CliError> 
     let mut plan = plan(&RenderArgs {
         classification: ClassificationArg::Pre,
         slicing: Some(SlicingArg::Image),
+        slab_post: None,
+        value_subsample: Supersample::Auto,
         ..args.clone()
     })?;
     plan.end = End::Post {

@@ -26,6 +26,10 @@
 //! the scene turned through azimuth 40°–50° in 0.1° steps at `--popping-size`, the change between
 //! consecutive frames for object slicing, image slicing and the continuous reference.
 //!
+//! **Post-classification** ([`post`], `DIR/post.csv`, `.svg`, `.png`; `--classification post`
+//! charts this alone): slab thicknesses and value subsamplings, frame time against PSNR against
+//! the post-classified continuous integral.
+//!
 //! **Levels of detail** ([`lod`], `DIR/lod.csv`, `.svg`, `.png`): every level of the scene, its
 //! frame time and its PSNR against level 0 (`--lod 0`), and the level `--lod auto` picks.
 //!
@@ -37,6 +41,7 @@ pub mod colorbar;
 pub mod lod;
 pub mod plot;
 pub mod popping;
+pub mod post;
 pub mod refine;
 pub mod stability;
 pub mod sweep;

@@ -1,8 +1,8 @@
 //! `footprint chart`: speed against accuracy on one scene, and stability where methods fail (see
 //! [`crate::charts`] for what is swept and how it is measured).
 
-use crate::args::{Lod, RenderArgs};
-use crate::charts::{lod, plot, popping, refine, stability, sweep};
+use crate::args::{ClassificationArg, Lod, RenderArgs};
+use crate::charts::{lod, plot, popping, post, refine, stability, sweep};
 use crate::io;
 use crate::pipeline::prepare;
 use crate::pipeline::quality::config::Config;
@@ -84,7 +84,17 @@ pub fn run(args: &ChartArgs) -> Result<(), CliError> {
         .map_or("built-in scene".to_string(), |n| {
             n.to_string_lossy().into_owned()
         });
-    if args.refine_only {
+    if base.classification == ClassificationArg::Post {
+        // Post-classification has its own trade-off (slab and value subsampling against the
+        // post-classified integral); the pre-classified sweeps do not apply to it.
+        let rows = post::sweep(&base, args.runs)?;
+        io::write_atomic(&dir.join("post.csv"), post::csv(&rows).as_bytes())?;
+        let title = format!(
+            "{name}, {}x{}: post-classified frame time against error",
+            base.size.0, base.size.1
+        );
+        post::write_chart(&dir, &rows, &title)?;
+    } else if args.refine_only {
         refine_chart(&dir, &base, args)?;
     } else {
         if !args.no_lod {

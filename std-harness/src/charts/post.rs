@@ -1,0 +1,166 @@
+//! The post-classification sweep (`footprint chart --classification post`: `post.csv` and
+//! `post.svg`/`.png`): the scene rendered post-classified at each slab thickness of
+//! [`SLABS`] and value subsampling of [`SCALES`], each point's frame time (median over the runs,
+//! the configurations timed in turn within each run so that drift hits them alike) and its PSNR
+//! (RGB) against the post-classified continuous integral (kernel reconstruction) of the same
+//! view: the speed a post-classified frame buys with accuracy. The pre-classified trade-off
+//! charts do not apply to this mode (they measure against the pre-classified models).
+
+use super::plot::{plot_err, time_chart, time_spread, write_svg_png};
+use crate::args::{ClassificationArg, RenderArgs, Supersample};
+use crate::metrics::compare;
+use crate::pipeline::ends::continuous::render_continuous_as;
+use crate::pipeline::stages::visible::FrameCache;
+use crate::pipeline::{prepare, render_frame};
+use crate::reference::continuous::{Model, Reconstruction, DEFAULT_CAP};
+use crate::CliError;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::path::Path;
+
+/// Slab thicknesses swept, smallest grid spacings.
+pub const SLABS: [f32; 5] = [1.0, 0.7, 0.5, 0.4, 0.3];
+/// Value subsamplings swept.
+pub const SCALES: [usize; 3] = [1, 2, 3];
+
+/// One configuration's row.
+#[derive(Clone, Debug)]
+pub struct PostRow {
+    pub slab: f32,
+    pub scale: usize,
+    pub median_s: f64,
+    pub min_s: f64,
+    pub max_s: f64,
+    /// PSNR (RGB) against the post-classified integral, dB.
+    pub psnr_db: f64,
+}
+
+/// The sweep over `base` (rendered post-classified whatever its `--classification`).
+pub fn sweep(base: &RenderArgs, runs: usize) -> Result<Vec<PostRow>, CliError> {
+    let mut base = base.clone();
+    base.classification = ClassificationArg::Post;
+    let p = prepare(&base)?;
+    let (truth, _) = render_continuous_as(&p, Reconstruction::Kernel, Model::Post, DEFAULT_CAP)?;
+    let configs: Vec<(RenderArgs, f32, usize)> = SLABS
+        .iter()
+        .flat_map(|&slab| SCALES.iter().map(move |&s| (slab, s)))
+        .map(|(slab, s)| {
+            let mut a = base.clone();
+            a.slab_post = Some(slab);
+            a.value_subsample = Supersample::Fixed(s);
+            (a, slab, s)
+        })
+        .collect();
+    let plans = configs
+        .iter()
+        .map(|(a, _, _)| crate::plan::plan(a))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut rows = Vec::new();
+    let mut times = vec![Vec::new(); configs.len()];
+    // One cache: every configuration splats the same voxels, found once.
+    let mut cache = FrameCache::default();
+    for run in 0..=runs.max(1) {
+        for (((_, slab, scale), plan), times) in configs.iter().zip(&plans).zip(&mut times) {
+            let f = render_frame(&p, plan, &mut cache)?;
+            if run == 0 {
+                rows.push(PostRow {
+                    slab: *slab,
+                    scale: *scale,
+                    median_s: 0.0,
+                    min_s: 0.0,
+                    max_s: 0.0,
+                    psnr_db: compare(&f.image, &truth.image).1.psnr_db,
+                });
+            } else {
+                times.push(f.seconds);
+            }
+        }
+    }
+    for (r, t) in rows.iter_mut().zip(&mut times) {
+        t.sort_by(f64::total_cmp);
+        (r.median_s, r.min_s, r.max_s) = (t[t.len() / 2], t[0], t[t.len() - 1]);
+    }
+    Ok(rows)
+}
+
+/// `slab,value_subsample,median_s,min_s,max_s,psnr_db`.
+pub fn csv(rows: &[PostRow]) -> String {
+    let mut s = String::from("slab,value_subsample,median_s,min_s,max_s,psnr_db\n");
+    for r in rows {
+        s.push_str(&format!(
+            "{},{},{:.6},{:.6},{:.6},{:.3}\n",
+            r.slab, r.scale, r.median_s, r.min_s, r.max_s, r.psnr_db
+        ));
+    }
+    s
+}
+
+/// `DIR/post.svg` and `.png`: PSNR against the post-classified integral over frame time, one
+/// point per configuration, a colour per value subsampling; a dashed guide at the 44 dB target.
+pub fn write_chart(dir: &Path, rows: &[PostRow], title: &str) -> Result<(), CliError> {
+    write_svg_png(
+        dir,
+        "post",
+        (900, 560),
+        |r| draw(r, rows, title),
+        |r| draw(r, rows, title),
+    )
+}
+
+fn draw<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    rows: &[PostRow],
+    title: &str,
+) -> Result<(), CliError> {
+    root.fill(&WHITE).map_err(plot_err)?;
+    if rows.is_empty() {
+        return Ok(());
+    }
+    let finite = rows.iter().map(|r| r.psnr_db).filter(|v| v.is_finite());
+    let ymax = finite.clone().fold(44.0, f64::max) + 3.0;
+    let ymin = finite.fold(44.0, f64::min) - 3.0;
+    let (tmin, tmax) = time_spread(rows, |r| r.min_s, |r| r.max_s);
+    let mut chart = time_chart(
+        root,
+        title,
+        (tmin, tmax),
+        (0.8, 2.0),
+        ymin..ymax,
+        "PSNR against the post-classified integral, dB",
+    )?;
+    chart
+        .draw_series(DashedLineSeries::new(
+            vec![(tmin * 0.8, 44.0), (tmax * 2.0, 44.0)],
+            6,
+            4,
+            BLACK.mix(0.4).stroke_width(1),
+        ))
+        .map_err(plot_err)?;
+    chart
+        .draw_series(rows.iter().map(|r| {
+            PathElement::new(
+                vec![(r.min_s, r.psnr_db), (r.max_s, r.psnr_db)],
+                BLACK.stroke_width(1),
+            )
+        }))
+        .map_err(plot_err)?;
+    for r in rows {
+        let colour = [BLUE, RED, MAGENTA][(r.scale - 1).min(2)];
+        chart
+            .draw_series(std::iter::once(Circle::new(
+                (r.median_s, r.psnr_db),
+                5,
+                colour.filled(),
+            )))
+            .map_err(plot_err)?;
+        chart
+            .draw_series(std::iter::once(Text::new(
+                format!("slab {}, 1/{}", r.slab, r.scale),
+                (r.median_s * 1.04, r.psnr_db + 0.4),
+                ("sans-serif", 13),
+            )))
+            .map_err(plot_err)?;
+    }
+    root.present().map_err(plot_err)?;
+    Ok(())
+}
