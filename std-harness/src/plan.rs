@@ -31,6 +31,9 @@ use footprint::render::Absorption;
 use footprint::Lookup;
 use std::path::PathBuf;
 
+mod post;
+use post::{no_post_flags, post_plan};
+
 /// How the float or fixed sheets accumulate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Precision {
@@ -177,12 +180,7 @@ pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
     if args.classification == ClassificationArg::Post {
         return post_plan(args, precision);
     }
-    if args.slab_post.is_some() || args.value_subsample != Supersample::Auto {
-        return Err(CliError::input(
-            "--slab-post and --value-subsample set up post-classified slabs: add \
-             --classification post (or drop them)",
-        ));
-    }
+    no_post_flags(args)?;
     let slicing = args.slicing.unwrap_or(SlicingArg::Object);
     let end = match (fa.method, args.refine, slicing) {
         (MethodArg::Reference, _, _) => End::Reference,
@@ -290,86 +288,6 @@ pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
             reference: args.quality_reference,
         }),
     })
-}
-
-/// `--classification post`'s plan: post-classified slabs, after the rules that the flags alone
-/// decide (what image slicing needs, and what post-classification cannot be combined with).
-fn post_plan(args: &RenderArgs, precision: Precision) -> Result<Plan, CliError> {
-    let refuse = |flag: &str, why: &str| {
-        Err(CliError::input(format!(
-            "--classification post with {flag}: {why}"
-        )))
-    };
-    let fa = &args.footprint;
-    if precision == Precision::Fixed {
-        return refuse(
-            "--accum fixed",
-            "there is no fixed-point post-classification (each slab sample is divided by its \
-             weight and shaded per pixel): use --accum float",
-        );
-    }
-    if fa.method == MethodArg::Reference {
-        return refuse(
-            "--method reference",
-            "the f64 sheet reference is pre-classified: compare against --reference continuous",
-        );
-    }
-    if args.refine.is_some() {
-        return refuse("--refine", "refinement refines the paper's sheets only");
-    }
-    if args.slicing == Some(SlicingArg::Object) {
-        return refuse(
-            "--slicing object",
-            "post-classification renders image-aligned slabs (drop --slicing)",
-        );
-    }
-    if args.perspective.is_some() {
-        return refuse(
-            "--perspective",
-            "image-aligned slabs are orthographic only (drop --perspective)",
-        );
-    }
-    if args.stream.is_some() {
-        return refuse(
-            "--stream",
-            "a slab of an oblique view crosses every sheet, so it cannot be fed from a few \
-             streamed sheets: drop --stream (the volume is loaded)",
-        );
-    }
-    if Absorption::from(args.absorption) == Absorption::Extinction {
-        return refuse(
-            "--absorption extinction",
-            "post-classification composites each sample's opacity over its step, as ray casters \
-             do (drop --absorption)",
-        );
-    }
-    if let Lod::Level(n @ 1..) = args.lod {
-        return refuse(
-            &format!("--lod {n}"),
-            "a coarser level carries pre-classified colours; post-classification reconstructs \
-             the values at full resolution (give --lod 0 or auto)",
-        );
-    }
-    if args.quality.is_some() {
-        return refuse(
-            "--quality",
-            "--quality chooses among pre-classified methods; give --slab-post instead",
-        );
-    }
-    let mut plan = plan(&RenderArgs {
-        classification: ClassificationArg::Pre,
-        slicing: Some(SlicingArg::Image),
-        slab_post: None,
-        value_subsample: Supersample::Auto,
-        ..args.clone()
-    })?;
-    plan.end = End::Post {
-        thickness: args
-            .slab_post
-            .unwrap_or_else(|| crate::args::default_post_slab(&args.shading)),
-        values: args.value_subsample,
-    };
-    Ok(plan)
 }
 
 impl From<Lookup> for LookupArg {

@@ -19,7 +19,7 @@ use plotters::prelude::*;
 use std::path::Path;
 
 /// Slab thicknesses swept, smallest grid spacings.
-pub const SLABS: [f32; 5] = [1.0, 0.7, 0.5, 0.4, 0.3];
+pub const SLABS: [f32; 7] = [2.0, 1.5, 1.0, 0.7, 0.5, 0.4, 0.3];
 /// Value subsamplings swept.
 pub const SCALES: [usize; 3] = [1, 2, 3];
 
