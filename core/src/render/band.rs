@@ -1,6 +1,7 @@
 //! Which voxels of a sheet can reach a band of image rows (see [`super::SheetRenderer`]'s
 //! "Bands"): a conservative test per voxel, and per sheet row the range of voxels to visit; and
-//! what sheet and slab renderers share when they start on a band (its checks, its first image).
+//! what sheet and slab renderers share when they start on a band (its checks, its first image);
+//! and the slab renderers' compositing order ([`SlabQueue`]).
 
 use super::RenderError;
 use crate::frame::{FrameSetup, Order};
@@ -200,6 +201,55 @@ pub(crate) fn start_image<X: Copy>(
     match (order, background) {
         (Order::BackToFront, Some(bg)) => image.copy_from_slice(&bg[..image.len()]),
         _ => image.fill(clear),
+    }
+}
+
+/// Which slab composites next, in compositing order, and the refusal of a voxel that reaches a
+/// slab already composited: what the slab renderers share.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SlabQueue {
+    count: usize,
+    order: Order,
+    done: usize,
+}
+
+impl SlabQueue {
+    pub(crate) fn new(count: usize, order: Order) -> Self {
+        SlabQueue {
+            count,
+            order,
+            done: 0,
+        }
+    }
+
+    /// The next slab to composite (`None` when all are done): slab 0 first front to back.
+    pub(crate) fn next(&self) -> Option<usize> {
+        (self.done < self.count).then(|| match self.order {
+            Order::FrontToBack => self.done,
+            Order::BackToFront => self.count - 1 - self.done,
+        })
+    }
+
+    /// Refuses a voxel reaching slabs `first..=last` if one of them is already composited.
+    pub(crate) fn admit(&self, first: usize, last: usize) -> Result<(), RenderError> {
+        let late = match (self.order, self.next()) {
+            (_, None) => true,
+            (Order::FrontToBack, Some(n)) => first < n,
+            (Order::BackToFront, Some(n)) => last > n,
+        };
+        if late {
+            return Err(RenderError::SlabOrder {
+                first,
+                last,
+                composited: self.done,
+            });
+        }
+        Ok(())
+    }
+
+    /// One more slab composited.
+    pub(crate) fn advance(&mut self) {
+        self.done += 1;
     }
 }
 

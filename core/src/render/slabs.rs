@@ -48,7 +48,7 @@
 //! ([`SlabError::Perspective`]).
 
 use super::absorption::{extinction_layer, Absorption, MAX_UNIT_ALPHA};
-use super::band::{check_band, start_image};
+use super::band::{check_band, start_image, SlabQueue};
 use super::precision::float_over_row;
 use super::{RenderError, RenderStats};
 use crate::composite::{over, RowSpan};
@@ -382,8 +382,7 @@ pub struct SlabRenderer<'a, const R: usize, const T: usize> {
     ring: usize,
     buffers: SlabBuffers<'a>,
     background: Option<&'a [[f32; 4]]>,
-    /// Slabs composited so far.
-    done: usize,
+    queue: SlabQueue,
     stats: RenderStats,
 }
 
@@ -419,7 +418,7 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
             ring,
             buffers,
             background,
-            done: 0,
+            queue: SlabQueue::new(setup.count, order),
             stats: RenderStats::default(),
         };
         start_image(&mut r.buffers.image[..n], background, order, [0.0; 4]);
@@ -434,11 +433,7 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
 
     /// The next slab [`SlabRenderer::composite_next`] composites (`None` when all are done).
     pub fn next_slab(&self) -> Option<usize> {
-        let c = self.setup.count;
-        (self.done < c).then(|| match self.order {
-            Order::FrontToBack => self.done,
-            Order::BackToFront => c - 1 - self.done,
-        })
+        self.queue.next()
     }
 
     /// Adds `voxel`'s kernel, cut by every slab it overlaps, to those slabs' accumulators
@@ -447,18 +442,7 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
         let s = self.setup;
         let [cx, cy, cz] = voxel.position;
         let (first, last) = s.slabs_of(cz);
-        let composited = match (self.order, self.next_slab()) {
-            (_, None) => true,
-            (Order::FrontToBack, Some(n)) => first < n,
-            (Order::BackToFront, Some(n)) => last > n,
-        };
-        if composited {
-            return Err(RenderError::SlabOrder {
-                first,
-                last,
-                composited: self.done,
-            });
-        }
+        self.queue.admit(first, last)?;
         let rows = s.rows_of(cy);
         let (b0, bn) = self.band;
         let (y0, y1) = (rows.start.max(b0), rows.end.min(b0 + bn));
@@ -574,7 +558,7 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
             self.stats.pixels_composited += u64::from(span.hi - span.lo + 1);
             *span = RowSpan::EMPTY;
         }
-        self.done += 1;
+        self.queue.advance();
         self.stats.sheets += 1;
     }
 

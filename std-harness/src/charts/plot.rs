@@ -373,17 +373,7 @@ pub fn time_chart<'a, DB: DrawingBackend>(
     pad: (f64, f64),
     ys: std::ops::Range<f64>,
     y_desc: &str,
-) -> Result<
-    ChartContext<
-        'a,
-        DB,
-        Cartesian2d<
-            plotters::coord::combinators::LogCoord<f64>,
-            plotters::coord::types::RangedCoordf64,
-        >,
-    >,
-    CliError,
-> {
+) -> Result<TimeChart<'a, DB>, CliError> {
     let tmin = times.0.max(1e-6);
     let tmax = times.1.max(tmin * 2.0);
     let mut chart = ChartBuilder::on(root)
@@ -400,6 +390,63 @@ pub fn time_chart<'a, DB: DrawingBackend>(
         .draw()
         .map_err(plot_err)?;
     Ok(chart)
+}
+
+/// The median, least and greatest of `times` (sorted in place; at least one).
+pub fn median_min_max(times: &mut [f64]) -> (f64, f64, f64) {
+    times.sort_by(f64::total_cmp);
+    (times[times.len() / 2], times[0], times[times.len() - 1])
+}
+
+/// A timed chart's chart area: log time against a linear axis.
+pub type TimeChart<'a, DB> = ChartContext<
+    'a,
+    DB,
+    Cartesian2d<
+        plotters::coord::combinators::LogCoord<f64>,
+        plotters::coord::types::RangedCoordf64,
+    >,
+>;
+
+/// One timed point: min–max time bar, median, its y, colour and label.
+pub struct TimedPoint {
+    pub min_s: f64,
+    pub max_s: f64,
+    pub median_s: f64,
+    pub y: f64,
+    pub colour: RGBColor,
+    pub label: String,
+}
+
+/// Draws each point's min–max bar and a filled dot at its median, labelled to its right.
+pub fn draw_timed_points<DB: DrawingBackend>(
+    chart: &mut TimeChart<'_, DB>,
+    points: &[TimedPoint],
+) -> Result<(), CliError> {
+    chart
+        .draw_series(
+            points.iter().map(|p| {
+                PathElement::new(vec![(p.min_s, p.y), (p.max_s, p.y)], BLACK.stroke_width(1))
+            }),
+        )
+        .map_err(plot_err)?;
+    for p in points {
+        chart
+            .draw_series(std::iter::once(Circle::new(
+                (p.median_s, p.y),
+                5,
+                p.colour.filled(),
+            )))
+            .map_err(plot_err)?;
+        chart
+            .draw_series(std::iter::once(Text::new(
+                p.label.clone(),
+                (p.median_s * 1.04, p.y + 0.4),
+                ("sans-serif", 13),
+            )))
+            .map_err(plot_err)?;
+    }
+    Ok(())
 }
 
 /// The fastest minimum and slowest maximum of timed rows.

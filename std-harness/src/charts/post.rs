@@ -6,7 +6,9 @@
 //! view: the speed a post-classified frame buys with accuracy. The pre-classified trade-off
 //! charts do not apply to this mode (they measure against the pre-classified models).
 
-use super::plot::{plot_err, time_chart, time_spread, write_svg_png};
+use super::plot::{
+    draw_timed_points, median_min_max, plot_err, time_chart, time_spread, write_svg_png, TimedPoint,
+};
 use crate::args::{ClassificationArg, RenderArgs, Supersample};
 use crate::metrics::compare;
 use crate::pipeline::ends::continuous::render_continuous_as;
@@ -77,8 +79,7 @@ pub fn sweep(base: &RenderArgs, runs: usize) -> Result<Vec<PostRow>, CliError> {
         }
     }
     for (r, t) in rows.iter_mut().zip(&mut times) {
-        t.sort_by(f64::total_cmp);
-        (r.median_s, r.min_s, r.max_s) = (t[t.len() / 2], t[0], t[t.len() - 1]);
+        (r.median_s, r.min_s, r.max_s) = median_min_max(t);
     }
     Ok(rows)
 }
@@ -136,31 +137,18 @@ fn draw<DB: DrawingBackend>(
             BLACK.mix(0.4).stroke_width(1),
         ))
         .map_err(plot_err)?;
-    chart
-        .draw_series(rows.iter().map(|r| {
-            PathElement::new(
-                vec![(r.min_s, r.psnr_db), (r.max_s, r.psnr_db)],
-                BLACK.stroke_width(1),
-            )
-        }))
-        .map_err(plot_err)?;
-    for r in rows {
-        let colour = [BLUE, RED, MAGENTA][(r.scale - 1).min(2)];
-        chart
-            .draw_series(std::iter::once(Circle::new(
-                (r.median_s, r.psnr_db),
-                5,
-                colour.filled(),
-            )))
-            .map_err(plot_err)?;
-        chart
-            .draw_series(std::iter::once(Text::new(
-                format!("slab {}, 1/{}", r.slab, r.scale),
-                (r.median_s * 1.04, r.psnr_db + 0.4),
-                ("sans-serif", 13),
-            )))
-            .map_err(plot_err)?;
-    }
+    let points: Vec<TimedPoint> = rows
+        .iter()
+        .map(|r| TimedPoint {
+            min_s: r.min_s,
+            max_s: r.max_s,
+            median_s: r.median_s,
+            y: r.psnr_db,
+            colour: [BLUE, RED, MAGENTA][(r.scale - 1).min(2)],
+            label: format!("slab {}, 1/{}", r.slab, r.scale),
+        })
+        .collect();
+    draw_timed_points(&mut chart, &points)?;
     root.present().map_err(plot_err)?;
     Ok(())
 }

@@ -6,7 +6,9 @@
 //! (`--refine-reference`, 128 by default) rendered with the same flags. The paper calls the
 //! threshold "a time versus quality tradeoff control"; this is that trade-off, measured.
 
-use super::plot::{plot_err, time_chart, time_spread, write_svg_png};
+use super::plot::{
+    draw_timed_points, median_min_max, plot_err, time_chart, time_spread, write_svg_png, TimedPoint,
+};
 use crate::args::RenderArgs;
 use crate::metrics::compare;
 use crate::pipeline::stages::visible::FrameCache;
@@ -97,8 +99,7 @@ pub fn sweep(base: &RenderArgs, reference: usize, runs: usize) -> Result<Vec<Ref
         }
     }
     for (r, t) in rows.iter_mut().zip(&mut times) {
-        t.sort_by(f64::total_cmp);
-        (r.median_s, r.min_s, r.max_s) = (t[t.len() / 2], t[0], t[t.len() - 1]);
+        (r.median_s, r.min_s, r.max_s) = median_min_max(t);
     }
     Ok(rows)
 }
@@ -184,35 +185,22 @@ fn draw<DB: DrawingBackend>(
             guide,
         ))
         .map_err(plot_err)?;
-    chart
-        .draw_series(rows.iter().map(|r| {
-            PathElement::new(
-                vec![(r.min_s, r.psnr_db), (r.max_s, r.psnr_db)],
-                BLACK.stroke_width(1),
-            )
-        }))
-        .map_err(plot_err)?;
-    for r in rows {
-        let colour = match (r.threshold, r.sheets) {
-            (None, _) => RED,
-            (_, true) => MAGENTA,
-            _ => BLUE,
-        };
-        chart
-            .draw_series(std::iter::once(Circle::new(
-                (r.median_s, r.psnr_db),
-                5,
-                colour.filled(),
-            )))
-            .map_err(plot_err)?;
-        chart
-            .draw_series(std::iter::once(Text::new(
-                format!("{} ({} samples)", label(r), r.samples),
-                (r.median_s * 1.04, r.psnr_db + 0.4),
-                ("sans-serif", 13),
-            )))
-            .map_err(plot_err)?;
-    }
+    let points: Vec<TimedPoint> = rows
+        .iter()
+        .map(|r| TimedPoint {
+            min_s: r.min_s,
+            max_s: r.max_s,
+            median_s: r.median_s,
+            y: r.psnr_db,
+            colour: match (r.threshold, r.sheets) {
+                (None, _) => RED,
+                (_, true) => MAGENTA,
+                _ => BLUE,
+            },
+            label: format!("{} ({} samples)", label(r), r.samples),
+        })
+        .collect();
+    draw_timed_points(&mut chart, &points)?;
     root.present().map_err(plot_err)?;
     Ok(())
 }

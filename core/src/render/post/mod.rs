@@ -50,7 +50,7 @@
 //! crosses every sheet, so a sheet-at-a-time source cannot feed it from a bounded window. There
 //! is no fixed-point variant (classification divides and shades per pixel and slab).
 
-use super::band::{check_band, start_image};
+use super::band::{check_band, start_image, SlabQueue};
 use super::precision::float_over_row;
 use super::slabs::centres_within;
 use super::{RenderError, RenderStats};
@@ -120,7 +120,7 @@ pub struct PostRenderer<'a, C: Classify, const N: usize> {
     ring: usize,
     buffers: PostBuffers<'a>,
     background: Option<&'a [[f32; 4]]>,
-    done: usize,
+    queue: SlabQueue,
     stats: RenderStats,
 }
 
@@ -161,7 +161,7 @@ impl<'a, C: Classify, const N: usize> PostRenderer<'a, C, N> {
             ring,
             buffers,
             background,
-            done: 0,
+            queue: SlabQueue::new(setup.full.count, order),
             stats: RenderStats::default(),
         };
         start_image(&mut r.buffers.image[..n], background, order, [0.0; 4]);
@@ -176,11 +176,7 @@ impl<'a, C: Classify, const N: usize> PostRenderer<'a, C, N> {
 
     /// The next slab [`PostRenderer::composite_next`] composites (`None` when all are done).
     pub fn next_slab(&self) -> Option<usize> {
-        let c = self.setup.full.count;
-        (self.done < c).then(|| match self.order {
-            Order::FrontToBack => self.done,
-            Order::BackToFront => c - 1 - self.done,
-        })
+        self.queue.next()
     }
 
     /// Adds `voxel`'s weighted value (and gradient) at the mid-plane of every slab its kernel
@@ -193,18 +189,7 @@ impl<'a, C: Classify, const N: usize> PostRenderer<'a, C, N> {
         let (first, last) = self.setup.full.slabs_of(voxel.position[2]);
         let inv = 1.0 / self.setup.scale as f32;
         let [cx, cy, cz] = voxel.position.map(|c| c * inv);
-        let composited = match (self.order, self.next_slab()) {
-            (_, None) => true,
-            (Order::FrontToBack, Some(n)) => first < n,
-            (Order::BackToFront, Some(n)) => last > n,
-        };
-        if composited {
-            return Err(RenderError::SlabOrder {
-                first,
-                last,
-                composited: self.done,
-            });
-        }
+        self.queue.admit(first, last)?;
         let rows = s.rows_of(cy);
         let (v0, vn) = self.values;
         let (y0, y1) = (rows.start.max(v0), rows.end.min(v0 + vn));
@@ -411,7 +396,7 @@ impl<'a, C: Classify, const N: usize> PostRenderer<'a, C, N> {
             *span = RowSpan::EMPTY;
         }
         self.stats.pixels_composited += composited;
-        self.done += 1;
+        self.queue.advance();
         self.stats.sheets += 1;
     }
 

@@ -33,7 +33,9 @@ fn weight_table_follows_the_gaussian() {
     for i in 0..=1000 {
         let r2 = i as f32 / 1000.0 * 0.999;
         let exact = (-0.5 * f64::from(sigmas).powi(2) * f64::from(r2)).exp();
-        assert!((f64::from(t.at(r2)) - exact).abs() < 2e-6, "r² {r2}");
+        // The interpolation's own bound, plus the math backend's error in the nodes.
+        let bound = 2e-6 + f64::from(crate::math::ERROR_BOUNDS.exp_rel);
+        assert!((f64::from(t.at(r2)) - exact).abs() < bound, "r² {r2}");
     }
     assert_eq!(t.at(1.0), 0.0);
     assert_eq!(t.at(f32::NAN), 0.0);

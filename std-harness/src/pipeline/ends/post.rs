@@ -21,9 +21,8 @@
 //! accumulation and colour-carrying levels of detail (their colours are pre-classified).
 
 use crate::args::Supersample;
-use crate::pipeline::stages::bands::{equal_bands, on_bands, CoreFrame, Phases};
+use crate::pipeline::stages::bands::{CoreFrame, Phases};
 use crate::pipeline::stages::prepare::Prepared;
-use crate::pipeline::stages::supersample::to_output;
 use crate::pipeline::stages::visible::{FrameCache, PostSamples};
 use crate::CliError;
 use footprint::composite::RowSpan;
@@ -87,29 +86,9 @@ pub fn render_post(
     let classify_time = classify_samples + t1.elapsed().as_secs_f64();
 
     let (setup, weights, classify, sv) = (&setup, &*weights, &classify, &voxels);
-    let [w, h] = p.frame.size;
-    let (image, mut stats, band_phases) = on_bands(
-        crate::io::try_filled(w * h, [0.0f32; 4], "the image")?,
-        p.frame.size,
-        equal_bands(h, threads),
-        p.background.as_deref(),
-        |rows, band, bg| render_band(p, setup, weights, classify, sv, bg, band, rows),
-    )?;
-    stats.voxels = voxels.voxels.len() as u64;
-    let phases = Phases {
-        classify: classify_time,
-        tables,
-        ..band_phases
-    };
-    let image = to_output(image, p.out_size(), p.supersample);
-    Ok(CoreFrame {
-        image,
-        stats,
-        seconds: start.elapsed().as_secs_f64(),
-        phases,
-        threads: threads.clamp(1, p.frame.size[1]),
-        visible: Some(voxels.voxels.len()),
-        refine: None,
+    let timing = (start, classify_time, tables);
+    super::slabs::banded_frame(p, threads, timing, voxels.voxels.len(), |rows, band, bg| {
+        render_band(p, setup, weights, classify, sv, bg, band, rows)
     })
 }
 

@@ -71,16 +71,41 @@ pub fn render_slabs(
     let classify = classify_lists + t1.elapsed().as_secs_f64();
 
     let (setup, table, sv) = (&setup, &*table, &voxels);
+    let timing = (start, classify, tables);
+    banded_frame(p, threads, timing, voxels.voxels.len(), |rows, band, bg| {
+        render_band(p, setup, table, sv, bg, band, rows)
+    })
+}
+
+/// A slab end's frame: `band` rendered on `threads` equal bands of image rows, with the phases
+/// timed before it (`timing`: the frame's start, classification and table seconds), its
+/// `voxels` (every band sees only those that reach it: the frame's are the list's), resampled to
+/// the output size.
+pub(crate) fn banded_frame<F>(
+    p: &Prepared,
+    threads: usize,
+    timing: (Instant, f64, f64),
+    voxels: usize,
+    band: F,
+) -> Result<CoreFrame, CliError>
+where
+    F: Fn(
+            std::ops::Range<usize>,
+            &mut [[f32; 4]],
+            Option<&[[f32; 4]]>,
+        ) -> Result<(RenderStats, Phases), CliError>
+        + Sync,
+{
+    let (start, classify, tables) = timing;
     let [w, h] = p.frame.size;
     let (image, mut stats, band_phases) = on_bands(
         crate::io::try_filled(w * h, [0.0f32; 4], "the image")?,
         p.frame.size,
         equal_bands(h, threads),
         p.background.as_deref(),
-        |rows, band, bg| render_band(p, setup, table, sv, bg, band, rows),
+        band,
     )?;
-    // Every band sees only the voxels that reach it: the frame's voxels are the visible ones.
-    stats.voxels = voxels.voxels.len() as u64;
+    stats.voxels = voxels as u64;
     let phases = Phases {
         classify,
         tables,
@@ -93,7 +118,7 @@ pub fn render_slabs(
         seconds: start.elapsed().as_secs_f64(),
         phases,
         threads: threads.clamp(1, p.frame.size[1]),
-        visible: Some(voxels.voxels.len()),
+        visible: Some(voxels),
         refine: None,
     })
 }
