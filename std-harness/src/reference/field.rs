@@ -17,7 +17,7 @@
 
 use crate::CliError;
 use footprint::frame::FrameSetup;
-use footprint::render::{gradient, SheetWindow};
+use footprint::render::{gradient, SheetRing};
 use footprint::shade::{Lighting, Shader};
 use footprint::Kernel;
 use glam::{DVec3, Vec3};
@@ -126,20 +126,12 @@ impl<'s> Field<'s> {
         // Opacity per world unit: the shader at an exponent of one.
         let lighting = Lighting::per_world_unit(f);
         let (len, na, nb) = f.sheet_shape();
-        let mut bufs = [vec![0.0f32; len], vec![0.0f32; len], vec![0.0f32; len]];
-        for s in 0..f.sheet_count() {
-            if s > 0 {
-                sheet(s - 1, &mut bufs[0]);
-            }
-            sheet(s, &mut bufs[1]);
-            if s + 1 < f.sheet_count() {
-                sheet(s + 1, &mut bufs[2]);
-            }
-            let window = SheetWindow {
-                lower: (s > 0).then_some(&bufs[0][..]),
-                current: &bufs[1][..],
-                upper: (s + 1 < f.sheet_count()).then_some(&bufs[2][..]),
-            };
+        // Each sheet read once, through a ring of three: a sheet's window is complete once the
+        // next is in.
+        let mut storage = vec![0.0f32; 3 * len];
+        let mut ring = SheetRing::new(&mut storage, f, f.order_for_ascending())?;
+        let mut store = |ring: &SheetRing<'_, f32>, n: usize| {
+            let (s, window) = (ring.sheet_index(n), ring.window(n));
             for v in 0..nb {
                 for u in 0..na {
                     let idx = f.grid_index(s, u, v);
@@ -165,6 +157,18 @@ impl<'s> Field<'s> {
                     }
                 }
             }
+        };
+        for s in 0..f.sheet_count() {
+            let done = ring.push_with(|slot| {
+                sheet(s, slot);
+                Ok::<_, footprint::render::RenderError>(())
+            })?;
+            if let Some(n) = done {
+                store(&ring, n);
+            }
+        }
+        if let Some(n) = ring.last() {
+            store(&ring, n);
         }
         let (reach, kernel) = match (scene.reconstruction, *scene.kernel) {
             (Reconstruction::Trilinear, _) => (1.0, None),

@@ -169,7 +169,8 @@ impl<'a, C: Classify, const N: usize> PostRenderer<'a, C, N> {
         Ok(r)
     }
 
-    /// Counts so far (`sheets` counts slabs composited; `pixel_updates` value pixels updated).
+    /// Counts so far (`sheets` counts slabs composited; `pixel_updates` the (value pixel, slab)
+    /// additions; `pixels_composited` the image pixels whose slab sums were read).
     pub fn stats(&self) -> RenderStats {
         self.stats
     }
@@ -318,7 +319,7 @@ impl<'a, C: Classify, const N: usize> PostRenderer<'a, C, N> {
         // One pixel's sums `a` classified and composited (nothing where it is transparent or
         // outside the voxel box).
         let shade = |pixel: &mut [f32; 4], a: &PostSample, x: usize, y: usize| {
-            if !(a[0] > 0.0) || a[1] <= clear * a[0] {
+            if transparent(a) {
                 return;
             }
             if order == Order::FrontToBack && pixel[3] >= 1.0 {
@@ -353,31 +354,32 @@ impl<'a, C: Classify, const N: usize> PostRenderer<'a, C, N> {
                 }
                 composited += (hi - lo + 1) as u64;
             }
-        }
-        for y in (0..bn).filter(|_| scale > 1) {
-            let (ry, fy) = cell_of(b0 + y, scale);
-            let (ra, rb) = (row(ry), row(ry + 1));
-            let (lo, hi) = match (ra, rb) {
-                (None, None) => continue,
-                (Some((_, s)), None) | (None, Some((_, s))) => (s.lo, s.hi),
-                (Some((_, s)), Some((_, t))) => (s.lo.min(t.lo), s.hi.max(t.hi)),
-            };
-            let line = &mut img[y * w..(y + 1) * w];
-            for cx in i64::from(lo) - 1..=i64::from(hi) {
-                let c = [at(ra, cx), at(ra, cx + 1), at(rb, cx), at(rb, cx + 1)];
-                if c.iter().all(|c| transparent(c)) {
-                    continue;
-                }
-                for x in pixels_of_cell(cx, scale, w) {
-                    let fx = cell_of(x, scale).1;
-                    let mut a = [0.0f32; 5];
-                    for (ch, v) in a.iter_mut().enumerate().take(channels) {
-                        let top = c[0][ch] + fx * (c[1][ch] - c[0][ch]);
-                        let bottom = c[2][ch] + fx * (c[3][ch] - c[2][ch]);
-                        *v = top + fy * (bottom - top);
+        } else {
+            for y in 0..bn {
+                let (ry, fy) = cell_of(b0 + y, scale);
+                let (ra, rb) = (row(ry), row(ry + 1));
+                let (lo, hi) = match (ra, rb) {
+                    (None, None) => continue,
+                    (Some((_, s)), None) | (None, Some((_, s))) => (s.lo, s.hi),
+                    (Some((_, s)), Some((_, t))) => (s.lo.min(t.lo), s.hi.max(t.hi)),
+                };
+                let line = &mut img[y * w..(y + 1) * w];
+                for cx in i64::from(lo) - 1..=i64::from(hi) {
+                    let c = [at(ra, cx), at(ra, cx + 1), at(rb, cx), at(rb, cx + 1)];
+                    if c.iter().all(|c| transparent(c)) {
+                        continue;
                     }
-                    composited += 1;
-                    shade(&mut line[x], &a, x, b0 + y);
+                    for x in pixels_of_cell(cx, scale, w) {
+                        let fx = cell_of(x, scale).1;
+                        let mut a = [0.0f32; 5];
+                        for (ch, v) in a.iter_mut().enumerate().take(channels) {
+                            let top = c[0][ch] + fx * (c[1][ch] - c[0][ch]);
+                            let bottom = c[2][ch] + fx * (c[3][ch] - c[2][ch]);
+                            *v = top + fy * (bottom - top);
+                        }
+                        composited += 1;
+                        shade(&mut line[x], &a, x, b0 + y);
+                    }
                 }
             }
         }

@@ -114,19 +114,17 @@ impl Classify for ShadedLayers<'_> {
 
     #[inline]
     fn layer(&self, value: f32, gradient: Vec3, index: [usize; 3], fraction: f32) -> [f32; 4] {
-        if fraction == 1.0 {
-            return self.shader.shade_with(
-                &self.lighting,
-                Some(&self.table),
-                value,
-                || gradient,
-                index,
-                self.dims,
-            );
-        }
-        let lighting = self.lighting.with_opacity_exponent(self.chord * fraction);
+        // The full chord's correction from the table; a part of it computed exactly.
+        let (lighting, table) = if fraction == 1.0 {
+            (self.lighting, Some(&self.table))
+        } else {
+            (
+                self.lighting.with_opacity_exponent(self.chord * fraction),
+                None,
+            )
+        };
         self.shader
-            .shade(&lighting, value, || gradient, index, self.dims)
+            .shade_with(&lighting, table, value, || gradient, index, self.dims)
     }
 }
 
@@ -281,11 +279,9 @@ pub(super) fn cell_of(x: usize, s: usize) -> (i64, f32) {
 /// to 0..`n`.
 #[inline]
 pub(super) fn pixels_of_cell(x0: i64, s: usize, n: usize) -> core::ops::Range<usize> {
-    // x is in cell x0 iff 2s·x0 ≤ 2x + 1 − s < 2s·(x0 + 1).
-    let start = |c: i64| {
-        (2 * s as i64 * c + s as i64 - 1).div_euclid(2)
-            + ((2 * s as i64 * c + s as i64 - 1).rem_euclid(2))
-    };
+    // x is in cell x0 iff 2s·x0 ≤ 2x + 1 − s < 2s·(x0 + 1): the cell's first pixel is
+    // ⌈(2s·x0 + s − 1)/2⌉ = ⌊(2s·x0 + s)/2⌋.
+    let start = |c: i64| (2 * s as i64 * c + s as i64).div_euclid(2);
     let (a, b) = (start(x0), start(x0 + 1));
     let clamp = |v: i64| v.clamp(0, n as i64) as usize;
     clamp(a)..clamp(b).max(clamp(a))

@@ -30,7 +30,7 @@ use footprint::frame::Order;
 use footprint::render::post::{MAX_VALUE_SCALE, WEIGHT_NODES};
 use footprint::render::{
     gradient, PostBuffers, PostRenderer, PostSetup, PostVoxel, RenderStats, ShadedLayers,
-    SheetWindow, WeightTable,
+    SheetRing, WeightTable,
 };
 use footprint::shade::OPACITY_TABLE_LEN;
 use std::time::Instant;
@@ -159,8 +159,8 @@ fn post_samples(
     if count.saturating_mul(BYTES_PER_SAMPLE) > budget {
         return Err(CliError::input(format!(
             "{}: --classification post keeps the {count} voxels near visible values in memory \
-             ({BYTES_PER_SAMPLE} bytes each), more than {} MiB: render a coarser level (--lod) or \
-             narrow the transfer function",
+             ({BYTES_PER_SAMPLE} bytes each), more than {} MiB: narrow the transfer function's \
+             visible values or use --classification pre",
             p.name,
             budget >> 20
         )));
@@ -174,21 +174,12 @@ fn post_samples(
     out.index.try_reserve_exact(count).map_err(reserve)?;
     out.value.try_reserve_exact(count).map_err(reserve)?;
     out.gradient.try_reserve_exact(count).map_err(reserve)?;
-    let mut bufs = [vec![0.0f32; len], vec![0.0f32; len], vec![0.0f32; len]];
-    let last = f.sheet_count() - 1;
-    for s in 0..=last {
-        if s > 0 {
-            volume.sheet_into(axis, s - 1, &mut bufs[0]);
-        }
-        volume.sheet_into(axis, s, &mut bufs[1]);
-        if s < last {
-            volume.sheet_into(axis, s + 1, &mut bufs[2]);
-        }
-        let window = SheetWindow {
-            lower: (s > 0).then_some(&bufs[0][..]),
-            current: &bufs[1][..],
-            upper: (s < last).then_some(&bufs[2][..]),
-        };
+    // Each sheet read once, through a ring of three: a sheet's window is complete once the
+    // next is in.
+    let mut storage = vec![0.0f32; 3 * len];
+    let mut ring = SheetRing::new(&mut storage, f, f.order_for_ascending())?;
+    let mut keep = |ring: &SheetRing<'_, f32>, n: usize| {
+        let (s, window) = (ring.sheet_index(n), ring.window(n));
         for v in 0..nb {
             for u in 0..na {
                 let value = window.current[v * na + u];
@@ -205,6 +196,18 @@ fn post_samples(
                 out.gradient.push(g);
             }
         }
+    };
+    for s in 0..f.sheet_count() {
+        let done = ring.push_with(|slot| {
+            volume.sheet_into(axis, s, slot);
+            Ok::<_, footprint::render::RenderError>(())
+        })?;
+        if let Some(n) = done {
+            keep(&ring, n);
+        }
+    }
+    if let Some(n) = ring.last() {
+        keep(&ring, n);
     }
     Ok(out)
 }
