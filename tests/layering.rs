@@ -66,6 +66,8 @@ fn rank(node: &str) -> u32 {
         "cli" => 8,
         "commands" => 7,
         "charts" => 6,
+        // Scale-out: bricks rendered by the pipeline and composited; commands call it.
+        "distributed" => 6,
         "pipeline" => 5,
         // The render plan: resolved from the arguments, read by the pipeline.
         "plan" => 4,

@@ -450,6 +450,20 @@ pub struct RenderArgs {
     pub quality_reference: QualityReferenceArg,
 }
 
+/// `--bricks X,Y,Z`: three counts, each at least 1.
+pub fn parse_bricks(s: &str) -> Result<[usize; 3], String> {
+    let v: Vec<usize> = s
+        .split(',')
+        .map(|x| x.trim().parse::<usize>().map_err(|e| format!("'{x}': {e}")))
+        .collect::<Result<_, _>>()?;
+    match v[..] {
+        [x, y, z] if x >= 1 && y >= 1 && z >= 1 => Ok([x, y, z]),
+        _ => Err(format!(
+            "expected X,Y,Z brick counts, each at least 1 (got '{s}')"
+        )),
+    }
+}
+
 fn parse_dims(s: &str) -> Result<[usize; 3], String> {
     let v: Vec<&str> = s.split(',').collect();
     if v.len() != 3 {

@@ -62,6 +62,7 @@ pub mod charts;
 pub mod cli;
 pub mod commands;
 pub mod dispatch;
+pub mod distributed;
 pub mod io;
 pub mod metrics;
 pub mod pipeline;

@@ -16,6 +16,10 @@ pub struct CompareArgs {
     /// Fail (exit 1) if max |A − B| / peak(B) exceeds this.
     #[arg(long)]
     pub max_diff: Option<f64>,
+    /// Fail (exit 1) if the PSNR of A against B, 10·log₁₀(1 / MSE) over every value (peak 1, the
+    /// convention of `verify`), is below this many dB.
+    #[arg(long, value_name = "DB")]
+    pub min_psnr: Option<f64>,
 }
 
 /// Exit 1 (a failed check) when the difference exceeds `--max-diff` or either image holds a
@@ -51,10 +55,28 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
         }
     }
     let d = max_rel_diff(&a, &b)?;
-    crate::say!("max |A-B| / peak(B) = {d:.6} ({:.4} %)", d * 100.0);
-    match args.max_diff {
-        Some(limit) if !(d <= limit) => Err(CliError::check(format!(
+    let mse = a
+        .data
+        .iter()
+        .zip(&b.data)
+        .map(|(&x, &y)| (f64::from(x) - f64::from(y)).powi(2))
+        .sum::<f64>()
+        / b.data.len().max(1) as f64;
+    let psnr = if mse > 0.0 {
+        10.0 * (1.0 / mse).log10()
+    } else {
+        f64::INFINITY
+    };
+    crate::say!(
+        "max |A-B| / peak(B) = {d:.6} ({:.4} %); PSNR {psnr:.2} dB (peak 1)",
+        d * 100.0
+    );
+    match (args.max_diff, args.min_psnr) {
+        (Some(limit), _) if !(d <= limit) => Err(CliError::check(format!(
             "difference {d:.6} exceeds --max-diff {limit}"
+        ))),
+        (_, Some(db)) if !(psnr >= db) => Err(CliError::check(format!(
+            "PSNR {psnr:.2} dB is below --min-psnr {db}"
         ))),
         _ => Ok(()),
     }

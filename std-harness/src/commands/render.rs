@@ -28,6 +28,13 @@ pub struct RenderCommandArgs {
     /// colours, its opacity as a white line, and the window's values, in a panel at the right.
     #[arg(help_heading = "Picture", long)]
     pub colorbar: bool,
+    /// Split the volume into X×Y×Z bricks rendered on their own and composited front to back
+    /// (sort-last). Under `mpirun -np N` (a build with the `mpi` feature) rank n renders brick n
+    /// and X·Y·Z must be N (default with N > 1: a balanced k-d split into N); in one process the
+    /// bricks render in turn. The JSON gains `ranks`, `bricks`, `order` and `per_rank`. See
+    /// docs/scale-out.md.
+    #[arg(help_heading = "Scale-out", long, value_name = "X,Y,Z", value_parser = crate::args::parse_bricks)]
+    pub bricks: Option<[usize; 3]>,
 }
 
 pub fn run(command: &RenderCommandArgs) -> Result<(), CliError> {
@@ -57,6 +64,17 @@ pub fn run(command: &RenderCommandArgs) -> Result<(), CliError> {
     // Every rule the flags decide, before anything is loaded.
     let asked = plan(args)?;
     let inputs = Inputs::from(args);
+    if let Some(split) = crate::distributed::render_split(&inputs, &asked, command.bricks)? {
+        if command.orbit.is_some() || command.colorbar {
+            return Err(CliError::input(
+                "--orbit and --colorbar render one process's frame: drop --bricks (or mpirun)",
+            ));
+        }
+        let Some((rgb, summary)) = split else {
+            return Ok(());
+        };
+        return write(args, &out, &rgb, summary);
+    }
     let (p, plan, choice) = apply_quality(prepare(args)?, &inputs, &asked)?;
     if let Some(n) = command.orbit {
         return orbit(p, args, &plan, &out, usize::from(n), command.colorbar);
@@ -128,9 +146,23 @@ pub fn run(command: &RenderCommandArgs) -> Result<(), CliError> {
     if command.colorbar {
         colorbar::draw(&mut rgb, args.size, &p.lut, p.window)?;
     }
-    let image = encode_rgb_for(&out, &rgb, args.size.0, args.size.1, args.png_style())?;
+    let summary = match crate::distributed::peak_memory_bytes() {
+        Some(m) => summary.num("peak_memory_bytes", m as f64),
+        None => summary,
+    };
+    write(args, &out, &rgb, summary)
+}
+
+/// Writes the image and the JSON summary (all or nothing).
+fn write(
+    args: &RenderArgs,
+    out: &Path,
+    rgb: &[[f32; 4]],
+    summary: crate::io::json::Json,
+) -> Result<(), CliError> {
+    let image = encode_rgb_for(out, rgb, args.size.0, args.size.1, args.png_style())?;
     let summary = summary.str("out", &out.display().to_string()).finish();
-    let mut files = vec![(out.as_path(), image.as_slice())];
+    let mut files = vec![(out, image.as_slice())];
     if let Some(j) = &args.json {
         files.push((j.as_path(), summary.as_bytes()));
     }

@@ -1,6 +1,7 @@
 //! Files: images (PFM, PNG) and generic tables. Every write goes to a temporary file beside the
 //! target and is renamed into place, so a failure never leaves a half-written output.
 
+pub mod brick;
 pub mod formats;
 pub mod image;
 pub mod json;

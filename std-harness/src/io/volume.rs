@@ -3,6 +3,7 @@
 //!
 //! Data are x-fastest: sample (i, j, k) is at `i + dims[0]·(j + dims[1]·k)`.
 
+use super::brick::BrickPlace;
 use crate::CliError;
 use footprint::lod::Coloured;
 use std::path::Path;
@@ -141,8 +142,14 @@ pub struct Volume {
     /// World direction (unit vector) of each grid axis: `directions[c]` for axis c. The identity for
     /// formats that state only spacings.
     pub directions: [[f32; 3]; 3],
-    /// The samples.
+    /// The samples: all `dims` of them, or, for a brick ([`Volume::brick`]), only the stored box.
     pub samples: Samples,
+    /// `Some` for one brick of a volume split among processes (`footprint render` under MPI,
+    /// [`super::brick`]): `dims` are the whole volume's, `samples` hold only
+    /// [`BrickPlace::stored`] (the brick and its ghost layers), and only the voxels of
+    /// [`BrickPlace::owned`] are rendered. Sheets read from it are the whole volume's, NaN
+    /// (missing, transparent) outside the stored box.
+    pub brick: Option<BrickPlace>,
 }
 
 /// The identity orientation.
@@ -156,7 +163,29 @@ impl Volume {
             spacing,
             directions: AXIS_ALIGNED,
             samples,
+            brick: None,
         }
+    }
+
+    /// The dims of the samples held: `dims`, or a brick's stored box.
+    pub fn stored_dims(&self) -> [usize; 3] {
+        self.brick.map_or(self.dims, |b| b.stored.dims())
+    }
+
+    /// The voxels of sheet `s` of `axis` this volume renders, as index ranges along the sheet's
+    /// two in-sheet axes (u, v); `None` when it renders none of them. The whole sheet unless the
+    /// volume is a brick.
+    pub fn owned_in_sheet(
+        &self,
+        axis: usize,
+        s: usize,
+    ) -> Option<(std::ops::Range<usize>, std::ops::Range<usize>)> {
+        let (a, b) = footprint::geometry::in_sheet_axes(axis);
+        let Some(brick) = self.brick else {
+            return Some((0..self.dims[a], 0..self.dims[b]));
+        };
+        let o = brick.owned;
+        (o.lo[axis] <= s && s < o.hi[axis]).then(|| (o.lo[a]..o.hi[a], o.lo[b]..o.hi[b]))
     }
 
     /// The grid-to-world matrix G: column c = `directions[c] × spacing[c]`.
@@ -195,7 +224,10 @@ impl Volume {
             Samples::F64(_) => 8,
             Samples::Coloured(_) => std::mem::size_of::<Coloured>(),
         };
-        self.len().saturating_mul(per)
+        self.stored_dims()
+            .iter()
+            .product::<usize>()
+            .saturating_mul(per)
     }
 
     /// Whether the volume has no voxel (never true for a loaded volume).
@@ -205,18 +237,38 @@ impl Volume {
 
     /// The finite samples at every [`sample_stride`]th index (0, s, 2s, …), ascending: at most
     /// [`SAMPLE_LIMIT`] values, the same ones a streamed file's range pass takes.
+    ///
+    /// A brick takes the indices of that same stride (of the whole volume) that it owns, so the
+    /// bricks' samples together are the whole volume's ([`super::brick`] joins them).
     pub fn strided_sample(&self) -> Vec<f32> {
         let n = self.len();
-        let mut out: Vec<f32> = (0..n)
-            .step_by(sample_stride(n))
-            .map(|i| self.value(i))
-            .filter(|x| x.is_finite())
-            .collect();
+        let mut out: Vec<f32> = match self.brick {
+            None => (0..n)
+                .step_by(sample_stride(n))
+                .map(|i| self.value(i))
+                .filter(|x| x.is_finite())
+                .collect(),
+            Some(b) => {
+                let [nx, ny, _] = self.dims;
+                let sd = b.stored.dims();
+                (0..n)
+                    .step_by(sample_stride(n))
+                    .map(|i| [i % nx, (i / nx) % ny, i / (nx * ny)])
+                    .filter(|&g| b.owned.contains(g))
+                    .map(|g| {
+                        let l = [0, 1, 2].map(|c| g[c] - b.stored.lo[c]);
+                        self.value(l[0] + sd[0] * (l[1] + sd[1] * l[2]))
+                    })
+                    .filter(|x| x.is_finite())
+                    .collect()
+            }
+        };
         out.sort_by(f32::total_cmp);
         out
     }
 
-    /// Smallest and largest finite sample; (+∞, −∞) when no sample is finite.
+    /// Smallest and largest finite sample (of those stored, for a brick); (+∞, −∞) when no
+    /// sample is finite.
     pub fn range(&self) -> (f32, f32) {
         // One loop per sample type (the type settled once, not per sample).
         fn over<T: Copy>(v: &[T], to: impl Fn(T) -> f32) -> (f32, f32) {
@@ -266,6 +318,9 @@ impl Volume {
         to: impl Fn(f32) -> O,
     ) {
         use footprint::volume::copy_sheets;
+        if let Some(b) = self.brick {
+            return self.brick_sheets_as(b, axis, sheets, out, to);
+        }
         let (d, a, s) = (self.dims, axis, sheets);
         match &self.samples {
             Samples::U8(v) => copy_sheets(v, d, a, s, out, |x| to(f32::from(x))),
@@ -277,6 +332,68 @@ impl Volume {
             Samples::F32(v) => copy_sheets(v, d, a, s, out, &to),
             Samples::F64(v) => copy_sheets(v, d, a, s, out, |x| to(x as f32)),
             Samples::Coloured(v) => copy_sheets(v, d, a, s, out, |x| to(x.value)),
+        }
+    }
+
+    /// [`Volume::sheets_as`] for a brick: each whole-volume sheet NaN outside the stored box,
+    /// the stored samples inside it.
+    fn brick_sheets_as<O>(
+        &self,
+        b: BrickPlace,
+        axis: usize,
+        sheets: std::ops::Range<usize>,
+        out: &mut [O],
+        to: impl Fn(f32) -> O,
+    ) {
+        let (a, c) = footprint::geometry::in_sheet_axes(axis);
+        let (na, len) = (self.dims[a], self.dims[a] * self.dims[c]);
+        let sd = b.stored.dims();
+        let local = Volume {
+            dims: sd,
+            brick: None,
+            ..self.clone_header()
+        };
+        let mut part = vec![0.0f32; sd[a] * sd[c]];
+        for (s, sheet) in sheets.zip(out.chunks_exact_mut(len)) {
+            sheet.iter_mut().for_each(|x| *x = to(f32::NAN));
+            if !(b.stored.lo[axis] <= s && s < b.stored.hi[axis]) {
+                continue;
+            }
+            local.sheet_into_with(&self.samples, axis, s - b.stored.lo[axis], &mut part);
+            for (v, row) in part.chunks_exact(sd[a]).enumerate() {
+                let start = (b.stored.lo[c] + v) * na + b.stored.lo[a];
+                for (o, &x) in sheet[start..start + sd[a]].iter_mut().zip(row) {
+                    *o = to(x);
+                }
+            }
+        }
+    }
+
+    /// This volume's header with no samples (for [`Volume::brick_sheets_as`]).
+    fn clone_header(&self) -> Volume {
+        Volume {
+            dims: self.dims,
+            spacing: self.spacing,
+            directions: self.directions,
+            samples: Samples::U8(Vec::new().into()),
+            brick: self.brick,
+        }
+    }
+
+    /// Sheet `s` of `axis` of `samples` laid out with this header's dims, as f32.
+    fn sheet_into_with(&self, samples: &Samples, axis: usize, s: usize, out: &mut [f32]) {
+        use footprint::volume::copy_sheet;
+        let (d, a) = (self.dims, axis);
+        match samples {
+            Samples::U8(v) => copy_sheet(v, d, a, s, out, f32::from),
+            Samples::I8(v) => copy_sheet(v, d, a, s, out, f32::from),
+            Samples::U16(v) => copy_sheet(v, d, a, s, out, f32::from),
+            Samples::I16(v) => copy_sheet(v, d, a, s, out, f32::from),
+            Samples::U32(v) => copy_sheet(v, d, a, s, out, |x| x as f32),
+            Samples::I32(v) => copy_sheet(v, d, a, s, out, |x| x as f32),
+            Samples::F32(v) => copy_sheet(v, d, a, s, out, |x| x),
+            Samples::F64(v) => copy_sheet(v, d, a, s, out, |x| x as f32),
+            Samples::Coloured(v) => copy_sheet(v, d, a, s, out, |x| x.value),
         }
     }
 

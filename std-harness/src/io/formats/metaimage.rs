@@ -233,6 +233,7 @@ pub fn load(path: &Path) -> Result<Volume, CliError> {
         spacing: h.spacing,
         directions: h.directions,
         samples: decode(&body, h.ty, h.big_endian).map_err(err)?,
+        brick: None,
     })
 }
 

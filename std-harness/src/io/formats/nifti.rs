@@ -502,5 +502,6 @@ pub fn load(path: &Path) -> Result<Volume, CliError> {
         spacing: h.spacing,
         directions: h.directions,
         samples,
+        brick: None,
     })
 }

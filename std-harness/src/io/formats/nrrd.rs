@@ -311,6 +311,7 @@ pub fn load(path: &Path) -> Result<Volume, CliError> {
         spacing: h.spacing,
         directions: h.directions,
         samples,
+        brick: None,
     })
 }
 

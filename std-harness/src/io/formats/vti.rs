@@ -496,5 +496,6 @@ pub fn load(path: &Path, array: Option<&str>) -> Result<Volume, CliError> {
         spacing: h.spacing,
         directions: h.directions,
         samples,
+        brick: None,
     })
 }

@@ -100,7 +100,9 @@ pub(crate) fn load_voxels(args: &Inputs) -> Result<Loaded, CliError> {
             ));
         }
         let v = &m.volume;
-        let (dims, grid, range) = (v.dims, v.grid_to_world(), Some(v.range()));
+        // A brick's range is its own, not the volume's: no warning compares the window with it.
+        let range = v.brick.is_none().then(|| v.range());
+        let (dims, grid) = (v.dims, v.grid_to_world());
         let sample = args.window.is_none().then(|| v.strided_sample());
         return Ok(Loaded {
             sample,

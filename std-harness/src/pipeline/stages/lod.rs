@@ -219,6 +219,7 @@ pub fn coarsen_volume(
         spacing: v.spacing.map(|s| s * scale),
         directions: v.directions,
         samples: Samples::Coloured(out.into()),
+        brick: None,
     })
 }
 

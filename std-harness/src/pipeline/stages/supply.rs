@@ -131,15 +131,27 @@ impl<T: ReadSheet> SheetSupply for OnTheFly<'_, T> {
                 .then(|| find(s + 1))
                 .flatten(),
         };
-        let n = classify_sheet(
-            f,
-            &shader,
-            s,
-            window,
-            &mut self.voxels,
-            &mut self.gradients,
-            &mut self.colours,
-        )?;
+        let n = match self.volume.owned_in_sheet(f.sheet_axis, s) {
+            Some(owned) => {
+                let n = classify_sheet(
+                    f,
+                    &shader,
+                    s,
+                    window,
+                    &mut self.voxels,
+                    &mut self.gradients,
+                    &mut self.colours,
+                )?;
+                super::visible::keep_owned(
+                    owned,
+                    n,
+                    &mut self.voxels,
+                    &mut self.gradients,
+                    &mut self.colours,
+                )
+            }
+            None => 0,
+        };
         self.supplied += n as u64;
         Ok(VisibleSheet {
             voxels: &self.voxels[..n],

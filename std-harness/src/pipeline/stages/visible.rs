@@ -356,7 +356,7 @@ fn classify_range(
 ) -> Result<Option<VisibleLists>, CliError> {
     let axis = p.frame.sheet_axis;
     if volume.is_coloured() {
-        return classify_sheets(p, range, budget, |s, buf: &mut [Coloured]| {
+        return classify_sheets(p, volume, range, budget, |s, buf: &mut [Coloured]| {
             volume.coloured_sheet_into(axis, s, buf)
         });
     }
@@ -370,7 +370,7 @@ fn classify_range(
         // (more than 1024² samples) are read one at a time, as before, rather than held twice.
         let mut block = Vec::new();
         let mut held = 0..0;
-        classify_sheets(p, range, budget, move |s, buf: &mut [f32]| {
+        classify_sheets(p, volume, range, budget, move |s, buf: &mut [f32]| {
             if !held.contains(&s) {
                 held = s..(s + per_block).min(count);
                 block.resize(held.len() * len, 0.0);
@@ -379,7 +379,7 @@ fn classify_range(
             buf.copy_from_slice(&block[(s - held.start) * len..][..len]);
         })
     } else {
-        classify_sheets(p, range, budget, |s, buf: &mut [f32]| {
+        classify_sheets(p, volume, range, budget, |s, buf: &mut [f32]| {
             volume.sheet_into(axis, s, buf)
         })
     }
@@ -395,6 +395,7 @@ const MAX_SHEET_BLOCK: usize = 16;
 /// [`classify_range`] over the samples `fill(s, sheet)` writes.
 fn classify_sheets<T: Sample + Default>(
     p: &Prepared,
+    volume: &Volume,
     range: std::ops::Range<usize>,
     budget: Budget<'_>,
     mut fill: impl FnMut(usize, &mut [T]),
@@ -444,15 +445,21 @@ fn classify_sheets<T: Sample + Default>(
             current: &cur,
             upper: upper.as_deref(),
         };
-        let n = classify_sheet(
-            f,
-            &shader,
-            s,
-            window,
-            &mut voxels,
-            &mut gradients,
-            &mut colours,
-        )?;
+        let n = match volume.owned_in_sheet(axis, s) {
+            Some(owned) => {
+                let n = classify_sheet(
+                    f,
+                    &shader,
+                    s,
+                    window,
+                    &mut voxels,
+                    &mut gradients,
+                    &mut colours,
+                )?;
+                keep_owned(owned, n, &mut voxels, &mut gradients, &mut colours)
+            }
+            None => 0,
+        };
         // The sheet's voxels, gradients, colours, runs (at most one per voxel) and offsets.
         let per = VisibleLists::BYTES_PER_VOXEL
             + 12 * (usize::from(needs_gradient) + usize::from(T::COLOURED))
@@ -484,6 +491,37 @@ fn classify_sheets<T: Sample + Default>(
         }
     }
     Ok(Some(out))
+}
+
+/// Of a sheet's `n` classified voxels (and their gradients and colours, where held), keeps those
+/// inside `owned` (index ranges along u and v: a brick's own voxels, [`Volume::owned_in_sheet`]),
+/// in order; returns how many. A whole volume's sheet keeps all of them, untouched.
+pub fn keep_owned(
+    (us, vs): (std::ops::Range<usize>, std::ops::Range<usize>),
+    n: usize,
+    voxels: &mut [VisibleVoxel],
+    gradients: &mut [[f32; 3]],
+    colours: &mut [[f32; 3]],
+) -> usize {
+    let inside =
+        |x: &VisibleVoxel| us.contains(&usize::from(x.u)) && vs.contains(&usize::from(x.v));
+    if voxels[..n].iter().all(inside) {
+        return n;
+    }
+    let mut kept = 0;
+    for i in 0..n {
+        if inside(&voxels[i]) {
+            voxels[kept] = voxels[i];
+            if !gradients.is_empty() {
+                gradients[kept] = gradients[i];
+            }
+            if !colours.is_empty() {
+                colours[kept] = colours[i];
+            }
+            kept += 1;
+        }
+    }
+    kept
 }
 
 #[cfg(test)]

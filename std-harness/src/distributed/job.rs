@@ -1,0 +1,441 @@
+//! One render split into bricks: what every brick shares ([`Job`]: the inputs, where the
+//! samples come from, the split, the window), and one brick's frame ([`Job::render`]).
+
+use super::BrickLayout;
+use crate::args::Lod;
+use crate::io::brick::{crop, read_box, BrickPlace, IndexBox};
+use crate::io::stream::{InMemory, Layout};
+use crate::io::volume::Volume;
+use crate::pipeline::stages::load::Voxels;
+use crate::pipeline::stages::visible::FrameCache;
+use crate::pipeline::{prepare, render_frame};
+use crate::plan::{End, Inputs, Plan};
+use crate::{io, scene, CliError};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// Where the bricks' samples come from.
+pub enum Source {
+    /// Raw samples at a known place in a file (a raw file with `--dims`, NRRD with raw
+    /// encoding, uncompressed MetaImage): each brick reads only its own box, with positioned
+    /// reads ([`crate::io::brick::read_box`]).
+    Seekable {
+        layout: Layout,
+        spacing: [f32; 3],
+        directions: [[f32; 3]; 3],
+    },
+    /// A volume loaded whole (a compressed file, a format without a raw layout, the built-in
+    /// scene): bricks are cut from it; `bytes` is what loading it read.
+    Whole { volume: Arc<Volume>, bytes: u64 },
+}
+
+/// One render split into bricks: what every brick shares.
+pub struct Job {
+    /// The inputs each brick renders with (its volume and the window set per brick).
+    pub inputs: Inputs,
+    pub plan: Plan,
+    /// The volume's name in messages and the JSON.
+    pub name: String,
+    /// The whole volume's dims.
+    pub dims: [usize; 3],
+    pub source: Source,
+    /// Whether the default window comes from the data's sample (a user's volume) or its range
+    /// (the built-in scene), as in one process.
+    sampled: bool,
+}
+
+impl Job {
+    /// The job for `inputs` and `plan`, refused with a reason where bricks cannot honour them.
+    /// Opens the source: a seekable file's header only; anything else is loaded whole.
+    pub fn new(inputs: &Inputs, plan: &Plan) -> Result<Job, CliError> {
+        refuse(inputs, plan)?;
+        let mut inputs = inputs.clone();
+        let builtin = inputs.volume.is_none() && inputs.memory.is_none();
+        inputs.tf = Some(
+            inputs
+                .tf
+                .clone()
+                .unwrap_or_else(|| if builtin { "density" } else { "ct-bone-skin" }.into()),
+        );
+        if inputs.lod == Lod::Auto {
+            // A level of detail is built from the whole volume; bricks render level 0.
+            inputs.lod = Lod::Level(0);
+        }
+        let raw = crate::pipeline::stages::load::raw_options(&inputs)?;
+        let (name, source) = match (&inputs.memory, &inputs.volume) {
+            (Some(m), _) => (
+                m.name.clone(),
+                Source::Whole {
+                    volume: Arc::clone(&m.volume),
+                    bytes: 0,
+                },
+            ),
+            (None, Some(path)) => (
+                path.display().to_string(),
+                match seekable(path, raw.as_ref())? {
+                    Some(s) => s,
+                    None => {
+                        let bytes = std::fs::metadata(path).map_or(0, |m| m.len());
+                        let volume = crate::io::formats::load_array(
+                            path,
+                            raw.as_ref(),
+                            inputs.array.as_deref(),
+                        )?;
+                        Source::Whole {
+                            volume: Arc::new(volume),
+                            bytes,
+                        }
+                    }
+                },
+            ),
+            (None, None) => (
+                match inputs.scene_size {
+                    scene::SIDE => "built-in electron-density scene".to_string(),
+                    n => format!("built-in electron-density scene, {n}^3"),
+                },
+                Source::Whole {
+                    volume: Arc::new(scene::volume(inputs.scene_size)?),
+                    bytes: 0,
+                },
+            ),
+        };
+        let dims = match &source {
+            Source::Seekable { layout, .. } => layout.dims,
+            Source::Whole { volume, .. } => volume.dims,
+        };
+        inputs.memory = None;
+        inputs.volume = None;
+        inputs.dims = None;
+        inputs.sample_type = None;
+        Ok(Job {
+            inputs,
+            plan: plan.clone(),
+            name,
+            dims,
+            source,
+            sampled: !builtin,
+        })
+    }
+
+    /// The split into `n` bricks (`--bricks` when given: its product must be `n`).
+    pub fn layout(&self, n: usize, bricks: Option<[usize; 3]>) -> Result<BrickLayout, CliError> {
+        match bricks {
+            Some(counts) => {
+                let m: usize = counts.iter().product();
+                if m != n {
+                    return Err(CliError::input(format!(
+                        "--bricks {},{},{} makes {m} bricks for {n} ranks: give as many bricks \
+                         as ranks",
+                        counts[0], counts[1], counts[2]
+                    )));
+                }
+                BrickLayout::grid(self.dims, counts)
+            }
+            None => BrickLayout::balanced(self.dims, n, self.sheet_axis()?),
+        }
+    }
+
+    /// The sheet axis of the frame the inputs ask for (what the default split cuts across).
+    fn sheet_axis(&self) -> Result<usize, CliError> {
+        let grid = footprint::geometry::Grid::from_matrix(self.grid())
+            .map_err(|e| CliError::input(format!("{}: {e}", self.name)))?;
+        let kernel = self.inputs.footprint.kernel()?;
+        let view = crate::pipeline::stages::prepare::view_for(&self.inputs, self.dims, &grid)?;
+        let g2s = view.grid_to_screen(&grid);
+        let options = footprint::geometry::FootprintOptions {
+            mapping: self.inputs.footprint.mapping()?,
+            min_radius_px: self.inputs.footprint.min_radius,
+        };
+        let f = footprint::geometry::Footprint::new(&kernel, &g2s, options)
+            .map_err(|e| CliError::input(format!("{}: {e}", self.name)))?;
+        Ok(f.sheet_axis)
+    }
+
+    /// The grid-to-world matrix.
+    fn grid(&self) -> glam::Mat3 {
+        match &self.source {
+            Source::Seekable {
+                spacing,
+                directions,
+                ..
+            } => {
+                let col = |c: usize| glam::Vec3::from_array(directions[c]) * spacing[c];
+                glam::Mat3::from_cols(col(0), col(1), col(2))
+            }
+            Source::Whole { volume, .. } => volume.grid_to_world(),
+        }
+    }
+
+    /// The brick owning `owned` (with its ghost layer), and the bytes read for it.
+    pub fn brick(&self, owned: IndexBox) -> Result<(Volume, u64), CliError> {
+        let place = BrickPlace::around(owned, self.dims);
+        match &self.source {
+            Source::Seekable {
+                layout,
+                spacing,
+                directions,
+            } => {
+                let (samples, bytes) = read_box(layout, place.stored)?;
+                Ok((
+                    Volume {
+                        dims: self.dims,
+                        spacing: *spacing,
+                        directions: *directions,
+                        samples,
+                        brick: Some(place),
+                    },
+                    bytes,
+                ))
+            }
+            Source::Whole { volume, bytes } => Ok((crop(volume, place)?, *bytes)),
+        }
+    }
+
+    /// What a brick contributes to the default window: its stored samples' finite range, and
+    /// (for a user's volume) its share of the whole volume's strided sample. `None` with
+    /// `--window`.
+    pub fn window_part(&self, brick: &Volume) -> Option<WindowPart> {
+        self.inputs.window.is_none().then(|| WindowPart {
+            range: brick.range(),
+            sample: if self.sampled {
+                brick.strided_sample()
+            } else {
+                Vec::new()
+            },
+        })
+    }
+
+    /// The window every brick renders with: `--window`, or the default window of the whole
+    /// volume from every brick's [`WindowPart`] (the same range and sample one process takes,
+    /// so the same window).
+    pub fn window(&self, parts: Vec<WindowPart>) -> Result<[f32; 2], CliError> {
+        if let Some(w) = self.inputs.window {
+            return Ok(w);
+        }
+        let range = parts
+            .iter()
+            .fold((f32::INFINITY, f32::NEG_INFINITY), |r, p| {
+                (r.0.min(p.range.0), r.1.max(p.range.1))
+            });
+        let mut sample: Vec<f32> = parts.into_iter().flat_map(|p| p.sample).collect();
+        sample.sort_by(f32::total_cmp);
+        let voxels = Voxels::Stdin {
+            dims: self.dims,
+            ty: crate::io::volume::SampleType::F32,
+            big_endian: false,
+            pipe: None,
+        };
+        crate::pipeline::stages::window::default_window(
+            &self.name,
+            Some(range),
+            &voxels,
+            self.sampled.then_some(sample.as_slice()),
+        )
+    }
+
+    /// Renders `brick` with `window`: its own voxels in the whole volume's frame, premultiplied
+    /// RGBA at the frame's internal size (a supersampled frame's k× size, a subsampled frame's
+    /// 1/s: the images are composited there, where one process composites its sheets, and
+    /// brought to the output size after: [`BrickFrame::finish`]), over nothing (the background
+    /// is composited once, under the finished image).
+    ///
+    /// A split render is one frame: object slicing classifies each sheet as it goes and keeps
+    /// no visible-voxel lists (the same voxels, the same bits), so a rank holds its brick and
+    /// its images, not lists; slabs keep their brick's lists, as they must.
+    pub fn render(&self, brick: Volume, window: [f32; 2]) -> Result<BrickFrame, CliError> {
+        let start = Instant::now();
+        let mut inputs = self.inputs.clone();
+        inputs.memory = Some(InMemory {
+            volume: Arc::new(brick),
+            name: self.name.clone(),
+        });
+        inputs.window = Some(window);
+        let mut p = prepare(&(inputs, self.plan.clone()))?;
+        let background = p.background_out.take();
+        p.background = None;
+        let out = p.out_size();
+        let s = p.subsample_factor(&self.plan)?;
+        let mut plan = self.plan.clone();
+        plan.subsample = crate::args::Supersample::Fixed(1);
+        let (p, resample) = if s > 1 {
+            let (low, _) = p.subsampled(&self.plan, s)?;
+            let low_size = low.out_size();
+            (low, Resample::Magnify { s, low: low_size })
+        } else if p.supersample > 1 {
+            let k = p.supersample;
+            p.supersample = 1;
+            (p, Resample::Average { k })
+        } else {
+            (p, Resample::None)
+        };
+        let ray = p.frame.grid_to_screen.inverse() * glam::Vec3::Z;
+        let mut cache = match plan.end {
+            End::Sheets(_) => FrameCache::with_list_budget(0),
+            _ => FrameCache::default(),
+        };
+        let frame = render_frame(&p, &plan, &mut cache)?;
+        Ok(BrickFrame {
+            image: frame.image,
+            ray: ray.to_array(),
+            size: out,
+            resample,
+            threads: plan.threads,
+            voxels: frame.stats.voxels,
+            seconds: start.elapsed().as_secs_f64(),
+            background,
+        })
+    }
+}
+
+/// How a composited image reaches the output size.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Resample {
+    /// Rendered at the output size.
+    None,
+    /// Rendered at k× the output size: the mean of each k×k block.
+    Average { k: usize },
+    /// Rendered at `low`, 1/s of the output size: magnified (`pipeline::stages::subsample`).
+    Magnify { s: usize, low: (usize, usize) },
+}
+
+/// What a brick contributes to the default window ([`Job::window`]).
+#[derive(Clone, Debug, Default)]
+pub struct WindowPart {
+    /// Smallest and largest finite stored sample.
+    pub range: (f32, f32),
+    /// Its owned share of the whole volume's strided sample.
+    pub sample: Vec<f32>,
+}
+
+/// A brick's frame.
+pub struct BrickFrame {
+    /// Premultiplied RGBA, linear, at the output size, over nothing.
+    pub image: Vec<[f32; 4]>,
+    /// The view's ray direction in grid index units (what orders the bricks).
+    pub ray: [f32; 3],
+    /// The output's width and height, pixels.
+    pub size: (usize, usize),
+    /// How the composited image reaches `size`.
+    pub resample: Resample,
+    /// Threads the frame used (and the magnification uses).
+    pub threads: usize,
+    /// Voxels the brick splatted (its visible own voxels).
+    pub voxels: u64,
+    /// Seconds from the brick's set-up to its image.
+    pub seconds: f64,
+    /// The background image (`--background FILE`), composited under the composited image.
+    pub background: Option<Arc<[[f32; 4]]>>,
+}
+
+impl BrickFrame {
+    /// The composited `image` (at this frame's internal size) at the output size, with the
+    /// background under it.
+    pub fn finish(&self, image: Vec<[f32; 4]>) -> Result<Vec<[f32; 4]>, CliError> {
+        use crate::pipeline::stages::{subsample, supersample};
+        let mut image = match self.resample {
+            Resample::None => image,
+            Resample::Average { k } => supersample::to_output(image, self.size, k),
+            Resample::Magnify { s, low } => {
+                subsample::magnify(&image, low, self.size, s, self.threads)?
+            }
+        };
+        if let Some(bg) = &self.background {
+            subsample::under_background(&mut image, bg);
+        }
+        Ok(image)
+    }
+}
+
+/// The flags bricks cannot honour, refused with the reason.
+fn refuse(inputs: &Inputs, plan: &Plan) -> Result<(), CliError> {
+    let no = |what: &str, why: &str| {
+        Err(CliError::input(format!(
+            "{what} does not render in bricks: {why}"
+        )))
+    };
+    match plan.end {
+        End::Sheets(_) | End::Slabs { .. } => {}
+        End::Post { .. } => {
+            return no(
+                "--classification post",
+                "its values are reconstructed across voxels before they are classified, so a \
+                 brick's pixels need its neighbours' values, not their colours",
+            )
+        }
+        End::Refined { .. } => {
+            return no("--refine", "refinement interpolates across the whole grid")
+        }
+        End::Reference => {
+            return no(
+                "--method reference",
+                "the f64 reference reads the whole volume",
+            )
+        }
+    }
+    if inputs.stream.is_some() {
+        return no(
+            "--stream",
+            "each rank already reads only its brick from the file (give it as VOLUME)",
+        );
+    }
+    if inputs.perspective.is_some() {
+        return no(
+            "--perspective",
+            "the bricks' visibility order is the orthographic one",
+        );
+    }
+    if matches!(inputs.lod, Lod::Level(1..)) {
+        return no(
+            "--lod N",
+            "a level averages voxel blocks across brick borders",
+        );
+    }
+    if inputs.quality || plan.quality.is_some() {
+        return no("--quality", "its pilots would choose per brick; choose the plan with one process and pass its flags");
+    }
+    Ok(())
+}
+
+/// The raw layout of `path` when its samples sit uncompressed at a known offset.
+fn seekable(
+    path: &std::path::Path,
+    raw: Option<&crate::io::formats::raw::RawOptions>,
+) -> Result<Option<Source>, CliError> {
+    if let Some(o) = raw {
+        let layout = Layout {
+            path: path.to_path_buf(),
+            offset: 0,
+            dims: o.dims,
+            ty: o.ty,
+            big_endian: o.big_endian,
+        };
+        let need = crate::io::volume::byte_len(o.dims, o.ty)
+            .map_err(|e| crate::io::volume::at(path, e))? as u64;
+        let len = io::regular_file_len(path)?;
+        if len != need {
+            return Err(crate::io::volume::at(
+                path,
+                format!("expected {need} bytes for --dims/--type, found {len}"),
+            ));
+        }
+        crate::io::volume::check_spacing(o.spacing).map_err(|e| crate::io::volume::at(path, e))?;
+        return Ok(Some(Source::Seekable {
+            layout,
+            spacing: o.spacing,
+            directions: crate::io::volume::AXIS_ALIGNED,
+        }));
+    }
+    let lower = path.display().to_string().to_ascii_lowercase();
+    let s = if lower.ends_with(".nrrd") || lower.ends_with(".nhdr") {
+        crate::io::formats::nrrd::raw_layout(path).ok()
+    } else if lower.ends_with(".mha") || lower.ends_with(".mhd") {
+        crate::io::formats::metaimage::raw_layout(path).ok()
+    } else {
+        None
+    };
+    Ok(s.map(|s| Source::Seekable {
+        layout: s.layout,
+        spacing: s.spacing,
+        directions: s.directions,
+    }))
+}

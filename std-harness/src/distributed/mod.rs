@@ -1,0 +1,235 @@
+//! Scale-out, sort-last: a volume split into bricks ([`layout`]), each brick rendered on its own
+//! into a premultiplied RGBA image of the whole frame, the images composited front to back in
+//! the bricks' visibility order. Under MPI (cargo feature `mpi`, `mpi` module) each
+//! rank reads and renders one brick and the images are composited by binary swap onto rank 0;
+//! without it, `render --bricks X,Y,Z` renders the bricks one after another in one process and
+//! composites them the same way (what the tests measure the border error with).
+//!
+//! **How a brick renders.** A rank holds its brick's voxels and one ghost layer around them
+//! (the core's gradients read a voxel's six neighbours: [`crate::io::brick::GHOST`]) as a
+//! [`Volume`](crate::io::volume::Volume) whose `brick` says where they sit; the frame is the whole volume's (same view,
+//! same slabs, same table), and only the brick's own voxels are classified and splatted
+//! (`pipeline::stages::visible::keep_owned`). So every voxel is splatted exactly as in one
+//! process, with the same colour, gradient and footprint.
+//!
+//! **What differs across brick borders.** One process adds every voxel of a sheet (or slab)
+//! into one accumulator and composites the sheets in order; here each brick composites its own
+//! sheets and the bricks are composited in order. Where a cut lies between two sheets (the
+//! default split cuts across the sheet axis: [`BrickLayout::balanced`]) the two are the same
+//! sums in another association, equal to rounding. Elsewhere pixels whose ray passes within a
+//! kernel radius of a cut see the two bricks' overlapping footprints composited one over the
+//! other instead of added in one sheet. `docs/scale-out.md` bounds and measures that.
+
+pub mod job;
+pub mod layout;
+#[cfg(feature = "mpi")]
+pub mod mpi;
+
+pub use job::{BrickFrame, Job, Resample, Source, WindowPart};
+pub use layout::BrickLayout;
+
+use crate::plan::{Inputs, Plan};
+use crate::CliError;
+use std::time::Instant;
+
+/// `front` over `back`, in place in `front` (premultiplied: c = f + (1 − α_f)·b).
+pub fn over(front: &mut [[f32; 4]], back: &[[f32; 4]]) {
+    for (f, b) in front.iter_mut().zip(back) {
+        let t = 1.0 - f[3];
+        for c in 0..4 {
+            f[c] += t * b[c];
+        }
+    }
+}
+
+/// Every brick of `layout` rendered in turn in this process and composited front to back (what
+/// `render --bricks` does without MPI): the image at the output size with the background
+/// under it, each brick's frame summary, and the bytes each read.
+pub fn render_in_turn(job: &Job, layout: &BrickLayout) -> Result<Composited, CliError> {
+    let mut bricks = Vec::with_capacity(layout.len());
+    let mut parts = Vec::with_capacity(layout.len());
+    for b in &layout.boxes {
+        let (v, bytes) = job.brick(*b)?;
+        parts.extend(job.window_part(&v));
+        bricks.push((v, bytes));
+    }
+    let window = job.window(parts)?;
+    let mut frames = Vec::with_capacity(bricks.len());
+    let mut read = Vec::with_capacity(bricks.len());
+    for (v, bytes) in bricks {
+        read.push(bytes);
+        frames.push(job.render(v, window)?);
+    }
+    let order = layout.front_to_back(frames[0].ray);
+    let start = Instant::now();
+    let mut image = frames[order[0]].image.clone();
+    for &n in &order[1..] {
+        over(&mut image, &frames[n].image);
+    }
+    let image = frames[0].finish(image)?;
+    let composite = start.elapsed().as_secs_f64();
+    Ok(Composited {
+        image,
+        window,
+        order,
+        ranks: frames
+            .iter()
+            .zip(read)
+            .map(|(f, bytes)| RankStats {
+                bytes_read: bytes,
+                render_seconds: f.seconds,
+                composite_seconds: composite / layout.len() as f64,
+                voxels: f.voxels,
+                peak_memory_bytes: None,
+            })
+            .collect(),
+    })
+}
+
+/// A composited frame and what each brick cost.
+pub struct Composited {
+    /// Premultiplied RGBA at the output size, with the background under it.
+    pub image: Vec<[f32; 4]>,
+    pub window: [f32; 2],
+    /// The bricks front to back.
+    pub order: Vec<usize>,
+    /// Per brick (rank).
+    pub ranks: Vec<RankStats>,
+}
+
+/// What one rank (brick) cost.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RankStats {
+    pub bytes_read: u64,
+    pub render_seconds: f64,
+    pub composite_seconds: f64,
+    pub voxels: u64,
+    /// The process's peak resident memory (Linux `VmHWM`), where it can be read; `None` for
+    /// bricks rendered in turn in one process.
+    pub peak_memory_bytes: Option<u64>,
+}
+
+/// This process's peak resident set, bytes (Linux: `VmHWM` of /proc/self/status).
+pub fn peak_memory_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+/// `base` with the fields a split render adds: `ranks`, `bricks` (each brick's owned box,
+/// `lo` and `hi`, brick n rendered by rank n), `order` (front to back) and `per_rank` (bytes
+/// read, render and composite seconds, voxels splatted, peak resident memory).
+pub fn json(
+    base: crate::io::json::Json,
+    layout: &BrickLayout,
+    c: &Composited,
+) -> crate::io::json::Json {
+    use crate::io::json::Json;
+    let bricks: Vec<Json> = layout
+        .boxes
+        .iter()
+        .map(|b| Json::object().arr_usize("lo", &b.lo).arr_usize("hi", &b.hi))
+        .collect();
+    let per_rank: Vec<Json> = c
+        .ranks
+        .iter()
+        .enumerate()
+        .map(|(r, s)| {
+            let j = Json::object()
+                .num("rank", r as f64)
+                .num("bytes_read", s.bytes_read as f64)
+                .num("render_seconds", s.render_seconds)
+                .num("composite_seconds", s.composite_seconds)
+                .num("voxels", s.voxels as f64);
+            match s.peak_memory_bytes {
+                Some(m) => j.num("peak_memory_bytes", m as f64),
+                None => j,
+            }
+        })
+        .collect();
+    base.num("ranks", layout.len() as f64)
+        .arr_obj("bricks", bricks)
+        .arr_usize("order", &c.order)
+        .arr_obj("per_rank", per_rank)
+}
+
+/// A render split into bricks, as `render` runs it: under MPI with more than one rank, one brick
+/// per rank (`mpi` module); otherwise, with `--bricks`, every brick in turn in this
+/// process ([`render_in_turn`]). `Ok(None)`: the render is not split (one process, no
+/// `--bricks`: the ordinary path, byte for byte). `Ok(Some(None))`: a rank other than 0, which
+/// writes nothing. `Ok(Some(Some((image, summary))))`: the composited image (premultiplied,
+/// background under it) and the JSON summary.
+#[allow(clippy::type_complexity)]
+pub fn render_split(
+    inputs: &Inputs,
+    plan: &Plan,
+    bricks: Option<[usize; 3]>,
+) -> Result<Option<Option<(Vec<[f32; 4]>, crate::io::json::Json)>>, CliError> {
+    let start = Instant::now();
+    #[cfg(feature = "mpi")]
+    {
+        use ::mpi::traits::Communicator;
+        if let Some(universe) = self::mpi::init() {
+            let world = universe.world();
+            if world.size() > 1 {
+                // Refusals of the flags come out the same on every rank: each reports, none waits.
+                let job = Job::new(inputs, plan)?;
+                let layout = job.layout(world.size() as usize, bricks)?;
+                // A failure on one rank (its read, its render) would leave the others waiting in
+                // a collective: it says why and ends the whole job (MPI_Abort, exit code 2).
+                let g = match self::mpi::render(&world, &job, &layout) {
+                    Ok(Some(g)) => g,
+                    Ok(None) => return Ok(Some(None)),
+                    Err(e) => {
+                        crate::warn!("rank {} of {}: {e}", world.rank(), world.size());
+                        world.abort(2)
+                    }
+                };
+                let c = Composited {
+                    image: g.image,
+                    window: g.window,
+                    order: g.order,
+                    ranks: g.ranks,
+                };
+                return Ok(Some(Some(summary(&job, &layout, c, start, "mpi"))));
+            }
+        }
+    }
+    let Some(counts) = bricks else {
+        return Ok(None);
+    };
+    let job = Job::new(inputs, plan)?;
+    let layout = job.layout(counts.iter().product(), Some(counts))?;
+    let c = render_in_turn(&job, &layout)?;
+    Ok(Some(Some(summary(&job, &layout, c, start, "in turn"))))
+}
+
+fn summary(
+    job: &Job,
+    layout: &BrickLayout,
+    c: Composited,
+    start: Instant,
+    how: &str,
+) -> (Vec<[f32; 4]>, crate::io::json::Json) {
+    let secs = start.elapsed().as_secs_f64();
+    let slowest = c.ranks.iter().map(|r| r.render_seconds).fold(0.0, f64::max);
+    crate::say!(
+        "{}: {}x{} in {:.3} s from {} bricks ({how}; slowest brick {:.3} s), composited front to back",
+        job.name,
+        job.inputs.size.0,
+        job.inputs.size.1,
+        secs,
+        layout.len(),
+        slowest
+    );
+    let base = crate::io::json::Json::object()
+        .str("volume", &job.name)
+        .arr_usize("size", &[job.inputs.size.0, job.inputs.size.1])
+        .arr_usize("dims", &job.dims)
+        .str("bricks_rendered", how)
+        .arr_f64("window", &[f64::from(c.window[0]), f64::from(c.window[1])])
+        .num("seconds", secs);
+    let j = json(base, layout, &c);
+    (c.image, j)
+}
