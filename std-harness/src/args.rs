@@ -450,7 +450,10 @@ pub struct RenderArgs {
     pub quality_reference: QualityReferenceArg,
 }
 
-/// `--bricks X,Y,Z`: three counts, each at least 1.
+/// The most bricks `--bricks` makes (a million: far past any MPI job's ranks per volume).
+pub const MAX_BRICKS: usize = 1 << 20;
+
+/// `--bricks X,Y,Z`: three counts, each at least 1, [`MAX_BRICKS`] at most in all.
 pub fn parse_bricks(s: &str) -> Result<[usize; 3], String> {
     let v: Vec<usize> = s
         .split(',')

@@ -25,8 +25,68 @@ pub enum Source {
         directions: [[f32; 3]; 3],
     },
     /// A volume loaded whole (a compressed file, a format without a raw layout, the built-in
-    /// scene): bricks are cut from it; `bytes` is what loading it read.
+    /// scene): bricks are cut from it; `bytes` is what loading it read. Under MPI only rank 0
+    /// loads it, and sends each rank its brick.
     Whole { volume: Arc<Volume>, bytes: u64 },
+    /// A volume another rank loads whole: this rank knows its grid and receives its brick.
+    Elsewhere(Header),
+}
+
+/// What a rank that does not load a volume needs to know of it: its grid and sample type.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Header {
+    pub dims: [usize; 3],
+    pub spacing: [f32; 3],
+    pub directions: [[f32; 3]; 3],
+    /// The sample type ([`crate::io::volume::SampleType`] order: u8, i8, u16, i16, u32, i32,
+    /// f32, f64).
+    pub ty: usize,
+}
+
+impl Header {
+    /// The header of `v`.
+    pub fn of(v: &Volume) -> Header {
+        use crate::io::volume::Samples;
+        Header {
+            dims: v.dims,
+            spacing: v.spacing,
+            directions: v.directions,
+            ty: match v.samples {
+                Samples::U8(_) => 0,
+                Samples::I8(_) => 1,
+                Samples::U16(_) => 2,
+                Samples::I16(_) => 3,
+                Samples::U32(_) => 4,
+                Samples::I32(_) => 5,
+                Samples::F32(_) | Samples::Coloured(_) => 6,
+                Samples::F64(_) => 7,
+            },
+        }
+    }
+
+    /// As 16 numbers (for a broadcast).
+    pub fn to_f64s(&self) -> [f64; 16] {
+        let mut out = [0.0; 16];
+        for c in 0..3 {
+            out[c] = self.dims[c] as f64;
+            out[3 + c] = f64::from(self.spacing[c]);
+            for r in 0..3 {
+                out[6 + 3 * c + r] = f64::from(self.directions[c][r]);
+            }
+        }
+        out[15] = self.ty as f64;
+        out
+    }
+
+    /// From [`Header::to_f64s`].
+    pub fn from_f64s(v: &[f64; 16]) -> Header {
+        Header {
+            dims: [0, 1, 2].map(|c| v[c] as usize),
+            spacing: [0, 1, 2].map(|c| v[3 + c] as f32),
+            directions: [0, 1, 2].map(|c| [0, 1, 2].map(|r| v[6 + 3 * c + r] as f32)),
+            ty: v[15] as usize,
+        }
+    }
 }
 
 /// One render split into bricks: what every brick shares.
@@ -48,6 +108,28 @@ impl Job {
     /// The job for `inputs` and `plan`, refused with a reason where bricks cannot honour them.
     /// Opens the source: a seekable file's header only; anything else is loaded whole.
     pub fn new(inputs: &Inputs, plan: &Plan) -> Result<Job, CliError> {
+        Job::open(inputs, plan, None)
+    }
+
+    /// Whether `inputs`' volume is loaded whole ([`Source::Whole`] from a file or the built-in
+    /// scene, not a program's volume in memory): the same answer on every rank.
+    pub fn loads_whole(inputs: &Inputs) -> Result<bool, CliError> {
+        let raw = crate::pipeline::stages::load::raw_options(inputs)?;
+        Ok(match (&inputs.memory, &inputs.volume) {
+            (Some(_), _) => false,
+            (None, Some(path)) => seekable(path, raw.as_ref())?.is_none(),
+            (None, None) => true,
+        })
+    }
+
+    /// [`Job::new`] on a rank that does not load a whole volume: `header` is what the loading
+    /// rank says of it ([`Source::Elsewhere`]); a seekable file or a volume in memory is opened
+    /// as by [`Job::new`].
+    pub fn remote(inputs: &Inputs, plan: &Plan, header: Header) -> Result<Job, CliError> {
+        Job::open(inputs, plan, Some(header))
+    }
+
+    fn open(inputs: &Inputs, plan: &Plan, remote: Option<Header>) -> Result<Job, CliError> {
         refuse(inputs, plan)?;
         let mut inputs = inputs.clone();
         let builtin = inputs.volume.is_none() && inputs.memory.is_none();
@@ -72,9 +154,10 @@ impl Job {
             ),
             (None, Some(path)) => (
                 path.display().to_string(),
-                match seekable(path, raw.as_ref())? {
-                    Some(s) => s,
-                    None => {
+                match (seekable(path, raw.as_ref())?, remote) {
+                    (Some(s), _) => s,
+                    (None, Some(h)) => Source::Elsewhere(h),
+                    (None, None) => {
                         let bytes = std::fs::metadata(path).map_or(0, |m| m.len());
                         let volume = crate::io::formats::load_array(
                             path,
@@ -93,15 +176,19 @@ impl Job {
                     scene::SIDE => "built-in electron-density scene".to_string(),
                     n => format!("built-in electron-density scene, {n}^3"),
                 },
-                Source::Whole {
-                    volume: Arc::new(scene::volume(inputs.scene_size)?),
-                    bytes: 0,
+                match remote {
+                    Some(h) => Source::Elsewhere(h),
+                    None => Source::Whole {
+                        volume: Arc::new(scene::volume(inputs.scene_size)?),
+                        bytes: 0,
+                    },
                 },
             ),
         };
         let dims = match &source {
             Source::Seekable { layout, .. } => layout.dims,
             Source::Whole { volume, .. } => volume.dims,
+            Source::Elsewhere(h) => h.dims,
         };
         inputs.memory = None;
         inputs.volume = None;
@@ -135,13 +222,24 @@ impl Job {
         }
     }
 
-    /// The sheet axis of the frame the inputs ask for (what the default split cuts across).
-    fn sheet_axis(&self) -> Result<usize, CliError> {
+    /// The grid-to-screen map of the view the inputs ask for (at the output size).
+    fn grid_to_screen(&self) -> Result<glam::Mat3, CliError> {
         let grid = footprint::geometry::Grid::from_matrix(self.grid())
             .map_err(|e| CliError::input(format!("{}: {e}", self.name)))?;
-        let kernel = self.inputs.footprint.kernel()?;
         let view = crate::pipeline::stages::prepare::view_for(&self.inputs, self.dims, &grid)?;
-        let g2s = view.grid_to_screen(&grid);
+        Ok(view.grid_to_screen(&grid))
+    }
+
+    /// The view's ray direction in grid index units, away from the viewer (what orders the
+    /// bricks; the same as [`BrickFrame::ray`]).
+    pub fn ray(&self) -> Result<[f32; 3], CliError> {
+        Ok((self.grid_to_screen()?.inverse() * glam::Vec3::Z).to_array())
+    }
+
+    /// The sheet axis of the frame the inputs ask for (what the default split cuts across).
+    fn sheet_axis(&self) -> Result<usize, CliError> {
+        let kernel = self.inputs.footprint.kernel()?;
+        let g2s = self.grid_to_screen()?;
         let options = footprint::geometry::FootprintOptions {
             mapping: self.inputs.footprint.mapping()?,
             min_radius_px: self.inputs.footprint.min_radius,
@@ -158,7 +256,12 @@ impl Job {
                 spacing,
                 directions,
                 ..
-            } => {
+            }
+            | Source::Elsewhere(Header {
+                spacing,
+                directions,
+                ..
+            }) => {
                 let col = |c: usize| glam::Vec3::from_array(directions[c]) * spacing[c];
                 glam::Mat3::from_cols(col(0), col(1), col(2))
             }
@@ -188,6 +291,9 @@ impl Job {
                 ))
             }
             Source::Whole { volume, bytes } => Ok((crop(volume, place)?, *bytes)),
+            Source::Elsewhere(_) => Err(CliError::input(
+                "this rank's brick comes from the rank that loads the volume",
+            )),
         }
     }
 
@@ -346,6 +452,11 @@ impl BrickFrame {
     }
 }
 
+/// The flags bricks cannot honour, refused with the reason (the same on every rank).
+pub fn check(inputs: &Inputs, plan: &Plan) -> Result<(), CliError> {
+    refuse(inputs, plan)
+}
+
 /// The flags bricks cannot honour, refused with the reason.
 fn refuse(inputs: &Inputs, plan: &Plan) -> Result<(), CliError> {
     let no = |what: &str, why: &str| {
@@ -438,4 +549,23 @@ fn seekable(
         spacing: s.spacing,
         directions: s.directions,
     }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A header survives the broadcast's encoding (every field, every sample type).
+    #[test]
+    fn header_round_trips() {
+        for ty in 0..8 {
+            let h = Header {
+                dims: [7, 300, 12_000],
+                spacing: [0.5, 1.25, 3.0],
+                directions: [[1.0, 0.0, 0.0], [0.0, 0.6, 0.8], [0.0, -0.8, 0.6]],
+                ty,
+            };
+            assert_eq!(Header::from_f64s(&h.to_f64s()), h);
+        }
+    }
 }

@@ -25,7 +25,7 @@ pub mod layout;
 #[cfg(feature = "mpi")]
 pub mod mpi;
 
-pub use job::{BrickFrame, Job, Resample, Source, WindowPart};
+pub use job::{BrickFrame, Header, Job, Resample, Source, WindowPart};
 pub use layout::BrickLayout;
 
 use crate::plan::{Inputs, Plan};
@@ -46,43 +46,50 @@ pub fn over(front: &mut [[f32; 4]], back: &[[f32; 4]]) {
 /// `render --bricks` does without MPI): the image at the output size with the background
 /// under it, each brick's frame summary, and the bytes each read.
 pub fn render_in_turn(job: &Job, layout: &BrickLayout) -> Result<Composited, CliError> {
-    let mut bricks = Vec::with_capacity(layout.len());
+    // One brick held at a time: a pass for the window's parts, then the bricks front to back,
+    // each composited under what is in front of it as it comes (one image kept, not one each).
     let mut parts = Vec::with_capacity(layout.len());
     for b in &layout.boxes {
-        let (v, bytes) = job.brick(*b)?;
+        let (v, _) = job.brick(*b)?;
         parts.extend(job.window_part(&v));
-        bricks.push((v, bytes));
     }
     let window = job.window(parts)?;
-    let mut frames = Vec::with_capacity(bricks.len());
-    let mut read = Vec::with_capacity(bricks.len());
-    for (v, bytes) in bricks {
-        read.push(bytes);
-        frames.push(job.render(v, window)?);
+    let order = layout.front_to_back(job.ray()?);
+    let mut ranks = vec![RankStats::default(); layout.len()];
+    let (mut acc, mut last) = (None::<Vec<[f32; 4]>>, None::<BrickFrame>);
+    let mut composite = 0.0;
+    for &n in &order {
+        let (v, bytes) = job.brick(layout.boxes[n])?;
+        let mut f = job.render(v, window)?;
+        ranks[n] = RankStats {
+            bytes_read: bytes,
+            render_seconds: f.seconds,
+            voxels: f.voxels,
+            ..RankStats::default()
+        };
+        let start = Instant::now();
+        match &mut acc {
+            None => acc = Some(std::mem::take(&mut f.image)),
+            Some(a) => over(a, &f.image),
+        }
+        composite += start.elapsed().as_secs_f64();
+        f.image = Vec::new();
+        last = Some(f);
     }
-    let order = layout.front_to_back(frames[0].ray);
+    let (Some(acc), Some(last)) = (acc, last) else {
+        return Err(CliError::input("a split into no bricks renders nothing"));
+    };
     let start = Instant::now();
-    let mut image = frames[order[0]].image.clone();
-    for &n in &order[1..] {
-        over(&mut image, &frames[n].image);
+    let image = last.finish(acc)?;
+    composite += start.elapsed().as_secs_f64();
+    for r in &mut ranks {
+        r.composite_seconds = composite / layout.len() as f64;
     }
-    let image = frames[0].finish(image)?;
-    let composite = start.elapsed().as_secs_f64();
     Ok(Composited {
         image,
         window,
         order,
-        ranks: frames
-            .iter()
-            .zip(read)
-            .map(|(f, bytes)| RankStats {
-                bytes_read: bytes,
-                render_seconds: f.seconds,
-                composite_seconds: composite / layout.len() as f64,
-                voxels: f.voxels,
-                peak_memory_bytes: None,
-            })
-            .collect(),
+        ranks,
     })
 }
 
@@ -174,7 +181,7 @@ pub fn render_split(
             let world = universe.world();
             if world.size() > 1 {
                 // Refusals of the flags come out the same on every rank: each reports, none waits.
-                let job = Job::new(inputs, plan)?;
+                let job = self::mpi::job(&world, inputs, plan)?;
                 let layout = job.layout(world.size() as usize, bricks)?;
                 // A failure on one rank (its read, its render) would leave the others waiting in
                 // a collective: it says why and ends the whole job (MPI_Abort, exit code 2).

@@ -15,7 +15,7 @@
 //! the 2^(s+1) participants that share v's bits above s, a contiguous run of the order; its
 //! partner's run lies wholly in front of it when v's bit s is 1.
 
-use super::{over, BrickLayout, Job, RankStats};
+use super::{over, BrickLayout, Header, Job, RankStats, Source as From};
 use crate::io::brick::{BrickPlace, IndexBox};
 use crate::io::volume::Volume;
 use crate::CliError;
@@ -44,16 +44,116 @@ pub struct Gathered {
     pub ranks: Vec<RankStats>,
 }
 
-/// This rank's share of `job` split by `layout` (one brick per rank): reads its brick, agrees
-/// the window with the others, renders, and composites onto rank 0, which gets `Some`.
+/// The job for `inputs` on this rank. A file read in part (raw samples at a known place) is
+/// opened by every rank; a volume that must be loaded whole (compressed, VTK, VTI, NIfTI, the
+/// built-in scene) is loaded by rank 0 alone, which broadcasts its grid ([`Header`]) and later
+/// sends each rank its brick ([`render`]). A failure to load on rank 0 ends the job
+/// (`MPI_Abort`): the others would wait for the grid.
+pub fn job(
+    comm: &SimpleCommunicator,
+    inputs: &crate::plan::Inputs,
+    plan: &crate::plan::Plan,
+) -> Result<Job, CliError> {
+    if !Job::loads_whole(inputs)? {
+        return Job::new(inputs, plan);
+    }
+    super::job::check(inputs, plan)?;
+    let root = comm.process_at_rank(0);
+    let mut header = [0.0f64; 16];
+    if comm.rank() == 0 {
+        let job = Job::new(inputs, plan).unwrap_or_else(|e| {
+            crate::warn!("rank 0 of {}: {e}", comm.size());
+            comm.abort(2)
+        });
+        let From::Whole { volume, .. } = &job.source else {
+            unreachable!("loads_whole said whole")
+        };
+        header = Header::of(volume).to_f64s();
+        root.broadcast_into(&mut header[..]);
+        return Ok(job);
+    }
+    root.broadcast_into(&mut header[..]);
+    Job::remote(inputs, plan, Header::from_f64s(&header))
+}
+
+/// This rank's share of `job` split by `layout` (one brick per rank): reads its brick (or gets
+/// it from rank 0, [`job`]), agrees the window with the others, renders, and composites onto
+/// rank 0, which gets `Some`.
 pub fn render(
     comm: &SimpleCommunicator,
     job: &Job,
     layout: &BrickLayout,
 ) -> Result<Option<Gathered>, CliError> {
     let rank = comm.rank() as usize;
-    let (brick, bytes) = job.brick(layout.boxes[rank])?;
+    let (brick, bytes) = match &job.source {
+        From::Seekable { .. } => job.brick(layout.boxes[rank])?,
+        From::Whole { .. } if comm.size() > 1 && rank == 0 => {
+            // Rank 0 holds the volume: each other rank's brick is cut and sent in turn.
+            for (r, b) in layout.boxes.iter().enumerate().skip(1) {
+                let (v, _) = job.brick(*b)?;
+                send_samples(&comm.process_at_rank(r as i32), &v.samples);
+            }
+            job.brick(layout.boxes[0])?
+        }
+        From::Whole { .. } => job.brick(layout.boxes[rank])?,
+        From::Elsewhere(h) => {
+            let place = BrickPlace::around(layout.boxes[rank], job.dims);
+            let samples = receive_samples(&comm.process_at_rank(0), h.ty, place.stored.count());
+            let volume = Volume {
+                dims: h.dims,
+                spacing: h.spacing,
+                directions: h.directions,
+                samples,
+                brick: Some(place),
+            };
+            (volume, 0)
+        }
+    };
     render_brick(comm, job, layout, brick, bytes)
+}
+
+/// Sends a brick's samples, in their own type.
+fn send_samples(to: &mpi::topology::Process<'_>, s: &crate::io::volume::Samples) {
+    use crate::io::volume::Samples;
+    match s {
+        Samples::U8(v) => to.send(&v[..]),
+        Samples::I8(v) => to.send(&v[..]),
+        Samples::U16(v) => to.send(&v[..]),
+        Samples::I16(v) => to.send(&v[..]),
+        Samples::U32(v) => to.send(&v[..]),
+        Samples::I32(v) => to.send(&v[..]),
+        Samples::F32(v) => to.send(&v[..]),
+        Samples::F64(v) => to.send(&v[..]),
+        // Colours come only from levels of detail, which bricks refuse.
+        Samples::Coloured(v) => to.send(&v.iter().map(|c| c.value).collect::<Vec<f32>>()[..]),
+    }
+}
+
+/// Receives `n` samples of type `ty` ([`Header::ty`]).
+fn receive_samples(
+    from: &mpi::topology::Process<'_>,
+    ty: usize,
+    n: usize,
+) -> crate::io::volume::Samples {
+    use crate::io::volume::Samples;
+    fn get<T: Equivalence + Default + Clone>(
+        from: &mpi::topology::Process<'_>,
+        n: usize,
+    ) -> crate::io::volume::Data<T> {
+        let mut v = vec![T::default(); n];
+        from.receive_into(&mut v[..]);
+        v.into()
+    }
+    match ty {
+        0 => Samples::U8(get(from, n)),
+        1 => Samples::I8(get(from, n)),
+        2 => Samples::U16(get(from, n)),
+        3 => Samples::I16(get(from, n)),
+        4 => Samples::U32(get(from, n)),
+        5 => Samples::I32(get(from, n)),
+        7 => Samples::F64(get(from, n)),
+        _ => Samples::F32(get(from, n)),
+    }
 }
 
 /// The in-situ entry point: a program whose ranks each hold one brick of a volume in memory (a
