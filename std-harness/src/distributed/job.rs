@@ -3,7 +3,8 @@
 
 use super::BrickLayout;
 use crate::args::Lod;
-use crate::io::brick::{crop, read_box, BrickPlace, IndexBox};
+use crate::io::brick::{BrickPlace, IndexBox};
+use crate::io::cut::{crop, read_box};
 use crate::io::stream::{InMemory, Layout};
 use crate::io::volume::Volume;
 use crate::pipeline::stages::load::Voxels;
@@ -18,7 +19,7 @@ use std::time::Instant;
 pub enum Source {
     /// Raw samples at a known place in a file (a raw file with `--dims`, NRRD with raw
     /// encoding, uncompressed MetaImage): each brick reads only its own box, with positioned
-    /// reads ([`crate::io::brick::read_box`]).
+    /// reads ([`crate::io::cut::read_box`]).
     Seekable {
         layout: Layout,
         spacing: [f32; 3],

@@ -2,6 +2,7 @@
 //! target and is renamed into place, so a failure never leaves a half-written output.
 
 pub mod brick;
+pub mod cut;
 pub mod formats;
 pub mod image;
 pub mod json;
