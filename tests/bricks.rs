@@ -8,17 +8,7 @@ use footprint_harness::distributed::{render_in_turn, BrickLayout, Job};
 use footprint_harness::pipeline::stages::visible::FrameCache;
 use footprint_harness::pipeline::{prepare, render_frame};
 use footprint_harness::plan::{plan, Inputs};
-
-/// PSNR (peak 1) of `a` against `b` over RGB.
-fn psnr(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
-    let mse = a
-        .iter()
-        .zip(b)
-        .flat_map(|(x, y)| (0..3).map(move |c| (f64::from(x[c]) - f64::from(y[c])).powi(2)))
-        .sum::<f64>()
-        / (3 * a.len()) as f64;
-    10.0 * (1.0 / mse).log10()
-}
+use footprint_suite::rgb_psnr as psnr;
 
 fn one_process(flags: &[&str]) -> Vec<[f32; 4]> {
     let args = parse_args(flags).unwrap();

@@ -67,6 +67,18 @@ pub fn compare(core: &[[f32; 4]], reference: &[[f64; 4]]) -> ([ErrorStats; 4], E
     (per, overall)
 }
 
+/// PSNR (dB, peak 1) of `a` against `b` over every value they hold (the grey values, or R, G and
+/// B together for colour PFMs): [`compare`]'s overall figure for images read from files.
+pub fn psnr(a: &GreyImage, b: &GreyImage) -> f64 {
+    let sum_sq = a
+        .data
+        .iter()
+        .zip(&b.data)
+        .map(|(&x, &y)| (f64::from(x) - f64::from(y)).powi(2))
+        .sum::<f64>();
+    ErrorStats::from_sums(sum_sq, b.data.len().max(1), 0.0).psnr_db
+}
+
 /// max |a − b| / max(b), the "normalised footprint" difference used throughout the tests. NaN if
 /// either image holds a non-finite value (so no threshold passes it).
 pub fn max_rel_diff(a: &GreyImage, b: &GreyImage) -> Result<f64, CliError> {

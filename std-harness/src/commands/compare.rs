@@ -2,7 +2,7 @@
 //! (`render --out x.pfm`'s; every channel of every pixel compared).
 
 use crate::io::{self, image::decode_pfm_any};
-use crate::metrics::max_rel_diff;
+use crate::metrics::{max_rel_diff, psnr};
 use crate::CliError;
 use clap::Args;
 use std::path::PathBuf;
@@ -55,18 +55,7 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
         }
     }
     let d = max_rel_diff(&a, &b)?;
-    let mse = a
-        .data
-        .iter()
-        .zip(&b.data)
-        .map(|(&x, &y)| (f64::from(x) - f64::from(y)).powi(2))
-        .sum::<f64>()
-        / b.data.len().max(1) as f64;
-    let psnr = if mse > 0.0 {
-        10.0 * (1.0 / mse).log10()
-    } else {
-        f64::INFINITY
-    };
+    let psnr = psnr(&a, &b);
     crate::say!(
         "max |A-B| / peak(B) = {d:.6} ({:.4} %); PSNR {psnr:.2} dB (peak 1)",
         d * 100.0

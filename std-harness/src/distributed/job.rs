@@ -11,7 +11,7 @@ use crate::pipeline::stages::load::Voxels;
 use crate::pipeline::stages::visible::FrameCache;
 use crate::pipeline::{prepare, render_frame};
 use crate::plan::{End, Inputs, Plan};
-use crate::{io, scene, CliError};
+use crate::{scene, CliError};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -134,12 +134,8 @@ impl Job {
         refuse(inputs, plan)?;
         let mut inputs = inputs.clone();
         let builtin = inputs.volume.is_none() && inputs.memory.is_none();
-        inputs.tf = Some(
-            inputs
-                .tf
-                .clone()
-                .unwrap_or_else(|| if builtin { "density" } else { "ct-bone-skin" }.into()),
-        );
+        // Bricks reach the pipeline as volumes in memory: the one-process choice, made here.
+        inputs.tf = Some(crate::pipeline::stages::prepare::tf_name(&inputs));
         if inputs.lod == Lod::Auto {
             // A level of detail is built from the whole volume; bricks render level 0.
             inputs.lod = Lod::Level(0);
@@ -173,10 +169,7 @@ impl Job {
                 },
             ),
             (None, None) => (
-                match inputs.scene_size {
-                    scene::SIDE => "built-in electron-density scene".to_string(),
-                    n => format!("built-in electron-density scene, {n}^3"),
-                },
+                crate::pipeline::stages::load::scene_name(inputs.scene_size),
                 match remote {
                     Some(h) => Source::Elsewhere(h),
                     None => Source::Whole {
@@ -232,7 +225,8 @@ impl Job {
     }
 
     /// The view's ray direction in grid index units, away from the viewer (what orders the
-    /// bricks; the same as [`BrickFrame::ray`]).
+    /// bricks; a supersampled or subsampled frame's map is this one scaled, so its rays run the
+    /// same way).
     pub fn ray(&self) -> Result<[f32; 3], CliError> {
         Ok((self.grid_to_screen()?.inverse() * glam::Vec3::Z).to_array())
     }
@@ -375,7 +369,6 @@ impl Job {
         } else {
             (p, Resample::None)
         };
-        let ray = p.frame.grid_to_screen.inverse() * glam::Vec3::Z;
         let mut cache = match plan.end {
             End::Sheets(_) => FrameCache::with_list_budget(0),
             _ => FrameCache::default(),
@@ -383,7 +376,6 @@ impl Job {
         let frame = render_frame(&p, &plan, &mut cache)?;
         Ok(BrickFrame {
             image: frame.image,
-            ray: ray.to_array(),
             size: out,
             resample,
             threads: plan.threads,
@@ -416,10 +408,9 @@ pub struct WindowPart {
 
 /// A brick's frame.
 pub struct BrickFrame {
-    /// Premultiplied RGBA, linear, at the output size, over nothing.
+    /// Premultiplied RGBA, linear, at the frame's internal size ([`BrickFrame::resample`]
+    /// brings it to `size`), over nothing.
     pub image: Vec<[f32; 4]>,
-    /// The view's ray direction in grid index units (what orders the bricks).
-    pub ray: [f32; 3],
     /// The output's width and height, pixels.
     pub size: (usize, usize),
     /// How the composited image reaches `size`.
@@ -508,48 +499,22 @@ fn refuse(inputs: &Inputs, plan: &Plan) -> Result<(), CliError> {
     Ok(())
 }
 
-/// The raw layout of `path` when its samples sit uncompressed at a known offset.
+/// The raw layout of `path` when its samples sit uncompressed at a known offset (what
+/// `--stream` reads: `pipeline::stages::load::raw_layout`); `None` for a file that must be loaded
+/// whole. A raw file given with `--dims` that does not match them is an error, as for streaming.
 fn seekable(
     path: &std::path::Path,
     raw: Option<&crate::io::formats::raw::RawOptions>,
 ) -> Result<Option<Source>, CliError> {
-    if let Some(o) = raw {
-        let layout = Layout {
-            path: path.to_path_buf(),
-            offset: 0,
-            dims: o.dims,
-            ty: o.ty,
-            big_endian: o.big_endian,
-        };
-        let need = crate::io::volume::byte_len(o.dims, o.ty)
-            .map_err(|e| crate::io::volume::at(path, e))? as u64;
-        let len = io::regular_file_len(path)?;
-        if len != need {
-            return Err(crate::io::volume::at(
-                path,
-                format!("expected {need} bytes for --dims/--type, found {len}"),
-            ));
-        }
-        crate::io::volume::check_spacing(o.spacing).map_err(|e| crate::io::volume::at(path, e))?;
-        return Ok(Some(Source::Seekable {
-            layout,
-            spacing: o.spacing,
-            directions: crate::io::volume::AXIS_ALIGNED,
-        }));
+    match crate::pipeline::stages::load::raw_layout(path, raw) {
+        Ok(s) => Ok(Some(Source::Seekable {
+            layout: s.layout,
+            spacing: s.spacing,
+            directions: s.directions,
+        })),
+        Err(e) if raw.is_some() => Err(e),
+        Err(_) => Ok(None),
     }
-    let lower = path.display().to_string().to_ascii_lowercase();
-    let s = if lower.ends_with(".nrrd") || lower.ends_with(".nhdr") {
-        crate::io::formats::nrrd::raw_layout(path).ok()
-    } else if lower.ends_with(".mha") || lower.ends_with(".mhd") {
-        crate::io::formats::metaimage::raw_layout(path).ok()
-    } else {
-        None
-    };
-    Ok(s.map(|s| Source::Seekable {
-        layout: s.layout,
-        spacing: s.spacing,
-        directions: s.directions,
-    }))
 }
 
 #[cfg(test)]

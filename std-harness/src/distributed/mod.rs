@@ -35,10 +35,7 @@ use std::time::Instant;
 /// `front` over `back`, in place in `front` (premultiplied: c = f + (1 − α_f)·b).
 pub fn over(front: &mut [[f32; 4]], back: &[[f32; 4]]) {
     for (f, b) in front.iter_mut().zip(back) {
-        let t = 1.0 - f[3];
-        for c in 0..4 {
-            f[c] += t * b[c];
-        }
+        *f = footprint::composite::over(*f, *b);
     }
 }
 
@@ -185,19 +182,13 @@ pub fn render_split(
                 let layout = job.layout(world.size() as usize, bricks)?;
                 // A failure on one rank (its read, its render) would leave the others waiting in
                 // a collective: it says why and ends the whole job (MPI_Abort, exit code 2).
-                let g = match self::mpi::render(&world, &job, &layout) {
-                    Ok(Some(g)) => g,
+                let c = match self::mpi::render(&world, &job, &layout) {
+                    Ok(Some(c)) => c,
                     Ok(None) => return Ok(Some(None)),
                     Err(e) => {
                         crate::warn!("rank {} of {}: {e}", world.rank(), world.size());
                         world.abort(2)
                     }
-                };
-                let c = Composited {
-                    image: g.image,
-                    window: g.window,
-                    order: g.order,
-                    ranks: g.ranks,
                 };
                 return Ok(Some(Some(summary(&job, &layout, c, start, "mpi"))));
             }

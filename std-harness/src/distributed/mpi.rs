@@ -15,7 +15,7 @@
 //! the 2^(s+1) participants that share v's bits above s, a contiguous run of the order; its
 //! partner's run lies wholly in front of it when v's bit s is 1.
 
-use super::{over, BrickLayout, Header, Job, RankStats, Source as From};
+use super::{over, BrickLayout, Composited, Header, Job, RankStats, Source as From};
 use crate::io::brick::{BrickPlace, IndexBox};
 use crate::io::volume::Volume;
 use crate::CliError;
@@ -28,20 +28,6 @@ use std::time::Instant;
 /// MPI, started once per process (`None` where it is already started). Dropping it finalises MPI.
 pub fn init() -> Option<mpi::environment::Universe> {
     mpi::initialize()
-}
-
-/// The communicator of every process `mpirun` started.
-pub fn world(universe: &mpi::environment::Universe) -> SimpleCommunicator {
-    universe.world()
-}
-
-/// What rank 0 gets from a split render: the composited image and every rank's costs.
-pub struct Gathered {
-    /// Premultiplied RGBA at the output size, the background under it.
-    pub image: Vec<[f32; 4]>,
-    pub window: [f32; 2],
-    pub order: Vec<usize>,
-    pub ranks: Vec<RankStats>,
 }
 
 /// The job for `inputs` on this rank. A file read in part (raw samples at a known place) is
@@ -83,7 +69,7 @@ pub fn render(
     comm: &SimpleCommunicator,
     job: &Job,
     layout: &BrickLayout,
-) -> Result<Option<Gathered>, CliError> {
+) -> Result<Option<Composited>, CliError> {
     let rank = comm.rank() as usize;
     let (brick, bytes) = match &job.source {
         From::Seekable { .. } => job.brick(layout.boxes[rank])?,
@@ -173,7 +159,7 @@ pub fn render_in_situ(
     samples: crate::io::volume::Samples,
     stored: IndexBox,
     owned: IndexBox,
-) -> Result<Option<Gathered>, CliError> {
+) -> Result<Option<Composited>, CliError> {
     let mut inputs = crate::plan::Inputs::from(args);
     let plan = crate::plan::plan(args)?;
     let held = [0, 1, 2].map(|c| stored.hi[c].saturating_sub(stored.lo[c]));
@@ -235,10 +221,10 @@ fn render_brick(
     layout: &BrickLayout,
     brick: Volume,
     bytes: u64,
-) -> Result<Option<Gathered>, CliError> {
+) -> Result<Option<Composited>, CliError> {
     let window = agree_window(comm, job, &brick)?;
     let mut frame = job.render(brick, window)?;
-    let order = layout.front_to_back(frame.ray);
+    let order = layout.front_to_back(job.ray()?);
     // Every rank's render done: the composite time that follows is compositing, not waiting.
     comm.barrier();
     let start = Instant::now();
@@ -269,7 +255,7 @@ fn render_brick(
             peak_memory_bytes: (c[4] >= 0.0).then_some(c[4] as u64),
         })
         .collect();
-    Ok(Some(Gathered {
+    Ok(Some(Composited {
         image,
         window,
         order,
@@ -385,10 +371,7 @@ pub fn binary_swap(
             } else {
                 // The partner's run is in front: partner over mine.
                 for (m, f) in mine.iter_mut().zip(&got) {
-                    let t = 1.0 - f[3];
-                    for c in 0..4 {
-                        m[c] = f[c] + t * m[c];
-                    }
+                    *m = footprint::composite::over(*f, *m);
                 }
             }
             region = keep;

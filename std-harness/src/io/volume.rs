@@ -317,21 +317,9 @@ impl Volume {
         out: &mut [O],
         to: impl Fn(f32) -> O,
     ) {
-        use footprint::volume::copy_sheets;
-        if let Some(b) = self.brick {
-            return self.brick_sheets_as(b, axis, sheets, out, to);
-        }
-        let (d, a, s) = (self.dims, axis, sheets);
-        match &self.samples {
-            Samples::U8(v) => copy_sheets(v, d, a, s, out, |x| to(f32::from(x))),
-            Samples::I8(v) => copy_sheets(v, d, a, s, out, |x| to(f32::from(x))),
-            Samples::U16(v) => copy_sheets(v, d, a, s, out, |x| to(f32::from(x))),
-            Samples::I16(v) => copy_sheets(v, d, a, s, out, |x| to(f32::from(x))),
-            Samples::U32(v) => copy_sheets(v, d, a, s, out, |x| to(x as f32)),
-            Samples::I32(v) => copy_sheets(v, d, a, s, out, |x| to(x as f32)),
-            Samples::F32(v) => copy_sheets(v, d, a, s, out, &to),
-            Samples::F64(v) => copy_sheets(v, d, a, s, out, |x| to(x as f32)),
-            Samples::Coloured(v) => copy_sheets(v, d, a, s, out, |x| to(x.value)),
+        match self.brick {
+            None => copy_as(&self.samples, self.dims, axis, sheets, out, to),
+            Some(b) => self.brick_sheets_as(b, axis, sheets, out, to),
         }
     }
 
@@ -348,52 +336,19 @@ impl Volume {
         let (a, c) = footprint::geometry::in_sheet_axes(axis);
         let (na, len) = (self.dims[a], self.dims[a] * self.dims[c]);
         let sd = b.stored.dims();
-        let local = Volume {
-            dims: sd,
-            brick: None,
-            ..self.clone_header()
-        };
-        let mut part = vec![0.0f32; sd[a] * sd[c]];
+        // One stored sheet, its rows swapped into place in the whole sheet.
+        let mut part: Vec<O> = (0..sd[a] * sd[c]).map(|_| to(f32::NAN)).collect();
         for (s, sheet) in sheets.zip(out.chunks_exact_mut(len)) {
             sheet.iter_mut().for_each(|x| *x = to(f32::NAN));
             if !(b.stored.lo[axis] <= s && s < b.stored.hi[axis]) {
                 continue;
             }
-            local.sheet_into_with(&self.samples, axis, s - b.stored.lo[axis], &mut part);
-            for (v, row) in part.chunks_exact(sd[a]).enumerate() {
+            let local = s - b.stored.lo[axis];
+            copy_as(&self.samples, sd, axis, local..local + 1, &mut part, &to);
+            for (v, row) in part.chunks_exact_mut(sd[a]).enumerate() {
                 let start = (b.stored.lo[c] + v) * na + b.stored.lo[a];
-                for (o, &x) in sheet[start..start + sd[a]].iter_mut().zip(row) {
-                    *o = to(x);
-                }
+                sheet[start..start + sd[a]].swap_with_slice(row);
             }
-        }
-    }
-
-    /// This volume's header with no samples (for [`Volume::brick_sheets_as`]).
-    fn clone_header(&self) -> Volume {
-        Volume {
-            dims: self.dims,
-            spacing: self.spacing,
-            directions: self.directions,
-            samples: Samples::U8(Vec::new().into()),
-            brick: self.brick,
-        }
-    }
-
-    /// Sheet `s` of `axis` of `samples` laid out with this header's dims, as f32.
-    fn sheet_into_with(&self, samples: &Samples, axis: usize, s: usize, out: &mut [f32]) {
-        use footprint::volume::copy_sheet;
-        let (d, a) = (self.dims, axis);
-        match samples {
-            Samples::U8(v) => copy_sheet(v, d, a, s, out, f32::from),
-            Samples::I8(v) => copy_sheet(v, d, a, s, out, f32::from),
-            Samples::U16(v) => copy_sheet(v, d, a, s, out, f32::from),
-            Samples::I16(v) => copy_sheet(v, d, a, s, out, f32::from),
-            Samples::U32(v) => copy_sheet(v, d, a, s, out, |x| x as f32),
-            Samples::I32(v) => copy_sheet(v, d, a, s, out, |x| x as f32),
-            Samples::F32(v) => copy_sheet(v, d, a, s, out, |x| x),
-            Samples::F64(v) => copy_sheet(v, d, a, s, out, |x| x as f32),
-            Samples::Coloured(v) => copy_sheet(v, d, a, s, out, |x| x.value),
         }
     }
 
@@ -412,6 +367,30 @@ impl Volume {
                 colour: None,
             }),
         }
+    }
+}
+
+/// Sheets `sheets` of `axis` of `samples` laid out with `dims`, one after another into `out`,
+/// each sample's value (as f32) through `to` (the one per-type copy behind every sheet read).
+fn copy_as<O>(
+    samples: &Samples,
+    d: [usize; 3],
+    a: usize,
+    s: std::ops::Range<usize>,
+    out: &mut [O],
+    to: impl Fn(f32) -> O,
+) {
+    use footprint::volume::copy_sheets;
+    match samples {
+        Samples::U8(v) => copy_sheets(v, d, a, s, out, |x| to(f32::from(x))),
+        Samples::I8(v) => copy_sheets(v, d, a, s, out, |x| to(f32::from(x))),
+        Samples::U16(v) => copy_sheets(v, d, a, s, out, |x| to(f32::from(x))),
+        Samples::I16(v) => copy_sheets(v, d, a, s, out, |x| to(f32::from(x))),
+        Samples::U32(v) => copy_sheets(v, d, a, s, out, |x| to(x as f32)),
+        Samples::I32(v) => copy_sheets(v, d, a, s, out, |x| to(x as f32)),
+        Samples::F32(v) => copy_sheets(v, d, a, s, out, &to),
+        Samples::F64(v) => copy_sheets(v, d, a, s, out, |x| to(x as f32)),
+        Samples::Coloured(v) => copy_sheets(v, d, a, s, out, |x| to(x.value)),
     }
 }
 

@@ -119,13 +119,7 @@ pub(crate) fn load_voxels(args: &Inputs) -> Result<Loaded, CliError> {
                 formats::load_array(path, raw.as_ref(), args.array.as_deref())?,
                 path.display().to_string(),
             ),
-            None => (
-                scene::volume(args.scene_size)?,
-                match args.scene_size {
-                    scene::SIDE => "built-in electron-density scene".to_string(),
-                    n => format!("built-in electron-density scene, {n}^3"),
-                },
-            ),
+            None => (scene::volume(args.scene_size)?, scene_name(args.scene_size)),
         };
         let (dims, grid, range) = (volume.dims, volume.grid_to_world(), Some(volume.range()));
         let sample =
@@ -140,6 +134,14 @@ pub(crate) fn load_voxels(args: &Inputs) -> Result<Loaded, CliError> {
         });
     };
     load_stream(args, stream, raw)
+}
+
+/// The built-in scene's name in messages and the JSON's `volume`, sampled on an `n`³ grid.
+pub(crate) fn scene_name(n: usize) -> String {
+    match n {
+        scene::SIDE => "built-in electron-density scene".to_string(),
+        n => format!("built-in electron-density scene, {n}^3"),
+    }
 }
 
 /// `--stream FILE|-`: the layout a streamed volume is read through (standard input, a raw file,
@@ -180,36 +182,11 @@ fn load_stream(
             sample: None,
         });
     }
-    let lower = name.to_ascii_lowercase();
-    let (layout, spacing, directions) = if let Some(o) = &raw {
-        let layout = Layout {
-            path: stream.to_path_buf(),
-            offset: 0,
-            dims: o.dims,
-            ty: o.ty,
-            big_endian: o.big_endian,
-        };
-        crate::io::volume::check_spacing(o.spacing)
-            .map_err(|e| crate::io::volume::at(stream, e))?;
-        (layout, o.spacing, crate::io::volume::AXIS_ALIGNED)
-    } else if lower.ends_with(".nrrd") || lower.ends_with(".nhdr") {
-        let s = formats::nrrd::raw_layout(stream)?;
-        (s.layout, s.spacing, s.directions)
-    } else if lower.ends_with(".mha") || lower.ends_with(".mhd") {
-        let s = formats::metaimage::raw_layout(stream)?;
-        (s.layout, s.spacing, s.directions)
-    } else {
-        return Err(crate::io::volume::at(stream, "streaming reads raw files (with --dims and --type), NRRD with raw encoding, or uncompressed MetaImage"));
-    };
-    let file_len = crate::io::regular_file_len(&layout.path)?;
-    let need = crate::io::volume::byte_len(layout.dims, layout.ty)
-        .map_err(|e| crate::io::volume::at(&layout.path, e))? as u64;
-    if raw.is_some() && file_len != need {
-        return Err(crate::io::volume::at(
-            &layout.path,
-            format!("expected {need} bytes for --dims/--type, found {file_len}"),
-        ));
-    }
+    let formats::Streamable {
+        layout,
+        spacing,
+        directions,
+    } = raw_layout(stream, raw.as_ref())?;
     let col = |c: usize| Vec3::from_array(directions[c]) * spacing[c];
     let grid = Mat3::from_cols(col(0), col(1), col(2));
     let (range, sample) = if args.window.is_none() {
@@ -226,6 +203,48 @@ fn load_stream(
         grid,
         range,
     })
+}
+
+/// Where a file's raw samples are, and its grid: a raw file (`--dims` and `--type`, its length
+/// checked), NRRD with raw encoding, or uncompressed MetaImage; an error for anything else.
+/// What `--stream` reads and what a brick of a split render reads in part.
+pub(crate) fn raw_layout(
+    stream: &std::path::Path,
+    raw: Option<&RawOptions>,
+) -> Result<formats::Streamable, CliError> {
+    let lower = stream.display().to_string().to_ascii_lowercase();
+    let found = if let Some(o) = raw {
+        crate::io::volume::check_spacing(o.spacing)
+            .map_err(|e| crate::io::volume::at(stream, e))?;
+        formats::Streamable {
+            layout: Layout {
+                path: stream.to_path_buf(),
+                offset: 0,
+                dims: o.dims,
+                ty: o.ty,
+                big_endian: o.big_endian,
+            },
+            spacing: o.spacing,
+            directions: crate::io::volume::AXIS_ALIGNED,
+        }
+    } else if lower.ends_with(".nrrd") || lower.ends_with(".nhdr") {
+        formats::nrrd::raw_layout(stream)?
+    } else if lower.ends_with(".mha") || lower.ends_with(".mhd") {
+        formats::metaimage::raw_layout(stream)?
+    } else {
+        return Err(crate::io::volume::at(stream, "streaming reads raw files (with --dims and --type), NRRD with raw encoding, or uncompressed MetaImage"));
+    };
+    let layout = &found.layout;
+    let file_len = crate::io::regular_file_len(&layout.path)?;
+    let need = crate::io::volume::byte_len(layout.dims, layout.ty)
+        .map_err(|e| crate::io::volume::at(&layout.path, e))? as u64;
+    if raw.is_some() && file_len != need {
+        return Err(crate::io::volume::at(
+            &layout.path,
+            format!("expected {need} bytes for --dims/--type, found {file_len}"),
+        ));
+    }
+    Ok(found)
 }
 
 pub(crate) fn load_background(

@@ -452,15 +452,7 @@ pub fn prepare_as_asked(args: &Inputs) -> Result<Prepared, CliError> {
     let kernel = kernel_at(args, &kernel, level);
 
     let order = compositing_order(args, &voxels, &frame)?;
-    let tf_name = args.tf.clone().unwrap_or_else(|| {
-        if args.volume.is_none() && args.stream.is_none() && args.memory.is_none() {
-            "density"
-        } else {
-            // Transparent below the default window's first 18 %: see `super::window`.
-            "ct-bone-skin"
-        }
-        .into()
-    });
+    let tf_name = tf_name(args);
     let lut = tf::lut(&tf::load(&tf_name)?);
     let window = match args.window {
         Some(w) => w,
@@ -524,6 +516,20 @@ pub fn prepare_as_asked(args: &Inputs) -> Result<Prepared, CliError> {
         supersample,
         absorption: args.absorption,
         view: view_for(args, dims, &grid)?,
+    })
+}
+
+/// The transfer function `args` render with: `--tf`, else `density` for the built-in scene and
+/// `ct-bone-skin` for a user's volume (transparent below the default window's first 18 %: see
+/// `super::window`).
+pub fn tf_name(args: &Inputs) -> String {
+    args.tf.clone().unwrap_or_else(|| {
+        if args.volume.is_none() && args.stream.is_none() && args.memory.is_none() {
+            "density"
+        } else {
+            "ct-bone-skin"
+        }
+        .into()
     })
 }
 

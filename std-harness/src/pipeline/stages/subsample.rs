@@ -132,10 +132,7 @@ pub fn low_size(size: (usize, usize), s: usize) -> (usize, usize) {
 /// C + (1 − A)·background per channel, what the core's sheet loop does with a background.
 pub fn under_background(image: &mut [[f32; 4]], background: &[[f32; 4]]) {
     for (c, b) in image.iter_mut().zip(background) {
-        let t = 1.0 - c[3];
-        for ch in 0..4 {
-            c[ch] += t * b[ch];
-        }
+        *c = footprint::composite::over(*c, *b);
     }
 }
 
