@@ -17,8 +17,13 @@
 # --opacity-unit-distance 1; VolPack's per-slice opacity equals it at unit spacing).
 #
 # Per volume and repetition, in this order: Footprint float 1 thread, float 2 threads, fixed 1
-# thread, float with --subsample auto on 1 and 2 threads (each `footprint bench --frames N --orbit
-# 2`: first_ms = fresh volume, median_ms = re-render), VTK vtkFixedPointVolumeRayCastMapper 1 and 2 threads, VolPack pre-classified. The
+# thread, float with --subsample auto on 1 and 2 threads, image-aligned slabs (--slicing image) on
+# 1 and 2 threads, object slicing and slabs with occlusion culling (--cull 0.004) on 1 and 2
+# threads (each `footprint bench --frames N --orbit 2`: first_ms = fresh volume, median_ms =
+# re-render), post-classified slabs on 1 thread, VTK vtkFixedPointVolumeRayCastMapper 1 and 2
+# threads, VolPack pre-classified. Once per volume, each of those methods against the default
+# continuous model (`verify --reference continuous`) and its culled voxels: docs/perf/methods.csv.
+# The 16-core table comes from docs/perf/threads16.csv (measured on a lent machine). The
 # medians over the repetitions go to docs/performance.md as ratios; the raw rows to
 # docs/perf/peers.csv. After VolPack in each repetition, benches/floor.rs times the scene's
 # unavoidable work at 512² (its pixel updates and composites, counted by `footprint render --json`,
@@ -83,7 +88,11 @@ volumes=(
 [ "$quick" = 1 ] && volumes=("${volumes[1]}")
 
 csv=docs/perf/peers.csv
-echo "volume,rep,renderer,threads,accum,first_ms,median_ms" > "$csv"
+echo "volume,rep,renderer,threads,accum,first_ms,median_ms,culled_voxels" > "$csv"
+mcsv=docs/perf/methods.csv
+echo "volume,method,psnr_continuous_db,psnr_f64_db,voxels,culled_voxels,pixel_updates" > "$mcsv"
+# Occlusion culling's threshold in the runs: 1/255, one 8-bit step at most per pixel.
+cull=0.004
 acsv=docs/perf/subsample.csv
 echo "volume,subsample,factor,psnr_f64_db,psnr_continuous_db" > "$acsv"
 pcsv=docs/perf/post.csv
@@ -126,6 +135,19 @@ PY
     "$py" -c "import json; j=json.load(open('$work/v.json')); print(f'$name,$sub,{int(j[\"subsample\"])},{j[\"overall\"][\"psnr_db\"]:.2f},{j[\"continuous\"][\"psnr_db\"]:.2f}')" >> "$acsv"
     [ "$sub" = 1 ] && cp "$work/v.json" "$work/v1.json"
   done
+  # Each method of the timing runs against the default continuous model (opacity reconstruction,
+  # `verify --reference continuous`), and what culling skipped (issue 42).
+  for m in "object|--slicing object" "object-cull|--slicing object --cull $cull" "slabs|--slicing image" \
+           "slabs-cull|--slicing image --cull $cull" "object-subsample|--slicing object --subsample auto"; do
+    IFS='|' read -r label flags <<<"$m"
+    # shellcheck disable=SC2086 # the method's flags
+    "$fp" verify "$raw" --dims "$nx,$ny,$nz" --type u8 --spacing "$sx,$sy,$sz" --window "$lo,$hi" --tf grey \
+      --size 512x512 --view-matrix "$vm" $flags --reference continuous --json "$work/m.json" >/dev/null
+    # shellcheck disable=SC2086
+    "$fp" render "$raw" --dims "$nx,$ny,$nz" --type u8 --spacing "$sx,$sy,$sz" --window "$lo,$hi" --tf grey \
+      --size 512x512 --view-matrix "$vm" $flags --threads 1 --out "$work/m.png" --json "$work/mr.json" >/dev/null
+    "$py" -c "import json; j=json.load(open('$work/m.json')); r=json.load(open('$work/mr.json')); print(f'$name,$label,{j[\"continuous\"][\"psnr_db\"]:.2f},{j[\"overall\"][\"psnr_db\"]:.2f},{int(r[\"voxels\"])},{int(r[\"culled_voxels\"])},{int(r[\"pixel_updates\"])}')" >> "$mcsv"
+  done
   # Post-classification (issue 47): Footprint's post-classified default and its pre-classified
   # default against the post-classified integral (the kernel's reconstruction, the default, and
   # trilinear, VTK's own), and VTK's image (from its first run above) against the same integrals.
@@ -166,21 +188,25 @@ print(f"{name}: mean RGB  footprint {fp.mean():.2f}  vtk {vt.mean():.2f}  volpac
 Image.fromarray(np.concatenate([fp, vt, vp], 1)).resize((768, 256)).save(dest)
 PY
   for rep in $(seq 1 "$reps"); do
-    for cfg in "1 float 1" "2 float 1" "1 fixed 1" "1 float auto" "2 float auto"; do
-      read -r th acc sub <<<"$cfg"
-      "$fp" bench "${common[@]}" --threads "$th" --accum "$acc" --subsample "$sub" --json "$work/b.json" >/dev/null
-      label=$acc; [ "$sub" = auto ] && label=$acc-subsample
-      "$py" -c "import json,sys; j=json.load(open('$work/b.json')); print(f'$name,$rep,footprint,$th,$label,{j[\"first_ms\"]:.3f},{j[\"median_ms\"]:.3f}')" >> "$csv"
+    for cfg in "1 float 1 object off" "2 float 1 object off" "1 fixed 1 object off" "1 float auto object off" \
+               "2 float auto object off" "1 float 1 image off" "2 float 1 image off" "1 float 1 object $cull" \
+               "2 float 1 object $cull" "1 float 1 image $cull" "2 float 1 image $cull"; do
+      read -r th acc sub slicing cl <<<"$cfg"
+      "$fp" bench "${common[@]}" --threads "$th" --accum "$acc" --subsample "$sub" --slicing "$slicing" \
+        --cull "$cl" --json "$work/b.json" >/dev/null
+      label=$acc; [ "$sub" = auto ] && label=$label-subsample
+      [ "$slicing" = image ] && label=$label-slabs; [ "$cl" != off ] && label=$label-cull
+      "$py" -c "import json,sys; j=json.load(open('$work/b.json')); print(f'$name,$rep,footprint,$th,$label,{j[\"first_ms\"]:.3f},{j[\"median_ms\"]:.3f},{int(j[\"culled_voxels\"])}')" >> "$csv"
     done
     # Post-classified (issue 47), one thread: beside VTK's ray caster, which post-classifies.
     "$fp" bench "${common[@]}" --threads 1 --classification post --json "$work/b.json" >/dev/null
-    "$py" -c "import json,sys; j=json.load(open('$work/b.json')); print(f'$name,$rep,footprint,1,float-post,{j[\"first_ms\"]:.3f},{j[\"median_ms\"]:.3f}')" >> "$csv"
+    "$py" -c "import json,sys; j=json.load(open('$work/b.json')); print(f'$name,$rep,footprint,1,float-post,{j[\"first_ms\"]:.3f},{j[\"median_ms\"]:.3f},0')" >> "$csv"
     for th in 1 2; do
       vtk "$th"
-      "$py" -c "import json; j=json.load(open('$work/out/vtk-$name.json'))['seconds']; print(f'$name,$rep,vtk,$th,-,{j[\"warmup_total\"]*1e3:.3f},{j[\"frame\"][\"median\"]*1e3:.3f}')" >> "$csv"
+      "$py" -c "import json; j=json.load(open('$work/out/vtk-$name.json'))['seconds']; print(f'$name,$rep,vtk,$th,-,{j[\"warmup_total\"]*1e3:.3f},{j[\"frame\"][\"median\"]*1e3:.3f},0')" >> "$csv"
     done
     "$work/vp_bench" "$raw" "$nx" "$ny" "$nz" "$sx" "$sy" "$sz" 512 512 30 20 "$lo" "$hi" "$frames" "$work/out/vp-$name" classified grey >/dev/null
-    "$py" -c "import json; j=json.load(open('$work/out/vp-$name.json'))['seconds']; print(f'$name,$rep,volpack,1,-,{(j[\"preprocess\"]+j[\"first_frame\"])*1e3:.3f},{j[\"frame\"][\"median\"]*1e3:.3f}')" >> "$csv"
+    "$py" -c "import json; j=json.load(open('$work/out/vp-$name.json'))['seconds']; print(f'$name,$rep,volpack,1,-,{(j[\"preprocess\"]+j[\"first_frame\"])*1e3:.3f},{j[\"frame\"][\"median\"]*1e3:.3f},0')" >> "$csv"
     # shellcheck disable=SC2086 # four counts
     cargo bench -q --bench floor -- $counts "$frames" 2>/dev/null \
       | sed -nE "s/^floor ([a-z]+): box ([0-9]+) px, accumulate ([0-9.]+) ms.*composite ([0-9.]+) ms.*floor ([0-9.]+) ms$/$name,$rep,\1,${counts// /,},\2,\3,\4,\5/p" >> "$fcsv"
@@ -222,5 +248,6 @@ PY
 done
 
 echo "== docs/performance.md"
-"$py" "$root/benches/peers_report.py" "$csv" "$scsv" docs/performance.md docs/charts/perf-scaling "$acsv" "$fcsv" "$pcsv"
+"$py" "$root/benches/peers_report.py" "$csv" "$scsv" docs/performance.md docs/charts/perf-scaling "$acsv" "$fcsv" "$pcsv" \
+  "$mcsv" docs/perf/threads16.csv
 echo "wrote docs/performance.md, docs/perf/*.csv, docs/charts/perf-scaling.{svg,png}, docs/images/peers-*.png"

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Writes docs/performance.md and the scaling chart from the CSVs benches/peers.sh measured.
 
-usage: peers_report.py PEERS.csv SCALING.csv OUT.md CHART_STEM [SUBSAMPLE.csv [FLOOR.csv [POST.csv]]]
+usage: peers_report.py PEERS.csv SCALING.csv OUT.md CHART_STEM [SUBSAMPLE.csv [FLOOR.csv [POST.csv
+       [METHODS.csv [THREADS16.csv]]]]]
 Every ratio is of medians over the repetitions, all measured alternately in one session.
 """
 import csv
@@ -21,6 +22,8 @@ peers_csv, scaling_csv, out_md, stem = sys.argv[1:5]
 sub_csv = sys.argv[5] if len(sys.argv) > 5 else None
 floor_csv = sys.argv[6] if len(sys.argv) > 6 else None
 post_csv = sys.argv[7] if len(sys.argv) > 7 else None
+methods_csv = sys.argv[8] if len(sys.argv) > 8 else None
+threads16_csv = sys.argv[9] if len(sys.argv) > 9 else None
 rows = list(csv.DictReader(open(peers_csv)))
 volumes = list(dict.fromkeys(r["volume"] for r in rows))
 
@@ -114,6 +117,63 @@ if any(r["accum"] == "float-subsample" for r in rows):
         f64s = f"{float(full['psnr_f64_db']):.1f} → {float(a['psnr_f64_db']):.1f} dB" if a and full else "–"
         cont = f"{float(full['psnr_continuous_db']):.2f} → {float(a['psnr_continuous_db']):.2f} dB" if a and full else "–"
         lines.append(f"| {v} | {s_} | {f1:.1f} ms | {r1:.1f} ms | {r2:.1f} ms | {t1 / f1:.2f}× | {r1 / vp:.1f}× | {r1 / r2:.2f}× | {f64s} | {cont} |")
+
+mrows = {(r["volume"], r["method"]): r for r in csv.DictReader(open(methods_csv))} if methods_csv else {}
+if any(r["accum"] == "float-slabs" for r in rows):
+    lines += [
+        "",
+        "## Methods: the default, object slicing, slabs, occlusion culling",
+        "",
+        "Same repetitions, float. *Object* is the paper's sheets (the default), *slabs* image-aligned "
+        "slabs one voxel spacing thick (`--slicing image`), *cull* adds occlusion culling at ε = 1/255 "
+        "(`--cull 0.004`: 8×8-pixel tiles whose every pixel reached opacity 1 − ε take nothing more, and "
+        "voxels landing only on them are skipped; each such pixel stays within ε per channel), "
+        "*subsample* is `--subsample auto`. Accuracy: `footprint verify --reference continuous` with the "
+        "same flags, PSNR against the default continuous model (opacity reconstruction) and, in brackets, "
+        "against the f64 sheet reference of the same method; *culled* is the share of visible voxels "
+        "culling skipped on one thread (`render --json`: `culled_voxels` ÷ (`voxels` + `culled_voxels`)). "
+        "Data: `docs/perf/peers.csv`, `docs/perf/methods.csv`.",
+        "",
+        "| volume | method | fresh, 1 thread | re-render, 1 thread | re-render, 2 threads | 1 ÷ 2 threads [≥ 1.8] | "
+        "VTK 1 thread ÷ fresh [≥ 5] | VTK 2 threads ÷ re-render 2 threads | re-render ÷ VolPack [≤ 2] | "
+        "÷ object, 1 / 2 threads [slabs ≤ 2.5] | culled | PSNR vs the default model (vs f64) |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for v in volumes:
+        t1, t2, vp = peer_times(v)
+        _, o1, o2 = footprint_times(v, "float")
+        for label, accum, method in [("object (default)", "float", "object"), ("object, cull", "float-cull", "object-cull"),
+                                     ("object, subsample", "float-subsample", "object-subsample"),
+                                     ("slabs", "float-slabs", "slabs"), ("slabs, cull", "float-slabs-cull", "slabs-cull")]:
+            f1, r1, r2 = footprint_times(v, accum)
+            m = mrows.get((v, method))
+            if m:
+                seen = int(m["voxels"]) + int(m["culled_voxels"])
+                culled = f"{100 * int(m['culled_voxels']) / seen:.1f} %" if seen else "–"
+                psnr = f"{m['psnr_continuous_db']} dB ({m['psnr_f64_db']} dB)"
+            else:
+                culled, psnr = "–", "–"
+            lines.append(f"| {v} | {label} | {f1:.1f} ms | {r1:.1f} ms | {r2:.1f} ms | {r1 / r2:.2f}× | {t1 / f1:.2f}× | "
+                         f"{t2 / r2:.2f}× | {r1 / vp:.1f}× | {r1 / o1:.2f}× / {r2 / o2:.2f}× | {culled} | {psnr} |")
+
+if threads16_csv and os.path.exists(threads16_csv):
+    t16 = list(csv.DictReader(open(threads16_csv)))
+    if t16:
+        lines += [
+            "",
+            "## Threads on 16 cores",
+            "",
+            f"Not measured by this run (a 16-core machine is lent to some sessions only): `{threads16_csv}`, "
+            f"measured on {t16[0]['machine']} at commit {t16[0]['commit']} ({t16[0]['date']}), "
+            "`footprint bench VOLUME --view 30,20,0 --frames 5 --orbit 2 --threads T`, median re-render; "
+            "volumes at their own files' values and the default transfer function. Target: 16 threads ≥ 10× one.",
+            "",
+            "| volume | size | method | 1 thread | 16 threads | 16 ÷ 1 [≥ 10] |",
+            "|---|---|---|---|---|---|",
+        ]
+        for r in t16:
+            ms = lambda k: f"{float(r[k]):.1f} ms" if r[k] else "not kept"
+            lines.append(f"| {r['volume']} | {r['size']}² | {r['method']} | {ms('t1_ms')} | {ms('t16_ms')} | {float(r['speedup']):.1f}× |")
 
 prows = {r["volume"]: r for r in csv.DictReader(open(post_csv))} if post_csv else {}
 if any(r["accum"] == "float-post" for r in rows):

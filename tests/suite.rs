@@ -7,6 +7,7 @@ mod bricks;
 mod classify;
 mod compact;
 mod continuous;
+mod cull;
 mod degenerate;
 mod display;
 mod ellipse_geometry;

@@ -278,6 +278,9 @@ fn bench_writes_the_named_keys() {
         "\"splat\"",
         "\"composite\"",
         "\"frames_ms\"",
+        "\"plan\"",
+        "\"end\": \"sheets\"",
+        "\"culled_voxels\": 0",
     ] {
         assert!(j.contains(key), "{key} missing from {j}");
     }

@@ -431,6 +431,12 @@ pub struct RenderArgs {
     /// render on 256.
     #[arg(help_heading = "Speed and quality", long, default_value_t = 0, value_parser = parse_threads)]
     pub threads: usize,
+    /// Occlusion culling (Mueller et al. 1999), sheets and slabs: front to back, 8x8-pixel tiles
+    /// whose every pixel reached opacity 1 - EPS take nothing more, and voxels landing only on
+    /// them are skipped. Each such pixel is within EPS per channel (peak 1) of the unculled image;
+    /// `off` (the default) culls nothing. Implies --order front-to-back. docs/performance.md.
+    #[arg(help_heading = "Speed and quality", long, value_name = "EPS|off", default_value = "off", value_parser = parse_cull)]
+    pub cull: Cull,
     /// Target PSNR, dB, against --quality-reference: choose the cheapest configuration expected
     /// to reach it for this scene and view (overrides the table, lookup, method and
     /// accumulation; with the continuous reference also the slab thickness). Against the sheet
@@ -448,23 +454,6 @@ pub struct RenderArgs {
     /// `--refine 0`.
     #[arg(help_heading = "Speed and quality", long, value_enum, default_value_t = QualityReferenceArg::Sheets, requires = "quality")]
     pub quality_reference: QualityReferenceArg,
-}
-
-/// The most bricks `--bricks` makes (a million: far past any MPI job's ranks per volume).
-pub const MAX_BRICKS: usize = 1 << 20;
-
-/// `--bricks X,Y,Z`: three counts, each at least 1, [`MAX_BRICKS`] at most in all.
-pub fn parse_bricks(s: &str) -> Result<[usize; 3], String> {
-    let v: Vec<usize> = s
-        .split(',')
-        .map(|x| x.trim().parse::<usize>().map_err(|e| format!("'{x}': {e}")))
-        .collect::<Result<_, _>>()?;
-    match v[..] {
-        [x, y, z] if x >= 1 && y >= 1 && z >= 1 => Ok([x, y, z]),
-        _ => Err(format!(
-            "expected X,Y,Z brick counts, each at least 1 (got '{s}')"
-        )),
-    }
 }
 
 fn parse_dims(s: &str) -> Result<[usize; 3], String> {

@@ -120,6 +120,8 @@ pub struct Plan {
     /// The subsampling decorator (`--subsample`): `Fixed(1)` off, `Fixed(s)` at 1/s of the size,
     /// `Auto` where the footprints allow it.
     pub subsample: Supersample,
+    /// Occlusion culling's ε (`--cull`; sheets and slabs, front to back, orthographic), or none.
+    pub cull: Option<f32>,
     /// `--quality DB`: the table, level and slicing are chosen by measured error
     /// (`pipeline::quality::choose::apply_quality` returns the plan it chose, with this `None`).
     pub quality: Option<Quality>,
@@ -219,9 +221,7 @@ pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
         }
         _ => {}
     }
-    if args.stream.is_some() {
-        streamed_rules(&end, args)?;
-    }
+    flag_rules(&end, args)?;
     check_levels(&Inputs::from(args))?;
     let extinction = Absorption::from(args.absorption) == Absorption::Extinction;
     if extinction && matches!(end, End::Sheets(_) | End::Refined { .. }) {
@@ -283,6 +283,7 @@ pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
         phases: args.phases,
         threads: args.thread_count(),
         subsample: args.subsample,
+        cull: args.cull.0,
         quality: args.quality.map(|target_db| Quality {
             target_db,
             reference: args.quality_reference,
@@ -308,6 +309,37 @@ pub const SUBSAMPLE_NOT_PERSPECTIVE: &str =
 /// choice in `pipeline::stages::subsample::factor`).
 pub const SUBSAMPLE_NOT_AT_A_LEVEL: &str =
     "the volume renders at a coarser level of detail (--lod); give --lod 0 or auto";
+
+/// The rules a streamed volume and `--cull` add to `end`.
+fn flag_rules(end: &End, args: &RenderArgs) -> Result<(), CliError> {
+    if args.stream.is_some() {
+        streamed_rules(end, args)?;
+    }
+    match args.cull.0 {
+        Some(eps) => cull_rules(eps, end, args),
+        None => Ok(()),
+    }
+}
+
+/// The rules `--cull EPS` adds: sheets or pre-classified slabs, front to back, orthographic, and
+/// not with `--quality` (which chooses the method itself).
+fn cull_rules(eps: f32, end: &End, args: &RenderArgs) -> Result<(), CliError> {
+    let why = if !matches!(end, End::Sheets(_) | End::Slabs { .. }) {
+        Some("the paper's sheets and pre-classified slabs only: drop --classification post, --refine or --method reference")
+    } else if args.perspective.is_some() {
+        Some("orthographic views only (a perspective view's footprints vary per voxel)")
+    } else if args.order == Some(OrderArg::BackToFront) {
+        Some("culling needs front-to-back compositing: drop --order back-to-front")
+    } else if args.quality.is_some() {
+        Some("--quality chooses the method from measured errors: drop one")
+    } else {
+        None
+    };
+    match why {
+        Some(why) => Err(CliError::input(format!("--cull {eps}: {why}"))),
+        None => Ok(()),
+    }
+}
 
 /// The rules a streamed volume (`--stream`: read once, a few sheets at a time) adds to `end`.
 fn streamed_rules(end: &End, args: &RenderArgs) -> Result<(), CliError> {
@@ -454,8 +486,10 @@ impl From<&RenderArgs> for Inputs {
             absorption: a.absorption.into(),
             // Post-classification composites front to back unless told: opaque pixels then take
             // nothing more (exact), where back to front must classify every slab.
+            // Culling needs what is in front first.
             order: match (a.classification, a.order) {
                 (ClassificationArg::Post, None) => Some(crate::args::OrderArg::FrontToBack),
+                (_, None) if a.cull.0.is_some() => Some(crate::args::OrderArg::FrontToBack),
                 (_, order) => order,
             },
             supersample: a.supersample,

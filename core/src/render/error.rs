@@ -66,6 +66,8 @@ pub enum RenderError {
         /// The renderer's.
         renderer: crate::frame::Order,
     },
+    /// Occlusion culling refused ([`SheetRenderer::with_occlusion`](super::SheetRenderer::with_occlusion)).
+    Occlusion(super::OcclusionError),
     /// A voxel above the channel bound a [`FixedPath`](super::FixedPath) was promised
     /// ([`FixedPath::with_value_bound`](super::FixedPath::with_value_bound)).
     ValueAboveBound {
@@ -117,6 +119,7 @@ impl fmt::Display for RenderError {
                 "the sheet ring was made for {ring:?} but the renderer composites {renderer:?}: \
                  make the ring with SheetRing::for_renderer"
             ),
+            Self::Occlusion(e) => e.fmt(f),
             Self::ValueAboveBound { value, bound } => write!(
                 f,
                 "a voxel channel of {value} (Q24) is above the bound {bound} the fixed path was given"

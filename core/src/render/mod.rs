@@ -23,6 +23,7 @@
 pub mod absorption;
 mod band;
 mod error;
+mod occlusion;
 mod perspective;
 pub mod post;
 mod precision;
@@ -30,11 +31,13 @@ mod refined;
 mod scaled;
 mod shade_cache;
 mod sheets;
+mod slab_renderer;
 pub mod slabs;
 mod visible;
 
 pub use absorption::Absorption;
 pub use error::RenderError;
+pub use occlusion::{occlusion_len, OcclusionError, OCCLUSION_TILE};
 pub use perspective::PerVoxel;
 pub use post::{
     Classify, PostBuffers, PostRenderer, PostSample, PostSetup, PostVoxel, ShadedLayers,
@@ -45,7 +48,8 @@ pub use refined::{key_spacings, rate_index, spacing_key, RefineTables, RefinedGr
 pub use scaled::{sheet_map, splat_scaled, ScaledFootprint};
 pub use shade_cache::{ShadeCacheEntry, SHADE_CACHE_LEN};
 pub use sheets::{gradient, SheetRing, SheetWindow};
-pub use slabs::{SlabBuffers, SlabError, SlabRenderer, SlabSetup, SlabVoxel};
+pub use slab_renderer::{SlabBuffers, SlabRenderer};
+pub use slabs::{SlabError, SlabSetup, SlabVoxel};
 pub use visible::{classify_sheet, VisibleSheet, VisibleVoxel};
 
 use crate::composite::RowSpan;
@@ -53,6 +57,7 @@ use crate::frame::{FrameSetup, Order};
 use crate::shade::{Lighting, OpacityTable, Sample, Shader};
 use crate::splat::{BufferError, ImageMut, Splatter};
 use band::{check_band, start_image, BandReach};
+use occlusion::Occlusion;
 use shade_cache::ShadeCache;
 
 /// The caller-owned buffers of a render, each [`FrameSetup::image_len`] long except `rows`
@@ -81,6 +86,9 @@ pub struct RenderStats {
     pub pixel_updates: u64,
     /// Pixel composites into the working image.
     pub pixels_composited: u64,
+    /// Voxels skipped because their footprint lay on opaque tiles only
+    /// ([`SheetRenderer::with_occlusion`]); with bands, once per band that skipped it.
+    pub culled_voxels: u64,
 }
 
 /// Renders sheets into caller-owned buffers, with float or fixed-point accumulation
@@ -104,6 +112,7 @@ pub struct SheetRenderer<'a, P: Precision> {
     band: (usize, usize),
     buffers: RenderBuffers<'a, P::Acc, P::Pixel>,
     background: Option<&'a [P::Pixel]>,
+    occlusion: Option<Occlusion<'a, P::Pixel>>,
     stats: RenderStats,
 }
 
@@ -191,6 +200,7 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
             band: (rows.start, band_rows),
             buffers,
             background,
+            occlusion: None,
             stats: RenderStats::default(),
         };
         start_image(&mut r.buffers.image[..n], background, order, P::CLEAR);
@@ -213,6 +223,24 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
     pub fn with_shade_cache(mut self, buffer: &'a mut [ShadeCacheEntry]) -> Self {
         self.cache = ShadeCache::new(&self.shader, buffer);
         self
+    }
+
+    /// Culls occluded voxels (Mueller et al. 1999): once every pixel of an [`OCCLUSION_TILE`]²
+    /// tile has opacity ≥ 1 − `eps`, nothing more is composited into it, and voxels whose
+    /// footprint lies on such tiles only are skipped before they are shaded; each such pixel stays
+    /// within `eps` per premultiplied channel of the image without culling. `buffer` holds
+    /// [`occlusion_len`]`(width, band rows)` bytes. Refused ([`OcclusionError`]) back to front,
+    /// for a perspective frame, for `eps` outside (0, 1), and for a band that does not start on a
+    /// multiple of [`OCCLUSION_TILE`] rows (which keeps the image the same for any bands).
+    pub fn with_occlusion(mut self, buffer: &'a mut [u8], eps: f32) -> Result<Self, RenderError> {
+        if self.frame.camera().is_some() {
+            return Err(RenderError::Occlusion(OcclusionError::Perspective));
+        }
+        let size = [self.frame.size[0], self.band.1];
+        Occlusion::<P::Pixel>::check(eps, self.order, self.band.0, size, buffer.len())?;
+        let half = self.frame.footprint.half_extent;
+        self.occlusion = Some(Occlusion::new::<P>(buffer, size, half, eps));
+        Ok(self)
     }
 
     /// The frame being rendered.
@@ -249,6 +277,7 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
             window.upper.map(<[T]>::len),
         ];
         let (path, opacity, cache) = (&self.path, self.opacity, &mut self.cache);
+        let occlusion = self.occlusion.as_ref();
         // Values the transfer function surely makes transparent skip shading (the same image).
         let clear = shader.transparent_at_or_below();
         let shade = |u: usize, v: usize| {
@@ -280,6 +309,7 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
             self.band,
             &mut self.buffers,
             &mut self.stats,
+            occlusion,
             index,
             lengths,
             |_| 0..usize::MAX,
@@ -337,6 +367,12 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
             }
             if !reach.may_reach(u, v) {
                 continue;
+            }
+            if let Some(o) = &self.occlusion {
+                if o.hides(f, index, u, v, self.band.0) {
+                    self.stats.culled_voxels += 1;
+                    continue;
+                }
             }
             let g = || {
                 if needs_gradient {
@@ -438,6 +474,7 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
             self.band,
             &mut self.buffers,
             &mut self.stats,
+            self.occlusion.as_ref(),
             index,
             [None, None, None],
             occupied,
@@ -462,6 +499,7 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
             self.band,
             &mut self.buffers,
             &mut self.stats,
+            self.occlusion.as_ref(),
             index,
             [len, None, None],
             |_| 0..usize::MAX,
@@ -481,6 +519,7 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
         band: (usize, usize),
         buffers: &mut RenderBuffers<'a, P::Acc, P::Pixel>,
         stats: &mut RenderStats,
+        occlusion: Option<&Occlusion<'a, P::Pixel>>,
         index: usize,
         lengths: [Option<usize>; 3],
         occupied: impl Fn(usize) -> core::ops::Range<usize>,
@@ -500,6 +539,10 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
         for v in 0..nb {
             let (reached, held) = (reach.row(v, na), occupied(v));
             for u in reached.start.max(held.start)..reached.end.min(held.end) {
+                if occlusion.is_some_and(|o| o.hides(f, index, u, v, band.0)) {
+                    stats.culled_voxels += 1;
+                    continue;
+                }
                 stats.voxels += 1;
                 let value = shade(u, v);
                 if P::is_transparent(&value) {
@@ -522,14 +565,25 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
     pub fn composite_sheet(&mut self) {
         let w = self.frame.size[0];
         let (acc, img) = (&mut *self.buffers.accumulator, &mut *self.buffers.image);
+        let (path, order) = (&self.path, self.order);
         for (y, span) in self.buffers.rows[..self.band.1].iter_mut().enumerate() {
             if span.is_empty() {
                 continue;
             }
-            let (lo, hi) = (y * w + span.lo as usize, y * w + span.hi as usize + 1);
-            self.path
-                .composite_row(&mut acc[lo..hi], &mut img[lo..hi], self.order);
-            self.stats.pixels_composited += u64::from(span.hi - span.lo + 1);
+            if let Some(o) = &mut self.occlusion {
+                let cols = (span.lo as usize, span.hi as usize);
+                self.stats.pixels_composited += o.composite_row(y, cols, img, |px, closed, img| {
+                    if closed {
+                        acc[px].fill(P::ACC_ZERO);
+                    } else {
+                        path.composite_row(&mut acc[px.clone()], &mut img[px], order);
+                    }
+                });
+            } else {
+                let (lo, hi) = (y * w + span.lo as usize, y * w + span.hi as usize + 1);
+                path.composite_row(&mut acc[lo..hi], &mut img[lo..hi], order);
+                self.stats.pixels_composited += u64::from(span.hi - span.lo + 1);
+            }
             *span = RowSpan::EMPTY;
         }
     }

@@ -48,6 +48,12 @@ pub trait Precision {
     fn composite_row(&self, acc: &mut [Self::Acc], image: &mut [Self::Pixel], order: Order);
     /// `front = front over back`, pixel by pixel.
     fn over_row(&self, front: &mut [Self::Pixel], back: &[Self::Pixel]);
+    /// A working-image pixel of opacity `alpha` (0 to 1) in this precision's format, rounded up,
+    /// colour zero: the threshold [`Precision::reaches`] compares with (occlusion culling,
+    /// [`super::SheetRenderer::with_occlusion`]).
+    fn opacity_pixel(alpha: f32) -> Self::Pixel;
+    /// Whether `pixel`'s opacity is at least `at`'s.
+    fn reaches(pixel: &Self::Pixel, at: &Self::Pixel) -> bool;
 }
 
 /// How the float path places one voxel of a sheet in the accumulator: any [`Splatter`] (a
@@ -181,6 +187,15 @@ impl<S: VoxelSplat + ?Sized> Precision for FloatPath<'_, S> {
     fn over_row(&self, front: &mut [[f32; 4]], back: &[[f32; 4]]) {
         float_over_row(front, back);
     }
+
+    fn opacity_pixel(alpha: f32) -> [f32; 4] {
+        [0.0, 0.0, 0.0, alpha]
+    }
+
+    #[inline]
+    fn reaches(pixel: &[f32; 4], at: &[f32; 4]) -> bool {
+        pixel[3] >= at[3]
+    }
 }
 
 /// An extinction sheet's compositing: each pixel's [E, τ] as a layer
@@ -224,7 +239,7 @@ pub(super) fn float_over_row(front: &mut [[f32; 4]], back: &[[f32; 4]]) {
 
 /// Screen position (pixels) of voxel (u, v) of sheet `sheet`.
 #[inline(always)]
-fn float_position(f: &FrameSetup, sheet: usize, u: usize, v: usize) -> [f32; 2] {
+pub(super) fn float_position(f: &FrameSetup, sheet: usize, u: usize, v: usize) -> [f32; 2] {
     let cols = f.grid_to_screen;
     let (a, b) = f.in_sheet;
     let p = f.origin
@@ -350,6 +365,17 @@ impl<const M: usize> Precision for FixedPath<'_, M> {
     fn over_row(&self, front: &mut [[u32; 4]], back: &[[u32; 4]]) {
         fixed::composite::over_row(front, back);
     }
+
+    fn opacity_pixel(alpha: f32) -> [u32; 4] {
+        // Set-up only (once per renderer): the one float operation of the fixed path's culling.
+        let q = -crate::math::floor(-alpha.clamp(0.0, 1.0) * fixed::ONE as f32) as u32;
+        [0, 0, 0, q.min(fixed::ONE)]
+    }
+
+    #[inline]
+    fn reaches(pixel: &[u32; 4], at: &[u32; 4]) -> bool {
+        pixel[3] >= at[3]
+    }
 }
 
 /// Compact fixed-point accumulation for small cores ([`crate::fixed::compact`]): Q15 values and
@@ -415,5 +441,15 @@ impl Precision for CompactPath<'_> {
 
     fn over_row(&self, front: &mut [[u16; 4]], back: &[[u16; 4]]) {
         compact::over_row(front, back);
+    }
+
+    fn opacity_pixel(alpha: f32) -> [u16; 4] {
+        let q = -crate::math::floor(-alpha.clamp(0.0, 1.0) * f32::from(compact::ONE)) as u16;
+        [0, 0, 0, q.min(compact::ONE)]
+    }
+
+    #[inline]
+    fn reaches(pixel: &[u16; 4], at: &[u16; 4]) -> bool {
+        pixel[3] >= at[3]
     }
 }

@@ -18,7 +18,7 @@
 //! ```
 //!
 //! of itself (l world length along the ray) into the slab between depths z_a < z_b, with G the
-//! [`SectionTable`]. For an anisotropic grid z* ≠ 0: the chord's midpoint moves with the pixel.
+//! [`SectionTable`](crate::table::SectionTable). For an anisotropic grid z* ≠ 0: the chord's midpoint moves with the pixel.
 //!
 //! # Values and compositing
 //! A voxel's value is what its [`Absorption`] model reconstructs, per world unit
@@ -39,7 +39,7 @@
 //!
 //! # Memory, streaming and precision
 //! The core holds nothing but the [`SlabSetup`] (a few dozen floats) and reads the caller's
-//! [`SectionTable`]; the caller supplies the slab accumulator, image and row spans (as for
+//! [`SectionTable`](crate::table::SectionTable); the caller supplies the slab accumulator, image and row spans (as for
 //! sheets) and, per slab, the voxels that overlap it ([`SlabSetup::slabs_of`]). A slab of an
 //! oblique view crosses every sheet of the volume, so a source that delivers sheets one at a
 //! time cannot feed it from a bounded window: the caller buffers the volume's non-transparent
@@ -48,16 +48,12 @@
 //! ([`SlabError::Perspective`]).
 
 use super::absorption::{extinction_layer, Absorption, MAX_UNIT_ALPHA};
-use super::band::{check_band, start_image, SlabQueue};
-use super::precision::float_over_row;
-use super::{RenderError, RenderStats};
-use crate::composite::{over, RowSpan};
-use crate::frame::{FrameSetup, Order};
+use crate::frame::FrameSetup;
 use crate::geometry::box_corners;
 use crate::kernel::Kernel;
 use crate::math;
 use crate::splat::pixel_range;
-use crate::table::{SectionError, SectionTable};
+use crate::table::SectionError;
 use core::fmt;
 
 /// The most slabs a frame may have.
@@ -291,7 +287,7 @@ impl SlabSetup {
     }
 
     /// The most slabs one kernel overlaps (at most [`MAX_RING`]): how many slab accumulators a
-    /// renderer keeps ([`SlabBuffers`]).
+    /// renderer keeps ([`SlabBuffers`](super::SlabBuffers)).
     pub fn ring(&self) -> usize {
         (ring_for(self.z_reach, self.thickness) as usize).min(self.count)
     }
@@ -342,238 +338,9 @@ pub(super) fn centres_within(lo: f32, hi: f32, n: usize) -> core::ops::Range<usi
     a..b.max(a)
 }
 
-/// The caller-owned buffers of a slab render over a band of `rows` image rows of width `w`, for a
-/// setup whose kernels span at most `ring` = [`SlabSetup::ring`] slabs.
-#[derive(Debug)]
-pub struct SlabBuffers<'a> {
-    /// The ring of slab accumulators, pixel-major: `accumulators[(y·w + x)·ring + slot]`, at least
-    /// `ring × w × rows` long, all zero at the start (left all zero).
-    pub accumulators: &'a mut [[f32; 4]],
-    /// Working image, premultiplied RGBA, row-major, `w × rows`: the result.
-    pub image: &'a mut [[f32; 4]],
-    /// Per slot and row, the extent touched: `rows[slot·rows + y]`, at least `ring × rows` long.
-    pub rows: &'a mut [RowSpan],
-}
-
 /// Slabs a depth span of 2·`reach` can overlap, at thickness `t`: ⌊2·reach/t⌋ + 2.
 fn ring_for(reach: f32, t: f32) -> f32 {
     math::floor(2.0 * reach / t) + 2.0
-}
-
-/// Renders slabs into caller-owned buffers, float only.
-///
-/// **Order of work.** Each voxel is splatted once ([`SlabRenderer::splat_voxel`]): its kernel's
-/// section in every slab it overlaps goes to that slab's accumulator, one of a ring of
-/// [`SlabSetup::ring`]. [`SlabRenderer::composite_next`] composites the next slab in compositing
-/// order (front to back: slab 0 first; back to front: the last first) and frees its slot. So the
-/// caller feeds voxels sorted by the slab they reach first in that order (their first slab front
-/// to back, their last back to front) and composites slab j once every voxel reaching it has
-/// been splatted; a voxel reaching a slab already composited is refused
-/// ([`RenderError::SlabOrder`]).
-///
-/// **Bands.** Like [`SheetRenderer`](super::SheetRenderer) it may own a band of image rows only;
-/// each pixel receives the same additions in the same order whatever the band, so bands put
-/// together are bit-identical to one whole-image render.
-pub struct SlabRenderer<'a, const R: usize, const T: usize> {
-    setup: &'a SlabSetup,
-    table: &'a SectionTable<R, T>,
-    order: Order,
-    band: (usize, usize),
-    ring: usize,
-    buffers: SlabBuffers<'a>,
-    background: Option<&'a [[f32; 4]]>,
-    queue: SlabQueue,
-    stats: RenderStats,
-}
-
-impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
-    /// Starts a frame over image rows `rows` (`0..height` for the whole image): `buffers` (and
-    /// `background`) hold `rows.len()` rows (see [`SlabBuffers`]). `background` as for sheets
-    /// (the starting image back to front, composited under the result front to back).
-    pub fn with_band(
-        setup: &'a SlabSetup,
-        table: &'a SectionTable<R, T>,
-        order: Order,
-        buffers: SlabBuffers<'a>,
-        background: Option<&'a [[f32; 4]]>,
-        rows: core::ops::Range<usize>,
-    ) -> Result<Self, RenderError> {
-        let ring = setup.ring();
-        let n = setup.size[0] * rows.len();
-        check_band(
-            &rows,
-            setup.size[1],
-            &[
-                (buffers.accumulators.len(), ring * n),
-                (buffers.image.len(), n),
-                (background.map_or(n, <[_]>::len), n),
-                (buffers.rows.len(), ring * rows.len()),
-            ],
-        )?;
-        let r = SlabRenderer {
-            setup,
-            table,
-            order,
-            band: (rows.start, rows.len()),
-            ring,
-            buffers,
-            background,
-            queue: SlabQueue::new(setup.count, order),
-            stats: RenderStats::default(),
-        };
-        start_image(&mut r.buffers.image[..n], background, order, [0.0; 4]);
-        r.buffers.rows[..ring * rows.len()].fill(RowSpan::EMPTY);
-        Ok(r)
-    }
-
-    /// Counts so far (`sheets` counts slabs composited).
-    pub fn stats(&self) -> RenderStats {
-        self.stats
-    }
-
-    /// The next slab [`SlabRenderer::composite_next`] composites (`None` when all are done).
-    pub fn next_slab(&self) -> Option<usize> {
-        self.queue.next()
-    }
-
-    /// Adds `voxel`'s kernel, cut by every slab it overlaps, to those slabs' accumulators
-    /// (nothing where it misses the band). Refused if it overlaps a slab already composited.
-    pub fn splat_voxel(&mut self, voxel: &SlabVoxel) -> Result<(), RenderError> {
-        let s = self.setup;
-        let [cx, cy, cz] = voxel.position;
-        let (first, last) = s.slabs_of(cz);
-        self.queue.admit(first, last)?;
-        let rows = s.rows_of(cy);
-        let (b0, bn) = self.band;
-        let (y0, y1) = (rows.start.max(b0), rows.end.min(b0 + bn));
-        if y0 >= y1 {
-            return Ok(());
-        }
-        self.stats.voxels += 1;
-        let (w, ring) = (s.size[0], self.ring);
-        let value = voxel.value.map(|c| c * s.scale);
-        let [qxx, qxy, qyy] = s.q;
-        // Chord coordinate of the first slab's front at the voxel's own pixel offset (0, 0), and
-        // per slab boundary.
-        let t0 = s.kappa * (s.front(first) - cz);
-        let dt = s.kappa * s.thickness;
-        let (ka, kb) = (s.kappa * s.shear[0], s.kappa * s.shear[1]);
-        let slabs = last - first + 1;
-        let first_slot = first % ring;
-        let inv_dt = 1.0 / dt;
-        let mut updates = 0u64;
-        for y in y0..y1 {
-            let dy = y as f32 + 0.5 - cy;
-            let disc = qxx - (qxx * qyy - qxy * qxy) * dy * dy;
-            if !(disc > 0.0) {
-                continue;
-            }
-            let root = math::sqrt(disc);
-            let cols = centres_within(
-                cx + (-qxy * dy - root) / qxx,
-                cx + (-qxy * dy + root) / qxx,
-                w,
-            );
-            let (x0, x1) = (cols.start, cols.end);
-            if x0 >= x1 {
-                continue;
-            }
-            let yl = y - b0;
-            let row = &mut self.buffers.accumulators[(yl * w + x0) * ring..(yl * w + x1) * ring];
-            let t_row = t0 - kb * dy;
-            let mut touched = [false; MAX_RING];
-            for (x, px) in row.chunks_exact_mut(ring).enumerate() {
-                let dx = (x + x0) as f32 + 0.5 - cx;
-                let rho2 = (qxx * dx + 2.0 * qxy * dy) * dx + qyy * dy * dy;
-                let Some(ray) = self.table.ray(rho2) else {
-                    continue;
-                };
-                // Skip the slabs before the chord starts (their sections are zero).
-                let t_front = t_row - ka * dx;
-                let c = ray.half_chord();
-                let skip = if t_front + c < 0.0 {
-                    (math::floor((-c - t_front) * inv_dt) as usize).min(slabs)
-                } else {
-                    0
-                };
-                let mut t = t_front + skip as f32 * dt;
-                let mut before = ray.at(t);
-                let mut slot = (first_slot + skip) % ring;
-                for hit in touched.iter_mut().take(slabs).skip(skip) {
-                    t += dt;
-                    let after = ray.at(t);
-                    let g = after - before;
-                    if g != 0.0 {
-                        for (p, v) in px[slot].iter_mut().zip(&value) {
-                            *p += v * g;
-                        }
-                        *hit = true;
-                    }
-                    if ray.past_end(t) {
-                        break;
-                    }
-                    before = after;
-                    slot = if slot + 1 == ring { 0 } else { slot + 1 };
-                }
-                updates += 1;
-            }
-            for (k, _) in touched.iter().enumerate().take(slabs).filter(|(_, &t)| t) {
-                let slot = (first + k) % ring;
-                self.buffers.rows[slot * bn + yl].include(x0, x1 - 1);
-            }
-        }
-        self.stats.pixel_updates += updates;
-        self.stats.voxels_splatted += u64::from(updates > 0);
-        Ok(())
-    }
-
-    /// Composites the next slab in compositing order (as one layer of the setup's model,
-    /// [`Absorption::layer`]) into the image over the rows it touched, and clears its slot.
-    /// Nothing once every slab is done.
-    pub fn composite_next(&mut self) {
-        let Some(slab) = self.next_slab() else {
-            return;
-        };
-        let (w, ring, bn) = (self.setup.size[0], self.ring, self.band.1);
-        let slot = slab % ring;
-        let (order, model, chord) = (self.order, self.setup.absorption, self.setup.chord);
-        let (acc, img) = (&mut *self.buffers.accumulators, &mut *self.buffers.image);
-        for (y, span) in self.buffers.rows[slot * bn..(slot + 1) * bn]
-            .iter_mut()
-            .enumerate()
-        {
-            if span.is_empty() {
-                continue;
-            }
-            let (lo, hi) = (y * w + span.lo as usize, y * w + span.hi as usize + 1);
-            for (p, i) in (lo..hi).zip(&mut img[lo..hi]) {
-                let a = &mut acc[p * ring + slot];
-                let layer = model.layer(*a, chord);
-                *a = [0.0; 4];
-                *i = match order {
-                    Order::BackToFront => over(layer, *i),
-                    Order::FrontToBack => over(*i, layer),
-                };
-            }
-            self.stats.pixels_composited += u64::from(span.hi - span.lo + 1);
-            *span = RowSpan::EMPTY;
-        }
-        self.queue.advance();
-        self.stats.sheets += 1;
-    }
-
-    /// Ends the frame: composites the slabs not yet composited, then (front to back) the
-    /// background under the result; returns the counts.
-    pub fn finish(mut self) -> RenderStats {
-        while self.next_slab().is_some() {
-            self.composite_next();
-        }
-        if let (Order::FrontToBack, Some(bg)) = (self.order, self.background) {
-            let n = self.setup.size[0] * self.band.1;
-            float_over_row(&mut self.buffers.image[..n], &bg[..n]);
-        }
-        self.stats
-    }
 }
 
 /// A slab's accumulated [E, τ] as a premultiplied layer of the extinction model

@@ -157,3 +157,42 @@ pub fn parse_scene_size(s: &str) -> Result<usize, String> {
         _ => Err(format!("{s:?} is not a grid side in 2..=512")),
     }
 }
+
+/// The most bricks `--bricks` makes (a million: far past any MPI job's ranks per volume).
+pub const MAX_BRICKS: usize = 1 << 20;
+
+/// `--bricks X,Y,Z`: three counts, each at least 1, [`MAX_BRICKS`] at most in all.
+pub fn parse_bricks(s: &str) -> Result<[usize; 3], String> {
+    let v: Vec<usize> = s
+        .split(',')
+        .map(|x| x.trim().parse::<usize>().map_err(|e| format!("'{x}': {e}")))
+        .collect::<Result<_, _>>()?;
+    match v[..] {
+        [x, y, z] if x >= 1 && y >= 1 && z >= 1 => Ok([x, y, z]),
+        _ => Err(format!(
+            "expected X,Y,Z brick counts, each at least 1 (got '{s}')"
+        )),
+    }
+}
+
+/// `--cull EPS|off`: the occlusion threshold ε, or none (`off`).
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct Cull(pub Option<f32>);
+
+/// `--cull EPS|off`: EPS must lie strictly between 0 and 1.
+pub fn parse_cull(s: &str) -> Result<Cull, String> {
+    if s.trim() == "off" {
+        return Ok(Cull(None));
+    }
+    let e: f32 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{s}' is neither a number nor 'off'"))?;
+    if e > 0.0 && e < 1.0 {
+        Ok(Cull(Some(e)))
+    } else {
+        Err(format!(
+            "'{s}': EPS must lie strictly between 0 and 1 (or be 'off')"
+        ))
+    }
+}

@@ -6,7 +6,9 @@
 //! Prints and writes (`--json`): `first_ms`, `median_ms`, `min_ms`, `max_ms` (over frames 2…N;
 //! null when N = 1), `threads`, `phases_ms` (frame 1: `classify`, `tables`, `splat`,
 //! `composite`, and `resample` for `--subsample`), `rerender_phases_ms` (the same, medians over
-//! frames 2…N), `frames_ms` (every frame), `frames`, `orbit_deg`, and the render summary's fields.
+//! frames 2…N), `frames_ms` (every frame), `frames`, `orbit_deg`, `culled_voxels` (frame 1's
+//! voxels skipped by occlusion culling, `--cull`; per band, as `render` counts them) and
+//! `culled_voxels_per_frame`, and the render summary's fields (`plan`: what drew the frames).
 
 use crate::args::RenderArgs;
 use crate::io::{self, json::Json};
@@ -83,6 +85,7 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
     let mut phases = Vec::with_capacity(args.frames);
     let mut first_image = None;
     let mut threads = 1;
+    let mut culled = Vec::with_capacity(args.frames);
     for k in 0..args.frames {
         // The same plan every frame; only the view turns.
         if k > 0 {
@@ -103,6 +106,7 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
         times.push(f.seconds * 1e3);
         phases.push(f.phases);
         threads = f.threads;
+        culled.push(f.stats.culled_voxels as f64);
         if k == 0 {
             first_image = Some(f.image);
         } else {
@@ -154,7 +158,9 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
             .num("max_ms", max)
             .obj("phases_ms", phases_json(&phases[0]))
             .obj("rerender_phases_ms", phases_json(&rerender))
-            .arr_f64("frames_ms", &times);
+            .arr_f64("frames_ms", &times)
+            .num("culled_voxels", culled[0])
+            .arr_f64("culled_voxels_per_frame", &culled);
         if let Some(c) = &choice {
             summary = summary.obj("quality", quality_json(c));
         }

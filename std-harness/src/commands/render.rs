@@ -132,7 +132,8 @@ pub fn run(command: &RenderCommandArgs) -> Result<(), CliError> {
             .num("voxels_splatted", stats.voxels_splatted as f64)
             .num("bands", frame.threads as f64)
             .num("pixel_updates", stats.pixel_updates as f64)
-            .num("pixels_composited", stats.pixels_composited as f64);
+            .num("pixels_composited", stats.pixels_composited as f64)
+            .num("culled_voxels", stats.culled_voxels as f64);
         let j = match &frame.refine {
             Some(r) => j.obj("refine", r.json()),
             None => j,

@@ -87,4 +87,34 @@ pub fn describe(p: &Prepared, args: &Inputs, plan: &Plan) -> Json {
         )
         .str("gamma", &format!("{:?}", args.gamma).to_lowercase())
         .num("depth", f64::from(args.depth))
+        .num("cull", plan.cull.map_or(f64::NAN, f64::from))
+        .obj("plan", plan_json(p, plan))
+}
+
+/// What drew the frame, resolved (defaults and `auto`s decided): `end` (`sheets`, `slabs`,
+/// `post`, `refined` or `reference`), `precision`, `slab` (voxel spacings; null but for slabs),
+/// `subsample` and `supersample` (factors), `lod` (level), `cull` (ε; null when off), `order`.
+pub fn plan_json(p: &Prepared, plan: &Plan) -> Json {
+    let (end, slab) = match plan.end {
+        End::Sheets(_) => ("sheets", f64::NAN),
+        End::Slabs { thickness } => ("slabs", f64::from(thickness)),
+        End::Post { thickness, .. } => ("post", f64::from(thickness)),
+        End::Refined { .. } => ("refined", f64::NAN),
+        End::Reference => ("reference", f64::NAN),
+    };
+    Json::object()
+        .str("end", end)
+        .str(
+            "precision",
+            match plan.precision() {
+                Precision::Float => "float",
+                Precision::Fixed => "fixed",
+            },
+        )
+        .num("slab", slab)
+        .num("subsample", p.subsample_factor(plan).unwrap_or(1) as f64)
+        .num("supersample", p.supersample as f64)
+        .num("lod", f64::from(p.level))
+        .num("cull", plan.cull.map_or(f64::NAN, f64::from))
+        .str("order", &format!("{:?}", p.order).to_lowercase())
 }

@@ -81,6 +81,12 @@ pub(super) fn post_plan(args: &RenderArgs, precision: Precision) -> Result<Plan,
             "--quality chooses among pre-classified methods; give --slab-post instead",
         );
     }
+    if let Some(eps) = args.cull.0 {
+        return refuse(
+            &format!("--cull {eps}"),
+            "post-classified slabs skip opaque pixels already (front to back); drop --cull",
+        );
+    }
     let mut plan = plan(&RenderArgs {
         classification: ClassificationArg::Pre,
         slicing: Some(SlicingArg::Image),

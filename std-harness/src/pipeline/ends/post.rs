@@ -21,6 +21,7 @@
 //! accumulation and colour-carrying levels of detail (their colours are pre-classified).
 
 use crate::args::Supersample;
+use crate::pipeline::stages::bands::Bands;
 use crate::pipeline::stages::bands::{CoreFrame, Phases};
 use crate::pipeline::stages::prepare::Prepared;
 use crate::pipeline::stages::visible::{FrameCache, PostSamples};
@@ -87,9 +88,16 @@ pub fn render_post(
 
     let (setup, weights, classify, sv) = (&setup, &*weights, &classify, &voxels);
     let timing = (start, classify_time, tables);
-    super::slabs::banded_frame(p, threads, timing, voxels.voxels.len(), |rows, band, bg| {
-        render_band(p, setup, weights, classify, sv, bg, band, rows)
-    })
+    super::slabs::banded_frame(
+        p,
+        Bands {
+            threads,
+            cull: None,
+        },
+        timing,
+        voxels.voxels.len(),
+        |rows, band, bg| render_band(p, setup, weights, classify, sv, bg, band, rows),
+    )
 }
 
 /// `--value-subsample auto`'s bound: the kernel's shorter semi-axis, in value pixels, stays at or

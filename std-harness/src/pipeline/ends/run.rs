@@ -7,7 +7,7 @@ use crate::io::progress::sheets;
 use crate::io::stream::{ColouredMemorySource, FileSource, MemorySource, PipeSource};
 use crate::io::try_filled;
 pub use crate::pipeline::stages::bands::CoreFrame;
-use crate::pipeline::stages::bands::{run_bands, Phases};
+use crate::pipeline::stages::bands::{run_bands, Bands, Phases};
 use crate::pipeline::stages::load::Voxels;
 use crate::pipeline::stages::lod::{with_level, DynSource};
 use crate::pipeline::stages::prepare::Prepared;
@@ -19,6 +19,7 @@ use crate::reference::render::{render_reference, ReferenceScene};
 use crate::CliError;
 use footprint::fixed::stencil::FixedStencils;
 use footprint::fixed::{self, FixedTable};
+use footprint::render::occlusion_len;
 use footprint::render::{
     FixedPath, FloatPath, PerVoxel, Precision, RenderBuffers, RenderStats, ShadeCacheEntry,
     SheetRenderer, SheetRing, SHADE_CACHE_LEN,
@@ -68,7 +69,9 @@ pub fn render_frame(
         End::Refined { threshold, sheets } => {
             super::refine::render_refined(p, plan, threshold, sheets)
         }
-        End::Slabs { thickness } => super::slabs::render_slabs(p, thickness, plan.threads, cache),
+        End::Slabs { thickness } => {
+            super::slabs::render_slabs(p, thickness, Bands::of(plan), cache)
+        }
         End::Post { thickness, values } => {
             super::post::render_post(p, thickness, values, plan.threads, cache)
         }
@@ -116,6 +119,7 @@ fn sheets_at<const N: usize>(
 ) -> Result<CoreFrame, CliError> {
     let lookup = plan.table.lookup;
     let threads = plan.threads;
+    let bands = Bands::of(plan);
     let direct = plan.table.footprints == Footprints::Direct;
     let start = Instant::now();
     {
@@ -128,7 +132,7 @@ fn sheets_at<const N: usize>(
                 let per = PerVoxel::new(&p.frame, &p.kernel, p.options, &*generic, lookup)?;
                 let path = FloatPath::new(&per).with_absorption(p.absorption);
                 let tables = start.elapsed().as_secs_f64();
-                let r = run_path(p, path, p.background.as_deref(), cache, threads)?;
+                let r = run_path(p, path, p.background.as_deref(), cache, bands)?;
                 (r.0, r.1, Phases { tables, ..r.2 }, r.3)
             }
             PlanPrecision::Float if direct => {
@@ -143,7 +147,7 @@ fn sheets_at<const N: usize>(
                     FloatPath::new(&sampler).with_absorption(p.absorption),
                     p.background.as_deref(),
                     cache,
-                    threads,
+                    bands,
                 )?;
                 (r.0, r.1, Phases { tables, ..r.2 }, r.3)
             }
@@ -160,7 +164,7 @@ fn sheets_at<const N: usize>(
                     let stencils = build_stencils(&*table, plan.phases, &mut buffer, threads)?;
                     let tables = start.elapsed().as_secs_f64();
                     let path = FloatPath::new(&stencils).with_absorption(p.absorption);
-                    let r = run_path(p, path, p.background.as_deref(), cache, threads)?;
+                    let r = run_path(p, path, p.background.as_deref(), cache, bands)?;
                     (r.0, r.1, Phases { tables, ..r.2 }, r.3)
                 } else {
                     let tables = start.elapsed().as_secs_f64();
@@ -169,7 +173,7 @@ fn sheets_at<const N: usize>(
                         FloatPath::new(&*table).with_absorption(p.absorption),
                         p.background.as_deref(),
                         cache,
-                        threads,
+                        bands,
                     )?;
                     (r.0, r.1, Phases { tables, ..r.2 }, r.3)
                 };
@@ -186,7 +190,7 @@ fn sheets_at<const N: usize>(
             seconds: start.elapsed().as_secs_f64(),
             phases,
             threads: if visible.is_some() {
-                threads.clamp(1, p.frame.size[1])
+                bands.count(p.frame.size[1])
             } else {
                 1
             },
@@ -205,7 +209,7 @@ fn fixed_sheets<const N: usize>(
     cache: &mut FrameCache,
     start: Instant,
 ) -> Result<PathResult<[f32; 4]>, CliError> {
-    let (lookup, threads) = (plan.table.lookup, plan.threads);
+    let lookup = plan.table.lookup;
     let direct = plan.table.footprints == Footprints::Direct;
     let fixed_range =
         |e: fixed::FixedError| CliError::input(format!("{}: --accum fixed: {e}", p.name));
@@ -255,7 +259,7 @@ fn fixed_sheets<const N: usize>(
     // they are: the renderer starts every pixel afresh.
     let [w, h] = p.frame.size;
     cache.reuse_image_as(w * h, |px: [f32; 4]| px.map(f32::to_bits));
-    let (img, stats, phases, visible) = run_path(p, path, bg.as_deref(), cache, threads)?;
+    let (img, stats, phases, visible) = run_path(p, path, bg.as_deref(), cache, Bands::of(plan))?;
     Ok((
         img.into_iter().map(fixed::to_f32).collect(),
         stats,
@@ -305,7 +309,7 @@ fn run_path<P>(
     path: P,
     background: Option<&[P::Pixel]>,
     cache: &mut FrameCache,
-    threads: usize,
+    bands: Bands,
 ) -> Result<PathResult<P::Pixel>, CliError>
 where
     P: Precision + Copy + Send + Sync,
@@ -315,19 +319,19 @@ where
     match &p.voxels {
         Voxels::Memory(volume) => {
             let t0 = Instant::now();
-            let (visible, fresh, spares) = cache.visible_and_spares(p, volume, threads)?;
+            let (visible, fresh, spares) = cache.visible_and_spares(p, volume, bands.threads)?;
             let classify = if fresh {
                 t0.elapsed().as_secs_f64()
             } else {
                 0.0
             };
-            let (image, stats, phases) = run_bands(p, path, background, visible, spares, threads)?;
+            let (image, stats, phases) = run_bands(p, path, background, visible, spares, bands)?;
             let count = stats.voxels as usize;
             Ok((image, stats, Phases { classify, ..phases }, Some(count)))
         }
         _ => {
             let t0 = Instant::now();
-            let (image, stats) = run_sheets(p, path, background)?;
+            let (image, stats) = run_sheets(p, path, background, bands.cull)?;
             let phases = Phases {
                 splat: t0.elapsed().as_secs_f64(),
                 ..Phases::default()
@@ -342,6 +346,7 @@ fn run_sheets<P: Precision>(
     p: &Prepared,
     path: P,
     background: Option<&[P::Pixel]>,
+    cull: Option<f32>,
 ) -> Result<(Vec<P::Pixel>, RenderStats), CliError> {
     let f = &p.frame;
     // A pipe's first z-slice arrives before any buffer is allocated: a short stream costs only
@@ -387,9 +392,13 @@ fn run_sheets<P: Precision>(
     };
     let mut opacity = vec![0.0f32; OPACITY_TABLE_LEN];
     let mut shades = vec![ShadeCacheEntry::default(); SHADE_CACHE_LEN];
+    let mut occluded = vec![0u8; occlusion_len(f.size[0], f.size[1])];
     let mut renderer = SheetRenderer::with_path(f, path, p.shader(), p.order, buffers, background)?
         .with_opacity_table(&mut opacity)?
         .with_shade_cache(&mut shades);
+    if let Some(eps) = cull {
+        renderer = renderer.with_occlusion(&mut occluded, eps)?;
+    }
     let mut show = Progress {
         inner: sheets("render"),
         count: f.sheet_count(),

@@ -17,14 +17,16 @@
 //! view crosses every sheet, so a streamed volume (`--stream`) is refused: feeding it from a
 //! bounded window of sheets is not possible (see the core module's docs).
 
-use crate::pipeline::stages::bands::{equal_bands, on_bands, CoreFrame, Phases};
+use crate::pipeline::stages::bands::{equal_bands_for, on_bands, Bands, CoreFrame, Phases};
 use crate::pipeline::stages::prepare::Prepared;
 use crate::pipeline::stages::supersample::to_output;
 use crate::pipeline::stages::visible::FrameCache;
 use crate::CliError;
 use footprint::composite::RowSpan;
 use footprint::frame::Order;
-use footprint::render::{RenderStats, SlabBuffers, SlabRenderer, SlabSetup, SlabVoxel};
+use footprint::render::{
+    occlusion_len, RenderStats, SlabBuffers, SlabRenderer, SlabSetup, SlabVoxel,
+};
 use footprint::shade::Lighting;
 use footprint::table::SectionTable;
 use std::time::Instant;
@@ -35,11 +37,11 @@ const ROWS: usize = 257;
 const COLUMNS: usize = 1025;
 
 /// Renders one frame of `p` with image-aligned slabs `thickness` voxel spacings thick on
-/// `threads` bands (float: the plan refuses fixed-point slabs).
+/// `bands` (float: the plan refuses fixed-point slabs), culling occluded voxels if they say so.
 pub fn render_slabs(
     p: &Prepared,
     thickness: f32,
-    threads: usize,
+    bands: Bands,
     cache: &mut FrameCache,
 ) -> Result<CoreFrame, CliError> {
     let refuse = |why: &str| CliError::input(format!("{}: --slicing image: {why}", p.name));
@@ -60,7 +62,7 @@ pub fn render_slabs(
     let tables = start.elapsed().as_secs_f64();
 
     let t0 = Instant::now();
-    let (lists, fresh) = cache.lists(p, volume, threads, "image slicing")?;
+    let (lists, fresh) = cache.lists(p, volume, bands.threads, "image slicing")?;
     let classify_lists = if fresh {
         t0.elapsed().as_secs_f64()
     } else {
@@ -72,18 +74,18 @@ pub fn render_slabs(
 
     let (setup, table, sv) = (&setup, &*table, &voxels);
     let timing = (start, classify, tables);
-    banded_frame(p, threads, timing, voxels.voxels.len(), |rows, band, bg| {
-        render_band(p, setup, table, sv, bg, band, rows)
+    banded_frame(p, bands, timing, voxels.voxels.len(), |rows, band, bg| {
+        render_band(p, setup, table, sv, bg, band, rows, bands.cull)
     })
 }
 
-/// A slab end's frame: `band` rendered on `threads` equal bands of image rows, with the phases
+/// A slab end's frame: `band` rendered on equal `bands` of image rows, with the phases
 /// timed before it (`timing`: the frame's start, classification and table seconds), its
 /// `voxels` (every band sees only those that reach it: the frame's are the list's), resampled to
 /// the output size.
 pub(crate) fn banded_frame<F>(
     p: &Prepared,
-    threads: usize,
+    bands: Bands,
     timing: (Instant, f64, f64),
     voxels: usize,
     band: F,
@@ -101,7 +103,7 @@ where
     let (image, mut stats, band_phases) = on_bands(
         crate::io::try_filled(w * h, [0.0f32; 4], "the image")?,
         p.frame.size,
-        equal_bands(h, threads),
+        equal_bands_for(h, bands),
         p.background.as_deref(),
         band,
     )?;
@@ -117,7 +119,7 @@ where
         stats,
         seconds: start.elapsed().as_secs_f64(),
         phases,
-        threads: threads.clamp(1, p.frame.size[1]),
+        threads: bands.count(h),
         visible: Some(voxels),
         refine: None,
     })
@@ -202,7 +204,8 @@ pub(crate) fn buckets(
 }
 
 /// One band: every slab in compositing order: the voxels that reach it first splatted (into every
-/// slab each overlaps), then the slab composited.
+/// slab each overlaps), then the slab composited; occluded voxels culled at `cull`'s ε.
+#[allow(clippy::too_many_arguments)]
 fn render_band(
     p: &Prepared,
     setup: &SlabSetup,
@@ -211,9 +214,11 @@ fn render_band(
     background: Option<&[[f32; 4]]>,
     image: &mut [[f32; 4]],
     rows: std::ops::Range<usize>,
+    cull: Option<f32>,
 ) -> Result<(RenderStats, Phases), CliError> {
     let w = p.frame.size[0];
     let ring = setup.ring();
+    let mut occluded = vec![0u8; cull.map_or(0, |_| occlusion_len(w, rows.len()))];
     let n = w * rows.len();
     let mut acc = crate::io::try_filled(
         ring.saturating_mul(n),
@@ -232,6 +237,9 @@ fn render_band(
     };
     let mut renderer =
         SlabRenderer::with_band(setup, table, p.order, buffers, background, rows.clone())?;
+    if let Some(eps) = cull {
+        renderer = renderer.with_occlusion(&mut occluded, eps)?;
+    }
     let mut phases = Phases::default();
     for k in 0..setup.slab_count() {
         let t0 = Instant::now();

@@ -11,7 +11,8 @@ use crate::CliError;
 use footprint::composite::RowSpan;
 use footprint::lod::Coloured;
 use footprint::render::{
-    Precision, RenderBuffers, RenderStats, ShadeCacheEntry, SheetRenderer, SHADE_CACHE_LEN,
+    occlusion_len, Precision, RenderBuffers, RenderStats, ShadeCacheEntry, SheetRenderer,
+    OCCLUSION_TILE, SHADE_CACHE_LEN,
 };
 use footprint::shade::OPACITY_TABLE_LEN;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -54,6 +55,71 @@ pub struct CoreFrame {
     pub refine: Option<super::refinement::Refinement>,
 }
 
+/// How a frame's sheets are cut into bands of rows, and what each band culls.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bands {
+    /// Threads asked for (one band each, at most one per row, or per tile row when culling).
+    pub threads: usize,
+    /// Occlusion culling's ε (`--cull`): bands then start on tile rows
+    /// ([`footprint::render::OCCLUSION_TILE`]), which keeps the image the same for any count.
+    pub cull: Option<f32>,
+}
+
+impl Bands {
+    /// The bands `plan` asks for.
+    pub fn of(plan: &crate::plan::Plan) -> Self {
+        Bands {
+            threads: plan.threads,
+            cull: plan.cull,
+        }
+    }
+
+    /// Bands used over an image `height` rows high.
+    pub fn count(&self, height: usize) -> usize {
+        let units = if self.cull.is_some() {
+            height.div_ceil(OCCLUSION_TILE)
+        } else {
+            height
+        };
+        self.threads.clamp(1, units.max(1))
+    }
+}
+
+/// `ranges` (tiling `height` rows) with every start moved to a multiple of the occlusion tile
+/// (rounded to the nearest), at most one band per tile row: the bands' work stays about as
+/// balanced, and every band starts on a tile row, as culling needs.
+fn on_tile_rows(ranges: Vec<std::ops::Range<usize>>, height: usize) -> Vec<std::ops::Range<usize>> {
+    let t = OCCLUSION_TILE;
+    let tile_rows = height.div_ceil(t).max(1);
+    let mut starts: Vec<usize> = ranges
+        .iter()
+        .map(|r| ((r.start + t / 2) / t).min(tile_rows - 1))
+        .collect();
+    starts.dedup();
+    let n = starts.len();
+    (0..n)
+        .map(|i| {
+            let end = if i + 1 == n {
+                height
+            } else {
+                starts[i + 1] * t
+            };
+            starts[i] * t..end
+        })
+        .collect()
+}
+
+/// [`equal_bands`] for `bands` over an image `height` rows high, starting on tile rows when
+/// culling.
+pub fn equal_bands_for(height: usize, bands: Bands) -> Vec<std::ops::Range<usize>> {
+    let ranges = equal_bands(height, bands.count(height));
+    if bands.cull.is_some() {
+        on_tile_rows(ranges, height)
+    } else {
+        ranges
+    }
+}
+
 /// The rows of band `t` of `bands` over an image `height` rows high: as equal as can be, the
 /// first bands one row taller.
 pub fn band_rows(height: usize, bands: usize, t: usize) -> std::ops::Range<usize> {
@@ -79,7 +145,7 @@ pub fn run_bands<P>(
     background: Option<&[P::Pixel]>,
     visible: Visible<'_>,
     spares: &Spares,
-    threads: usize,
+    bands: Bands,
 ) -> Result<(Vec<P::Pixel>, RenderStats, Phases), CliError>
 where
     P: Precision + Copy + Send + Sync,
@@ -87,24 +153,33 @@ where
     P::Acc: Send + PartialEq + 'static,
 {
     let [w, h] = p.frame.size;
+    let threads = bands.count(h);
     let ranges = match visible {
         Visible::Kept(lists) => balanced_rows(&p.frame, lists, threads),
         Visible::OnTheFly(_) => equal_bands(h, threads),
     };
+    let ranges = if bands.cull.is_some() {
+        on_tile_rows(ranges, h)
+    } else {
+        ranges
+    };
+    let cull = bands.cull;
     // Any image of the right size will do: each band's renderer starts its rows afresh.
     let image = spares.take_image(w * h, P::CLEAR, "the image")?;
     let found = AtomicU64::new(0);
     let (image, mut stats, phases) =
         on_bands(image, p.frame.size, ranges, background, |rows, band, bg| {
             let r = match visible {
-                Visible::Kept(lists) => render_band(p, path, bg, &mut &*lists, spares, band, rows),
+                Visible::Kept(lists) => {
+                    render_band(p, path, bg, &mut &*lists, spares, band, rows, cull)
+                }
                 Visible::OnTheFly(v) if v.is_coloured() => {
                     let mut lists = OnTheFly::<Coloured>::new(p, v)?;
-                    render_band(p, path, bg, &mut lists, spares, band, rows)
+                    render_band(p, path, bg, &mut lists, spares, band, rows, cull)
                 }
                 Visible::OnTheFly(v) => {
                     let mut lists = OnTheFly::<f32>::new(p, v)?;
-                    render_band(p, path, bg, &mut lists, spares, band, rows)
+                    render_band(p, path, bg, &mut lists, spares, band, rows, cull)
                 }
             }?;
             found.fetch_max(r.2, Ordering::Relaxed);
@@ -244,6 +319,7 @@ where
         stats.voxels_splatted += s.voxels_splatted;
         stats.pixel_updates += s.pixel_updates;
         stats.pixels_composited += s.pixels_composited;
+        stats.culled_voxels += s.culled_voxels;
         phases.splat = phases.splat.max(ph.splat);
         phases.composite = phases.composite.max(ph.composite);
     }
@@ -251,7 +327,9 @@ where
 }
 
 /// One band: every sheet in compositing order, splat then composite, timed, and the visible
-/// voxels `lists` supplied. Its accumulator is taken from `spares` and given back clear.
+/// voxels `lists` supplied; occluded voxels culled at `cull`'s ε. Its accumulator is taken from
+/// `spares` and given back clear.
+#[allow(clippy::too_many_arguments)]
 fn render_band<P: Precision>(
     p: &Prepared,
     path: P,
@@ -260,6 +338,7 @@ fn render_band<P: Precision>(
     spares: &Spares,
     image: &mut [P::Pixel],
     rows: std::ops::Range<usize>,
+    cull: Option<f32>,
 ) -> Result<(RenderStats, Phases, u64), CliError>
 where
     P::Acc: Send + PartialEq + 'static,
@@ -270,6 +349,7 @@ where
     let mut spans = vec![RowSpan::EMPTY; rows.len()];
     let mut opacity = vec![0.0f32; OPACITY_TABLE_LEN];
     let mut shades = vec![ShadeCacheEntry::default(); SHADE_CACHE_LEN];
+    let mut occluded = vec![0u8; cull.map_or(0, |_| occlusion_len(f.size[0], rows.len()))];
     let buffers = RenderBuffers {
         accumulator: &mut acc,
         image,
@@ -279,6 +359,9 @@ where
         SheetRenderer::with_band(f, path, p.shader(), p.order, buffers, background, rows)?
             .with_opacity_table(&mut opacity)?
             .with_shade_cache(&mut shades);
+    if let Some(eps) = cull {
+        renderer = renderer.with_occlusion(&mut occluded, eps)?;
+    }
     let mut phases = Phases::default();
     for k in 0..f.sheet_count() {
         let s = f.sheet_at(p.order, k);
