@@ -189,13 +189,25 @@ impl<S: VoxelSplat + ?Sized> Precision for FloatPath<'_, S> {
     }
 
     fn opacity_pixel(alpha: f32) -> [f32; 4] {
-        [0.0, 0.0, 0.0, alpha]
+        float_opacity_pixel(alpha)
     }
 
     #[inline]
     fn reaches(pixel: &[f32; 4], at: &[f32; 4]) -> bool {
-        pixel[3] >= at[3]
+        float_reaches(pixel, at)
     }
+}
+
+/// A float image pixel of opacity `alpha`, colour zero: the float path's and the slab renderer's
+/// culling threshold ([`Precision::opacity_pixel`]).
+pub(super) fn float_opacity_pixel(alpha: f32) -> [f32; 4] {
+    [0.0, 0.0, 0.0, alpha]
+}
+
+/// Whether a float pixel's opacity is at least `at`'s ([`Precision::reaches`]).
+#[inline]
+pub(super) fn float_reaches(pixel: &[f32; 4], at: &[f32; 4]) -> bool {
+    pixel[3] >= at[3]
 }
 
 /// An extinction sheet's compositing: each pixel's [E, τ] as a layer

@@ -4,7 +4,7 @@
 
 use super::band::{check_band, start_image, SlabQueue};
 use super::occlusion::Occlusion;
-use super::precision::float_over_row;
+use super::precision::{float_opacity_pixel, float_over_row, float_reaches};
 use super::slabs::{centres_within, SlabSetup, SlabVoxel, MAX_RING};
 use super::{RenderError, RenderStats};
 use crate::composite::{over, RowSpan};
@@ -101,14 +101,12 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
     pub fn with_occlusion(mut self, buffer: &'a mut [u8], eps: f32) -> Result<Self, RenderError> {
         let size = [self.setup.size[0], self.band.1];
         Occlusion::<[f32; 4]>::check(eps, self.order, self.band.0, size, buffer.len())?;
-        let opaque = [0.0, 0.0, 0.0, 1.0 - eps];
-        let reaches: fn(&[f32; 4], &[f32; 4]) -> bool = |p, at| p[3] >= at[3];
         self.occlusion = Some(Occlusion::with_test(
             buffer,
             size,
             self.setup.half,
-            opaque,
-            reaches,
+            float_opacity_pixel(1.0 - eps),
+            float_reaches,
         ));
         Ok(self)
     }
@@ -152,8 +150,21 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
         let dt = s.kappa * s.thickness;
         let (ka, kb) = (s.kappa * s.shear[0], s.kappa * s.shear[1]);
         let slabs = last - first + 1;
-        let first_slot = first % ring;
-        let inv_dt = 1.0 / dt;
+        // Each slab's slot in the ring, so the pixel loop does no modular arithmetic.
+        let mut slots = [0usize; MAX_RING];
+        for (k, slot) in slots.iter_mut().enumerate().take(slabs) {
+            *slot = (first + k) % ring;
+        }
+        let slots = &slots[..slabs];
+        // Without shear every pixel's chord meets slab boundary k at the same chord position
+        // t0 + k·dt: the depth integral there is read once per voxel, not per pixel.
+        let mut ends = [0.0f32; MAX_RING + 1];
+        let boundaries = s.shear_free().then(|| {
+            for (k, e) in ends.iter_mut().enumerate().take(slabs + 1) {
+                *e = self.table.depth(t0 + k as f32 * dt);
+            }
+            &ends[..slabs + 1]
+        });
         let mut updates = 0u64;
         for y in y0..y1 {
             let dy = y as f32 + 0.5 - cy;
@@ -181,37 +192,44 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
                 let Some(ray) = self.table.ray(rho2) else {
                     continue;
                 };
-                // Skip the slabs before the chord starts (their sections are zero).
-                let t_front = t_row - ka * dx;
-                let c = ray.half_chord();
-                let skip = if t_front + c < 0.0 {
-                    (math::floor((-c - t_front) * inv_dt) as usize).min(slabs)
-                } else {
-                    0
+                // Every slab the kernel spans, with no branch per slab (outside the chord
+                // [−c, c] a section is exactly zero and adds nothing).
+                let add = |px: &mut [[f32; 4]], slot: usize, g: f32, hit: &mut bool| {
+                    for (p, v) in px[slot].iter_mut().zip(&value) {
+                        *p += v * g;
+                    }
+                    *hit |= g != 0.0;
                 };
-                let mut t = t_front + skip as f32 * dt;
-                let mut before = ray.at(t);
-                let mut slot = (first_slot + skip) % ring;
-                for hit in touched.iter_mut().take(slabs).skip(skip) {
-                    t += dt;
-                    let after = ray.at(t);
-                    let g = after - before;
-                    if g != 0.0 {
-                        for (p, v) in px[slot].iter_mut().zip(&value) {
-                            *p += v * g;
+                if let Some(ends) = &boundaries {
+                    // No shear: the boundaries' depth integrals are the voxel's, clamped to
+                    // this ray's chord (C is increasing: see `SectionRay::depth_ends`).
+                    let (radial, (lo, hi)) = (ray.radial(), ray.depth_ends());
+                    let clamp = |e: f32| {
+                        let e = if e > lo { e } else { lo };
+                        if e < hi {
+                            e
+                        } else {
+                            hi
                         }
-                        *hit = true;
+                    };
+                    let mut before = clamp(ends[0]);
+                    for ((&slot, hit), &end) in slots.iter().zip(&mut touched).zip(&ends[1..]) {
+                        let after = clamp(end);
+                        add(px, slot, radial * (after - before), hit);
+                        before = after;
                     }
-                    if ray.past_end(t) {
-                        break;
+                } else {
+                    let t_front = t_row - ka * dx;
+                    let mut before = ray.at(t_front);
+                    for (k, (&slot, hit)) in slots.iter().zip(&mut touched).enumerate() {
+                        let after = ray.at(t_front + (k + 1) as f32 * dt);
+                        add(px, slot, after - before, hit);
+                        before = after;
                     }
-                    before = after;
-                    slot = if slot + 1 == ring { 0 } else { slot + 1 };
                 }
                 updates += 1;
             }
-            for (k, _) in touched.iter().enumerate().take(slabs).filter(|(_, &t)| t) {
-                let slot = (first + k) % ring;
+            for (&slot, _) in slots.iter().zip(&touched).filter(|(_, &t)| t) {
                 self.buffers.rows[slot * bn + yl].include(x0, x1 - 1);
             }
         }

@@ -59,6 +59,13 @@ use core::fmt;
 /// The most slabs a frame may have.
 pub const MAX_SLABS: usize = 1 << 16;
 
+/// A chord-midpoint shear (z* over the footprint, in chord units: unit kernel radii) at or below
+/// this is taken as none. It moves a slab boundary along a chord by at most this much, which
+/// changes a section by at most 10⁻⁶ × max C′ = 1.01·10⁻⁶ of the peak footprint for the default
+/// Gaussian (C′(0) / (C(1) − C(−1)), [`SectionTable`](crate::table::SectionTable)'s C), below the
+/// section table's own error (2.4·10⁻⁶ of the peak).
+pub const SHEAR_SNAP: f32 = 1e-6;
+
 /// The most slabs one kernel may span ([`SlabSetup::ring`], the ring of slab accumulators a
 /// renderer keeps): slabs thinner than about a twentieth of the kernel's depth along the ray are
 /// refused ([`SlabError::KernelTooDeep`]).
@@ -242,6 +249,14 @@ impl SlabSetup {
         if needed > MAX_SLABS as f32 {
             return Err(SlabError::TooManySlabs { needed });
         }
+        // A shear far below f32 resolution of a chord position is rounding on an isotropic grid
+        // (measured ≤ 8·10⁻⁸ chord units over the footprint): snap it to zero so the renderer
+        // takes its shear-free path ([`SlabSetup::shear_free`]).
+        let (a, b) = if (dl / r) * (a.abs() * half[0] + b.abs() * half[1]) <= SHEAR_SNAP {
+            (0.0, 0.0)
+        } else {
+            (a, b)
+        };
         let ring = ring_for(z_reach, t);
         if ring > MAX_RING as f32 {
             return Err(SlabError::KernelTooDeep { slabs: ring });
@@ -284,6 +299,15 @@ impl SlabSetup {
         self.absorption
             .voxel_value(rgba)
             .map(|value| SlabVoxel { position, value })
+    }
+
+    /// Whether chords through a kernel all have their midpoint at the kernel's own depth (z* = 0:
+    /// any orthographic view of an isotropic grid, or one along an axis of an anisotropic grid;
+    /// a shear below [`SHEAR_SNAP`] counts as none). Then a slab boundary sits at the same chord
+    /// position for every pixel of a footprint, and the renderer reads the depth table once per
+    /// voxel and boundary instead of once per pixel and boundary.
+    pub fn shear_free(&self) -> bool {
+        self.shear == [0.0, 0.0]
     }
 
     /// The most slabs one kernel overlaps (at most [`MAX_RING`]): how many slab accumulators a

@@ -139,7 +139,7 @@ impl<const R: usize, const T: usize> SectionTable<R, T> {
             return None;
         }
         let ri = rho2 * (R - 1) as f32;
-        let i = (ri as usize).min(R - 2);
+        let i = (ri as u32 as usize).min(R - 2);
         let radial = self.radial[i] + (ri - i as f32) * (self.radial[i + 1] - self.radial[i]);
         Some(SectionRay {
             depth: &self.depth,
@@ -166,10 +166,21 @@ impl<const T: usize> SectionRay<'_, T> {
         // Compare-and-select (maxss/minss): a NaN depth passes through and reads as node 0.
         let x = if t > -self.c { t } else { -self.c };
         let x = if x < self.c { x } else { self.c };
-        let tj = (x + 1.0) * (0.5 * (T - 1) as f32);
-        let j = (tj as usize).min(T - 2);
-        let d = self.depth;
-        self.radial * (d[j] + (tj - j as f32) * (d[j + 1] - d[j]))
+        self.radial * depth_at(self.depth, x)
+    }
+
+    /// The radial factor e^(−ρ²s²/2) of this ray: G(ρ², t) = radial · C(clamp(t, −c, c)).
+    #[inline]
+    pub fn radial(&self) -> f32 {
+        self.radial
+    }
+
+    /// C(−c) and C(c): the depth integral at the chord's ends, between which
+    /// C(clamp(t, −c, c)) = clamp(C(t), C(−c), C(c)) lies (C is increasing, and so is its
+    /// piecewise-linear table).
+    #[inline]
+    pub fn depth_ends(&self) -> (f32, f32) {
+        (depth_at(self.depth, -self.c), depth_at(self.depth, self.c))
     }
 
     /// The half chord c (unit radii): G is constant before −c and after c.
@@ -183,6 +194,28 @@ impl<const T: usize> SectionRay<'_, T> {
     pub fn past_end(&self, t: f32) -> bool {
         t >= self.c
     }
+}
+
+impl<const R: usize, const T: usize> SectionTable<R, T> {
+    /// C(clamp(t, −1, 1)): the depth integral on its own, the same for every ray (a section is
+    /// radial · [C(t_b) − C(t_a)] with both depths clamped to the ray's chord: see
+    /// [`SectionRay::depth_ends`]). A NaN depth reads as node 0.
+    #[inline]
+    pub fn depth(&self, t: f32) -> f32 {
+        let x = if t > -1.0 { t } else { -1.0 };
+        let x = if x < 1.0 { x } else { 1.0 };
+        depth_at(&self.depth, x)
+    }
+}
+
+/// The depth table read linearly at `x` ∈ [−1, 1] (the caller clamps).
+#[inline]
+fn depth_at<const T: usize>(d: &[f32; T], x: f32) -> f32 {
+    let tj = (x + 1.0) * (0.5 * (T - 1) as f32);
+    // tj ∈ [0, T − 1]: a 32-bit conversion (one instruction and a clamp) rather than the
+    // 64-bit unsigned one, which x86-64 emulates in a dozen.
+    let j = (tj as u32 as usize).min(T - 2);
+    d[j] + (tj - j as f32) * (d[j + 1] - d[j])
 }
 
 #[cfg(test)]
@@ -253,5 +286,34 @@ mod tests {
         let cone = Kernel::cone(1.5).unwrap();
         let mut table = SectionTable::<5, 5>::zeroed(cone);
         assert_eq!(table.build_into(cone), Err(SectionError::NotAVolumeKernel));
+    }
+
+    /// The shear-free slab splat's form: radial · clamp(C(t), C(−c), C(c)) is G(ρ², t), the
+    /// clamp applied to the table's value instead of to t (the table is increasing).
+    #[test]
+    fn clamping_the_depth_integral_is_clamping_the_depth() {
+        let kernel = Kernel::gaussian(1.6, 2.5).unwrap();
+        let mut table = SectionTable::<257, 1025>::zeroed(kernel);
+        table.build_into(kernel).unwrap();
+        assert!(table.depth.windows(2).all(|w| w[0] <= w[1]));
+        let peak = table.section(0.0, -1.0, 1.0);
+        for i in 0..97 {
+            let rho2 = i as f32 / 97.0 + 0.003;
+            let ray = table.ray(rho2).unwrap();
+            let (lo, hi) = ray.depth_ends();
+            assert!(lo <= hi);
+            for j in 0..400 {
+                let t = -1.3 + 2.6 * j as f32 / 400.0;
+                let got = ray.radial() * table.depth(t).clamp(lo, hi);
+                let want = ray.at(t);
+                assert!(
+                    (got - want).abs() <= 1e-6 * peak,
+                    "ρ²={rho2} t={t}: {got} vs {want}"
+                );
+            }
+        }
+        assert_eq!(table.depth(f32::NAN), table.depth[0]);
+        assert_eq!(table.depth(-5.0), table.depth[0]);
+        assert!((table.depth(5.0) - table.depth[1024]).abs() <= 1e-6 * peak);
     }
 }

@@ -74,7 +74,7 @@ impl Bands {
         }
     }
 
-    /// Bands used over an image `height` rows high.
+    /// Bands used over an image `height` rows high ([`Bands::cut`] keeps them all).
     pub fn count(&self, height: usize) -> usize {
         let units = if self.cull.is_some() {
             height.div_ceil(OCCLUSION_TILE)
@@ -85,39 +85,49 @@ impl Bands {
     }
 }
 
-/// `ranges` (tiling `height` rows) with every start moved to a multiple of the occlusion tile
-/// (rounded to the nearest), at most one band per tile row: the bands' work stays about as
-/// balanced, and every band starts on a tile row, as culling needs.
-fn on_tile_rows(ranges: Vec<std::ops::Range<usize>>, height: usize) -> Vec<std::ops::Range<usize>> {
+/// `ranges` (tiling `height` rows, at most one per tile row) with every start moved to a
+/// multiple of the occlusion tile, the nearest that keeps the starts increasing and leaves a tile
+/// row for each later band: as many bands as given, their work about as balanced, and every band
+/// starting on a tile row, as culling needs.
+fn on_tile_rows(ranges: &[std::ops::Range<usize>], height: usize) -> Vec<std::ops::Range<usize>> {
     let t = OCCLUSION_TILE;
     let tile_rows = height.div_ceil(t).max(1);
-    let mut starts: Vec<usize> = ranges
-        .iter()
-        .map(|r| ((r.start + t / 2) / t).min(tile_rows - 1))
-        .collect();
-    starts.dedup();
-    let n = starts.len();
+    let n = ranges.len().min(tile_rows);
+    let mut starts: Vec<usize> = Vec::with_capacity(n);
+    for (i, r) in ranges.iter().take(n).enumerate() {
+        let lo = starts.last().map_or(0, |s| s + 1);
+        let hi = (tile_rows - (n - i)).max(lo);
+        starts.push(((r.start + t / 2) / t).clamp(lo, hi));
+    }
     (0..n)
         .map(|i| {
-            let end = if i + 1 == n {
-                height
-            } else {
-                starts[i + 1] * t
-            };
+            let end = starts.get(i + 1).map_or(height, |s| s * t);
             starts[i] * t..end
         })
         .collect()
 }
 
+impl Bands {
+    /// The final bands from `ranges` (tiling `height` rows, [`Bands::count`] of them): as given,
+    /// or starting on tile rows when culling (`on_tile_rows`). The one place both the sheets'
+    /// balanced bands and the slabs' equal ones are aligned.
+    pub fn cut(
+        &self,
+        ranges: Vec<std::ops::Range<usize>>,
+        height: usize,
+    ) -> Vec<std::ops::Range<usize>> {
+        if self.cull.is_some() {
+            on_tile_rows(&ranges, height)
+        } else {
+            ranges
+        }
+    }
+}
+
 /// [`equal_bands`] for `bands` over an image `height` rows high, starting on tile rows when
 /// culling.
 pub fn equal_bands_for(height: usize, bands: Bands) -> Vec<std::ops::Range<usize>> {
-    let ranges = equal_bands(height, bands.count(height));
-    if bands.cull.is_some() {
-        on_tile_rows(ranges, height)
-    } else {
-        ranges
-    }
+    bands.cut(equal_bands(height, bands.count(height)), height)
 }
 
 /// The rows of band `t` of `bands` over an image `height` rows high: as equal as can be, the
@@ -158,11 +168,7 @@ where
         Visible::Kept(lists) => balanced_rows(&p.frame, lists, threads),
         Visible::OnTheFly(_) => equal_bands(h, threads),
     };
-    let ranges = if bands.cull.is_some() {
-        on_tile_rows(ranges, h)
-    } else {
-        ranges
-    };
+    let ranges = bands.cut(ranges, h);
     let cull = bands.cull;
     // Any image of the right size will do: each band's renderer starts its rows afresh.
     let image = spares.take_image(w * h, P::CLEAR, "the image")?;
@@ -380,7 +386,7 @@ where
 
 #[cfg(test)]
 mod tests {
-    use super::{balanced_rows, band_rows};
+    use super::{balanced_rows, band_rows, equal_bands, on_tile_rows, Bands, OCCLUSION_TILE};
     use crate::pipeline::stages::visible::{RowRun, VisibleLists};
     use footprint::frame::FrameSetup;
     use footprint::geometry::FootprintOptions;
@@ -459,5 +465,46 @@ mod tests {
                 assert_eq!(next, h);
             }
         }
+    }
+
+    /// Culling's bands start on tile rows, tile the image and keep their number (the JSON's
+    /// `bands`), even where several equal bands would round to one tile row; lopsided cuts too.
+    #[test]
+    fn culled_bands_start_on_tile_rows_and_keep_their_number() {
+        let t = OCCLUSION_TILE;
+        for h in [1, 7, 8, 9, 17, 33, 64, 100, 513] {
+            let bands = |threads| Bands {
+                threads,
+                cull: Some(0.004),
+            };
+            for threads in 1..=20 {
+                let n = bands(threads).count(h);
+                assert!(n <= h.div_ceil(t));
+                let lopsided: Vec<_> = {
+                    // All but the last band one row tall: starts crowd the first tile row.
+                    let mut r: Vec<_> = (0..n.saturating_sub(1)).map(|i| i..i + 1).collect();
+                    r.push(n - 1..h);
+                    r
+                };
+                for ranges in [equal_bands(h, n), lopsided] {
+                    let cut = bands(threads).cut(ranges, h);
+                    assert_eq!(cut.len(), n, "h {h}, {threads} threads: {cut:?}");
+                    assert_eq!(cut[0].start, 0);
+                    assert_eq!(cut[n - 1].end, h);
+                    assert!(cut.windows(2).all(|w| w[0].end == w[1].start));
+                    assert!(
+                        cut.iter().all(|b| !b.is_empty() && b.start % t == 0),
+                        "{cut:?}"
+                    );
+                }
+            }
+        }
+        // Without culling the ranges pass through.
+        let plain = Bands {
+            threads: 3,
+            cull: None,
+        };
+        assert_eq!(plain.cut(vec![0..1, 1..2, 2..9], 9), vec![0..1, 1..2, 2..9]);
+        assert_eq!(on_tile_rows(&[0..5, 5..9], 9), vec![0..8, 8..9]);
     }
 }
