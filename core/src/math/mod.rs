@@ -142,6 +142,18 @@ pub fn abs(x: f32) -> f32 {
     f32::from_bits(x.to_bits() & 0x7fff_ffff)
 }
 
+/// `x` clamped to [`lo`, `hi`] by compare-and-select (maxss/minss, no branch): a NaN `x` reads
+/// as `lo`. `f32::clamp` keeps the NaN.
+#[inline]
+pub fn select_clamp(x: f32, lo: f32, hi: f32) -> f32 {
+    let x = if x > lo { x } else { lo };
+    if x < hi {
+        x
+    } else {
+        hi
+    }
+}
+
 /// x², spelled out so call sites read like the formulas they implement.
 #[inline]
 pub fn sq(x: f32) -> f32 {

@@ -165,6 +165,13 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
             }
             &ends[..slabs + 1]
         });
+        // A section g of the voxel into one slab's slot of a pixel's ring.
+        let add = |px: &mut [[f32; 4]], slot: usize, g: f32, hit: &mut bool| {
+            for (p, v) in px[slot].iter_mut().zip(&value) {
+                *p += v * g;
+            }
+            *hit |= g != 0.0;
+        };
         let mut updates = 0u64;
         for y in y0..y1 {
             let dy = y as f32 + 0.5 - cy;
@@ -194,24 +201,11 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
                 };
                 // Every slab the kernel spans, with no branch per slab (outside the chord
                 // [−c, c] a section is exactly zero and adds nothing).
-                let add = |px: &mut [[f32; 4]], slot: usize, g: f32, hit: &mut bool| {
-                    for (p, v) in px[slot].iter_mut().zip(&value) {
-                        *p += v * g;
-                    }
-                    *hit |= g != 0.0;
-                };
                 if let Some(ends) = &boundaries {
                     // No shear: the boundaries' depth integrals are the voxel's, clamped to
                     // this ray's chord (C is increasing: see `SectionRay::depth_ends`).
                     let (radial, (lo, hi)) = (ray.radial(), ray.depth_ends());
-                    let clamp = |e: f32| {
-                        let e = if e > lo { e } else { lo };
-                        if e < hi {
-                            e
-                        } else {
-                            hi
-                        }
-                    };
+                    let clamp = |e: f32| math::select_clamp(e, lo, hi);
                     let mut before = clamp(ends[0]);
                     for ((&slot, hit), &end) in slots.iter().zip(&mut touched).zip(&ends[1..]) {
                         let after = clamp(end);

@@ -131,6 +131,14 @@ impl<const R: usize, const T: usize> SectionTable<R, T> {
         self.ray(rho2).map_or(0.0, |r| r.at(t_b) - r.at(t_a))
     }
 
+    /// C(clamp(t, −1, 1)): the depth integral on its own, the same for every ray (a section is
+    /// radial · [C(t_b) − C(t_a)] with both depths clamped to the ray's chord: see
+    /// [`SectionRay::depth_ends`]). A NaN depth reads as node 0.
+    #[inline]
+    pub fn depth(&self, t: f32) -> f32 {
+        depth_at(&self.depth, math::select_clamp(t, -1.0, 1.0))
+    }
+
     /// The part of the table one ray reads (a ray at squared unit distance `rho2` from the
     /// kernel's centre), for evaluating G at several depths: `None` when it misses the kernel.
     #[inline]
@@ -163,10 +171,8 @@ impl<const T: usize> SectionRay<'_, T> {
     /// kernel in front of chord position `t` (unit radii).
     #[inline]
     pub fn at(&self, t: f32) -> f32 {
-        // Compare-and-select (maxss/minss): a NaN depth passes through and reads as node 0.
-        let x = if t > -self.c { t } else { -self.c };
-        let x = if x < self.c { x } else { self.c };
-        self.radial * depth_at(self.depth, x)
+        // A NaN depth reads as node 0.
+        self.radial * depth_at(self.depth, math::select_clamp(t, -self.c, self.c))
     }
 
     /// The radial factor e^(−ρ²s²/2) of this ray: G(ρ², t) = radial · C(clamp(t, −c, c)).
@@ -181,30 +187,6 @@ impl<const T: usize> SectionRay<'_, T> {
     #[inline]
     pub fn depth_ends(&self) -> (f32, f32) {
         (depth_at(self.depth, -self.c), depth_at(self.depth, self.c))
-    }
-
-    /// The half chord c (unit radii): G is constant before −c and after c.
-    #[inline]
-    pub fn half_chord(&self) -> f32 {
-        self.c
-    }
-
-    /// Whether chord position `t` lies at or beyond the chord's far end (G is whole there).
-    #[inline]
-    pub fn past_end(&self, t: f32) -> bool {
-        t >= self.c
-    }
-}
-
-impl<const R: usize, const T: usize> SectionTable<R, T> {
-    /// C(clamp(t, −1, 1)): the depth integral on its own, the same for every ray (a section is
-    /// radial · [C(t_b) − C(t_a)] with both depths clamped to the ray's chord: see
-    /// [`SectionRay::depth_ends`]). A NaN depth reads as node 0.
-    #[inline]
-    pub fn depth(&self, t: f32) -> f32 {
-        let x = if t > -1.0 { t } else { -1.0 };
-        let x = if x < 1.0 { x } else { 1.0 };
-        depth_at(&self.depth, x)
     }
 }
 

@@ -83,6 +83,21 @@ impl Bands {
         };
         self.threads.clamp(1, units.max(1))
     }
+
+    /// The final bands from `ranges` (tiling `height` rows, [`Bands::count`] of them): as given,
+    /// or starting on tile rows when culling (`on_tile_rows`). The one place both the sheets'
+    /// balanced bands and the slabs' equal ones are aligned.
+    pub fn cut(
+        &self,
+        ranges: Vec<std::ops::Range<usize>>,
+        height: usize,
+    ) -> Vec<std::ops::Range<usize>> {
+        if self.cull.is_some() {
+            on_tile_rows(&ranges, height)
+        } else {
+            ranges
+        }
+    }
 }
 
 /// `ranges` (tiling `height` rows, at most one per tile row) with every start moved to a
@@ -105,23 +120,6 @@ fn on_tile_rows(ranges: &[std::ops::Range<usize>], height: usize) -> Vec<std::op
             starts[i] * t..end
         })
         .collect()
-}
-
-impl Bands {
-    /// The final bands from `ranges` (tiling `height` rows, [`Bands::count`] of them): as given,
-    /// or starting on tile rows when culling (`on_tile_rows`). The one place both the sheets'
-    /// balanced bands and the slabs' equal ones are aligned.
-    pub fn cut(
-        &self,
-        ranges: Vec<std::ops::Range<usize>>,
-        height: usize,
-    ) -> Vec<std::ops::Range<usize>> {
-        if self.cull.is_some() {
-            on_tile_rows(&ranges, height)
-        } else {
-            ranges
-        }
-    }
 }
 
 /// [`equal_bands`] for `bands` over an image `height` rows high, starting on tile rows when
