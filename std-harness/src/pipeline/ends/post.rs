@@ -21,7 +21,7 @@
 //! accumulation and colour-carrying levels of detail (their colours are pre-classified).
 
 use crate::args::Supersample;
-use crate::pipeline::stages::bands::Bands;
+use crate::pipeline::stages::bands::{equal_bands_for, on_bands, Bands};
 use crate::pipeline::stages::bands::{CoreFrame, Phases};
 use crate::pipeline::stages::prepare::Prepared;
 use crate::pipeline::stages::visible::{FrameCache, PostSamples};
@@ -87,16 +87,26 @@ pub fn render_post(
     let classify_time = classify_samples + t1.elapsed().as_secs_f64();
 
     let (setup, weights, classify, sv) = (&setup, &*weights, &classify, &voxels);
+    let bands = Bands {
+        threads,
+        cull: None,
+    };
+    let size = p.frame.size;
     let timing = (start, classify_time, tables);
     super::slabs::banded_frame(
         p,
-        Bands {
-            threads,
-            cull: None,
-        },
+        bands.count(size[1]),
         timing,
         voxels.voxels.len(),
-        |rows, band, bg| render_band(p, setup, weights, classify, sv, bg, band, rows),
+        |image| {
+            on_bands(
+                image,
+                size,
+                equal_bands_for(size[1], bands),
+                p.background.as_deref(),
+                |rows, band, bg| render_band(p, setup, weights, classify, sv, bg, band, rows),
+            )
+        },
     )
 }
 

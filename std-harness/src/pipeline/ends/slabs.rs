@@ -6,18 +6,22 @@
 //!    ([`SlabSetup::voxel`]), placed on screen, and sorted by the slab each reaches
 //!    first in compositing order (counting sorts: the voxel order within a slab does not depend
 //!    on the thread count).
-//! 2. Each thread owns a band of image rows and walks the slabs in compositing order: the voxels
-//!    that reach slab j first (that reach its band) are splatted into every slab they overlap,
+//! 2. The image is cut into blocks of rows whose slab accumulators fit the cache
+//!    ([`crate::pipeline::stages::blocks`]), each voxel listed in the blocks it reaches; threads
+//!    take blocks as they come free. A block walks the slabs in compositing order: the voxels
+//!    that reach slab j first (that reach the block) are splatted into every slab they overlap,
 //!    then slab j is composited (the core's ring of slab accumulators).
 //!
 //! **Memory.** 40 bytes per visible voxel (its [`SlabVoxel`] and slab range) on top of the
-//! visible lists; per band a ring of `SlabSetup::ring` slab accumulators (16 bytes per pixel
-//! each: on an isotropic grid a kernel 1.6 voxels in radius spans at most 5 slabs of one
-//! spacing, 8 of half a spacing), and the 5 KiB section table. A slab of an oblique
+//! visible lists, and 4 per voxel and block it reaches; per thread the ring of `SlabSetup::ring`
+//! slab accumulators of the block it renders (16 bytes per pixel each: on an isotropic grid a
+//! kernel 1.6 voxels in radius spans at most 5 slabs of one spacing, 8 of half a spacing), and
+//! the 5 KiB section table. A slab of an oblique
 //! view crosses every sheet, so a streamed volume (`--stream`) is refused: feeding it from a
 //! bounded window of sheets is not possible (see the core module's docs).
 
-use crate::pipeline::stages::bands::{equal_bands_for, on_bands, Bands, CoreFrame, Phases};
+use crate::pipeline::stages::bands::{Bands, CoreFrame, Phases};
+use crate::pipeline::stages::blocks::{block_rows, blocks, on_blocks, Members};
 use crate::pipeline::stages::prepare::Prepared;
 use crate::pipeline::stages::supersample::to_output;
 use crate::pipeline::stages::visible::FrameCache;
@@ -70,43 +74,53 @@ pub fn render_slabs(
     };
     let t1 = Instant::now();
     let voxels = slab_voxels(p, &setup, lists)?;
-    let classify = classify_lists + t1.elapsed().as_secs_f64();
+    let classify = classify_lists;
 
-    let (setup, table, sv) = (&setup, &*table, &voxels);
+    let [w, h] = p.frame.size;
+    let rows = block_rows(w, setup.ring(), std::mem::size_of::<[f32; 4]>());
+    let ranges = blocks(h, rows);
+    let members = Members::of(voxels.voxels.len(), h, rows, |i| {
+        setup.rows_of(voxels.voxels[i].position[1])
+    })?;
+    let classify = classify + t1.elapsed().as_secs_f64();
+
+    let (setup, table, sv, members) = (&setup, &*table, &voxels, &members);
+    let threads = bands.threads.clamp(1, ranges.len().max(1));
     let timing = (start, classify, tables);
-    banded_frame(p, bands, timing, voxels.voxels.len(), |rows, band, bg| {
-        render_band(p, setup, table, sv, bg, band, rows, bands.cull)
+    banded_frame(p, threads, timing, voxels.voxels.len(), |image| {
+        on_blocks(
+            image,
+            w,
+            &ranges,
+            threads,
+            p.background.as_deref(),
+            |b, rows, band, bg| {
+                let mine = members.of_block(b);
+                render_band(p, setup, table, sv, mine, bg, band, rows, bands.cull)
+            },
+        )
     })
 }
 
-/// A slab end's frame: `band` rendered on equal `bands` of image rows, with the phases
-/// timed before it (`timing`: the frame's start, classification and table seconds), its
-/// `voxels` (every band sees only those that reach it: the frame's are the list's), resampled to
-/// the output size.
+/// A slab end's frame: the image rendered by `render` (given a clear image, it returns the image,
+/// the counts and the busiest thread's phases) on `threads` threads, with the phases timed before
+/// it (`timing`: the frame's start, classification and table seconds) and its `voxels` (every
+/// band or block sees only those that reach it: the frame's are the list's), resampled to the
+/// output size.
 pub(crate) fn banded_frame<F>(
     p: &Prepared,
-    bands: Bands,
+    threads: usize,
     timing: (Instant, f64, f64),
     voxels: usize,
-    band: F,
+    render: F,
 ) -> Result<CoreFrame, CliError>
 where
-    F: Fn(
-            std::ops::Range<usize>,
-            &mut [[f32; 4]],
-            Option<&[[f32; 4]]>,
-        ) -> Result<(RenderStats, Phases), CliError>
-        + Sync,
+    F: FnOnce(Vec<[f32; 4]>) -> Result<(Vec<[f32; 4]>, RenderStats, Phases), CliError>,
 {
     let (start, classify, tables) = timing;
     let [w, h] = p.frame.size;
-    let (image, mut stats, band_phases) = on_bands(
-        crate::io::try_filled(w * h, [0.0f32; 4], "the image")?,
-        p.frame.size,
-        equal_bands_for(h, bands),
-        p.background.as_deref(),
-        band,
-    )?;
+    let (image, mut stats, band_phases) =
+        render(crate::io::try_filled(w * h, [0.0f32; 4], "the image")?)?;
     stats.voxels = voxels as u64;
     let phases = Phases {
         classify,
@@ -119,7 +133,7 @@ where
         stats,
         seconds: start.elapsed().as_secs_f64(),
         phases,
-        threads: bands.count(h),
+        threads,
         visible: Some(voxels),
         refine: None,
     })
@@ -203,14 +217,16 @@ pub(crate) fn buckets(
     (order, starts)
 }
 
-/// One band: every slab in compositing order: the voxels that reach it first splatted (into every
-/// slab each overlaps), then the slab composited; occluded voxels culled at `cull`'s ε.
+/// One band (a block of rows): every slab in compositing order: the voxels that reach it first
+/// splatted (into every slab each overlaps), then the slab composited; occluded voxels culled at
+/// `cull`'s ε. `mine` lists the voxels that reach the band's rows, in the list's order.
 #[allow(clippy::too_many_arguments)]
 fn render_band(
     p: &Prepared,
     setup: &SlabSetup,
     table: &SectionTable<ROWS, COLUMNS>,
     sv: &SlabVoxels,
+    mine: &[u32],
     background: Option<&[[f32; 4]]>,
     image: &mut [[f32; 4]],
     rows: std::ops::Range<usize>,
@@ -231,22 +247,18 @@ fn render_band(
         image,
         rows: &mut spans,
     };
-    let reaches = |v: &SlabVoxel| {
-        let r = setup.rows_of(v.position[1]);
-        r.start < rows.end && r.end > rows.start
-    };
     let mut renderer =
         SlabRenderer::with_band(setup, table, p.order, buffers, background, rows.clone())?;
     if let Some(eps) = cull {
         renderer = renderer.with_occlusion(&mut occluded, eps)?;
     }
     let mut phases = Phases::default();
+    let mut mine = mine.iter().map(|&i| i as usize).peekable();
     for k in 0..setup.slab_count() {
         let t0 = Instant::now();
-        for v in sv.voxels[sv.starts[k]..sv.starts[k + 1]].iter() {
-            if reaches(v) {
-                renderer.splat_voxel(v)?;
-            }
+        // `mine` is in list order, so the voxels entering at step k come next.
+        while let Some(i) = mine.next_if(|&i| i < sv.starts[k + 1]) {
+            renderer.splat_voxel(&sv.voxels[i])?;
         }
         let t1 = Instant::now();
         renderer.composite_next();

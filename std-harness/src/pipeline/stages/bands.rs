@@ -320,14 +320,20 @@ where
         let (s, ph) = r?;
         stats.sheets = s.sheets;
         stats.voxels = s.voxels;
-        stats.voxels_splatted += s.voxels_splatted;
-        stats.pixel_updates += s.pixel_updates;
-        stats.pixels_composited += s.pixels_composited;
-        stats.culled_voxels += s.culled_voxels;
+        add_counts(&mut stats, &s);
         phases.splat = phases.splat.max(ph.splat);
         phases.composite = phases.composite.max(ph.composite);
     }
     Ok((image, stats, phases))
+}
+
+/// Adds the work counts of `part` (a band's or block's: voxels splatted and culled, pixel updates
+/// and composites) to `total`.
+pub fn add_counts(total: &mut RenderStats, part: &RenderStats) {
+    total.voxels_splatted += part.voxels_splatted;
+    total.pixel_updates += part.pixel_updates;
+    total.pixels_composited += part.pixels_composited;
+    total.culled_voxels += part.culled_voxels;
 }
 
 /// One band: every sheet in compositing order, splat then composite, timed, and the visible
