@@ -74,7 +74,6 @@ pub fn render_slabs(
     };
     let t1 = Instant::now();
     let voxels = slab_voxels(p, &setup, lists)?;
-    let classify = classify_lists;
 
     let [w, h] = p.frame.size;
     let rows = block_rows(w, setup.ring(), std::mem::size_of::<[f32; 4]>());
@@ -82,7 +81,7 @@ pub fn render_slabs(
     let members = Members::of(voxels.voxels.len(), h, rows, |i| {
         setup.rows_of(voxels.voxels[i].position[1])
     })?;
-    let classify = classify + t1.elapsed().as_secs_f64();
+    let classify = classify_lists + t1.elapsed().as_secs_f64();
 
     let (setup, table, sv, members) = (&setup, &*table, &voxels, &members);
     let threads = bands.threads.clamp(1, ranges.len().max(1));
