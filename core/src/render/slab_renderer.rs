@@ -196,16 +196,16 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
             for (x, px) in row.chunks_exact_mut(ring).enumerate() {
                 let dx = (x + x0) as f32 + 0.5 - cx;
                 let rho2 = (qxx * dx + 2.0 * qxy * dy) * dx + qyy * dy * dy;
-                let Some(ray) = self.table.ray(rho2) else {
-                    continue;
-                };
                 // Every slab the kernel spans, with no branch per slab (outside the chord
                 // [−c, c] a section is exactly zero and adds nothing).
                 if let Some(ends) = &boundaries {
                     // No shear: the boundaries' depth integrals are the voxel's, clamped to
-                    // this ray's chord (C is increasing: see `SectionRay::depth_ends`).
-                    let (radial, (lo, hi)) = (ray.radial(), ray.depth_ends());
-                    let clamp = |e: f32| math::select_clamp(e, lo, hi);
+                    // this ray's chord [C(−c), C(c)] = [−C(c), C(c)] (C is increasing and odd:
+                    // see `SectionTable::chord`).
+                    let Some([radial, hi]) = self.table.chord(rho2) else {
+                        continue;
+                    };
+                    let clamp = |e: f32| math::select_clamp(e, -hi, hi);
                     let mut before = clamp(ends[0]);
                     for ((&slot, hit), &end) in slots.iter().zip(&mut touched).zip(&ends[1..]) {
                         let after = clamp(end);
@@ -213,6 +213,9 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
                         before = after;
                     }
                 } else {
+                    let Some(ray) = self.table.ray(rho2) else {
+                        continue;
+                    };
                     let t_front = t_row - ka * dx;
                     let mut before = ray.at(t_front);
                     for (k, (&slot, hit)) in slots.iter().zip(&mut touched).enumerate() {

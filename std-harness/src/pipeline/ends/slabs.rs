@@ -16,7 +16,7 @@
 //! visible lists, and 4 per voxel and block it reaches; per thread the ring of `SlabSetup::ring`
 //! slab accumulators of the block it renders (16 bytes per pixel each: on an isotropic grid a
 //! kernel 1.6 voxels in radius spans at most 5 slabs of one spacing, 8 of half a spacing), and
-//! the 5 KiB section table. A slab of an oblique
+//! the 13 KiB section table. A slab of an oblique
 //! view crosses every sheet, so a streamed volume (`--stream`) is refused: feeding it from a
 //! bounded window of sheets is not possible (see the core module's docs).
 
@@ -36,7 +36,7 @@ use footprint::table::SectionTable;
 use std::time::Instant;
 
 /// The section table's nodes: the radial factor over ρ², the depth integral over the chord (see
-/// `footprint::table::SectionTable`: 2.4·10⁻⁶ of the peak at worst, 5 KiB).
+/// `footprint::table::SectionTable`: 2.4·10⁻⁶ of the peak at worst, 13 KiB).
 const ROWS: usize = 257;
 const COLUMNS: usize = 1025;
 
