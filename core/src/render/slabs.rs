@@ -306,7 +306,8 @@ impl SlabSetup {
     /// a shear below [`SHEAR_SNAP`] counts as none). Then a slab boundary sits at the same chord
     /// position for every pixel of a footprint, and the renderer reads the depth table once per
     /// voxel and boundary instead of once per pixel and boundary, and per pixel only the radial
-    /// factor and the chord's ends, in one walk ([`SectionTable::chord`](crate::table::SectionTable::chord)).
+    /// factor and the chord's ends, in one walk
+    /// ([`SectionTable::chord`](crate::table::SectionTable::chord)).
     pub fn shear_free(&self) -> bool {
         self.shear == [0.0, 0.0]
     }

@@ -32,7 +32,8 @@
 //!
 //! [`SectionTable::build_into`] evaluates radial at R nodes ρ² = i/(R−1) and C at T nodes
 //! x = −1 + 2j/(T−1), both read linearly; per pixel a splat takes one square root (c) and no
-//! division.
+//! division. The other kernels are 2D footprint models with no 3D profile to cut, and are refused
+//! ([`SectionError::NotAVolumeKernel`]).
 //!
 //! # The chord's ends in one read
 //! A splat whose slab boundaries sit at the same chord positions for every pixel (no shear: see
@@ -41,12 +42,11 @@
 //! holds both as functions of the half-chord c, at T nodes c = j/(T−1): radial(1 − c²) and C(c),
 //! side by side, so [`SectionTable::chord`] reads them with one index and one pair of loads.
 //! Both are smooth in c (C(c) in ρ² is not: it has a square-root edge at ρ² = 1), so reading
-//! them linearly in c is as accurate as the two tables above (measured in the tests below). The other kernels are 2D footprint models with no 3D profile to cut, and are refused
-//! ([`SectionError::NotAVolumeKernel`]).
+//! them linearly in c is as accurate as the two tables above (measured in the tests below).
 //!
 //! # Size and accuracy
-//! 4·(R + 3T) bytes (257 + 3 × 1025: 13 KiB, so it stays in the L1 cache). With R = 257 and T = 1025
-//! and the default Gaussian (2.5 σ per radius) a section is within 2.4·10⁻⁶ of the peak footprint
+//! 4·(R + 3T) bytes (257 + 3 × 1025: 13 KiB, so it stays in the L1 cache). With R = 257 and
+//! T = 1025 and the default Gaussian (2.5 σ per radius) a section is within 2.4·10⁻⁶ of the peak footprint
 //! of the f64 closed form (measured in this module's tests). (A first version tabulated G over
 //! (ρ², t) in two dimensions: a kink where t = ±c and the square-root edge at ρ² = 1 cost 0.4 %
 //! of the peak under bilinear interpolation, and its lookups cost a division and four loads per
@@ -119,21 +119,17 @@ impl<const R: usize, const T: usize> SectionTable<R, T> {
         self.kernel = kernel;
         let k = sigmas * core::f32::consts::FRAC_1_SQRT_2;
         let scale = math::sqrt(core::f32::consts::PI * 0.5) / sigmas / kernel.integral();
+        let radial = |rho2: f32| math::exp(-0.5 * rho2 * sigmas * sigmas);
+        let depth = |x: f32| scale * math::erf(k * x);
         for (i, r) in self.radial.iter_mut().enumerate() {
-            let rho2 = i as f32 / (R - 1) as f32;
-            *r = math::exp(-0.5 * rho2 * sigmas * sigmas);
+            *r = radial(i as f32 / (R - 1) as f32);
         }
         for (j, d) in self.depth.iter_mut().enumerate() {
-            let x = -1.0 + 2.0 * j as f32 / (T - 1) as f32;
-            *d = scale * math::erf(k * x);
+            *d = depth(-1.0 + 2.0 * j as f32 / (T - 1) as f32);
         }
         for (j, e) in self.chord.iter_mut().enumerate() {
             let c = j as f32 / (T - 1) as f32;
-            let rho2 = 1.0 - c * c;
-            *e = [
-                math::exp(-0.5 * rho2 * sigmas * sigmas),
-                scale * math::erf(k * c),
-            ];
+            *e = [radial(1.0 - c * c), depth(c)];
         }
         Ok(())
     }
@@ -175,9 +171,7 @@ impl<const R: usize, const T: usize> SectionTable<R, T> {
             c: math::sqrt(1.0 - rho2),
         })
     }
-}
 
-impl<const R: usize, const T: usize> SectionTable<R, T> {
     /// The ray at squared unit distance `rho2` from the kernel's centre as its radial factor and
     /// the depth integral at its chord's end, [radial(ρ²), C(c)] (C(−c) = −C(c)), read from the
     /// half-chord table in one walk (see the module docs); the same values as
