@@ -16,8 +16,9 @@
 # docs/images/peers-*.png to check by eye. Opacity is per world unit in all three (VTK's
 # --opacity-unit-distance 1; VolPack's per-slice opacity equals it at unit spacing).
 #
-# Per volume and repetition, in this order: Footprint float 1 thread, float 2 threads, fixed 1
-# thread, float with --subsample auto on 1 and 2 threads, image-aligned slabs (--slicing image) on
+# Per volume and repetition, in this order: Footprint's default (`--slicing auto`: object slicing
+# where its pilot measures 44 dB against the continuous model, slabs otherwise; fresh includes the
+# pilot) on 1 and 2 threads, object slicing float 1 thread, float 2 threads, fixed 1 thread, float with --subsample auto on 1 and 2 threads, image-aligned slabs (--slicing image) on
 # 1 and 2 threads, object slicing and slabs with occlusion culling (--cull 0.004) on 1 and 2
 # threads (each `footprint bench --frames N --orbit 2`: first_ms = fresh volume, median_ms =
 # re-render), post-classified slabs on 1 thread, VTK vtkFixedPointVolumeRayCastMapper 1 and 2
@@ -124,20 +125,20 @@ PY
   common=("$raw" --dims "$nx,$ny,$nz" --type u8 --spacing "$sx,$sy,$sz" --window "$lo,$hi" --tf grey
           --size 512x512 --view-matrix "$vm" --frames "$frames" --orbit 2)
   "$fp" render "$raw" --dims "$nx,$ny,$nz" --type u8 --spacing "$sx,$sy,$sz" --window "$lo,$hi" --tf grey \
-    --size 512x512 --view-matrix "$vm" --threads 1 --out "$work/out/fp-$name.png" --json "$work/out/fp-$name.json" >/dev/null
+    --size 512x512 --view-matrix "$vm" --slicing object --threads 1 --out "$work/out/fp-$name.png" --json "$work/out/fp-$name.json" >/dev/null
   # The scene's unavoidable work at 512² (benches/floor.rs): pixel updates, composites, voxels, sheets.
   counts=$("$py" -c "import json; j=json.load(open('$work/out/fp-$name.json')); print(*(int(j[k]) for k in ('pixel_updates', 'pixels_composited', 'voxels_splatted', 'sheets')))")
   # What --subsample auto costs in accuracy on this view: against the full-size f64 reference
   # (the splatting itself) and against the continuous integral, beside the full-size render's.
   for sub in 1 auto; do
     "$fp" verify "$raw" --dims "$nx,$ny,$nz" --type u8 --spacing "$sx,$sy,$sz" --window "$lo,$hi" --tf grey \
-      --size 512x512 --view-matrix "$vm" --subsample "$sub" --reference continuous --json "$work/v.json" >/dev/null
+      --size 512x512 --view-matrix "$vm" --slicing object --subsample "$sub" --reference continuous --json "$work/v.json" >/dev/null
     "$py" -c "import json; j=json.load(open('$work/v.json')); print(f'$name,$sub,{int(j[\"subsample\"])},{j[\"overall\"][\"psnr_db\"]:.2f},{j[\"continuous\"][\"psnr_db\"]:.2f}')" >> "$acsv"
     [ "$sub" = 1 ] && cp "$work/v.json" "$work/v1.json"
   done
   # Each method of the timing runs against the default continuous model (opacity reconstruction,
   # `verify --reference continuous`), and what culling skipped (issue 42).
-  for m in "object|--slicing object" "object-cull|--slicing object --cull $cull" "slabs|--slicing image" \
+  for m in "default|--slicing auto" "object|--slicing object" "object-cull|--slicing object --cull $cull" "slabs|--slicing image" \
            "slabs-cull|--slicing image --cull $cull" "object-subsample|--slicing object --subsample auto"; do
     IFS='|' read -r label flags <<<"$m"
     # shellcheck disable=SC2086 # the method's flags
@@ -188,13 +189,13 @@ print(f"{name}: mean RGB  footprint {fp.mean():.2f}  vtk {vt.mean():.2f}  volpac
 Image.fromarray(np.concatenate([fp, vt, vp], 1)).resize((768, 256)).save(dest)
 PY
   for rep in $(seq 1 "$reps"); do
-    for cfg in "1 float 1 object off" "2 float 1 object off" "1 fixed 1 object off" "1 float auto object off" \
+    for cfg in "1 float 1 auto off" "2 float 1 auto off" "1 float 1 object off" "2 float 1 object off" "1 fixed 1 object off" "1 float auto object off" \
                "2 float auto object off" "1 float 1 image off" "2 float 1 image off" "1 float 1 object $cull" \
                "2 float 1 object $cull" "1 float 1 image $cull" "2 float 1 image $cull"; do
       read -r th acc sub slicing cl <<<"$cfg"
       "$fp" bench "${common[@]}" --threads "$th" --accum "$acc" --subsample "$sub" --slicing "$slicing" \
         --cull "$cl" --json "$work/b.json" >/dev/null
-      label=$acc; [ "$sub" = auto ] && label=$label-subsample
+      label=$acc; [ "$sub" = auto ] && label=$label-subsample; [ "$slicing" = auto ] && label=$label-default
       [ "$slicing" = image ] && label=$label-slabs; [ "$cl" != off ] && label=$label-cull
       "$py" -c "import json,sys; j=json.load(open('$work/b.json')); print(f'$name,$rep,footprint,$th,$label,{j[\"first_ms\"]:.3f},{j[\"median_ms\"]:.3f},{int(j[\"culled_voxels\"])}')" >> "$csv"
     done

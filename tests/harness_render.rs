@@ -57,8 +57,18 @@ fn verify_passes_and_fails_on_its_threshold() {
     let d = tmpdir("verify");
     let json = d.join("v.json");
     let heart = data("heart_32x32x12_float32_le.nhdr");
+    // Object slicing: the sheets the f64 reference renders (the default plan takes slabs here).
     let common = [
-        "--size", "128x128", "--table", "65", "--lookup", "bilinear", "--view", "30,20,0",
+        "--size",
+        "128x128",
+        "--table",
+        "65",
+        "--lookup",
+        "bilinear",
+        "--view",
+        "30,20,0",
+        "--slicing",
+        "object",
     ];
     let mut args = vec!["verify", s(&heart)];
     args.extend_from_slice(&common);

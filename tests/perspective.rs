@@ -149,8 +149,10 @@ fn front_faces_have_the_pinhole_size_and_nearer_is_larger() {
         "near face left edge {nl:.2}, pinhole {left:.2}"
     );
     // Orthographic (VTK's parallel ResetCamera, 512 / 2R px per unit): both faces the same size.
+    // Object slicing, as the perspective frame: a slab would hold the red face and the blue body
+    // behind it together, so red would no longer be the face's coverage alone.
     let mut args = common.to_vec();
-    args.extend_from_slice(&["--view", "0,0,0"]);
+    args.extend_from_slice(&["--view", "0,0,0", "--slicing", "object"]);
     run(&args);
     let (_, _, red) = red_rows(&out);
     let row = &red[256 * w..257 * w];

@@ -173,8 +173,11 @@ type Loaded<'py> = (Bound<'py, PyAny>, (f32, f32, f32), Bound<'py, PyDict>);
 fn frame(args: &RenderArgs) -> Result<Frame, CliError> {
     let asked = footprint_harness::plan::plan(args)?;
     let inputs = footprint_harness::plan::Inputs::from(args);
-    let (p, plan, _) = apply_quality(prepare(args)?, &inputs, &asked)?;
-    let image = if plan.end == footprint_harness::plan::End::Reference {
+    let (p, plan, choice) = apply_quality(prepare(args)?, &inputs, &asked)?;
+    // The default plan's pilot rendered the chosen frame whole already.
+    let image = if let Some(f) = choice.and_then(|c| c.frame) {
+        f.image
+    } else if plan.end == footprint_harness::plan::End::Reference {
         render_ref(&p)?
             .0
             .iter()

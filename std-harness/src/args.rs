@@ -63,6 +63,9 @@ pub enum SlicingArg {
     /// Slabs parallel to the image plane (Mueller and Crawfis 1998): each voxel's kernel cut by
     /// the slabs it overlaps, each section from the pre-integrated section table.
     Image,
+    /// The default: object slicing where a pilot measures it within the default target of the
+    /// continuous model (`plan::DEFAULT_TARGET_DB`), the thickest slabs that reach it otherwise.
+    Auto,
 }
 
 /// What `--quality DB` aims at (`--quality-reference`).
@@ -108,6 +111,7 @@ impl SlicingArg {
         match self {
             SlicingArg::Object => "object",
             SlicingArg::Image => "image",
+            SlicingArg::Auto => "auto",
         }
     }
 }
@@ -347,10 +351,13 @@ pub struct RenderArgs {
     #[arg(help_heading = "Method", long, value_enum, default_value_t = AccumArg::Float)]
     pub accum: AccumArg,
     /// Slicing: `object`, the paper's sheets along the grid axis most parallel to the image (the
-    /// way to reproduce the paper; pops where that axis switches), or `image`, slabs parallel to
-    /// the image plane (Mueller and Crawfis 1998; no popping). Image slicing needs a gaussian
-    /// kernel, float accumulation, an orthographic view and the volume in memory.
-    /// [default: object]
+    /// way to reproduce the paper; pops where that axis switches), `image`, slabs parallel to
+    /// the image plane (Mueller and Crawfis 1998; no popping), or `auto`: object slicing where a
+    /// pilot of sampled rays measures it at 44 dB or more against the continuous model, else the
+    /// thickest slabs that reach it (docs/modes.md, "The default plan"). Image slicing needs a
+    /// gaussian kernel, float accumulation, an orthographic view and the volume in memory; where
+    /// it cannot run, or with --accum fixed, --refine, --quality or --stream, `auto` is object
+    /// slicing without a pilot. [default: auto]
     #[arg(help_heading = "Method", long, value_enum)]
     pub slicing: Option<SlicingArg>,
     /// With --slicing image: slab thickness along the view ray, in voxel spacings (the smallest

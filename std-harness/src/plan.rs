@@ -31,7 +31,9 @@ use footprint::render::Absorption;
 use footprint::Lookup;
 use std::path::PathBuf;
 
+mod auto;
 mod post;
+pub use auto::DEFAULT_TARGET_DB;
 use post::{no_post_flags, post_plan};
 
 /// How the float or fixed sheets accumulate.
@@ -125,6 +127,11 @@ pub struct Plan {
     /// `--quality DB`: the table, level and slicing are chosen by measured error
     /// (`pipeline::quality::choose::apply_quality` returns the plan it chose, with this `None`).
     pub quality: Option<Quality>,
+    /// `--slicing auto` (the default) where the flags leave the choice open: the PSNR, dB, the
+    /// frame must reach against the continuous model for object slicing to be kept
+    /// ([`DEFAULT_TARGET_DB`]); the pipeline measures it on a pilot and returns the plan it chose,
+    /// with this `None` (`pipeline::quality::choose::apply_quality`). `None`: `end` as it is.
+    pub auto_slicing: Option<f64>,
 }
 
 /// `--quality DB --quality-reference R`.
@@ -183,7 +190,10 @@ pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
         return post_plan(args, precision);
     }
     no_post_flags(args)?;
-    let slicing = args.slicing.unwrap_or(SlicingArg::Object);
+    let slicing = match args.slicing {
+        Some(SlicingArg::Image) => SlicingArg::Image,
+        _ => SlicingArg::Object,
+    };
     let end = match (fa.method, args.refine, slicing) {
         (MethodArg::Reference, _, _) => End::Reference,
         (_, Some(threshold), _) => End::Refined {
@@ -193,7 +203,7 @@ pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
         (_, None, SlicingArg::Image) => End::Slabs {
             thickness: args.slab,
         },
-        (_, None, SlicingArg::Object) => End::Sheets(precision),
+        (_, None, _) => End::Sheets(precision),
     };
     let refuse = |flag: &str, why: &str| Err(CliError::input(format!("{flag}: {why}")));
     match end {
@@ -234,41 +244,7 @@ pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
             );
         }
     }
-    let factor = match args.subsample {
-        Supersample::Fixed(1) => None,
-        Supersample::Fixed(s) => Some(s.to_string()),
-        Supersample::Auto => Some("auto".to_string()),
-    };
-    if let Some(s) = factor {
-        if args.quality.is_some() {
-            return refuse(
-                &format!("--subsample {s}"),
-                "--quality chooses the method from measured errors at the output size; drop one",
-            );
-        }
-        if args.refine.is_some() && s != "auto" {
-            return refuse(
-                &format!("--subsample {s}"),
-                "--refine adds samples for magnified volumes; subsampling removes pixels: drop one",
-            );
-        }
-        // An explicit factor where the flags already rule subsampling out (`auto` then means
-        // 1; the frame decides the rest: `pipeline::stages::subsample::factor`).
-        let blocked = if s == "auto" {
-            None
-        } else if args.perspective.is_some() {
-            Some(SUBSAMPLE_NOT_PERSPECTIVE)
-        } else if matches!(args.supersample, Supersample::Fixed(2..)) {
-            Some("the frame is supersampled (--supersample): give one of them")
-        } else if matches!(args.lod, Lod::Level(1..)) {
-            Some(SUBSAMPLE_NOT_AT_A_LEVEL)
-        } else {
-            None
-        };
-        if let Some(why) = blocked {
-            return refuse(&format!("--subsample {s}"), why);
-        }
-    }
+    subsample_rules(args)?;
     Ok(Plan {
         end,
         table: Table {
@@ -288,7 +264,51 @@ pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
             target_db,
             reference: args.quality_reference,
         }),
+        auto_slicing: auto::slicing_target(&end, args),
     })
+}
+
+/// The rules `--subsample` adds: not with `--quality` (which chooses at the output size), an
+/// explicit factor not with `--refine`, a perspective view, supersampling or a coarser level.
+fn subsample_rules(args: &RenderArgs) -> Result<(), CliError> {
+    let refuse = |flag: &str, why: &str| Err(CliError::input(format!("{flag}: {why}")));
+    let factor = match args.subsample {
+        Supersample::Fixed(1) => None,
+        Supersample::Fixed(s) => Some(s.to_string()),
+        Supersample::Auto => Some("auto".to_string()),
+    };
+    let Some(s) = factor else {
+        return Ok(());
+    };
+    if args.quality.is_some() {
+        return refuse(
+            &format!("--subsample {s}"),
+            "--quality chooses the method from measured errors at the output size; drop one",
+        );
+    }
+    if args.refine.is_some() && s != "auto" {
+        return refuse(
+            &format!("--subsample {s}"),
+            "--refine adds samples for magnified volumes; subsampling removes pixels: drop one",
+        );
+    }
+    // An explicit factor where the flags already rule subsampling out (`auto` then means
+    // 1; the frame decides the rest: `pipeline::stages::subsample::factor`).
+    let blocked = if s == "auto" {
+        None
+    } else if args.perspective.is_some() {
+        Some(SUBSAMPLE_NOT_PERSPECTIVE)
+    } else if matches!(args.supersample, Supersample::Fixed(2..)) {
+        Some("the frame is supersampled (--supersample): give one of them")
+    } else if matches!(args.lod, Lod::Level(1..)) {
+        Some(SUBSAMPLE_NOT_AT_A_LEVEL)
+    } else {
+        None
+    };
+    if let Some(why) = blocked {
+        return refuse(&format!("--subsample {s}"), why);
+    }
+    Ok(())
 }
 
 impl From<Lookup> for LookupArg {

@@ -3,8 +3,10 @@
 //! `--orbit` degrees of azimuth further (a user turning the volume around) and may reuse what the
 //! earlier frames cached (the visible-voxel lists of each sheet axis).
 //!
-//! Prints and writes (`--json`): `first_ms`, `median_ms`, `min_ms`, `max_ms` (over frames 2…N;
-//! null when N = 1), `threads`, `phases_ms` (frame 1: `classify`, `tables`, `splat`,
+//! Prints and writes (`--json`): `first_ms` (what a fresh volume costs: frame 1 and `plan_ms`,
+//! choosing the plan, the default's pilot or `--quality`'s; the default's pilot renders frame 1
+//! itself, so there `first_ms` is `plan_ms`), `plan_ms`, `median_ms`,
+//! `min_ms`, `max_ms` (over frames 2…N, which keep frame 1's plan; null when N = 1), `threads`, `phases_ms` (frame 1: `classify`, `tables`, `splat`,
 //! `composite`, and `resample` for `--subsample`), `rerender_phases_ms` (the same, medians over
 //! frames 2…N), `frames_ms` (every frame), `frames`, `orbit_deg`, `culled_voxels` (frame 1's
 //! voxels skipped by occlusion culling, `--cull`; per band, as `render` counts them) and
@@ -19,6 +21,7 @@ use crate::pipeline::{quality::choose::apply_quality, quality::model::quality_js
 use crate::plan::{plan, turned, Inputs};
 use crate::CliError;
 use clap::Args;
+use std::time::Instant;
 
 #[derive(Args, Debug, Clone)]
 pub struct BenchArgs {
@@ -55,8 +58,20 @@ fn phases_json(p: &Phases) -> Json {
         .num("resample", p.resample * 1e3)
 }
 
-pub fn run(args: &BenchArgs) -> Result<(), CliError> {
-    // Every rule the flags decide, before anything is loaded.
+/// Each phase's median over `later` frames.
+fn medians(later: &[Phases]) -> Phases {
+    let over = |phase: fn(&Phases) -> f64| median(&later.iter().map(phase).collect::<Vec<_>>());
+    Phases {
+        classify: over(|p| p.classify),
+        tables: over(|p| p.tables),
+        splat: over(|p| p.splat),
+        composite: over(|p| p.composite),
+        resample: over(|p| p.resample),
+    }
+}
+
+/// Every rule the flags decide, before anything is loaded.
+fn check(args: &BenchArgs) -> Result<(), CliError> {
     plan(&args.render)?;
     if args.frames == 0 {
         return Err(CliError::input("--frames must be at least 1"));
@@ -77,9 +92,21 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
     if let Some(out) = &args.render.out {
         io::image::check_style(out, args.render.png_style())?;
     }
+    Ok(())
+}
+
+pub fn run(args: &BenchArgs) -> Result<(), CliError> {
+    check(args)?;
     let base = &args.render;
     let inputs = Inputs::from(base);
-    let (mut p, plan, choice) = apply_quality(prepare(base)?, &inputs, &plan(base)?)?;
+    let prepared = prepare(base)?;
+    // The default plan's pilot (or --quality's) is part of a fresh volume's cost.
+    let choosing = Instant::now();
+    let (mut p, plan, mut choice) = apply_quality(prepared, &inputs, &plan(base)?)?;
+    let plan_ms = choosing.elapsed().as_secs_f64() * 1e3;
+    // Frame 1 as the default plan's pilot rendered it, if it did (its time is in plan_ms).
+    let mut piloted = choice.as_mut().and_then(|c| c.frame.take());
+    let pilot_frame = piloted.is_some();
     let mut cache = FrameCache::default();
     let mut times = Vec::with_capacity(args.frames);
     let mut phases = Vec::with_capacity(args.frames);
@@ -91,7 +118,10 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
         if k > 0 {
             p.reframe(&Inputs::from(&turned(base, args.orbit * k as f32)))?;
         }
-        let f = render_frame(&p, &plan, &mut cache)?;
+        let f = match piloted.take() {
+            Some(f) => *f,
+            None => render_frame(&p, &plan, &mut cache)?,
+        };
         crate::say!(
             "frame {:>3}: {:8.2} ms (classify {:.2}, tables {:.2}, splat {:.2}, composite {:.2}, resample {:.2}); sheets along {}",
             k + 1,
@@ -114,29 +144,36 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
         }
     }
     let later = &times[1..];
-    let (first, med) = (times[0], median(later));
+    let first = if pilot_frame {
+        plan_ms
+    } else {
+        times[0] + plan_ms
+    };
+    let med = median(later);
     let (min, max) = later
         .iter()
         .fold((f64::NAN, f64::NAN), |(lo, hi), &t| (lo.min(t), hi.max(t)));
-    // Each phase's median over frames 2…N.
-    let over_later =
-        |phase: fn(&Phases) -> f64| median(&phases[1..].iter().map(phase).collect::<Vec<_>>());
-    let rerender = Phases {
-        classify: over_later(|p| p.classify),
-        tables: over_later(|p| p.tables),
-        splat: over_later(|p| p.splat),
-        composite: over_later(|p| p.composite),
-        resample: over_later(|p| p.resample),
-    };
+    let rerender = medians(&phases[1..]);
     let later_text = if later.is_empty() {
         "no later frames (--frames 1)".to_string()
     } else {
         format!("frames 2..: median {med:.2} ms (min {min:.2}, max {max:.2})")
     };
     crate::say!(
-        "{}: {} frames on {threads} thread(s): first {first:.2} ms; {later_text}",
+        "{}: {} frames on {threads} thread(s): first {first:.2} ms{}; {later_text}",
         p.name,
-        args.frames
+        args.frames,
+        match (&choice, pilot_frame) {
+            (Some(_), true) => format!(
+                " (the plan's pilot, which rendered frame 1 in {:.2} ms)",
+                times[0]
+            ),
+            (Some(_), false) => format!(
+                " (choosing the plan {plan_ms:.2} ms, frame 1 {:.2} ms)",
+                times[0]
+            ),
+            (None, _) => String::new(),
+        }
     );
     let mut files: Vec<(&std::path::Path, Vec<u8>)> = Vec::new();
     if let Some(out) = &base.out {
@@ -153,6 +190,7 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
             .num("orbit_deg", f64::from(args.orbit))
             .num("threads", threads as f64)
             .num("first_ms", first)
+            .num("plan_ms", plan_ms)
             .num("median_ms", med)
             .num("min_ms", min)
             .num("max_ms", max)

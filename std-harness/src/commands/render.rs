@@ -75,7 +75,7 @@ pub fn run(command: &RenderCommandArgs) -> Result<(), CliError> {
         };
         return write(args, &out, &rgb, summary);
     }
-    let (p, plan, choice) = apply_quality(prepare(args)?, &inputs, &asked)?;
+    let (p, plan, mut choice) = apply_quality(prepare(args)?, &inputs, &asked)?;
     if let Some(n) = command.orbit {
         return orbit(p, args, &plan, &out, usize::from(n), command.colorbar);
     }
@@ -85,7 +85,11 @@ pub fn run(command: &RenderCommandArgs) -> Result<(), CliError> {
         crate::say!("{}: f64 reference render in {:.3} s", p.name, secs);
         (rgb, describe(&p, &inputs, &plan).num("seconds", secs))
     } else {
-        let frame = render_frame(&p, &plan, &mut FrameCache::default())?;
+        // The default plan's pilot rendered the chosen frame whole already.
+        let frame = match choice.as_mut().and_then(|c| c.frame.take()) {
+            Some(f) => *f,
+            None => render_frame(&p, &plan, &mut FrameCache::default())?,
+        };
         let (img, stats, secs) = (frame.image, frame.stats, frame.seconds);
         if let Some(r) = &frame.refine {
             crate::say!(

@@ -41,7 +41,9 @@ pub struct VerifyArgs {
     /// built-in scene only: the same integral of its analytic field sampled --field-size N³ over
     /// the same box, the finer field the grid stands for, under `continuous` with `field_size`;
     /// the one reference `--refine` may be measured against). `--min-psnr` applies to the one
-    /// chosen.
+    /// chosen. The plan is `render`'s, defaults included: where `--slicing auto` (the default)
+    /// chooses slabs, the figure against `sheets` is the difference between the two slicings
+    /// (said so); give `--slicing object` to measure the sheets' table and precision error.
     #[arg(long, value_enum, default_value_t = ReferenceArg::Sheets)]
     pub reference: ReferenceArg,
     /// With `--reference continuous` or `field`: reconstruct the field with the kernel (Gaussian) or
@@ -160,8 +162,12 @@ struct Measured {
 /// the fixed one.
 fn measure(args: &VerifyArgs, r: &RenderArgs) -> Result<Measured, CliError> {
     let inputs = Inputs::from(r);
-    let (p, plan, choice) = apply_quality(prepare(r)?, &inputs, &plan(r)?)?;
-    let (core, stats, core_s) = render_core(&p, &plan)?;
+    let (p, plan, mut choice) = apply_quality(prepare(r)?, &inputs, &plan(r)?)?;
+    // The default plan's pilot rendered the chosen frame whole already.
+    let (core, stats, core_s) = match choice.as_mut().and_then(|c| c.frame.take()) {
+        Some(f) => (f.image, f.stats, f.seconds),
+        None => render_core(&p, &plan)?,
+    };
     let (reference, ref_s) = render_ref(&p)?;
     let (per, overall) = compare(&core, &reference);
     let continuous = match args.reference {

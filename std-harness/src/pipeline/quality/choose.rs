@@ -31,16 +31,28 @@ use crate::pipeline::stages::prepare::Prepared;
 use crate::plan::{End, Inputs, Plan};
 use crate::CliError;
 
-/// `plan` with `--quality`'s choice applied (unchanged without `--quality`; the plan returned
-/// has no `quality`), the prepared render at the level chosen (`p` itself at level 0), and the
-/// choice.
+/// `plan` with `--quality`'s choice applied, or the default plan's (`--slicing auto`,
+/// [`super::pilot::choose_slicing`]); unchanged without either. The plan returned has neither
+/// `quality` nor `auto_slicing`; with it the prepared render at the level chosen (`p` itself at
+/// level 0) and the choice.
 pub fn apply_quality(
     p: Prepared,
     args: &Inputs,
     plan: &Plan,
 ) -> Result<(Prepared, Plan, Option<Choice>), CliError> {
     let Some(quality) = plan.quality else {
-        return Ok((p, plan.clone(), None));
+        let auto = match plan.auto_slicing {
+            Some(target) => super::pilot::choose_slicing(&p, plan, target)?,
+            None => None,
+        };
+        let Some((chosen, choice)) = auto else {
+            let mut plan = plan.clone();
+            plan.auto_slicing = None;
+            return Ok((p, plan, None));
+        };
+        let e = p.frame.footprint.half_extent;
+        crate::say!("{}", choice.explain(2.0 * e[0].max(e[1])));
+        return Ok((p, chosen, Some(choice)));
     };
     let q = quality.target_db;
     let (p, choice) = match quality.reference {

@@ -30,6 +30,7 @@ use super::level_pilot::LevelPilot;
 pub use super::sampling::Estimate;
 use crate::args::{AccumArg, LookupArg, MethodArg, QualityReferenceArg};
 use crate::io::json::Json;
+use crate::pipeline::stages::bands::CoreFrame;
 use crate::pipeline::stages::prepare::Prepared;
 use crate::reference::ReferenceFootprint;
 use crate::CliError;
@@ -115,6 +116,13 @@ pub struct Choice {
     /// The pilot that measured the levels against full resolution (sheets, when levels were
     /// candidates; see [`super::level_pilot`]).
     pub level_pilot: Option<LevelPilot>,
+    /// Made by the default plan (`--slicing auto`, [`super::pilot::choose_slicing`]), not by
+    /// `--quality`.
+    pub by_default: bool,
+    /// The chosen plan's frame as the default plan's pilot rendered it, whole (the command
+    /// takes it instead of rendering the frame again); `None` from `--quality`, and where no
+    /// candidate reached the target.
+    pub frame: Option<Box<CoreFrame>>,
 }
 
 impl Choice {
@@ -163,7 +171,12 @@ impl Choice {
             ),
         };
         format!(
-            "--quality {:.1} dB ({}): chose {}{} ({why}){rejected}{}",
+            "{} {:.1} dB ({}): chose {}{} ({why}){rejected}{}",
+            if self.by_default {
+                "default plan (--slicing auto),"
+            } else {
+                "--quality"
+            },
             self.target_db,
             reference_name(self.reference),
             self.config.label(),
@@ -405,6 +418,8 @@ pub fn pick(p: &Prepared, target_db: f64) -> Result<(Choice, bool), CliError> {
                 pilot: None,
                 level: 0,
                 level_pilot: None,
+                by_default: false,
+                frame: None,
             };
             return Ok((choice, true));
         }
@@ -424,16 +439,19 @@ pub fn pick(p: &Prepared, target_db: f64) -> Result<(Choice, bool), CliError> {
         pilot: None,
         level: 0,
         level_pilot: None,
+        by_default: false,
+        frame: None,
     };
     Ok((choice, false))
 }
 
-/// The JSON record of a `--quality` choice: `target_db`, `reference` (`sheets`, `continuous`
-/// or `field`), `predicted_db`, `level`, `chosen`; with sheets `footprint_error` and `k_db`
+/// The JSON record of a `--quality` choice or of the default plan's: `by` (`quality` or
+/// `default`), `target_db`, `reference` (`sheets`, `continuous` or `field`), `predicted_db`, `level`, `chosen`; with sheets `footprint_error` and `k_db`
 /// (the table's, at the level chosen) and, when levels were measured, `level_pilot`; with
 /// continuous `pilot` (`pixels`, `stride`, `converged`, seconds, and each candidate tried).
 pub fn quality_json(c: &Choice) -> Json {
     let mut j = Json::object()
+        .str("by", if c.by_default { "default" } else { "quality" })
         .num("target_db", c.target_db)
         .str("reference", &reference_name(c.reference))
         .num("predicted_db", c.predicted_db);

@@ -35,17 +35,25 @@
 //! DB --quality-reference continuous` costs the pilot reference, one frame per candidate tried,
 //! and the frame. The default stays `--quality-reference sheets`: it costs milliseconds, and the
 //! sheet reference is what the table configuration alone controls.
+//!
+//! # The default plan
+//! [`choose_slicing`] runs the same pilot for `--slicing auto` (the default) at
+//! [`crate::plan::DEFAULT_TARGET_DB`], with other candidates: the frame as the flags ask for it
+//! (object slicing, its own table), then the slabs, thickest first. Its chosen frame is kept in
+//! the choice ([`Choice::frame`]) and is the command's frame, not rendered again (unless no
+//! candidate reached the target: the most accurate is then rendered again).
 
 use super::config::Config;
 use super::model::{self as quality, Choice, Estimate, Pilot};
 use super::sampling::mix;
-use crate::args::QualityReferenceArg;
+use crate::args::{AccumArg, MethodArg, QualityReferenceArg};
 use crate::pipeline::ends::continuous::continuous_at;
 use crate::pipeline::ends::run::render_frame;
+use crate::pipeline::stages::bands::CoreFrame;
 use crate::pipeline::stages::prepare::Prepared;
 use crate::pipeline::stages::visible::FrameCache;
 use crate::plan::Inputs;
-use crate::plan::{End, Plan};
+use crate::plan::{End, Footprints, Plan};
 use crate::CliError;
 use std::time::Instant;
 
@@ -153,71 +161,172 @@ pub fn choose_continuous(
         QualityReferenceArg::Field => Some(super::field::prepare_field(args)?),
         _ => None,
     };
-    let candidates = candidates(p, base, target_db, reference)?;
-    let (w, h) = p.out_size();
-    let (pixels, stride) = sample_pixels(w, h, PILOT_RAYS);
-    let (reference_image, reference_seconds) = continuous_at(fine.as_ref().unwrap_or(p), &pixels)?;
-    drop(fine);
-    let start = Instant::now();
-    let mut cache = FrameCache::default();
-    let mut tried: Vec<(Config, Estimate)> = Vec::new();
-    let mut chosen = None;
-    for c in candidates {
-        let frame = render_frame(p, &c.plan(base), &mut cache)?;
-        let e = estimate(&frame.image, w, &pixels, &reference_image.image, w * h);
-        tried.push((c, e));
-        if e.bound_db >= target_db {
-            chosen = Some(tried.len() - 1);
-            break;
-        }
-    }
-    let index = match chosen {
-        Some(i) => i,
-        None => {
-            let best = (0..tried.len())
-                .max_by(|&a, &b| tried[a].1.bound_db.total_cmp(&tried[b].1.bound_db))
-                .expect("at least one candidate");
-            let slabs = if tried.iter().any(|(c, _)| c.slab().is_some()) {
-                ""
-            } else {
-                " (image slicing cannot render this frame: it needs a gaussian kernel and an \
-                 orthographic view)"
-            };
-            crate::say!(
-                "--quality {target_db:.1} dB ({}): no candidate was measured to reach it; \
-                 using the most accurate, {} ({:.1} dB on the pilot){slabs}",
-                quality::reference_name(reference),
-                tried[best].0.label(),
-                tried[best].1.bound_db
-            );
-            best
-        }
-    };
-    let (config, e) = tried[index];
-    // Candidates are distinct, so those tried before the choice are the cheaper ones.
-    let rejected = tried[..index]
-        .iter()
-        .map(|(c, e)| (*c, e.bound_db))
+    let candidates = candidates(p, base, target_db, reference)?
+        .into_iter()
+        .map(|c| (c, c.plan(base)))
         .collect();
-    Ok(Choice {
-        target_db,
-        config,
-        predicted_db: e.bound_db,
-        reference,
-        footprint_error: None,
-        rejected,
-        pilot: Some(Pilot {
-            pixels: pixels.len(),
+    let mut run = Run::new(p, fine.as_ref().unwrap_or(p), target_db, reference)?;
+    drop(fine);
+    if reference == QualityReferenceArg::Field {
+        run.field_size = Some(args.field_size);
+    }
+    let mut choice = run.measure(candidates)?.1;
+    // `--quality`'s winner is rendered again by the command (its choice may change the level).
+    choice.frame = None;
+    Ok(choice)
+}
+
+/// The default plan (`--slicing auto`, [`crate::plan::DEFAULT_TARGET_DB`]): `base` itself
+/// (object slicing, its own table) where the pilot measures it at `target_db` or more against
+/// the continuous integral of `p`'s grid, else the thickest slabs that reach it (the most
+/// accurate measured if none does, said so); returned with `auto_slicing` cleared, and the
+/// choice. `None` where there is nothing to choose: no slab thickness can draw `p`'s frame (a
+/// kernel other than the gaussian), or `p` renders a coarser level of detail (its own pilot
+/// validated it against level 0, `super::level_pilot`).
+pub fn choose_slicing(
+    p: &Prepared,
+    base: &Plan,
+    target_db: f64,
+) -> Result<Option<(Plan, Choice)>, CliError> {
+    let mut object = base.clone();
+    object.auto_slicing = None;
+    let mut slabs = Config::slabs(&p.frame, &p.kernel);
+    if slabs.is_empty() || p.level > 0 || p.volume().is_none() {
+        return Ok(None);
+    }
+    slabs.sort_by_key(|c| std::cmp::Reverse(c.slab_quarters));
+    let own = Config {
+        table: base.table.size,
+        lookup: base.table.lookup.into(),
+        method: match base.table.footprints {
+            Footprints::Direct => MethodArg::Direct,
+            Footprints::ViewTable => MethodArg::Robust,
+        },
+        accum: AccumArg::Float,
+        slab_quarters: None,
+        refine: false,
+    };
+    let mut candidates = vec![(own, object.clone())];
+    candidates.extend(slabs.into_iter().map(|c| (c, c.plan(&object))));
+    let run = Run::new(p, p, target_db, QualityReferenceArg::Continuous)?;
+    let (plan, mut choice) = run.measure(candidates)?;
+    choice.by_default = true;
+    Ok(Some((plan, choice)))
+}
+
+/// One pilot: the frames `p` renders, measured at sampled pixels against a continuous
+/// integral marched through those pixels once.
+struct Run<'a> {
+    p: &'a Prepared,
+    target_db: f64,
+    reference: QualityReferenceArg,
+    /// The side N of the finer field's sampling (`field` only).
+    field_size: Option<usize>,
+    pixels: Vec<[usize; 2]>,
+    stride: usize,
+    reference_image: crate::reference::continuous::Continuous,
+    reference_seconds: f64,
+}
+
+impl<'a> Run<'a> {
+    /// The pilot of `p`'s frame against the continuous integral of `against` (`p` itself, or
+    /// the finer field), marched through the sampled pixels.
+    fn new(
+        p: &'a Prepared,
+        against: &Prepared,
+        target_db: f64,
+        reference: QualityReferenceArg,
+    ) -> Result<Self, CliError> {
+        let (w, h) = p.out_size();
+        let (pixels, stride) = sample_pixels(w, h, PILOT_RAYS);
+        let (reference_image, reference_seconds) = continuous_at(against, &pixels)?;
+        Ok(Run {
+            p,
+            target_db,
+            reference,
+            field_size: None,
+            pixels,
             stride,
-            converged: reference_image.converged,
+            reference_image,
             reference_seconds,
-            render_seconds: start.elapsed().as_secs_f64(),
-            tried,
-            field_size: (reference == QualityReferenceArg::Field).then_some(args.field_size),
-        }),
-        level: 0,
-        level_pilot: None,
-    })
+        })
+    }
+
+    /// Renders `candidates` (cheapest first) until one's bound reaches the target: that one's
+    /// plan and the choice (the most accurate tried where none reaches it, said so).
+    fn measure(&self, candidates: Vec<(Config, Plan)>) -> Result<(Plan, Choice), CliError> {
+        let (p, target_db, reference) = (self.p, self.target_db, self.reference);
+        let (w, h) = p.out_size();
+        let (pixels, reference_image) = (&self.pixels, &self.reference_image);
+        let start = Instant::now();
+        let mut cache = FrameCache::default();
+        let mut tried: Vec<(Config, Estimate)> = Vec::new();
+        let mut chosen = None;
+        // The frame of the candidate that reaches the target: the command's frame. One that
+        // falls short is dropped before the next renders (one frame held at a time); if none
+        // reaches it, the command renders the most accurate again.
+        let mut kept: Option<CoreFrame> = None;
+        for (c, plan) in &candidates {
+            let frame = render_frame(p, plan, &mut cache)?;
+            let e = estimate(&frame.image, w, pixels, &reference_image.image, w * h);
+            tried.push((*c, e));
+            if e.bound_db >= target_db {
+                kept = Some(frame);
+                chosen = Some(tried.len() - 1);
+                break;
+            }
+        }
+        let index = match chosen {
+            Some(i) => i,
+            None => {
+                let best = (0..tried.len())
+                    .max_by(|&a, &b| tried[a].1.bound_db.total_cmp(&tried[b].1.bound_db))
+                    .expect("at least one candidate");
+                let slabs = if tried.iter().any(|(c, _)| c.slab().is_some()) {
+                    ""
+                } else {
+                    " (image slicing cannot render this frame: it needs a gaussian kernel and an \
+                     orthographic view)"
+                };
+                crate::say!(
+                    "{target_db:.1} dB against the {} integral: no candidate was measured to \
+                     reach it; using the most accurate, {} ({:.1} dB on the pilot){slabs}",
+                    quality::reference_name(reference),
+                    tried[best].0.label(),
+                    tried[best].1.bound_db
+                );
+                best
+            }
+        };
+        let (config, e) = tried[index];
+        // Candidates are distinct, so those tried before the choice are the cheaper ones.
+        let rejected = tried[..index]
+            .iter()
+            .map(|(c, e)| (*c, e.bound_db))
+            .collect();
+        let choice = Choice {
+            target_db,
+            config,
+            predicted_db: e.bound_db,
+            reference,
+            footprint_error: None,
+            rejected,
+            pilot: Some(Pilot {
+                pixels: pixels.len(),
+                stride: self.stride,
+                converged: reference_image.converged,
+                reference_seconds: self.reference_seconds,
+                render_seconds: start.elapsed().as_secs_f64(),
+                tried,
+                field_size: self.field_size,
+            }),
+            level: 0,
+            level_pilot: None,
+            by_default: false,
+            frame: kept.map(Box::new),
+        };
+        Ok((candidates[index].1.clone(), choice))
+    }
 }
 
 #[cfg(test)]

@@ -1,0 +1,27 @@
+//! `--slicing auto`, the default (issue 42): which flags leave the slicing to a pilot.
+//!
+//! Object slicing composites each kernel whole in one sheet; where voxels are nearly opaque that
+//! departs from the continuous integral by more than any table error (docs/accuracy.md), and by
+//! how much depends on the data along every ray, so it is measured, not predicted
+//! (`pipeline::quality::pilot::choose_slicing`). The flags decide only whether there is a choice
+//! to make: there is none when they fix the end point (`--slicing object|image`,
+//! `--classification post`, `--refine`, `--method reference`), when slabs cannot draw what they
+//! ask (`--accum fixed`, `--perspective`, `--stream`: a streamed volume is read once, and the
+//! pilot's reference needs it whole) or when `--quality` chooses instead. The frame decides the
+//! rest (a kernel with no slabs, a coarser level of detail): the pilot is skipped there.
+
+use super::{End, Precision};
+use crate::args::{RenderArgs, SlicingArg};
+
+/// The PSNR, dB, against the continuous model (`--absorption`'s, opacity by default) that the
+/// default plan's frame is measured to reach on its pilot before object slicing is kept.
+pub const DEFAULT_TARGET_DB: f64 = 44.0;
+
+/// [`DEFAULT_TARGET_DB`] where `args` leave the slicing to the pilot and `end` (what the flags
+/// alone resolved) is float sheets; `None` otherwise.
+pub fn slicing_target(end: &End, args: &RenderArgs) -> Option<f64> {
+    let open = matches!(args.slicing, None | Some(SlicingArg::Auto));
+    let drawable = args.perspective.is_none() && args.stream.is_none();
+    (open && drawable && args.quality.is_none() && *end == End::Sheets(Precision::Float))
+        .then_some(DEFAULT_TARGET_DB)
+}
