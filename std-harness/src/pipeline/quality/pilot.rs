@@ -191,7 +191,24 @@ pub fn choose_slicing(
     let mut object = base.clone();
     object.auto_slicing = None;
     let mut slabs = Config::slabs(&p.frame, &p.kernel);
-    if slabs.is_empty() || p.level > 0 || p.volume().is_none() {
+    let Some(volume) = p.volume() else {
+        return Ok(None);
+    };
+    if slabs.is_empty() || p.level > 0 {
+        return Ok(None);
+    }
+    // The pilot's reference holds each voxel's classified RGBA (16 bytes): past the budget the
+    // visible lists get, the default renders object slicing unmeasured and says so.
+    let field = volume.len().saturating_mul(16);
+    let budget = crate::pipeline::stages::visible::list_budget(volume);
+    if field > budget {
+        crate::say!(
+            "default plan (--slicing auto): object slicing, not measured: the pilot's continuous \
+             reference would hold {} MiB for this volume (budget {} MiB); give --slicing image \
+             for slabs",
+            field >> 20,
+            budget >> 20
+        );
         return Ok(None);
     }
     slabs.sort_by_key(|c| std::cmp::Reverse(c.slab_quarters));
