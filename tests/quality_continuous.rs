@@ -34,7 +34,10 @@ fn the_pilot_reference_is_the_whole_reference_at_its_pixels() {
         let (w, h) = p.out_size();
         let (pixels, stride) = sample_pixels(w, h, PILOT_RAYS / 4);
         assert!(stride > 1, "the test must sample, not take every pixel");
-        let (pilot, _) = continuous_at(&p, &pixels).unwrap();
+        let (pilot, _) = continuous_at(&p, &pixels, 1).unwrap();
+        // Each ray is marched by one thread alone: any thread count gives the same bytes.
+        let (threaded, _) = continuous_at(&p, &pixels, 3).unwrap();
+        assert_eq!(pilot.image, threaded.image, "{extra:?}: 1 vs 3 threads");
         let (whole, _) = render_continuous_ref(&p, Reconstruction::Kernel).unwrap();
         let mut worst = 0.0f64;
         for (&[x, y], v) in pixels.iter().zip(&pilot.image) {

@@ -105,9 +105,7 @@ fn march(scene: &ContinuousScene<'_>, field: &Field, h: f64, rays: Rays<'_>) -> 
         (f.dims[1] - 1) as f64 + field.extent(),
         (f.dims[2] - 1) as f64 + field.extent(),
     );
-    let threads = std::thread::available_parallelism()
-        .map_or(1, |n| n.get())
-        .clamp(1, 16);
+    let threads = scene.threads.max(1);
     let count = rays.count(f);
     let mut image = vec![[0.0f64; 4]; count];
     let band = count.div_ceil(threads).max(1);

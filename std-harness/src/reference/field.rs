@@ -58,6 +58,9 @@ pub struct ContinuousScene<'a> {
     /// is capped at 1 − `cap`): [`DEFAULT_CAP`], the renderer's. The opacity model has no cap and
     /// ignores it (`tests/continuous.rs` moves it from 10⁻⁴ to 10⁻⁹ and checks that).
     pub cap: f64,
+    /// Worker threads the march spreads its rays over (at least 1; each ray is marched by one
+    /// thread alone, so the image is the same for every count).
+    pub threads: usize,
 }
 
 /// [`ContinuousScene::cap`] as the renderer takes it: 1 − `SlabVoxel::MAX_UNIT_ALPHA` = 10⁻⁶.
@@ -342,38 +345,59 @@ impl<'s> Field<'s> {
                 // The Gaussian factors per axis (separable inside the ball), one per lattice
                 // offset within R of the sample: at most `taps.n` per axis.
                 let k = sigmas * sigmas / (2.0 * r * r);
+                let fall = (-2.0 * k).exp();
                 let gc = [g.x, g.y, g.z];
                 let lo = gc.map(|c| (c - r).ceil() as i64);
                 let hi = gc.map(|c| (c + r).floor() as i64);
                 let n = taps.n;
                 for a in 0..3 {
-                    for (j, v) in (lo[a]..=hi[a]).enumerate() {
-                        let dd = (gc[a] - v as f64).powi(2);
-                        taps.d2[a * n + j] = dd;
-                        taps.e[a * n + j] = (-k * dd).exp();
-                    }
+                    let count = (hi[a] - lo[a] + 1).max(0) as usize;
+                    let span = a * n..a * n + count;
+                    let d0 = gc[a] - lo[a] as f64;
+                    gaussian_taps(d0, k, fall, &mut taps.d2[span.clone()], &mut taps.e[span]);
                 }
                 let (e, d2) = (&taps.e, &taps.d2);
                 let r2 = r * r;
-                for (jz, z) in (lo[2]..=hi[2]).enumerate() {
-                    for (jy, y) in (lo[1]..=hi[1]).enumerate() {
+                // Only the taps inside the grid: the rest have no voxel.
+                let inside = |a: usize| lo[a].max(0)..=hi[a].min(d[a] as i64 - 1);
+                for z in inside(2) {
+                    let jz = (z - lo[2]) as usize;
+                    for y in inside(1) {
+                        let jy = (y - lo[1]) as usize;
                         let dyz = d2[2 * n + jz] + d2[n + jy];
                         if dyz >= r2 {
                             continue;
                         }
-                        let eyz = e[2 * n + jz] * e[n + jy];
-                        for (jx, x) in (lo[0]..=hi[0]).enumerate() {
+                        let eyz = e[2 * n + jz] * e[n + jy] * norm;
+                        let row = (z as usize * d[1] + y as usize) * d[0];
+                        for x in inside(0) {
+                            let jx = (x - lo[0]) as usize;
                             if dyz + d2[jx] >= r2 {
                                 continue;
                             }
-                            if let Some(v) = voxel(x, y, z) {
-                                visit(v, eyz * e[jx] * norm);
-                            }
+                            visit(&self.voxels[row + x as usize], eyz * e[jx]);
                         }
                     }
                 }
             }
         }
+    }
+}
+
+/// The squared offsets d² and Gaussian factors exp(−k·d²) of the taps d = `d0`, `d0` − 1, …
+/// along one axis (as many as `d2` holds; `e` the same length), with `fall` = exp(−2k). The
+/// offset falls by one per tap, so two exponentials give them all: e(d − 1) = e(d)·q with
+/// q(d) = exp(k·(2d − 1)) and q(d − 1) = q(d)·`fall` (relative error a few ulps over the
+/// ⌊2R⌋ + 1 taps of a sample; the test below checks it against `exp`).
+#[inline]
+fn gaussian_taps(d0: f64, k: f64, fall: f64, d2: &mut [f64], e: &mut [f64]) {
+    let (mut ej, mut q) = ((-k * d0 * d0).exp(), (k * (2.0 * d0 - 1.0)).exp());
+    for (j, (dd, ee)) in d2.iter_mut().zip(e.iter_mut()).enumerate() {
+        let d = d0 - j as f64;
+        *dd = d * d;
+        *ee = ej;
+        ej *= q;
+        q *= fall;
     }
 }
 
@@ -393,6 +417,36 @@ fn pre_classified(rgba: [f32; 4], absorption: Absorption, cap: f64) -> Option<[f
                 let c = [0, 1, 2].map(|ch| f64::from(rgba[ch]) / a);
                 [sigma, sigma * c[0], sigma * c[1], sigma * c[2]].map(|x| x as f32)
             })
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::gaussian_taps;
+
+    #[test]
+    fn the_tap_recurrence_matches_exp() {
+        // Spreads 0.5–3 and sigma counts 1–4 (k = s²/2R²), sample offsets across a lattice cell.
+        for (r, sigmas) in [(0.5f64, 1.0f64), (1.5, 2.0), (2.0, 3.0), (3.0, 4.0)] {
+            let k = sigmas * sigmas / (2.0 * r * r);
+            for i in 0..50 {
+                let c = 7.0 + i as f64 / 50.0;
+                let lo = (c - r).ceil();
+                let count = ((c + r).floor() - lo + 1.0) as usize;
+                let (mut d2, mut e) = (vec![0.0; count], vec![0.0; count]);
+                gaussian_taps(c - lo, k, (-2.0 * k).exp(), &mut d2, &mut e);
+                for j in 0..count {
+                    let d = c - (lo + j as f64);
+                    let want = (-k * d * d).exp();
+                    assert!((d2[j] - d * d).abs() <= 1e-12, "d² at r={r} c={c} j={j}");
+                    assert!(
+                        (e[j] - want).abs() <= 1e-13 * want,
+                        "r={r} s={sigmas} c={c} j={j}: {} vs {want}",
+                        e[j]
+                    );
+                }
+            }
         }
     }
 }

@@ -37,6 +37,10 @@ fn continuous_scene(
         reconstruction,
         model,
         cap,
+        // A reference: every core (at most 16) unless the caller says otherwise.
+        threads: std::thread::available_parallelism()
+            .map_or(1, |n| n.get())
+            .clamp(1, 16),
     };
     Ok((volume, scene))
 }
@@ -148,15 +152,21 @@ pub fn render_continuous_as(
 /// The continuous reference of `p` at the listed pixels of the *output* image only ((x, y), each
 /// below [`Prepared::out_size`]; a supersampled frame marches the k×k rays of each and averages
 /// them, as the renders are averaged): their values in the order given, how it converged, and
-/// its seconds. Kernel reconstruction, `p`'s model. The volume must be in memory.
-pub fn continuous_at(p: &Prepared, pixels: &[[usize; 2]]) -> Result<(Continuous, f64), CliError> {
+/// its seconds. Kernel reconstruction, `p`'s model, marched on `threads` threads (the image is
+/// the same for every count). The volume must be in memory.
+pub fn continuous_at(
+    p: &Prepared,
+    pixels: &[[usize; 2]],
+    threads: usize,
+) -> Result<(Continuous, f64), CliError> {
     let start = Instant::now();
-    let (volume, scene) = continuous_scene(
+    let (volume, mut scene) = continuous_scene(
         p,
         Reconstruction::Kernel,
         Model::Pre(p.absorption),
         DEFAULT_CAP,
     )?;
+    scene.threads = threads.max(1);
     let k = p.supersample;
     let rays: Vec<[usize; 2]> = pixels
         .iter()

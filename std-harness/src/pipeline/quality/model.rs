@@ -494,8 +494,12 @@ fn level_pilot_json(p: &LevelPilot) -> Json {
 /// How the pilot went.
 #[derive(Clone, Debug)]
 pub struct Pilot {
-    /// Sampled output pixels (rays per pixel: the supersampling squared).
+    /// Sampled output pixels the reference was marched through (rays per pixel: the
+    /// supersampling squared).
     pub pixels: usize,
+    /// Of those, the first stage's: a candidate is measured on these alone unless that leaves
+    /// it undecided ([`super::pilot`], "Two stages").
+    pub first_pixels: usize,
     /// Cell side S, pixels.
     pub stride: usize,
     /// Whether the pilot reference converged (`reference::continuous::CONVERGED_DB`).
@@ -509,7 +513,7 @@ pub struct Pilot {
     pub field_size: Option<usize>,
 }
 
-/// The JSON record of a pilot: `pixels`, `stride`, `converged`, `reference_seconds`,
+/// The JSON record of a pilot: `pixels`, `first_pixels`, `stride`, `converged`, `reference_seconds`,
 /// `render_seconds`, `field_size` (against the field reference), and `tried`, each candidate's
 /// `config`, `estimate_db` and `bound_db`.
 fn pilot_json(p: &Pilot) -> Json {
@@ -518,6 +522,7 @@ fn pilot_json(p: &Pilot) -> Json {
         None => Json::object(),
     };
     j.num("pixels", p.pixels as f64)
+        .num("first_pixels", p.first_pixels as f64)
         .num("stride", p.stride as f64)
         .bool("converged", p.converged)
         .num("reference_seconds", p.reference_seconds)

@@ -9,13 +9,16 @@ pub struct Estimate {
     /// The same with the MSE's upper confidence bound (the pilot's: [`super::pilot`] over
     /// pixels, [`super::level_pilot`] over rows): what is compared with the target, dB.
     pub bound_db: f64,
+    /// The same with the MSE's lower confidence bound, m − z·s/√n·√(1 − n/total) (at least 0):
+    /// where even this falls short of a target, more samples would not reach it, dB.
+    pub hope_db: f64,
 }
 
 impl Estimate {
     /// The estimate of `values` (one squared error per sampling unit, RGB mean) sampled from
     /// `total` units: their mean m and standard deviation s give m, and the upper bound
-    /// m + z·s/√n·√(1 − n/total) (m itself when every unit is sampled). A NaN error reaches
-    /// nothing.
+    /// m + z·s/√n·√(1 − n/total) (m itself when every unit is sampled), and the lower one
+    /// m − z·s/√n·√(1 − n/total). A NaN error reaches nothing.
     pub fn of(values: &[f64], total: usize, z: f64) -> Estimate {
         let n = values.len().max(1) as f64;
         let mean = values.iter().sum::<f64>() / n;
@@ -25,7 +28,8 @@ impl Estimate {
             0.0
         };
         let finite = (1.0 - n / total.max(1) as f64).max(0.0);
-        let bound = mean + z * (var / n * finite).sqrt();
+        let half = z * (var / n * finite).sqrt();
+        let bound = mean + half;
         let db = |mse: f64| {
             if mse > 0.0 {
                 -10.0 * mse.log10()
@@ -38,6 +42,8 @@ impl Estimate {
         Estimate {
             estimate_db: db(mean),
             bound_db: db(bound),
+            // (`max` would turn a NaN into 0.)
+            hope_db: db(if mean - half < 0.0 { 0.0 } else { mean - half }),
         }
     }
 }
