@@ -9,7 +9,7 @@ use footprint_harness::pipeline::stages::visible::FrameCache;
 use footprint_harness::pipeline::{prepare, render_continuous_ref, render_frame, Prepared};
 use footprint_harness::plan::{plan, End, DEFAULT_TARGET_DB};
 use footprint_harness::reference::continuous::Reconstruction;
-use footprint_suite::{apply_quality, path_str as s, run_cli as run, tmpdir};
+use footprint_suite::{apply_quality, json_number, path_str as s, run_cli as run, tmpdir};
 
 const HEART: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -138,16 +138,7 @@ fn bench_counts_the_pilot_in_the_fresh_frame() {
     ];
     assert_eq!(run(&a), 0);
     let j = std::fs::read_to_string(&json).unwrap();
-    let num = |key: &str| -> f64 {
-        let at = j
-            .find(&format!("\"{key}\": "))
-            .unwrap_or_else(|| panic!("{key}: {j}"));
-        let rest = &j[at + key.len() + 4..];
-        rest[..rest.find([',', '\n', '}']).unwrap()]
-            .trim()
-            .parse()
-            .unwrap()
-    };
+    let num = |key: &str| json_number(&j, key);
     assert!(num("plan_ms") > 0.0);
     assert_eq!(num("first_ms"), num("plan_ms"));
     assert!(

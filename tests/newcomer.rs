@@ -7,20 +7,7 @@ use std::path::Path;
 
 const HEAD: &str = "tests/data/headsq_64x64x93_int16_le.nhdr";
 
-use footprint_suite::{path_str as s, run_cli as run};
-
-/// The numbers of JSON array `key` in `text` (a flat array of numbers).
-fn json_numbers(text: &str, key: &str) -> Vec<f64> {
-    let at = text
-        .find(&format!("\"{key}\""))
-        .unwrap_or_else(|| panic!("no {key} in {text}"));
-    let rest = &text[at..];
-    let (open, close) = (rest.find('[').unwrap(), rest.find(']').unwrap());
-    rest[open + 1..close]
-        .split(',')
-        .map(|x| x.trim().parse().unwrap())
-        .collect()
-}
+use footprint_suite::{json_numbers, path_str as s, run_cli as run};
 
 /// 8-bit RGB pixels and the frame count of a PNG (1 unless animated).
 fn decode(path: &Path) -> (Vec<u8>, u32) {

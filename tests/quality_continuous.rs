@@ -5,7 +5,7 @@
 use footprint_harness::args::parse_args;
 use footprint_harness::args::QualityReferenceArg::Continuous;
 use footprint_harness::metrics::compare;
-use footprint_harness::pipeline::ends::continuous::continuous_at;
+use footprint_harness::pipeline::ends::continuous::{continuous_at, PilotReference};
 use footprint_harness::pipeline::quality::pilot::{sample_pixels, PILOT_RAYS};
 use footprint_harness::pipeline::{prepare, render_continuous_ref, render_core, Prepared};
 use footprint_harness::reference::continuous::Reconstruction;
@@ -38,6 +38,21 @@ fn the_pilot_reference_is_the_whole_reference_at_its_pixels() {
         // Each ray is marched by one thread alone: any thread count gives the same bytes.
         let (threaded, _) = continuous_at(&p, &pixels, 3).unwrap();
         assert_eq!(pilot.image, threaded.image, "{extra:?}: 1 vs 3 threads");
+        // The two stages march one field twice: the same values as one march through all.
+        let field = PilotReference::new(&p, 2).unwrap();
+        let half = pixels.len() / 3;
+        let mut staged = field.at(&pixels[..half]).unwrap().image;
+        staged.extend(field.at(&pixels[half..]).unwrap().image);
+        assert_eq!(staged.len(), pilot.image.len());
+        let worst_stage = staged
+            .iter()
+            .zip(&pilot.image)
+            .flat_map(|(a, b)| a.iter().zip(b).map(|(x, y)| (x - y).abs()))
+            .fold(0.0f64, f64::max);
+        assert!(
+            worst_stage < 2e-3,
+            "{extra:?}: staged vs one march: {worst_stage:e}"
+        );
         let (whole, _) = render_continuous_ref(&p, Reconstruction::Kernel).unwrap();
         let mut worst = 0.0f64;
         for (&[x, y], v) in pixels.iter().zip(&pilot.image) {

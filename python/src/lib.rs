@@ -18,9 +18,9 @@
 use footprint_harness::args::{parse_args, RenderArgs};
 use footprint_harness::io::stream::{InMemory, Pipe};
 use footprint_harness::io::volume::{check_spacing, Data, Samples, Volume};
-use footprint_harness::pipeline::quality::choose::apply_quality;
+use footprint_harness::pipeline::quality::choose::{apply_quality, chosen_frame};
 use footprint_harness::pipeline::stages::visible::FrameCache;
-use footprint_harness::pipeline::{prepare, render_frame, render_ref};
+use footprint_harness::pipeline::{prepare, render_ref};
 use footprint_harness::CliError;
 use numpy::{
     Element, PyArray1, PyArray3, PyArrayDyn, PyArrayMethods, PyReadonlyArray3,
@@ -173,18 +173,18 @@ type Loaded<'py> = (Bound<'py, PyAny>, (f32, f32, f32), Bound<'py, PyDict>);
 fn frame(args: &RenderArgs) -> Result<Frame, CliError> {
     let asked = footprint_harness::plan::plan(args)?;
     let inputs = footprint_harness::plan::Inputs::from(args);
-    let (p, plan, choice) = apply_quality(prepare(args)?, &inputs, &asked)?;
-    // The default plan's pilot rendered the chosen frame whole already.
-    let image = if let Some(f) = choice.and_then(|c| c.frame) {
-        f.image
-    } else if plan.end == footprint_harness::plan::End::Reference {
+    let (p, plan, mut choice) = apply_quality(prepare(args)?, &inputs, &asked)?;
+    let image = if plan.end == footprint_harness::plan::End::Reference {
         render_ref(&p)?
             .0
             .iter()
             .map(|c| c.map(|x| x as f32))
             .collect()
     } else {
-        render_frame(&p, &plan, &mut FrameCache::default())?.image
+        // The default plan's pilot rendered the chosen frame whole already.
+        chosen_frame(&p, &plan, &mut choice, &mut FrameCache::default())?
+            .0
+            .image
     };
     Ok((image, args.size))
 }

@@ -16,6 +16,33 @@ pub fn run_cli(args: &[&str]) -> i32 {
     footprint_harness::run(std::iter::once("footprint").chain(args.iter().copied()))
 }
 
+/// The number after the first `"key": ` in the JSON text `text` (a command's `--json`); panics,
+/// naming the key, where there is none.
+pub fn json_number(text: &str, key: &str) -> f64 {
+    let at = text
+        .find(&format!("\"{key}\": "))
+        .unwrap_or_else(|| panic!("no {key} in {text}"));
+    let rest = &text[at + key.len() + 4..];
+    let end = rest.find([',', '\n', '}']).unwrap_or(rest.len());
+    rest[..end]
+        .trim()
+        .parse()
+        .unwrap_or_else(|e| panic!("{key}: {e} in {text}"))
+}
+
+/// The numbers of the first JSON array `key` in `text` (a flat array of numbers).
+pub fn json_numbers(text: &str, key: &str) -> Vec<f64> {
+    let at = text
+        .find(&format!("\"{key}\""))
+        .unwrap_or_else(|| panic!("no {key} in {text}"));
+    let rest = &text[at..];
+    let (open, close) = (rest.find('[').unwrap(), rest.find(']').unwrap());
+    rest[open + 1..close]
+        .split(',')
+        .map(|x| x.trim().parse().unwrap())
+        .collect()
+}
+
 /// A test path as the `&str` a command line takes.
 pub fn path_str(p: &std::path::Path) -> &str {
     p.to_str().expect("a UTF-8 test path")

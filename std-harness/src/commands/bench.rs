@@ -14,10 +14,11 @@
 
 use crate::args::RenderArgs;
 use crate::io::{self, json::Json};
+use crate::pipeline::quality::choose::{apply_quality, chosen_frame};
+use crate::pipeline::quality::model::quality_json;
 use crate::pipeline::stages::bands::Phases;
 use crate::pipeline::stages::visible::FrameCache;
-use crate::pipeline::{describe, prepare, render_frame};
-use crate::pipeline::{quality::choose::apply_quality, quality::model::quality_json};
+use crate::pipeline::{describe, prepare};
 use crate::plan::{plan, turned, Inputs};
 use crate::CliError;
 use clap::Args;
@@ -105,8 +106,7 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
     let (mut p, plan, mut choice) = apply_quality(prepared, &inputs, &plan(base)?)?;
     let plan_ms = choosing.elapsed().as_secs_f64() * 1e3;
     // Frame 1 as the default plan's pilot rendered it, if it did (its time is in plan_ms).
-    let mut piloted = choice.as_mut().and_then(|c| c.frame.take());
-    let pilot_frame = piloted.is_some();
+    let mut pilot_frame = false;
     let mut cache = FrameCache::default();
     let mut times = Vec::with_capacity(args.frames);
     let mut phases = Vec::with_capacity(args.frames);
@@ -118,10 +118,8 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
         if k > 0 {
             p.reframe(&Inputs::from(&turned(base, args.orbit * k as f32)))?;
         }
-        let f = match piloted.take() {
-            Some(f) => *f,
-            None => render_frame(&p, &plan, &mut cache)?,
-        };
+        let (f, piloted) = chosen_frame(&p, &plan, &mut choice, &mut cache)?;
+        pilot_frame |= piloted;
         crate::say!(
             "frame {:>3}: {:8.2} ms (classify {:.2}, tables {:.2}, splat {:.2}, composite {:.2}, resample {:.2}); sheets along {}",
             k + 1,

@@ -5,9 +5,10 @@ use crate::args::{MethodArg, RenderArgs};
 use crate::charts::colorbar;
 use crate::io::image::{check_style, encode_apng, encode_rgb_for, RGB_EXTENSIONS};
 use crate::io::outputs::{self, Planned};
+use crate::pipeline::quality::choose::{apply_quality, chosen_frame};
+use crate::pipeline::quality::model::quality_json;
 use crate::pipeline::stages::visible::FrameCache;
 use crate::pipeline::{describe, prepare, render_frame, render_ref, Prepared};
-use crate::pipeline::{quality::choose::apply_quality, quality::model::quality_json};
 use crate::plan::{plan, turned, End, Inputs, Plan};
 use crate::CliError;
 use std::path::{Path, PathBuf};
@@ -86,10 +87,7 @@ pub fn run(command: &RenderCommandArgs) -> Result<(), CliError> {
         (rgb, describe(&p, &inputs, &plan).num("seconds", secs))
     } else {
         // The default plan's pilot rendered the chosen frame whole already.
-        let frame = match choice.as_mut().and_then(|c| c.frame.take()) {
-            Some(f) => *f,
-            None => render_frame(&p, &plan, &mut FrameCache::default())?,
-        };
+        let frame = chosen_frame(&p, &plan, &mut choice, &mut FrameCache::default())?.0;
         let (img, stats, secs) = (frame.image, frame.stats, frame.seconds);
         if let Some(r) = &frame.refine {
             crate::say!(

@@ -234,26 +234,69 @@ pub fn render_continuous_at(
     progress: impl FnMut(usize, f64),
     pixels: &[[usize; 2]],
 ) -> Result<Continuous, CliError> {
-    let f = scene.frame;
-    if let Some(p) = pixels
+    check_pixels(scene.frame, pixels)?;
+    converge(scene, sheet, progress, Rays::Pixels(pixels))
+}
+
+/// A continuous field built once and marched through listed pixels as often as asked (what the
+/// pilot's two stages share: the field is the costly part of a small sample).
+pub struct PixelMarcher<'s> {
+    scene: ContinuousScene<'s>,
+    field: Field<'s>,
+}
+
+impl<'s> PixelMarcher<'s> {
+    /// The field of `scene`, each sheet read once through `sheet(s, buffer)`.
+    pub fn new(
+        scene: ContinuousScene<'s>,
+        mut sheet: impl FnMut(usize, &mut [f32]),
+    ) -> Result<Self, CliError> {
+        let field = Field::new(&scene, &mut sheet)?;
+        Ok(PixelMarcher { scene, field })
+    }
+
+    /// [`render_continuous_at`] through this field: the same values for the same pixels.
+    pub fn at(
+        &self,
+        progress: impl FnMut(usize, f64),
+        pixels: &[[usize; 2]],
+    ) -> Result<Continuous, CliError> {
+        check_pixels(self.scene.frame, pixels)?;
+        converge_on(&self.scene, &self.field, progress, Rays::Pixels(pixels))
+    }
+}
+
+/// An error naming the first of `pixels` outside `f`'s frame.
+fn check_pixels(f: &FrameSetup, pixels: &[[usize; 2]]) -> Result<(), CliError> {
+    match pixels
         .iter()
         .find(|p| p[0] >= f.size[0] || p[1] >= f.size[1])
     {
-        return Err(CliError::input(format!(
+        Some(p) => Err(CliError::input(format!(
             "continuous reference: pixel ({}, {}) lies outside the {}x{} frame",
             p[0], p[1], f.size[0], f.size[1]
-        )));
+        ))),
+        None => Ok(()),
     }
-    converge(scene, sheet, progress, Rays::Pixels(pixels))
 }
 
 fn converge(
     scene: &ContinuousScene<'_>,
     mut sheet: impl FnMut(usize, &mut [f32]),
-    mut progress: impl FnMut(usize, f64),
+    progress: impl FnMut(usize, f64),
     rays: Rays<'_>,
 ) -> Result<Continuous, CliError> {
     let field = Field::new(scene, &mut sheet)?;
+    converge_on(scene, &field, progress, rays)
+}
+
+/// Marches `rays` through `field`, halving the step until two passes agree (module docs).
+fn converge_on(
+    scene: &ContinuousScene<'_>,
+    field: &Field<'_>,
+    mut progress: impl FnMut(usize, f64),
+    rays: Rays<'_>,
+) -> Result<Continuous, CliError> {
     let smallest = scene
         .frame
         .spacing
@@ -261,13 +304,13 @@ fn converge(
         .copied()
         .fold(f32::INFINITY, f32::min);
     let mut h = 0.5 * f64::from(smallest);
-    let mut image = march(scene, &field, h, rays);
+    let mut image = march(scene, field, h, rays);
     progress(1, h);
     let mut passes = 1;
     let mut change = 0.0;
     for _ in 0..MAX_HALVINGS {
         h *= 0.5;
-        let finer = march(scene, &field, h, rays);
+        let finer = march(scene, field, h, rays);
         passes += 1;
         progress(passes, h);
         change = change_db(&image, &finer);

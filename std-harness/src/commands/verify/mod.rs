@@ -11,7 +11,9 @@ use crate::io::image::{check_style, RGB_EXTENSIONS};
 use crate::io::outputs::{self, Planned};
 use crate::metrics::{compare, ErrorStats};
 use crate::pipeline::ends::continuous::{continuous_models, ModelFigures};
-use crate::pipeline::quality::{choose::apply_quality, field::prepare_field, model::Choice};
+use crate::pipeline::quality::choose::{apply_quality, chosen_frame};
+use crate::pipeline::quality::{field::prepare_field, model::Choice};
+use crate::pipeline::stages::visible::FrameCache;
 use crate::pipeline::{prepare, render_core, render_ref, Prepared};
 use crate::plan::{plan, End, Inputs, Plan, Precision};
 use crate::reference::continuous::{Continuous, Model};
@@ -164,10 +166,8 @@ fn measure(args: &VerifyArgs, r: &RenderArgs) -> Result<Measured, CliError> {
     let inputs = Inputs::from(r);
     let (p, plan, mut choice) = apply_quality(prepare(r)?, &inputs, &plan(r)?)?;
     // The default plan's pilot rendered the chosen frame whole already.
-    let (core, stats, core_s) = match choice.as_mut().and_then(|c| c.frame.take()) {
-        Some(f) => (f.image, f.stats, f.seconds),
-        None => render_core(&p, &plan)?,
-    };
+    let frame = chosen_frame(&p, &plan, &mut choice, &mut FrameCache::default())?.0;
+    let (core, stats, core_s) = (frame.image, frame.stats, frame.seconds);
     let (reference, ref_s) = render_ref(&p)?;
     let (per, overall) = compare(&core, &reference);
     let continuous = match args.reference {

@@ -6,7 +6,7 @@ use crate::io::progress::sheets;
 use crate::pipeline::stages::prepare::Prepared;
 use crate::pipeline::stages::supersample::downsample;
 use crate::reference::continuous::{
-    render_continuous, render_continuous_at, Absorption, Continuous, ContinuousScene, Model,
+    render_continuous, Absorption, Continuous, ContinuousScene, Model, PixelMarcher,
     Reconstruction, DEFAULT_CAP, MAX_HALVINGS,
 };
 use crate::CliError;
@@ -149,52 +149,74 @@ pub fn render_continuous_as(
     Ok((c, start.elapsed().as_secs_f64()))
 }
 
-/// The continuous reference of `p` at the listed pixels of the *output* image only ((x, y), each
-/// below [`Prepared::out_size`]; a supersampled frame marches the k×k rays of each and averages
-/// them, as the renders are averaged): their values in the order given, how it converged, and
-/// its seconds. Kernel reconstruction, `p`'s model, marched on `threads` threads (the image is
-/// the same for every count). The volume must be in memory.
+/// The continuous reference of `p` at listed pixels of the *output* image ((x, y), each below
+/// [`Prepared::out_size`]; a supersampled frame marches the k×k rays of each and averages them,
+/// as the renders are averaged): kernel reconstruction, `p`'s model, its field built once and
+/// marched through as many lists of pixels as asked (the pilot's two stages). The volume must
+/// be in memory.
+pub struct PilotReference<'a> {
+    marcher: PixelMarcher<'a>,
+    k: usize,
+}
+
+impl<'a> PilotReference<'a> {
+    /// The field of `p`, to be marched on `threads` threads (the image is the same for every
+    /// count).
+    pub fn new(p: &'a Prepared, threads: usize) -> Result<Self, CliError> {
+        let (volume, mut scene) = continuous_scene(
+            p,
+            Reconstruction::Kernel,
+            Model::Pre(p.absorption),
+            DEFAULT_CAP,
+        )?;
+        scene.threads = threads.max(1);
+        let axis = p.frame.sheet_axis;
+        let marcher = PixelMarcher::new(scene, |s, out| volume.sheet_into(axis, s, out))?;
+        Ok(PilotReference {
+            marcher,
+            k: p.supersample,
+        })
+    }
+
+    /// The reference at `pixels`: their values in the order given and how it converged.
+    pub fn at(&self, pixels: &[[usize; 2]]) -> Result<Continuous, CliError> {
+        let k = self.k;
+        let rays: Vec<[usize; 2]> = pixels
+            .iter()
+            .flat_map(|&[x, y]| (0..k * k).map(move |i| [x * k + i % k, y * k + i / k]))
+            .collect();
+        let mut bar = sheets("continuous pilot");
+        let mut c = self
+            .marcher
+            .at(|pass, _| bar(pass, MAX_HALVINGS + 1), &rays)?;
+        if k > 1 {
+            let scale = 1.0 / (k * k) as f64;
+            c.image = c
+                .image
+                .chunks(k * k)
+                .map(|block| {
+                    let mut sum = [0.0f64; 4];
+                    for v in block {
+                        for ch in 0..4 {
+                            sum[ch] += v[ch];
+                        }
+                    }
+                    sum.map(|v| v * scale)
+                })
+                .collect();
+        }
+        Ok(c)
+    }
+}
+
+/// [`PilotReference`] of `p` at `pixels`, on `threads` threads, in one go: the values, how it
+/// converged, and its seconds.
 pub fn continuous_at(
     p: &Prepared,
     pixels: &[[usize; 2]],
     threads: usize,
 ) -> Result<(Continuous, f64), CliError> {
     let start = Instant::now();
-    let (volume, mut scene) = continuous_scene(
-        p,
-        Reconstruction::Kernel,
-        Model::Pre(p.absorption),
-        DEFAULT_CAP,
-    )?;
-    scene.threads = threads.max(1);
-    let k = p.supersample;
-    let rays: Vec<[usize; 2]> = pixels
-        .iter()
-        .flat_map(|&[x, y]| (0..k * k).map(move |i| [x * k + i % k, y * k + i / k]))
-        .collect();
-    let mut bar = sheets("continuous pilot");
-    let axis = p.frame.sheet_axis;
-    let mut c = render_continuous_at(
-        &scene,
-        |s, out| volume.sheet_into(axis, s, out),
-        |pass, _| bar(pass, MAX_HALVINGS + 1),
-        &rays,
-    )?;
-    if k > 1 {
-        let scale = 1.0 / (k * k) as f64;
-        c.image = c
-            .image
-            .chunks(k * k)
-            .map(|block| {
-                let mut sum = [0.0f64; 4];
-                for v in block {
-                    for ch in 0..4 {
-                        sum[ch] += v[ch];
-                    }
-                }
-                sum.map(|v| v * scale)
-            })
-            .collect();
-    }
+    let c = PilotReference::new(p, threads)?.at(pixels)?;
     Ok((c, start.elapsed().as_secs_f64()))
 }

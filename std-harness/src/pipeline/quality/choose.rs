@@ -27,9 +27,26 @@ use super::config::Config;
 use super::level_pilot::{candidate_levels, measure};
 use super::model::{self as quality, choose, footprint_error, predict_db, Choice};
 use crate::args::{Lod, MethodArg, QualityReferenceArg};
+use crate::pipeline::ends::run::{render_frame, CoreFrame};
 use crate::pipeline::stages::prepare::Prepared;
+use crate::pipeline::stages::visible::FrameCache;
 use crate::plan::{End, Inputs, Plan};
 use crate::CliError;
+
+/// The frame of `plan` for `p`: the one the default plan's pilot rendered and kept in `choice`
+/// (taken out of it, so the next call renders), else rendered now with `cache`; and whether it
+/// was the pilot's (its time is then the pilot's, not the frame's).
+pub fn chosen_frame(
+    p: &Prepared,
+    plan: &Plan,
+    choice: &mut Option<Choice>,
+    cache: &mut FrameCache,
+) -> Result<(CoreFrame, bool), CliError> {
+    match choice.as_mut().and_then(|c| c.frame.take()) {
+        Some(f) => Ok((*f, true)),
+        None => Ok((render_frame(p, plan, cache)?, false)),
+    }
+}
 
 /// `plan` with `--quality`'s choice applied, or the default plan's (`--slicing auto`,
 /// [`super::pilot::choose_slicing`]); unchanged without either. The plan returned has neither
@@ -131,12 +148,8 @@ fn choose_sheets(
     }
     // What the pilot renders with: the plan's table (the default; --quality overrides it).
     let c0 = Config {
-        table: plan.table.size,
-        lookup: plan.table.lookup.into(),
         method: MethodArg::Robust,
-        accum: crate::args::AccumArg::Float,
-        slab_quarters: None,
-        refine: false,
+        ..Config::of_plan(plan)
     };
     let allowed = rmse(target);
     let t00 = table_rmse(&p0, &c0)?;

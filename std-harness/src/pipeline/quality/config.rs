@@ -115,6 +115,22 @@ impl Config {
 }
 
 impl Config {
+    /// The configuration `plan` renders with as object slicing in float: its table, lookup and
+    /// footprint method (`direct`, or `robust` through the view table), unrefined.
+    pub fn of_plan(plan: &Plan) -> Config {
+        Config {
+            table: plan.table.size,
+            lookup: plan.table.lookup.into(),
+            method: match plan.table.footprints {
+                Footprints::Direct => MethodArg::Direct,
+                Footprints::ViewTable => MethodArg::Robust,
+            },
+            accum: AccumArg::Float,
+            slab_quarters: None,
+            refine: false,
+        }
+    }
+
     /// `base` with this configuration's table, lookup, method, accumulation and slicing, and
     /// refined at threshold 0 if it refines (`base`'s own refinement is kept otherwise): the plan
     /// `--quality` and `chart` render, derived, not rewritten from flags.

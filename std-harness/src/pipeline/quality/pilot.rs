@@ -37,8 +37,9 @@
 //! own at twice the cell side, about a quarter; at least [`MIN_FIRST_STAGE`], else one stage). A
 //! candidate is decided there when its upper bound reaches DB (taken) or its lower bound,
 //! m − Z·s/√n·√(1 − n/N), does not (more pixels would not lift the estimate past it: rejected);
-//! otherwise the reference is marched through the other pixels too and the candidate, and every
-//! later one, is measured on all of them. A scene far from the target on either side costs a
+//! otherwise the reference is marched through the other pixels too (through the same field,
+//! built once and held until then: 16 bytes a voxel, so two stages only where that fits the
+//! visible lists' budget) and the candidate, and every later one, is measured on all of them. A scene far from the target on either side costs a
 //! quarter of the reference (the reference is 0.14–0.53 s of a 512² pilot on the shared
 //! volumes, `docs/perf/default-plan.csv`), one near it the whole as before. Looking twice at
 //! Z = 3 leaves the chance of taking a candidate that misses DB at most twice one look's.
@@ -58,14 +59,14 @@
 use super::config::Config;
 use super::model::{self as quality, Choice, Estimate, Pilot};
 use super::sampling::mix;
-use crate::args::{AccumArg, MethodArg, QualityReferenceArg};
-use crate::pipeline::ends::continuous::continuous_at;
+use crate::args::QualityReferenceArg;
+use crate::pipeline::ends::continuous::{continuous_at, PilotReference};
 use crate::pipeline::ends::run::render_frame;
 use crate::pipeline::stages::bands::CoreFrame;
 use crate::pipeline::stages::prepare::Prepared;
 use crate::pipeline::stages::visible::FrameCache;
 use crate::plan::Inputs;
-use crate::plan::{End, Footprints, Plan};
+use crate::plan::{End, Plan};
 use crate::CliError;
 use std::time::Instant;
 
@@ -190,7 +191,7 @@ pub fn choose_continuous(
     if reference == QualityReferenceArg::Field {
         run.field_size = Some(args.field_size);
     }
-    let mut choice = run.measure(candidates)?.1;
+    let mut choice = run.measure(candidates, false)?.1;
     // `--quality`'s winner is rendered again by the command (its choice may change the level).
     choice.frame = None;
     Ok(choice)
@@ -208,12 +209,10 @@ pub fn choose_slicing(
     base: &Plan,
     target_db: f64,
 ) -> Result<Option<(Plan, Choice)>, CliError> {
-    let mut object = base.clone();
-    object.auto_slicing = None;
-    let mut slabs = Config::slabs(&p.frame, &p.kernel);
     let Some(volume) = p.volume() else {
         return Ok(None);
     };
+    let mut slabs = Config::slabs(&p.frame, &p.kernel);
     if slabs.is_empty() || p.level > 0 {
         return Ok(None);
     }
@@ -232,17 +231,9 @@ pub fn choose_slicing(
         return Ok(None);
     }
     slabs.sort_by_key(|c| std::cmp::Reverse(c.slab_quarters));
-    let own = Config {
-        table: base.table.size,
-        lookup: base.table.lookup.into(),
-        method: match base.table.footprints {
-            Footprints::Direct => MethodArg::Direct,
-            Footprints::ViewTable => MethodArg::Robust,
-        },
-        accum: AccumArg::Float,
-        slab_quarters: None,
-        refine: false,
-    };
+    let mut object = base.clone();
+    object.auto_slicing = None;
+    let own = Config::of_plan(base);
     let mut candidates = vec![(own, object.clone())];
     candidates.extend(slabs.into_iter().map(|c| (c, c.plan(&object))));
     let mut run = Run::new(
@@ -252,9 +243,7 @@ pub fn choose_slicing(
         QualityReferenceArg::Continuous,
         base.threads,
     )?;
-    let (plan, mut choice) = run.measure(candidates)?;
-    choice.by_default = true;
-    Ok(Some((plan, choice)))
+    Ok(Some(run.measure(candidates, true)?))
 }
 
 /// One pilot: the frames `p` renders, measured at sampled pixels against a continuous
@@ -265,8 +254,6 @@ struct Run<'a> {
     reference: QualityReferenceArg,
     /// The side N of the finer field's sampling (`field` only).
     field_size: Option<usize>,
-    /// Worker threads of the reference's march (the plan's).
-    threads: usize,
     /// The sampled pixels, the first stage's first.
     pixels: Vec<[usize; 2]>,
     /// How many of `pixels` the first stage marched.
@@ -275,12 +262,16 @@ struct Run<'a> {
     /// The reference at the first `reference_image.image.len()` of `pixels`.
     reference_image: crate::reference::continuous::Continuous,
     reference_seconds: f64,
+    /// The field the second stage marches, while there is one to march (two stages only).
+    marcher: Option<PilotReference<'a>>,
 }
 
 impl<'a> Run<'a> {
     /// The pilot of `p`'s frame against the continuous integral of `against` (`p` itself, or
     /// the finer field), marched on `threads` threads through the sampled pixels: where
-    /// `against` is `p`, through the first stage's only (the rest on demand, [`Run::widen`]).
+    /// `against` is `p`, through the first stage's only, its field kept for the second
+    /// ([`Run::widen`]; 16 bytes a voxel, held while the candidates render, so only where that
+    /// fits the visible lists' budget: one stage otherwise).
     fn new(
         p: &'a Prepared,
         against: &Prepared,
@@ -290,25 +281,33 @@ impl<'a> Run<'a> {
     ) -> Result<Self, CliError> {
         let (w, h) = p.out_size();
         let (pixels, stride) = sample_pixels(w, h, PILOT_RAYS);
-        let (pixels, first) = if std::ptr::eq(p, against) {
-            first_stage(pixels, stride)
+        let start = Instant::now();
+        let staged = std::ptr::eq(p, against)
+            && p.volume().is_some_and(|v| {
+                v.len().saturating_mul(16) <= crate::pipeline::stages::visible::list_budget(v)
+            });
+        let (pixels, first, reference_image, marcher) = if staged {
+            let (pixels, first) = first_stage(pixels, stride);
+            let marcher = PilotReference::new(p, threads)?;
+            let image = marcher.at(&pixels[..first])?;
+            let marcher = (first < pixels.len()).then_some(marcher);
+            (pixels, first, image, marcher)
         } else {
             let n = pixels.len();
-            (pixels, n)
+            let (image, _) = continuous_at(against, &pixels, threads)?;
+            (pixels, n, image, None)
         };
-        let (reference_image, reference_seconds) =
-            continuous_at(against, &pixels[..first], threads)?;
         Ok(Run {
             p,
             target_db,
             reference,
             field_size: None,
-            threads,
             pixels,
             first,
             stride,
             reference_image,
-            reference_seconds,
+            reference_seconds: start.elapsed().as_secs_f64(),
+            marcher,
         })
     }
 
@@ -326,24 +325,30 @@ impl<'a> Run<'a> {
     }
 
     /// Marches the reference through the second stage's pixels, if it has not yet: whether it
-    /// did (only ever for `p`'s own reference, [`Run::new`]).
+    /// did (only ever for `p`'s own reference, [`Run::new`]). The field is dropped after.
     fn widen(&mut self) -> Result<bool, CliError> {
-        let marched = self.reference_image.image.len();
-        if marched == self.pixels.len() {
+        let Some(marcher) = self.marcher.take() else {
             return Ok(false);
-        }
-        let (rest, seconds) = continuous_at(self.p, &self.pixels[marched..], self.threads)?;
+        };
+        let start = Instant::now();
+        let marched = self.reference_image.image.len();
+        let rest = marcher.at(&self.pixels[marched..])?;
         self.reference_image.image.extend(rest.image);
         self.reference_image.converged &= rest.converged;
-        self.reference_seconds += seconds;
+        self.reference_seconds += start.elapsed().as_secs_f64();
         Ok(true)
     }
 
     /// Renders `candidates` (cheapest first) until one's bound reaches the target: that one's
-    /// plan and the choice (the most accurate tried where none reaches it, said so). A
+    /// plan and the choice (the most accurate tried where none reaches it, said so, naming the
+    /// default plan or `--quality` as `by_default` says). A
     /// candidate the first stage leaves undecided (its bound below the target, its lower bound
     /// above) is measured again on every sampled pixel.
-    fn measure(&mut self, candidates: Vec<(Config, Plan)>) -> Result<(Plan, Choice), CliError> {
+    fn measure(
+        &mut self,
+        candidates: Vec<(Config, Plan)>,
+        by_default: bool,
+    ) -> Result<(Plan, Choice), CliError> {
         let (p, target_db, reference) = (self.p, self.target_db, self.reference);
         let start = Instant::now();
         let widen_before = self.reference_seconds;
@@ -380,8 +385,13 @@ impl<'a> Run<'a> {
                      orthographic view)"
                 };
                 crate::say!(
-                    "{target_db:.1} dB against the {} integral: no candidate was measured to \
-                     reach it; using the most accurate, {} ({:.1} dB on the pilot){slabs}",
+                    "{} {target_db:.1} dB ({}): no candidate was measured to reach it; using \
+                     the most accurate, {} ({:.1} dB on the pilot){slabs}",
+                    if by_default {
+                        "default plan (--slicing auto),"
+                    } else {
+                        "--quality"
+                    },
                     quality::reference_name(reference),
                     tried[best].0.label(),
                     tried[best].1.bound_db
@@ -415,7 +425,7 @@ impl<'a> Run<'a> {
             }),
             level: 0,
             level_pilot: None,
-            by_default: false,
+            by_default,
             frame: kept.map(Box::new),
         };
         Ok((candidates[index].1.clone(), choice))
