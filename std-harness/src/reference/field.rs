@@ -133,6 +133,19 @@ impl<'s> Field<'s> {
         // next is in.
         let mut storage = vec![0.0f32; 3 * len];
         let mut ring = SheetRing::new(&mut storage, f, f.order_for_ascending())?;
+        // A voxel that can be seen: pre, any opacity; post, a value above every transparent one
+        // (a sample is a convex combination of its neighbours' values, so a block whose
+        // neighbourhood stays at or below that bound is transparent throughout). Pre-classified
+        // voxels at or below it are transparent whatever their gradient: not shaded at all.
+        let clear = scene.shader.transparent_at_or_below();
+        let seen = |v: &[f32; 4]| match scene.model {
+            Model::Pre(_) => v[0] > 0.0,
+            Model::Post => !(v[0] <= clear),
+        };
+        // The blocks holding a voxel that can be seen (dilated below by the reconstruction's
+        // reach into the blocks it can be seen from).
+        let blocks = dims.map(|d| d.div_ceil(BLOCK));
+        let mut holds = vec![false; blocks.iter().product()];
         let mut store = |ring: &SheetRing<'_, f32>, n: usize| {
             let (s, window) = (ring.sheet_index(n), ring.window(n));
             for v in 0..nb {
@@ -140,6 +153,7 @@ impl<'s> Field<'s> {
                     let idx = f.grid_index(s, u, v);
                     let value = window.current[v * na + u];
                     let stored = match scene.model {
+                        Model::Pre(_) if value <= clear => None,
                         Model::Pre(absorption) => {
                             let rgba = scene.shader.shade(
                                 &lighting,
@@ -157,6 +171,10 @@ impl<'s> Field<'s> {
                     };
                     if let Some(v) = stored {
                         voxels[(idx[2] * dims[1] + idx[1]) * dims[0] + idx[0]] = v;
+                        if seen(&v) {
+                            let b = idx.map(|c| c / BLOCK);
+                            holds[(b[2] * blocks[1] + b[1]) * blocks[0] + b[0]] = true;
+                        }
                     }
                 }
             }
@@ -188,36 +206,11 @@ impl<'s> Field<'s> {
                 )))
             }
         };
-        // A voxel that can be seen: pre, any opacity; post, a value above every transparent one
-        // (a sample is a convex combination of its neighbours' values, so a block whose
-        // neighbourhood stays at or below that bound is transparent throughout).
-        let clear = scene.shader.transparent_at_or_below();
-        let seen = |v: &[f32; 4]| match scene.model {
-            Model::Pre(_) => v[0] > 0.0,
-            Model::Post => !(v[0] <= clear),
-        };
-        let blocks = dims.map(|d| d.div_ceil(BLOCK));
-        let mut active = vec![false; blocks.iter().product()];
+        // A voxel at x is read by samples within `reach` of it, so it makes the blocks of
+        // x ± pad active: every block within ⌈pad / BLOCK⌉ blocks of one that holds it (a
+        // superset, which only costs the march a few more looks at zero voxels).
         let pad = reach.ceil() as usize + 1;
-        for z in 0..dims[2] {
-            for y in 0..dims[1] {
-                for x in 0..dims[0] {
-                    if !seen(&voxels[(z * dims[1] + y) * dims[0] + x]) {
-                        continue;
-                    }
-                    let range = |c: usize, a: usize| {
-                        (c.saturating_sub(pad) / BLOCK)..=((c + pad).min(dims[a] - 1) / BLOCK)
-                    };
-                    for bz in range(z, 2) {
-                        for by in range(y, 1) {
-                            for bx in range(x, 0) {
-                                active[(bz * blocks[1] + by) * blocks[0] + bx] = true;
-                            }
-                        }
-                    }
-                }
-            }
-        }
+        let active = dilate(&holds, blocks, pad.div_ceil(BLOCK));
         Ok(Field {
             dims,
             voxels,
@@ -384,6 +377,30 @@ impl<'s> Field<'s> {
     }
 }
 
+/// The blocks of a `blocks`-sized map (x fastest) within `r` blocks along every axis of one set
+/// in `holds`.
+fn dilate(holds: &[bool], blocks: [usize; 3], r: usize) -> Vec<bool> {
+    let mut out = vec![false; holds.len()];
+    let span = |c: usize, a: usize| c.saturating_sub(r)..=(c + r).min(blocks[a] - 1);
+    for z in 0..blocks[2] {
+        for y in 0..blocks[1] {
+            for x in 0..blocks[0] {
+                if !holds[(z * blocks[1] + y) * blocks[0] + x] {
+                    continue;
+                }
+                for bz in span(z, 2) {
+                    for by in span(y, 1) {
+                        for bx in span(x, 0) {
+                            out[(bz * blocks[1] + by) * blocks[0] + bx] = true;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
 /// The squared offsets d² and Gaussian factors exp(−k·d²) of the taps d = `d0`, `d0` − 1, …
 /// along one axis (as many as `d2` holds; `e` the same length), with `fall` = exp(−2k). The
 /// offset falls by one per tap, so two exponentials give them all: e(d − 1) = e(d)·q with
@@ -423,7 +440,39 @@ fn pre_classified(rgba: [f32; 4], absorption: Absorption, cap: f64) -> Option<[f
 
 #[cfg(test)]
 mod tests {
-    use super::gaussian_taps;
+    use super::{dilate, gaussian_taps, BLOCK};
+
+    #[test]
+    fn dilated_blocks_cover_every_block_a_voxel_can_be_seen_from() {
+        // A few voxels of a 37x20x9 grid; each must activate every block within `pad` voxels
+        // of it (the rule the march relies on), and the dilation must not reach further than
+        // one block past that.
+        let dims = [37usize, 20, 9];
+        let blocks = dims.map(|d| d.div_ceil(BLOCK));
+        for pad in [1usize, 3, 8, 9] {
+            for voxel in [[0usize, 0, 0], [36, 19, 8], [8, 7, 4], [15, 16, 0]] {
+                let mut holds = vec![false; blocks.iter().product()];
+                let b = voxel.map(|c| c / BLOCK);
+                holds[(b[2] * blocks[1] + b[1]) * blocks[0] + b[0]] = true;
+                let active = dilate(&holds, blocks, pad.div_ceil(BLOCK));
+                for z in 0..dims[2] {
+                    for y in 0..dims[1] {
+                        for x in 0..dims[0] {
+                            let near = [x, y, z]
+                                .iter()
+                                .zip(voxel)
+                                .all(|(&c, v)| c.abs_diff(v) <= pad);
+                            let bi = ((z / BLOCK) * blocks[1] + y / BLOCK) * blocks[0] + x / BLOCK;
+                            assert!(!near || active[bi], "pad {pad}, {voxel:?}: ({x},{y},{z})");
+                        }
+                    }
+                }
+                let count = active.iter().filter(|&&a| a).count();
+                let most = (2 * pad.div_ceil(BLOCK) + 1).pow(3);
+                assert!(count <= most, "pad {pad}: {count} blocks");
+            }
+        }
+    }
 
     #[test]
     fn the_tap_recurrence_matches_exp() {
