@@ -39,15 +39,26 @@
 //! m − Z·s/√n·√(1 − n/N), does not (more pixels would not lift the estimate past it: rejected);
 //! otherwise the reference is marched through the other pixels too (through the same field,
 //! built once and held until then: 16 bytes a voxel, so two stages only where that fits the
-//! visible lists' budget) and the candidate, and every later one, is measured on all of them. A scene far from the target on either side costs a
-//! quarter of the reference (the reference is 0.14–0.53 s of a 512² pilot on the shared
-//! volumes, `docs/perf/default-plan.csv`), one near it the whole as before. Looking twice at
-//! Z = 3 leaves the chance of taking a candidate that misses DB at most twice one look's.
+//! visible lists' budget) and the candidate, and every later one, is measured on all of them.
+//! A scene far from the target on either side costs a quarter of the reference, one near it
+//! the whole as before (the pilot reference took 0.01–0.21 s at 256² on the shared volumes,
+//! `docs/perf/default-plan.csv`). Looking twice at Z = 3 leaves the chance of taking a
+//! candidate that misses DB at most twice one look's.
 //!
-//! The winner is rendered again by the command (its pilot render is not kept), so `--quality
-//! DB --quality-reference continuous` costs the pilot reference, one frame per candidate tried,
-//! and the frame. The default stays `--quality-reference sheets`: it costs milliseconds, and the
-//! sheet reference is what the table configuration alone controls.
+//! **Why not a smaller first stage.** A first stage of a sixteenth (256 pixels at 512², then a
+//! quarter, then the rest) cut the pilot reference on the walnut and the CT head by half
+//! (`footprint bench --frames 1`, 512², 99–119 → 56–59 and 86–97 → 25–35 ms), but on
+//! `benches/default_plan.sh` it took object slicing for the CT head (30,20,0, emission, 256²)
+//! on a bound of 44.9 dB whose whole image measured 43.9 dB, where the quarter rejects it
+//! (41.6 dB on its 1 024 pixels) and takes slabs (60.2 dB). A sample of 256 can miss the few
+//! pixels that carry most of the squared error, and understate the standard error with them:
+//! the normal bound did not hold there.
+//!
+//! Under `--quality DB` the winner is rendered again by the command (its pilot render is not
+//! kept, as its choice may change the level), so `--quality DB --quality-reference continuous`
+//! costs the pilot reference, one frame per candidate tried, and the frame. The default stays
+//! `--quality-reference sheets`: it costs milliseconds, and the sheet reference is what the
+//! table configuration alone controls.
 //!
 //! # The default plan
 //! [`choose_slicing`] runs the same pilot for `--slicing auto` (the default) at
@@ -69,6 +80,16 @@ use crate::plan::Inputs;
 use crate::plan::{End, Plan};
 use crate::CliError;
 use std::time::Instant;
+
+/// The bytes the pilot's continuous field holds for `volume` (each voxel's classified RGBA, 16
+/// bytes) and the budget it must fit: the visible lists' ([`list_budget`]). The default plan
+/// measures only where it fits, and the two stages hold the field only where it fits.
+///
+/// [`list_budget`]: crate::pipeline::stages::visible::list_budget
+fn field_bytes(volume: &crate::io::volume::Volume) -> (usize, usize) {
+    let field = volume.len().saturating_mul(16);
+    (field, crate::pipeline::stages::visible::list_budget(volume))
+}
 
 /// Rays the pilot aims at: the image is sampled once per cell of about W·H / `PILOT_RAYS`
 /// pixels.
@@ -216,10 +237,9 @@ pub fn choose_slicing(
     if slabs.is_empty() || p.level > 0 {
         return Ok(None);
     }
-    // The pilot's reference holds each voxel's classified RGBA (16 bytes): past the budget the
-    // visible lists get, the default renders object slicing unmeasured and says so.
-    let field = volume.len().saturating_mul(16);
-    let budget = crate::pipeline::stages::visible::list_budget(volume);
+    // Past the budget the visible lists get, the default renders object slicing unmeasured and
+    // says so.
+    let (field, budget) = field_bytes(volume);
     if field > budget {
         crate::say!(
             "default plan (--slicing auto): object slicing, not measured: the pilot's continuous \
@@ -284,7 +304,8 @@ impl<'a> Run<'a> {
         let start = Instant::now();
         let staged = std::ptr::eq(p, against)
             && p.volume().is_some_and(|v| {
-                v.len().saturating_mul(16) <= crate::pipeline::stages::visible::list_budget(v)
+                let (field, budget) = field_bytes(v);
+                field <= budget
             });
         let (pixels, first, reference_image, marcher) = if staged {
             let (pixels, first) = first_stage(pixels, stride);
