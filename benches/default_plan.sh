@@ -6,7 +6,9 @@
 # 1. Accuracy: every shared volume, views 30,20,0 and 75,-40,20, emission and Phong, 256x256,
 #    default flags: `verify --reference continuous` measures the whole image against the default
 #    (opacity) model; the JSON says what the pilot chose (`plan`), its bound on the pilot
-#    (`quality.predicted_db`) and the seconds of its reference and candidate renders.
+#    (`quality.predicted_db`) and the seconds of its reference and candidate renders. `chosen`
+#    is `sheets/nearest` where object slicing read at the nearest phase was kept, and the object
+#    column is the first object-slicing candidate's bound (the nearest phase where it was tried).
 # 2. Cost: each volume at 512x512, view 30,20,0, emission, one thread, `bench --frames 3
 #    --orbit 2`, the default and `--slicing object` run alternately ROUNDS times; the minimum
 #    over rounds of `first_ms` (a fresh volume: the pilot, which renders frame 1, included) and of
@@ -34,7 +36,7 @@ import json, sys
 j = json.load(open(sys.argv[1]))
 name, view, shading = sys.argv[2:]
 plan, q = j["plan"], j.get("quality")
-chosen = plan["end"]
+chosen = plan["end"] + ("/nearest" if plan.get("phase_lookup") == "nearest" else "")
 slab = plan["slab"] if plan["slab"] is not None else ""
 if q:
     pilot = q["pilot"]
@@ -61,7 +63,7 @@ for vol in "$data"/*/*.nhdr; do
 import json,sys
 j=json.load(open('$tmp/b.json'))
 p=j['plan']
-print(f\"$name,$r,$slicing,{p['end']}{'' if p['slab'] is None else ' '+str(p['slab'])},{j['first_ms']:.1f},{j['median_ms']:.1f},{j['plan_ms']:.1f}\")" >> "$cost"
+print(f\"$name,$r,$slicing,{p['end']}{'/nearest' if p.get('phase_lookup') == 'nearest' else ''}{'' if p['slab'] is None else ' '+str(p['slab'])},{j['first_ms']:.1f},{j['median_ms']:.1f},{j['plan_ms']:.1f}\")" >> "$cost"
     done
   done
 done

@@ -285,6 +285,46 @@ fn frames(c: &mut Criterion) {
     g.finish();
 }
 
+/// One splat through the phase stencils (`footprint::stencil`, 32 phases, the 129 view table)
+/// read by each [`PhaseLookup`], footprints about 3 to 14 px across (the small-box windows and the
+/// general row loop): `stencil/phase=nearest/fp=8px`.
+fn stencils(c: &mut Criterion) {
+    use footprint::stencil::{self, PhaseLookup, Stencils, DEFAULT_PHASES};
+    let generic = Box::new(GenericTable::<129>::build(Kernel::PAPER_GAUSSIAN));
+    let mut g = c.benchmark_group("stencil");
+    for across in [3.0f32, 6.0, 10.0, 14.0] {
+        let f = frame(across);
+        let view = Box::new(ViewTable::<129>::build(
+            &f.footprint,
+            &generic,
+            Lookup::Bilinear,
+            Lookup::Bilinear,
+        ));
+        let len = stencil::len_for(&f.footprint, DEFAULT_PHASES).expect("stencils fit");
+        let mut buffer = vec![0.0f32; len];
+        let built = Stencils::build(&*view, DEFAULT_PHASES, &mut buffer).unwrap();
+        for (lookup, name) in [
+            (PhaseLookup::Blend, "blend"),
+            (PhaseLookup::Nearest, "nearest"),
+        ] {
+            let st = built.with_phase_lookup(lookup);
+            let mut px = vec![[0.0f32; 4]; 128 * 128];
+            g.bench_function(format!("phase={name}/fp={across}px"), |b| {
+                let mut img = ImageMut::new(&mut px, 128, 128, 128).unwrap();
+                let mut i = 0u32;
+                let value = [0.3f32, 0.4, 0.5, 0.6];
+                b.iter(|| {
+                    i = i.wrapping_add(1);
+                    black_box(&st)
+                        .splat(centre(i), &value, &mut img, |_, _, _| {})
+                        .unwrap()
+                });
+            });
+        }
+    }
+    g.finish();
+}
+
 fn quick() -> Criterion {
     Criterion::default()
         .warm_up_time(Duration::from_millis(300))
@@ -295,6 +335,6 @@ fn quick() -> Criterion {
 criterion_group! {
     name = splat_benches;
     config = quick();
-    targets = thin, per_splat, per_view, frames
+    targets = thin, per_splat, per_view, frames, stencils
 }
 criterion_main!(splat_benches);

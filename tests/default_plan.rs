@@ -3,6 +3,7 @@
 //! otherwise; each choice checked on the whole image, the frame the pilot rendered checked to be
 //! the plan's frame bit for bit, and the flags that leave nothing to choose checked to skip it.
 
+use footprint::stencil::PhaseLookup;
 use footprint_harness::args::parse_args;
 use footprint_harness::metrics::compare;
 use footprint_harness::pipeline::stages::visible::FrameCache;
@@ -34,8 +35,9 @@ fn chosen(a: &[&str]) -> (footprint_harness::plan::Plan, Vec<[f32; 4]>, f64, Pre
     (chosen, frame.image, db, p)
 }
 
-/// The built-in scene is far from opaque: object slicing reaches the target and is kept, and its
-/// frame is the one `--slicing object` renders.
+/// The built-in scene is far from opaque: object slicing read at the nearest phase (the first
+/// candidate) reaches the target and is kept, and its frame is the one `--slicing object
+/// --phase-lookup nearest` renders, which differs from the blended one's.
 #[test]
 fn object_slicing_is_kept_where_it_reaches_the_target() {
     let (plan_chosen, image, db, p) = chosen(&["--size", "200x200", "--view", "30,20,0"]);
@@ -44,24 +46,32 @@ fn object_slicing_is_kept_where_it_reaches_the_target() {
         "{:?}",
         plan_chosen.end
     );
+    assert_eq!(plan_chosen.phase_lookup, Some(PhaseLookup::Nearest));
     assert!(db >= DEFAULT_TARGET_DB, "whole image {db:.2} dB");
-    let object = plan(
-        &parse_args(&[
+    let object = |lookup: &str| {
+        let a = [
             "--size",
             "200x200",
             "--view",
             "30,20,0",
             "--slicing",
             "object",
-        ])
-        .unwrap(),
-    )
-    .unwrap();
-    let again = render_frame(&p, &object, &mut FrameCache::default()).unwrap();
+            "--phase-lookup",
+            lookup,
+        ];
+        let explicit = plan(&parse_args(&a).unwrap()).unwrap();
+        render_frame(&p, &explicit, &mut FrameCache::default())
+            .unwrap()
+            .image
+    };
     assert!(
-        again.image == image,
-        "the pilot's frame is --slicing object's"
+        object("nearest") == image,
+        "the pilot's frame is --slicing object --phase-lookup nearest's"
     );
+    let blended = object("blend");
+    assert!(blended != image, "the nearest phase moved no pixel");
+    // `auto` outside the default plan blends.
+    assert!(object("auto") == blended);
 }
 
 /// The heart seen obliquely (12 slices 4 spacings apart): object slicing, compositing each kernel
@@ -145,4 +155,55 @@ fn bench_counts_the_pilot_in_the_fresh_frame() {
         j.contains("\"by\": \"default\"") && j.contains("\"end\": \"slabs\""),
         "{j}"
     );
+}
+
+/// `--phase-lookup nearest` where nothing reads phase stencils is refused before anything is
+/// drawn, naming the flag; where they are read it renders, and the JSON's `plan` says how.
+#[test]
+fn the_nearest_phase_is_refused_where_no_stencils_are_read() {
+    let d = tmpdir("phase-lookup");
+    let (out, json) = (d.join("x.png"), d.join("x.json"));
+    let (o, j) = (s(&out), s(&json));
+    for bad in [
+        &["--slicing", "image"][..],
+        &["--accum", "fixed"],
+        &["--perspective", "40"],
+        &["--method", "direct"],
+        &["--phases", "0"],
+        &["--refine", "0.1"],
+        &["--method", "reference"],
+        &["--classification", "post"],
+    ] {
+        let mut a = vec![
+            "render",
+            "-s",
+            "32x32",
+            "-o",
+            o,
+            "--phase-lookup",
+            "nearest",
+        ];
+        a.extend_from_slice(bad);
+        assert_eq!(run(&a), 2, "{bad:?} is refused");
+    }
+    assert!(!out.exists(), "no image from a refused render");
+    for (lookup, want) in [("nearest", "nearest"), ("blend", "blend")] {
+        let a = [
+            "render",
+            "-s",
+            "32x32",
+            "-o",
+            o,
+            "--json",
+            j,
+            "--slicing",
+            "object",
+            "--phase-lookup",
+            lookup,
+        ];
+        assert_eq!(run(&a), 0, "{a:?}");
+        let text = std::fs::read_to_string(&json).unwrap();
+        let key = format!("\"phase_lookup\": \"{want}\"");
+        assert!(text.contains(&key), "{lookup}: {text}");
+    }
 }

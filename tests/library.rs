@@ -446,8 +446,9 @@ fn bad_transfer_functions_are_typed_errors() {
 mod in_memory_example;
 
 /// `core/examples/in_memory.rs` (the front door, `footprint::prelude`) and `footprint render` on
-/// the same volume written as a raw file, with the flags its doc names and every other flag at
-/// its default (threads, levels, supersampling, table, phases): the same PNG bytes.
+/// the same volume written as a raw file, with the flags its doc names (`--slicing object`: the
+/// core has no pilot for the default plan) and every other flag at its default (threads, levels,
+/// supersampling, table, phases, their lookup): the same PNG bytes.
 #[test]
 fn the_in_memory_example_writes_the_cli_png_byte_for_byte() {
     let dir = tempfile::tempdir().unwrap();
@@ -457,7 +458,8 @@ fn the_in_memory_example_writes_the_cli_png_byte_for_byte() {
     std::fs::write(&raw, bytes).unwrap();
     in_memory_example::render_png(lib.to_str().unwrap()).unwrap();
     let args = "render RAW --dims 64,64,48 --type u16 --spacing 1,1,1.5 --view 30,20,0 \
-                --tf ct-bone-skin --window 0,4000 --shading phong --size 256x256 --out OUT";
+                --tf ct-bone-skin --window 0,4000 --shading phong --size 256x256 --slicing object \
+                --out OUT";
     let args: Vec<&str> = args
         .split_whitespace()
         .map(|a| match a {

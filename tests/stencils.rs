@@ -6,13 +6,16 @@
 //!   phase stencils computed here from the sampler (so the ranges skip only exact zeros); for a
 //!   wide one the same blend inside the support where all four corners are non-zero, the sampler
 //!   itself at the support's edge, and zero outside it;
+//! - read at the nearest phase instead ([`PhaseLookup::Nearest`]), every pixel of a narrow
+//!   footprint is, bit for bit, the nearest corner stencil's entry (a wide one is still blended);
 //! - the weights stay within the blending bound of the per-pixel table walk (`splat_rows` through
 //!   the same view table), and the total deposit matches it.
 
 use footprint::geometry::{Footprint, FootprintOptions};
 use footprint::splat::{splat, ImageMut};
 use footprint::stencil::{
-    self, minor_semi_axis, Stencils, BLEND_REACH, DEFAULT_PHASES, MAX_STENCIL_SIDE, PHASE_REACH,
+    self, minor_semi_axis, PhaseLookup, Stencils, BLEND_REACH, DEFAULT_PHASES, MAX_STENCIL_SIDE,
+    PHASE_REACH,
 };
 use footprint::{GenericTable, Kernel, Lookup, ViewTable};
 use glam::Mat3;
@@ -55,13 +58,24 @@ fn phase(c: f32, i: i64, p: usize) -> (usize, f32) {
 }
 
 /// Checks the splat of footprint (`s`, `a`, `deg`) ([`footprint`]) at every [`CENTRES`] against
-/// brute force, bit for bit; returns its box side and whether it is edged (`None` when no stencils
-/// apply).
+/// brute force, bit for bit, with each [`PhaseLookup`]; returns its box side and whether it is
+/// edged (`None` when no stencils apply).
 fn check_against_brute_force(
     generic: &GenericTable<129>,
     s: f32,
     a: f32,
     deg: f32,
+) -> Option<(usize, bool)> {
+    let r = check_lookup(generic, (s, a, deg), PhaseLookup::Blend);
+    assert_eq!(r, check_lookup(generic, (s, a, deg), PhaseLookup::Nearest));
+    r
+}
+
+/// [`check_against_brute_force`] with one `lookup`.
+fn check_lookup(
+    generic: &GenericTable<129>,
+    (s, a, deg): (f32, f32, f32),
+    lookup: PhaseLookup,
 ) -> Option<(usize, bool)> {
     let fp = footprint(s, a, deg);
     let table = ViewTable::<129>::build(&fp, generic, Lookup::Bilinear, Lookup::Bilinear);
@@ -75,10 +89,17 @@ fn check_against_brute_force(
         return None;
     };
     let mut buffer = vec![0.0f32; len];
-    let st = Stencils::build(&table, DEFAULT_PHASES, &mut buffer).unwrap();
+    let st = Stencils::build(&table, DEFAULT_PHASES, &mut buffer)
+        .unwrap()
+        .with_phase_lookup(lookup);
     let r = minor_semi_axis(&fp);
     let p = st.phases();
     let wide = stencil::plan_for(&fp, DEFAULT_PHASES).unwrap().edged;
+    let nearest = lookup == PhaseLookup::Nearest && !wide;
+    assert_eq!(
+        st.phase_lookup(),
+        if nearest { lookup } else { PhaseLookup::Blend }
+    );
     let reach = if wide { PHASE_REACH } else { BLEND_REACH };
     assert!(
         p == DEFAULT_PHASES || p as f32 * r >= reach,
@@ -163,6 +184,8 @@ fn check_against_brute_force(
                     0.0
                 } else if wide && corners.contains(&0.0) {
                     table.weight(q)
+                } else if nearest {
+                    corners[usize::from(fx >= 0.5) + 2 * usize::from(fy >= 0.5)]
                 } else {
                     w00 * corners[0] + w10 * corners[1] + w01 * corners[2] + w11 * corners[3]
                 };
@@ -171,7 +194,8 @@ fn check_against_brute_force(
         for (i, (g, w)) in got.iter().zip(&want).enumerate() {
             assert!(
                 g.to_bits() == w.to_bits(),
-                "scale {s}, {a}:1 at {deg}°, centre {c:?}: pixel {i} is {g}, brute force {w}"
+                "scale {s}, {a}:1 at {deg}°, {lookup:?}, centre {c:?}: pixel {i} is {g}, brute \
+                 force {w}"
             );
         }
     }
@@ -218,6 +242,19 @@ fn every_window_width_matches_brute_force() {
     assert!(sides.contains(&5) && sides.contains(&19), "{sides:?}");
 }
 
+/// One unit splatted by `st` at centre `c` into a fresh `SIZE`² image.
+fn splat_one(st: &Stencils<'_, ViewTable<129>>, c: [f32; 2]) -> Vec<f32> {
+    let mut img = vec![0.0f32; SIZE * SIZE];
+    st.splat(
+        c,
+        &1.0f32,
+        &mut ImageMut::new(&mut img, SIZE, SIZE, SIZE).unwrap(),
+        |_, _, _| {},
+    )
+    .unwrap();
+    img
+}
+
 #[test]
 fn wide_footprints_match_the_table_walk() {
     let generic = GenericTable::<129>::build(Kernel::PAPER_GAUSSIAN);
@@ -234,15 +271,8 @@ fn wide_footprints_match_the_table_walk() {
         let mut buffer = vec![0.0f32; len];
         let st = Stencils::build(&table, DEFAULT_PHASES, &mut buffer).unwrap();
         for c in &CENTRES[..4] {
-            let mut got = vec![0.0f32; SIZE * SIZE];
+            let got = splat_one(&st, *c);
             let mut want = vec![0.0f32; SIZE * SIZE];
-            st.splat(
-                *c,
-                &1.0f32,
-                &mut ImageMut::new(&mut got, SIZE, SIZE, SIZE).unwrap(),
-                |_, _, _| {},
-            )
-            .unwrap();
             splat(
                 &table,
                 *c,
@@ -321,4 +351,105 @@ fn split_builds_are_the_same_bits() {
         assert_eq!(bits(&plain), bits(&reversed), "scale {s}, {a}:1 at {deg}°");
         assert_eq!(bits(&plain), bits(&threaded), "scale {s}, {a}:1 at {deg}°");
     }
+}
+
+/// Read at the nearest phase ([`PhaseLookup::Nearest`]), a narrow footprint's weights stay within
+/// the bound `footprint::stencil::PhaseLookup` derives against the blended splat at the same
+/// centre c, as fractions of the footprint's peak (its weight at its centre). The footprint moved to the nearest phase node c' (at most √2/(2P) px) changes a
+/// weight by at most √2/(2P) · peak/(σ·√e), σ = r/2.5 (r the shorter semi-axis), where the pixel
+/// centre lies inside the support from both; where it crosses the support's edge (the truncated
+/// Gaussian drops there from a few per cent of its peak to nothing) by at most its weight on the
+/// inside. A renormalised footprint is divided by its sum over the pixels, S(c') instead of S(c),
+/// which adds at most peak · |S(c)/S(c') − 1|; and blending's own error is (2.5/(P·r))²/8 (all
+/// the sums and weights here computed from the table). Every splat of a renormalised footprint
+/// deposits the blended splat's total.
+#[test]
+fn nearest_phase_stays_within_its_bound() {
+    let generic = GenericTable::<129>::build(Kernel::PAPER_GAUSSIAN);
+    let mut tested = 0;
+    let mut worst = 0.0f64;
+    for &(s, a, deg) in &SHAPES {
+        let fp = footprint(s, a, deg);
+        let table = ViewTable::<129>::build(&fp, &generic, Lookup::Bilinear, Lookup::Bilinear);
+        let Some(plan) = stencil::plan_for(&fp, DEFAULT_PHASES).filter(|p| !p.edged) else {
+            continue;
+        };
+        let mut buffer = vec![0.0f32; plan.floats()];
+        let blend = Stencils::build(&table, DEFAULT_PHASES, &mut buffer).unwrap();
+        let nearest = blend.with_phase_lookup(PhaseLookup::Nearest);
+        let (p, r) = (plan.phases as f64, f64::from(minor_semi_axis(&fp)));
+        let sigma = r / 2.5;
+        let moved_by = 2f64.sqrt() / (2.0 * p) / (sigma * 1f64.exp().sqrt());
+        let blending = (2.5 / (p * r)).powi(2) / 8.0;
+        let reach = plan.side as i64 / 2;
+        let weight = |q: [f64; 2]| {
+            let q = q.map(|x| x as f32);
+            fp.contains(q).then(|| f64::from(table.weight(q)))
+        };
+        // The footprint's weights at the pixel centres of the box around `c`.
+        let weights = |c: [f64; 2]| {
+            let (ix, iy) = (c[0].floor() as i64, c[1].floor() as i64);
+            let mut v = Vec::new();
+            for y in iy - reach..=iy + reach {
+                for x in ix - reach..=ix + reach {
+                    v.push((
+                        (x, y),
+                        weight([x as f64 + 0.5 - c[0], y as f64 + 0.5 - c[1]]),
+                    ));
+                }
+            }
+            v
+        };
+        let sum = |c: [f64; 2]| weights(c).iter().filter_map(|w| w.1).sum::<f64>();
+        let mut moved_any = false;
+        for c in CENTRES.iter().chain(&[[100.49, 100.51], [100.01, 100.99]]) {
+            let (want, got) = (splat_one(&blend, *c), splat_one(&nearest, *c));
+            let exact = c.map(f64::from);
+            let node = exact.map(|x| (x * p).round() / p);
+            let (renormalised, divided) = if fp.renormalise {
+                ((sum(exact) / sum(node) - 1.0).abs(), sum(exact))
+            } else {
+                (0.0, 1.0)
+            };
+            // The footprint's peak (at its centre; a small one's pixels may all lie well off it).
+            let raw_peak = weight([0.0, 0.0]).unwrap();
+            let peak = raw_peak / divided;
+            for ((x, y), w) in weights(exact) {
+                let (ux, uy) = (x as usize, y as usize);
+                if x < 0 || y < 0 || ux >= SIZE || uy >= SIZE {
+                    continue;
+                }
+                let moved = weight([x as f64 + 0.5 - node[0], y as f64 + 0.5 - node[1]]);
+                let edge = match (w, moved) {
+                    (Some(_), Some(_)) | (None, None) => 0.0,
+                    (Some(v), None) | (None, Some(v)) => v / raw_peak,
+                };
+                let bound = moved_by + edge + renormalised + blending;
+                let i = uy * SIZE + ux;
+                let err = f64::from((got[i] - want[i]).abs()) / peak;
+                assert!(
+                    err <= bound,
+                    "scale {s}, {a}:1 at {deg}°, centre {c:?}, pixel ({x}, {y}): {err:.2e} of \
+                     peak, bound {bound:.2e} (edge {edge:.2e})"
+                );
+                moved_any |= err > 0.0;
+                worst = worst.max(err / bound);
+            }
+            let total = |v: &[f32]| v.iter().map(|&x| f64::from(x)).sum::<f64>();
+            let mass = (total(&got) / total(&want) - 1.0).abs();
+            // Not renormalised: the sampled sum of a wide footprint varies with its phase too.
+            let tolerance = if fp.renormalise { 1e-5 } else { 1e-3 };
+            assert!(
+                mass < tolerance,
+                "scale {s}, {a}:1 at {deg}°: total off by {mass:.2e}"
+            );
+        }
+        assert!(
+            moved_any,
+            "scale {s}, {a}:1 at {deg}°: nearest read no other phase"
+        );
+        tested += 1;
+    }
+    assert!(tested >= 5, "{tested} narrow or blended shapes");
+    println!("worst error {:.0} % of the bound", worst * 100.0);
 }

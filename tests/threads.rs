@@ -32,10 +32,10 @@ fn frame(extra: &[&str], threads: usize) -> (Vec<[u32; 4]>, [u64; 4]) {
 
 #[test]
 fn every_thread_count_gives_the_same_bits() {
-    // Stencil splats (small and wide footprints), the per-pixel table walk (--phases 0), the direct
-    // method, fixed point; phong needs gradients; front to back composites under; a view whose
+    // Stencil splats (small and wide footprints, blended and nearest), the per-pixel table walk
+    // (--phases 0), the direct method, fixed point; phong needs gradients; front to back composites under; a view whose
     // sheets run along i.
-    let cases: [&[&str]; 10] = [
+    let cases: [&[&str]; 12] = [
         // Perspective: a footprint per voxel, no band test.
         &["--view", "30,20,0", "--perspective", "60"],
         &[
@@ -52,6 +52,18 @@ fn every_thread_count_gives_the_same_bits() {
         // Zoomed so the footprints are wide (box over 16 px): stencils with exact edges.
         &["--view", "30,20,0", "--zoom", "12"],
         &["--view", "30,20,0", "--phases", "0"],
+        // Stencils read at the nearest phase: the windowed and clipped loops at band edges.
+        &["--view", "30,20,0", "--phase-lookup", "nearest"],
+        &[
+            "--view",
+            "75,-40,20",
+            "--phase-lookup",
+            "nearest",
+            "--zoom",
+            "3",
+            "--shading",
+            "phong",
+        ],
         &[
             "--view",
             "75,-40,20",

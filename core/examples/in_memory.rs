@@ -1,5 +1,6 @@
 //! A volume in memory to a PNG, the same bytes as `footprint render V.raw --dims 64,64,48 --type u16
-//! --spacing 1,1,1.5 --view 30,20,0 --tf ct-bone-skin --window 0,4000 --shading phong --size 256x256`
+//! --spacing 1,1,1.5 --view 30,20,0 --tf ct-bone-skin --window 0,4000 --shading phong --size 256x256
+//! --slicing object` (the core renders object slicing; the CLI's default plan measures its choice)
 #![allow(clippy::disallowed_types)] // core/clippy.toml bans floats in the fixed-point modules.
 use footprint::prelude::*;
 

@@ -12,8 +12,10 @@ use std::path::PathBuf;
 
 mod model;
 mod parse;
+mod phase;
 pub use model::*;
 pub use parse::*;
+pub use phase::*;
 
 /// Table lookup, as on the command line.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, ValueEnum)]
@@ -389,11 +391,14 @@ pub struct RenderArgs {
     #[arg(help_heading = "Method", long, value_name = "S", default_value = "auto", value_parser = parse_supersample)]
     pub value_subsample: Supersample,
     /// View-table renders: sub-pixel phases per pixel (at most; wide footprints use fewer) of the
-    /// phase stencils that splat footprints up to 128 px across: the view table (float, the
-    /// core's `stencil` module) or the integer table (fixed, `fixed::stencil`) sampled once per
-    /// phase; 0 walks the table per pixel instead.
+    /// stencils that splat footprints up to 128 px across, the view table (float, `stencil`) or
+    /// integer table (fixed, `fixed::stencil`) sampled per phase; 0 walks the table per pixel.
     #[arg(help_heading = "Method", long, default_value_t = footprint::stencil::DEFAULT_PHASES)]
     pub phases: usize,
+    /// Stencils read at the nearest phase (the footprint up to 1/(2P) px off) or blended from four;
+    /// `auto`: nearest where the default plan's pilot measures it at target (docs/modes.md).
+    #[arg(help_heading = "Method", long, value_enum, default_value = "auto")]
+    pub phase_lookup: PhaseLookupArg,
     /// Compositing direction (default back-to-front; a pipe's views impose theirs).
     #[arg(help_heading = "Method", long, value_enum)]
     pub order: Option<OrderArg>,

@@ -117,6 +117,9 @@ pub struct Plan {
     pub table: Table,
     /// Sub-pixel phases of the stencils (0: walk the table).
     pub phases: usize,
+    /// How float sheets read the stencils at a voxel's phase (`--phase-lookup`); `None` (`auto`):
+    /// blended, unless the default plan's pilot chose the nearest (`pilot::choose_slicing`).
+    pub phase_lookup: Option<footprint::stencil::PhaseLookup>,
     /// Threads (bands of image rows), at least one.
     pub threads: usize,
     /// The subsampling decorator (`--subsample`): `Fixed(1)` off, `Fixed(s)` at 1/s of the size,
@@ -257,6 +260,7 @@ pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
             file: fa.table_file.clone(),
         },
         phases: args.phases,
+        phase_lookup: args.phase_lookup.fixed(),
         threads: args.thread_count(),
         subsample: args.subsample,
         cull: args.cull.0,
@@ -332,11 +336,41 @@ pub const SUBSAMPLE_NOT_AT_A_LEVEL: &str =
 
 /// The rules a streamed volume and `--cull` add to `end`.
 fn flag_rules(end: &End, args: &RenderArgs) -> Result<(), CliError> {
+    phase_lookup_rules(end, args)?;
     if args.stream.is_some() {
         streamed_rules(end, args)?;
     }
     match args.cull.0 {
         Some(eps) => cull_rules(eps, end, args),
+        None => Ok(()),
+    }
+}
+
+/// The rules `--phase-lookup nearest` adds: float sheets through a view table's stencils (the
+/// fixed path's integer stencils, slabs, refined grids, perspective frames and `--method direct`
+/// have no phase to read nearest).
+fn phase_lookup_rules(end: &End, args: &RenderArgs) -> Result<(), CliError> {
+    if args.phase_lookup != crate::args::PhaseLookupArg::Nearest {
+        return Ok(());
+    }
+    let why = if *end != End::Sheets(Precision::Float) {
+        Some("float object slicing only (drop --accum fixed, --slicing image, --refine or --method reference)")
+    } else if args.perspective.is_some() {
+        Some("orthographic views only (a perspective view samples each voxel's own footprint)")
+    } else if args.footprint.method == MethodArg::Direct {
+        Some("view-table methods only (--method direct samples the generic table per pixel)")
+    } else if args.phases == 0 {
+        Some("--phases 0 walks the table: give a phase count")
+    } else {
+        None
+    };
+    refused_if("--phase-lookup nearest", why)
+}
+
+/// `flag` refused for reason `why`, if there is one.
+fn refused_if(flag: &str, why: Option<&str>) -> Result<(), CliError> {
+    match why {
+        Some(why) => Err(CliError::input(format!("{flag}: {why}"))),
         None => Ok(()),
     }
 }
@@ -355,10 +389,7 @@ fn cull_rules(eps: f32, end: &End, args: &RenderArgs) -> Result<(), CliError> {
     } else {
         None
     };
-    match why {
-        Some(why) => Err(CliError::input(format!("--cull {eps}: {why}"))),
-        None => Ok(()),
-    }
+    refused_if(&format!("--cull {eps}"), why)
 }
 
 /// The rules a streamed volume (`--stream`: read once, a few sheets at a time) adds to `end`.

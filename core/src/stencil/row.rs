@@ -12,9 +12,11 @@ const BLOCK: usize = 8;
 
 /// Adds `value` × w to each pixel of `px`, w = Σ blend[i] · rows[i][k] (the blend of the four
 /// corner stencils' row entries, in that order, as [`super::Stencils::splat`] sums them); every
-/// row holds at least `px.len()` entries. Returns how many weights were non-zero.
+/// row holds at least `px.len()` entries. Returns how many weights were non-zero. `NEAREST`: w =
+/// rows[0][k] itself (the nearest phase's stencil, [`super::PhaseLookup::Nearest`]; the other
+/// rows and weights are not read).
 #[inline(always)]
-pub(super) fn blend_row<P: Pixel>(
+pub(super) fn blend_row<const NEAREST: bool, P: Pixel>(
     [w00, w10, w01, w11]: [f32; 4],
     (r00, r10, r01, r11): (&[f32], &[f32], &[f32], &[f32]),
     value: &P,
@@ -32,7 +34,11 @@ pub(super) fn blend_row<P: Pixel>(
         let (a, b, c, e) = (block(r00, k), block(r10, k), block(r01, k), block(r11, k));
         let mut wt = [0.0f32; BLOCK];
         for (i, o) in wt.iter_mut().enumerate() {
-            *o = w00 * a[i] + w10 * b[i] + w01 * c[i] + w11 * e[i];
+            *o = if NEAREST {
+                a[i]
+            } else {
+                w00 * a[i] + w10 * b[i] + w01 * c[i] + w11 * e[i]
+            };
         }
         for (d, &w) in ds.iter_mut().zip(&wt) {
             d.add_weighted(value, w);
@@ -41,7 +47,11 @@ pub(super) fn blend_row<P: Pixel>(
     }
     let k0 = n - rest.len();
     for (k, d) in (k0..).zip(rest.iter_mut()) {
-        let wt = w00 * r00[k] + w10 * r10[k] + w01 * r01[k] + w11 * r11[k];
+        let wt = if NEAREST {
+            r00[k]
+        } else {
+            w00 * r00[k] + w10 * r10[k] + w01 * r01[k] + w11 * r11[k]
+        };
         d.add_weighted(value, wt);
         updated += u32::from(wt != 0.0);
     }

@@ -50,9 +50,10 @@ fn window_for(run: usize, side: usize) -> usize {
 
 impl<S: ?Sized> Stencils<'_, S> {
     /// [`Stencils::splat_window`] for this view's longest row run if [`window_for`] gives it a
-    /// window (one instance per width, each with a fixed trip count), else `None`.
+    /// window (one instance per width, each with a fixed trip count), else `None`; `NEAREST` as
+    /// in [`super::row::blend_row`].
     #[inline(always)]
-    pub(super) fn splat_small<P: Pixel>(
+    pub(super) fn splat_small<const NEAREST: bool, P: Pixel>(
         &self,
         (corners, blend, spans, at): SmallBox<'_>,
         value: &P,
@@ -64,7 +65,7 @@ impl<S: ?Sized> Stencils<'_, S> {
         macro_rules! by_width {
             ($($w:literal)*) => {
                 match width {
-                    $($w => self.splat_window::<$w, P>(
+                    $($w => self.splat_window::<$w, NEAREST, P>(
                         corners, blend, spans, at, value, data, stride, touched,
                     ),)*
                     _ => None,
@@ -80,10 +81,11 @@ impl<S: ?Sized> Stencils<'_, S> {
     /// stay inside the box; a fixed-length loop the compiler vectorises) and added across it.
     /// Outside a row's stored run all four corner stencils are zero, so the weight there is +0
     /// and the pixel is unchanged: the same sums, statistics and touched runs as the general loop.
-    /// `None` (nothing added) if a run is longer than `W` or `W` exceeds the box.
+    /// `None` (nothing added) if a run is longer than `W` or `W` exceeds the box. `NEAREST`: the
+    /// weight is the first corner's entry itself ([`super::row::blend_row`]).
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn splat_window<const W: usize, P: Pixel>(
+    fn splat_window<const W: usize, const NEAREST: bool, P: Pixel>(
         &self,
         corners: [usize; 4],
         [w00, w10, w01, w11]: [f32; 4],
@@ -127,7 +129,11 @@ impl<S: ?Sized> Stencils<'_, S> {
             );
             let mut wt = [0.0f32; W];
             for (k, o) in wt.iter_mut().enumerate() {
-                *o = w00 * a[k] + w10 * b[k] + w01 * c[k] + w11 * d[k];
+                *o = if NEAREST {
+                    a[k]
+                } else {
+                    w00 * a[k] + w10 * b[k] + w01 * c[k] + w11 * d[k]
+                };
             }
             let y = y0 + my;
             let begin = y * stride + x0 + start;

@@ -93,7 +93,8 @@ pub fn describe(p: &Prepared, args: &Inputs, plan: &Plan) -> Json {
 
 /// What drew the frame, resolved (defaults and `auto`s decided): `end` (`sheets`, `slabs`,
 /// `post`, `refined` or `reference`), `precision`, `slab` (voxel spacings; null but for slabs),
-/// `subsample` and `supersample` (factors), `lod` (level), `cull` (ε; null when off), `order`.
+/// `subsample` and `supersample` (factors), `lod` (level), `cull` (ε; null when off), `order`,
+/// `phase_lookup` (`blend` or `nearest`: how float sheets read the phase stencils).
 pub fn plan_json(p: &Prepared, plan: &Plan) -> Json {
     let (end, slab) = match plan.end {
         End::Sheets(_) => ("sheets", f64::NAN),
@@ -117,4 +118,8 @@ pub fn plan_json(p: &Prepared, plan: &Plan) -> Json {
         .num("lod", f64::from(p.level))
         .num("cull", plan.cull.map_or(f64::NAN, f64::from))
         .str("order", &format!("{:?}", p.order).to_lowercase())
+        .str(
+            "phase_lookup",
+            crate::args::phase_lookup_name(plan.phase_lookup.unwrap_or_default()),
+        )
 }

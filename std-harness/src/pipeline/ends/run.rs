@@ -161,7 +161,8 @@ fn sheets_at<const N: usize>(
                 let r = if let Some(len) = stencil_len(p, plan.phases) {
                     // Footprints up to 128 px across: the view table sampled once per phase.
                     let mut buffer = vec![0.0f32; len];
-                    let stencils = build_stencils(&*table, plan.phases, &mut buffer, threads)?;
+                    let stencils = build_stencils(&*table, plan.phases, &mut buffer, threads)?
+                        .with_phase_lookup(plan.phase_lookup.unwrap_or_default());
                     let tables = start.elapsed().as_secs_f64();
                     let path = FloatPath::new(&stencils).with_absorption(p.absorption);
                     let r = run_path(p, path, p.background.as_deref(), cache, bands)?;

@@ -25,6 +25,9 @@ pub struct Config {
     /// paper's adaptive re-sampling; float, robust method, orthographic only). Only the pilot
     /// against `--quality-reference field` ([`super::pilot`]) tries it.
     pub refine: bool,
+    /// Object slicing with the stencils read at the nearest phase (`--phase-lookup nearest`);
+    /// only the default plan's pilot tries it ([`super::pilot::choose_slicing`]).
+    pub nearest_phase: bool,
 }
 
 impl Config {
@@ -53,6 +56,7 @@ impl Config {
                             accum,
                             slab_quarters: None,
                             refine: false,
+                            nearest_phase: false,
                         });
                     }
                 }
@@ -75,6 +79,7 @@ impl Config {
                 accum: AccumArg::Float,
                 slab_quarters: Some((t * 4.0) as u16),
                 refine: false,
+                nearest_phase: false,
             })
             .collect()
     }
@@ -85,19 +90,25 @@ impl Config {
     }
 
     /// `n=65/bilinear/view/float/libm`, the bench naming; `image/slab=0.5/float/libm` for slabs;
-    /// `n=65/bilinear/view/float/libm/refine=0` refined.
+    /// `n=65/bilinear/view/float/libm/refine=0` refined, `…/phase=nearest` read at the nearest
+    /// phase.
     pub fn label(&self) -> String {
         if let Some(t) = self.slab() {
             return format!("image/slab={t}/float/{}", footprint::math::BACKEND);
         }
         format!(
-            "n={}/{}/{}/{}/{}{}",
+            "n={}/{}/{}/{}/{}{}{}",
             self.table,
             lookup_name(self.lookup),
             method_name(self.method),
             accum_name(self.accum),
             footprint::math::BACKEND,
-            if self.refine { "/refine=0" } else { "" }
+            if self.refine { "/refine=0" } else { "" },
+            if self.nearest_phase {
+                "/phase=nearest"
+            } else {
+                ""
+            }
         )
     }
 
@@ -109,6 +120,7 @@ impl Config {
             accum: AccumArg::Float,
             slab_quarters: None,
             refine: true,
+            nearest_phase: false,
             ..*self
         }
     }
@@ -128,12 +140,22 @@ impl Config {
             accum: AccumArg::Float,
             slab_quarters: None,
             refine: false,
+            nearest_phase: plan.phase_lookup == Some(footprint::stencil::PhaseLookup::Nearest),
+        }
+    }
+
+    /// This configuration read at the nearest phase ([`Config::nearest_phase`]).
+    pub fn nearest(&self) -> Config {
+        Config {
+            nearest_phase: true,
+            ..*self
         }
     }
 
     /// `base` with this configuration's table, lookup, method, accumulation and slicing, and
-    /// refined at threshold 0 if it refines (`base`'s own refinement is kept otherwise): the plan
-    /// `--quality` and `chart` render, derived, not rewritten from flags.
+    /// refined at threshold 0 if it refines (`base`'s own refinement is kept otherwise), read at
+    /// the nearest phase if it is (`base`'s phase lookup otherwise): the plan `--quality` and
+    /// `chart` render, derived, not rewritten from flags.
     pub fn plan(&self, base: &Plan) -> Plan {
         let mut p = base.clone();
         p.table.size = self.table;
@@ -147,6 +169,9 @@ impl Config {
             AccumArg::Float => Precision::Float,
             AccumArg::Fixed => Precision::Fixed,
         };
+        if self.nearest_phase {
+            p.phase_lookup = Some(footprint::stencil::PhaseLookup::Nearest);
+        }
         p.end = match (self.slab(), self.refine, base.end) {
             (_, true, _) => End::Refined {
                 threshold: 0.0,
@@ -156,6 +181,10 @@ impl Config {
             (None, false, End::Refined { threshold, sheets }) => End::Refined { threshold, sheets },
             (None, false, _) => End::Sheets(precision),
         };
+        if p.end != End::Sheets(Precision::Float) {
+            // Only float sheets read phase stencils nearest (`plan::phase_lookup_rules`).
+            p.phase_lookup = None;
+        }
         p
     }
 }

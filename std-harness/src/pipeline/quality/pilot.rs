@@ -63,7 +63,11 @@
 //! # The default plan
 //! [`choose_slicing`] runs the same pilot for `--slicing auto` (the default) at
 //! [`crate::plan::DEFAULT_TARGET_DB`], with other candidates: the frame as the flags ask for it
-//! (object slicing, its own table), then the slabs, thickest first. Its chosen frame is kept in
+//! (object slicing, its own table), read at the nearest phase first where that is a frame of its
+//! own (`--phase-lookup auto`, blended stencils: [`footprint::stencil::PhaseLookup`], one
+//! stencil row per pixel instead of four's blend: object re-renders 1.09–1.15× faster at 512² on
+//! the peers' volumes, −0.01 to −0.44 dB against the continuous model, docs/modes.md), then
+//! blended, then the slabs, thickest first. Its chosen frame is kept in
 //! the choice ([`Choice::frame`]) and is the command's frame, not rendered again (unless no
 //! candidate reached the target: the most accurate is then rendered again).
 
@@ -254,7 +258,12 @@ pub fn choose_slicing(
     let mut object = base.clone();
     object.auto_slicing = None;
     let own = Config::of_plan(base);
-    let mut candidates = vec![(own, object.clone())];
+    let mut candidates = Vec::new();
+    if nearest_phase_differs(p, base) {
+        let nearest = own.nearest();
+        candidates.push((nearest, nearest.plan(&object)));
+    }
+    candidates.push((own, object.clone()));
     candidates.extend(slabs.into_iter().map(|c| (c, c.plan(&object))));
     let mut run = Run::new(
         p,
@@ -264,6 +273,20 @@ pub fn choose_slicing(
         base.threads,
     )?;
     Ok(Some(run.measure(candidates, true)?))
+}
+
+/// Whether `base`'s object slicing of `p` read at the nearest phase is a frame of its own: the
+/// phase lookup left to the pilot (`--phase-lookup auto`), float sheets through the view table's
+/// stencils (`--phases` > 0, orthographic, not `--method direct`), and a footprint whose stencils
+/// are blended (an edged one is blended whatever the lookup, [`footprint::stencil::Plan::edged`]).
+fn nearest_phase_differs(p: &Prepared, base: &Plan) -> bool {
+    use crate::plan::{Footprints, Precision};
+    base.phase_lookup.is_none()
+        && base.end == End::Sheets(Precision::Float)
+        && base.table.footprints == Footprints::ViewTable
+        && base.phases > 0
+        && p.frame.camera().is_none()
+        && footprint::stencil::plan_for(&p.frame.footprint, base.phases).is_some_and(|s| !s.edged)
 }
 
 /// One pilot: the frames `p` renders, measured at sampled pixels against a continuous

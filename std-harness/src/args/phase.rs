@@ -1,0 +1,35 @@
+//! `--phase-lookup`: how the phase stencils are read at a voxel's sub-pixel phase.
+
+use footprint::stencil::PhaseLookup;
+
+/// `--phase-lookup`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum PhaseLookupArg {
+    /// The default plan's pilot measures the nearest phase first and keeps it where it reaches
+    /// the target; blended everywhere else.
+    #[default]
+    Auto,
+    /// The bilinear blend of the four stencils around the phase.
+    Blend,
+    /// The stencil of the nearest phase.
+    Nearest,
+}
+
+impl PhaseLookupArg {
+    /// The lookup the flag fixes; `None` for `auto`.
+    pub fn fixed(self) -> Option<PhaseLookup> {
+        match self {
+            PhaseLookupArg::Auto => None,
+            PhaseLookupArg::Blend => Some(PhaseLookup::Blend),
+            PhaseLookupArg::Nearest => Some(PhaseLookup::Nearest),
+        }
+    }
+}
+
+/// The name the flag and the JSON use.
+pub fn phase_lookup_name(l: PhaseLookup) -> &'static str {
+    match l {
+        PhaseLookup::Blend => "blend",
+        PhaseLookup::Nearest => "nearest",
+    }
+}
