@@ -40,7 +40,7 @@
 //! ## Rendering a volume that is in memory
 //! The front door ([`quick`], imported with [`prelude`]): a `&[T]` volume (x fastest), VTK's
 //! camera as `footprint render --view` takes it, a transfer-function [`Preset`](shade::Preset),
-//! into caller-owned buffers, the same image as the CLI bit for bit:
+//! into caller-owned buffers, the same image as `footprint render --slicing object` bit for bit:
 //! ```
 //! use footprint::prelude::*;
 //! let (dims, data) = ([16, 16, 16], (0..4096u32).map(|i| (i * 37 % 256) as u8).collect::<Vec<_>>());

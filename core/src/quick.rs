@@ -1,7 +1,9 @@
 //! The front door: a volume in memory (`&[T]`, x fastest) rendered with VTK's camera, a transfer
-//! function and the CLI's defaults into caller buffers, in one call. It is `footprint render`'s
-//! float path for a volume in memory, and gives the same image bit for bit (`tests/library.rs`
-//! renders `core/examples/in_memory.rs` both ways and compares the PNG bytes).
+//! function and the CLI's defaults into caller buffers, in one call. It is `footprint render
+//! --slicing object`'s float path for a volume in memory (object slicing, blended phase stencils:
+//! the CLI's default plan measures its choice on a pilot the core does not run), and gives the
+//! same image bit for bit (`tests/library.rs` renders `core/examples/in_memory.rs` both ways and
+//! compares the PNG bytes).
 //!
 //! ```
 //! use footprint::prelude::*;
