@@ -17,7 +17,15 @@ const HEADSQ: &str = concat!(
 
 #[test]
 fn pilot_rows_are_the_frames_rows_bit_for_bit() {
-    for (lod, shading) in [("0", "emission"), ("1", "phong"), ("2", "emission")] {
+    // Stencils blended, and read at the nearest phase (`--phase-lookup nearest`).
+    let cases = [
+        ("0", "emission", "blend"),
+        ("1", "phong", "blend"),
+        ("2", "emission", "blend"),
+        ("0", "emission", "nearest"),
+        ("1", "phong", "nearest"),
+    ];
+    for (lod, shading, lookup) in cases {
         let args = parse_args(&[
             HEADSQ,
             "--size",
@@ -28,6 +36,10 @@ fn pilot_rows_are_the_frames_rows_bit_for_bit() {
             lod,
             "--shading",
             shading,
+            "--slicing",
+            "object",
+            "--phase-lookup",
+            lookup,
         ])
         .unwrap();
         let p = prepare(&args).unwrap();
@@ -42,7 +54,7 @@ fn pilot_rows_are_the_frames_rows_bit_for_bit() {
             assert_eq!(
                 &got[i * 40..(i + 1) * 40],
                 &whole[y * 40..(y + 1) * 40],
-                "lod {lod}, row {y}"
+                "lod {lod}, {lookup}, row {y}"
             );
         }
     }

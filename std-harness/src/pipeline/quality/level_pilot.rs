@@ -140,13 +140,15 @@ pub fn render_rows(p: &Prepared, plan: &Plan, rows: &[usize]) -> Result<Vec<[f32
                 lookup,
             ));
             // The sampler the whole frame's render uses (`crate::pipeline::ends::run`): phase
-            // stencils where the footprint allows them, else the view table.
+            // stencils where the footprint allows them, read by the plan's phase lookup, else
+            // the view table.
             let len = stencil_len(p, plan.phases);
             let threads = plan.threads;
             let bands = match len {
                 Some(len) => {
                     let mut buffer = vec![0.0f32; len];
-                    let stencils = build_stencils(&*table, plan.phases, &mut buffer, threads)?;
+                    let stencils = build_stencils(&*table, plan.phases, &mut buffer, threads)?
+                        .with_phase_lookup(plan.phase_lookup.unwrap_or_default());
                     split_rows(p, &stencils, volume, rows, threads)?
                 }
                 None => split_rows(p, &*table, volume, rows, threads)?,
