@@ -181,8 +181,9 @@ impl Config {
             (None, false, End::Refined { threshold, sheets }) => End::Refined { threshold, sheets },
             (None, false, _) => End::Sheets(precision),
         };
-        if p.end != End::Sheets(Precision::Float) {
-            // Only float sheets read phase stencils nearest (`plan::phase_lookup_rules`).
+        if p.end != End::Sheets(Precision::Float) || p.table.footprints == Footprints::Direct {
+            // Only float sheets through a view table read phase stencils nearest
+            // (`plan::phase_lookup_rules`).
             p.phase_lookup = None;
         }
         p
