@@ -32,8 +32,10 @@ use footprint::Lookup;
 use std::path::PathBuf;
 
 mod auto;
+mod phase;
 mod post;
 pub use auto::DEFAULT_TARGET_DB;
+use phase::phase_lookup_rules;
 use post::{no_post_flags, post_plan};
 
 /// How the float or fixed sheets accumulate.
@@ -344,27 +346,6 @@ fn flag_rules(end: &End, args: &RenderArgs) -> Result<(), CliError> {
         Some(eps) => cull_rules(eps, end, args),
         None => Ok(()),
     }
-}
-
-/// The rules `--phase-lookup nearest` adds: float sheets through a view table's stencils (the
-/// fixed path's integer stencils, slabs, refined grids, perspective frames and `--method direct`
-/// have no phase to read nearest).
-fn phase_lookup_rules(end: &End, args: &RenderArgs) -> Result<(), CliError> {
-    if args.phase_lookup != crate::args::PhaseLookupArg::Nearest {
-        return Ok(());
-    }
-    let why = if *end != End::Sheets(Precision::Float) {
-        Some("float object slicing only (drop --accum fixed, --slicing image, --refine or --method reference)")
-    } else if args.perspective.is_some() {
-        Some("orthographic views only (a perspective view samples each voxel's own footprint)")
-    } else if args.footprint.method == MethodArg::Direct {
-        Some("view-table methods only (--method direct samples the generic table per pixel)")
-    } else if args.phases == 0 {
-        Some("--phases 0 walks the table: give a phase count")
-    } else {
-        None
-    };
-    refused_if("--phase-lookup nearest", why)
 }
 
 /// `flag` refused for reason `why`, if there is one.

@@ -118,7 +118,6 @@ fn sheets_at<const N: usize>(
     cache: &mut FrameCache,
 ) -> Result<CoreFrame, CliError> {
     let lookup = plan.table.lookup;
-    let threads = plan.threads;
     let bands = Bands::of(plan);
     let direct = plan.table.footprints == Footprints::Direct;
     let start = Instant::now();
@@ -161,8 +160,7 @@ fn sheets_at<const N: usize>(
                 let r = if let Some(len) = stencil_len(p, plan.phases) {
                     // Footprints up to 128 px across: the view table sampled once per phase.
                     let mut buffer = vec![0.0f32; len];
-                    let stencils = build_stencils(&*table, plan.phases, &mut buffer, threads)?
-                        .with_phase_lookup(plan.phase_lookup.unwrap_or_default());
+                    let stencils = build_stencils(&*table, plan, &mut buffer)?;
                     let tables = start.elapsed().as_secs_f64();
                     let path = FloatPath::new(&stencils).with_absorption(p.absorption);
                     let r = run_path(p, path, p.background.as_deref(), cache, bands)?;
@@ -269,15 +267,16 @@ fn fixed_sheets<const N: usize>(
     ))
 }
 
-/// The float path's phase stencils of `sampler` (at most `phases` per pixel) in `buffer`,
-/// sampled on `threads` threads, whole stencils each: the same bits for any number.
+/// The float path's phase stencils of `sampler` for `plan` in `buffer` (at most `plan.phases`
+/// per pixel, read by its phase lookup), sampled on `plan.threads` threads, whole stencils each:
+/// the same bits for any number.
 pub fn build_stencils<'a, S: footprint::Sampler + Sync + ?Sized>(
     sampler: &'a S,
-    phases: usize,
+    plan: &Plan,
     buffer: &'a mut [f32],
-    threads: usize,
 ) -> Result<Stencils<'a, S>, footprint::splat::BufferError> {
-    Stencils::build_split(sampler, phases, buffer, |weights, fill| {
+    let threads = plan.threads;
+    let stencils = Stencils::build_split(sampler, plan.phases, buffer, |weights, fill| {
         let cells = fill.cells();
         let count = weights.len() / cells.max(1);
         let per = count.div_ceil(threads.clamp(1, count.max(1))).max(1);
@@ -290,7 +289,8 @@ pub fn build_stencils<'a, S: footprint::Sampler + Sync + ?Sized>(
                 });
             }
         });
-    })
+    })?;
+    Ok(stencils.with_phase_lookup(plan.phase_lookup.unwrap_or_default()))
 }
 
 /// The buffer length of the float path's phase stencils for `p`'s footprint with `phases`

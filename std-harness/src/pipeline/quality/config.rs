@@ -181,9 +181,7 @@ impl Config {
             (None, false, End::Refined { threshold, sheets }) => End::Refined { threshold, sheets },
             (None, false, _) => End::Sheets(precision),
         };
-        if p.end != End::Sheets(Precision::Float) || p.table.footprints == Footprints::Direct {
-            // Only float sheets through a view table read phase stencils nearest
-            // (`plan::phase_lookup_rules`).
+        if !p.reads_phase_stencils() {
             p.phase_lookup = None;
         }
         p

@@ -147,8 +147,7 @@ pub fn render_rows(p: &Prepared, plan: &Plan, rows: &[usize]) -> Result<Vec<[f32
             let bands = match len {
                 Some(len) => {
                     let mut buffer = vec![0.0f32; len];
-                    let stencils = build_stencils(&*table, plan.phases, &mut buffer, threads)?
-                        .with_phase_lookup(plan.phase_lookup.unwrap_or_default());
+                    let stencils = build_stencils(&*table, plan, &mut buffer)?;
                     split_rows(p, &stencils, volume, rows, threads)?
                 }
                 None => split_rows(p, &*table, volume, rows, threads)?,

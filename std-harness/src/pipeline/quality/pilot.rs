@@ -276,15 +276,12 @@ pub fn choose_slicing(
 }
 
 /// Whether `base`'s object slicing of `p` read at the nearest phase is a frame of its own: the
-/// phase lookup left to the pilot (`--phase-lookup auto`), float sheets through the view table's
-/// stencils (`--phases` > 0, orthographic, not `--method direct`), and a footprint whose stencils
-/// are blended (an edged one is blended whatever the lookup, [`footprint::stencil::Plan::edged`]).
+/// phase lookup left to the pilot (`--phase-lookup auto`), a plan that reads phase stencils
+/// ([`Plan::reads_phase_stencils`]) in an orthographic frame, and a footprint whose stencils are
+/// blended (an edged one is blended whatever the lookup, [`footprint::stencil::Plan::edged`]).
 fn nearest_phase_differs(p: &Prepared, base: &Plan) -> bool {
-    use crate::plan::{Footprints, Precision};
     base.phase_lookup.is_none()
-        && base.end == End::Sheets(Precision::Float)
-        && base.table.footprints == Footprints::ViewTable
-        && base.phases > 0
+        && base.reads_phase_stencils()
         && p.frame.camera().is_none()
         && footprint::stencil::plan_for(&p.frame.footprint, base.phases).is_some_and(|s| !s.edged)
 }
