@@ -15,6 +15,7 @@
 //!   nothing is extrapolated past its faces); a NaN value is a missing sample (weight zero) and a
 //!   sample whose weights are all missing is transparent.
 
+use super::sparse::SparseGrid;
 use crate::CliError;
 use footprint::frame::FrameSetup;
 use footprint::render::{gradient, SheetRing};
@@ -66,8 +67,8 @@ pub struct ContinuousScene<'a> {
 /// [`ContinuousScene::cap`] as the renderer takes it: 1 − `SlabVoxel::MAX_UNIT_ALPHA` = 10⁻⁶.
 pub const DEFAULT_CAP: f64 = 1e-6;
 
-/// Voxels per block side of the empty-space map.
-const BLOCK: usize = 8;
+/// Voxels per block side of the empty-space map, the sparse grid's blocks.
+const BLOCK: usize = super::sparse::SIDE;
 
 /// Which continuous integral the field defines.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -95,11 +96,12 @@ pub(super) struct Taps {
     d2: Vec<f64>,
 }
 
-/// The voxels as the model reads them, x fastest, and the block map.
+/// The voxels as the model reads them, in blocks allocated where a voxel is stored, and the block map.
 pub(super) struct Field<'s> {
     dims: [usize; 3],
-    /// Pre: [α, αr, αg, αb] or [σ, σr, σg, σb]; post: [value, gx, gy, gz] (world gradient).
-    voxels: Vec<[f32; 4]>,
+    /// Pre: [α, αr, αg, αb] or [σ, σr, σg, σb], only those that can be seen (an absent voxel is
+    /// transparent); post: [value, gx, gy, gz] (world gradient), every voxel.
+    voxels: SparseGrid,
     model: Model,
     /// Post: the shader and lighting that classify each sample.
     classify: Option<(Shader<'s>, Lighting)>,
@@ -121,11 +123,14 @@ impl<'s> Field<'s> {
         let f = scene.frame;
         let dims = f.dims;
         let n = dims.iter().product::<usize>();
-        let mut voxels = zeroed(n).ok_or_else(|| {
+        let cannot = || {
             CliError::input(format!(
                 "cannot allocate the continuous reference's {n} voxels"
             ))
-        })?;
+        };
+        // Post-classification stores every voxel; the pre-classified models only those seen.
+        let mut voxels = SparseGrid::new(dims, scene.model == Model::Post).ok_or_else(cannot)?;
+        let mut full = false;
         // Opacity per world unit: the shader at an exponent of one.
         let lighting = Lighting::per_world_unit(f);
         let (len, na, nb) = f.sheet_shape();
@@ -144,7 +149,7 @@ impl<'s> Field<'s> {
         };
         // The blocks holding a voxel that can be seen (dilated below by the reconstruction's
         // reach into the blocks it can be seen from).
-        let blocks = dims.map(|d| d.div_ceil(BLOCK));
+        let blocks = voxels.count();
         let mut holds = vec![false; blocks.iter().product()];
         let mut store = |ring: &SheetRing<'_, f32>, n: usize| {
             let (s, window) = (ring.sheet_index(n), ring.window(n));
@@ -170,7 +175,9 @@ impl<'s> Field<'s> {
                         }
                     };
                     if let Some(v) = stored {
-                        voxels[(idx[2] * dims[1] + idx[1]) * dims[0] + idx[0]] = v;
+                        if voxels.set(idx, v).is_err() {
+                            full = true;
+                        }
                         if seen(&v) {
                             let b = idx.map(|c| c / BLOCK);
                             holds[(b[2] * blocks[1] + b[1]) * blocks[0] + b[0]] = true;
@@ -190,6 +197,9 @@ impl<'s> Field<'s> {
         }
         if let Some(n) = ring.last() {
             store(&ring, n);
+        }
+        if full {
+            return Err(cannot());
         }
         let (reach, kernel) = match (scene.reconstruction, *scene.kernel) {
             (Reconstruction::Trilinear, _) => (1.0, None),
@@ -314,7 +324,7 @@ impl<'s> Field<'s> {
             if x < 0 || y < 0 || z < 0 || x >= d[0] as i64 || y >= d[1] as i64 || z >= d[2] as i64 {
                 return None;
             }
-            Some(&self.voxels[(z as usize * d[1] + y as usize) * d[0] + x as usize])
+            self.voxels.get(x as usize, y as usize, z as usize)
         };
         match self.kernel {
             None => {
@@ -362,39 +372,21 @@ impl<'s> Field<'s> {
                             continue;
                         }
                         let eyz = e[2 * n + jz] * e[n + jy] * norm;
-                        let row = (z as usize * d[1] + y as usize) * d[0];
                         for x in inside(0) {
                             let jx = (x - lo[0]) as usize;
                             if dyz + d2[jx] >= r2 {
                                 continue;
                             }
-                            visit(&self.voxels[row + x as usize], eyz * e[jx]);
+                            // An absent voxel is transparent: it adds nothing (pre-classified
+                            // only; post-classification stores every voxel).
+                            if let Some(v) = self.voxels.get(x as usize, y as usize, z as usize) {
+                                visit(v, eyz * e[jx]);
+                            }
                         }
                     }
                 }
             }
         }
-    }
-}
-
-/// `n` transparent voxels (all bits zero), or `None` if they cannot be allocated. The memory
-/// comes zeroed from the allocator (fresh pages from the system for a large field), not written
-/// here, so the pages of a transparent region are never touched. On the 256³ blobs (268 MB of
-/// field, much of it transparent) 59 % of the samples of `perf record` over a one-frame
-/// `footprint bench` at 512² were the kernel clearing the pages that writing the zeros faulted
-/// in.
-fn zeroed(n: usize) -> Option<Vec<[f32; 4]>> {
-    let layout = std::alloc::Layout::array::<[f32; 4]>(n).ok()?;
-    if layout.size() == 0 {
-        return Some(Vec::new());
-    }
-    // SAFETY: the layout has a non-zero size, as `alloc_zeroed` requires. A non-null result
-    // is valid for `n` `[f32; 4]`s of zero bits, which are valid values (0.0), allocated by the
-    // global allocator with exactly the layout of a `Vec` of capacity `n`, so `from_raw_parts`
-    // (length and capacity `n`) takes ownership of it as a `Vec` would have allocated it.
-    unsafe {
-        let ptr = std::alloc::alloc_zeroed(layout).cast::<[f32; 4]>();
-        (!ptr.is_null()).then(|| Vec::from_raw_parts(ptr, n, n))
     }
 }
 

@@ -17,6 +17,7 @@ pub mod continuous;
 pub mod field;
 pub mod perspective;
 pub mod render;
+mod sparse;
 
 use footprint::geometry::{in_sheet_axes, sheet_axis, RENORMALISE_BELOW_PX};
 use footprint::{GeometryError, Kernel};
