@@ -129,8 +129,7 @@ impl<'s> Field<'s> {
             ))
         };
         // Post-classification stores every voxel; the pre-classified models only those seen.
-        let mut voxels = SparseGrid::new(dims, scene.model == Model::Post).ok_or_else(cannot)?;
-        let mut full = false;
+        let mut voxels = SparseGrid::new(dims).ok_or_else(cannot)?;
         // Opacity per world unit: the shader at an exponent of one.
         let lighting = Lighting::per_world_unit(f);
         let (len, na, nb) = f.sheet_shape();
@@ -155,8 +154,11 @@ impl<'s> Field<'s> {
             let (s, window) = (ring.sheet_index(n), ring.window(n));
             for v in 0..nb {
                 for u in 0..na {
-                    let idx = f.grid_index(s, u, v);
                     let value = window.current[v * na + u];
+                    if matches!(scene.model, Model::Pre(_)) && value <= clear {
+                        continue;
+                    }
+                    let idx = f.grid_index(s, u, v);
                     let stored = match scene.model {
                         Model::Pre(_) if value <= clear => None,
                         Model::Pre(absorption) => {
@@ -175,9 +177,7 @@ impl<'s> Field<'s> {
                         }
                     };
                     if let Some(v) = stored {
-                        if voxels.set(idx, v).is_err() {
-                            full = true;
-                        }
+                        voxels.set(idx, v);
                         if seen(&v) {
                             let b = idx.map(|c| c / BLOCK);
                             holds[(b[2] * blocks[1] + b[1]) * blocks[0] + b[0]] = true;
@@ -197,9 +197,6 @@ impl<'s> Field<'s> {
         }
         if let Some(n) = ring.last() {
             store(&ring, n);
-        }
-        if full {
-            return Err(cannot());
         }
         let (reach, kernel) = match (scene.reconstruction, *scene.kernel) {
             (Reconstruction::Trilinear, _) => (1.0, None),
@@ -372,6 +369,7 @@ impl<'s> Field<'s> {
                             continue;
                         }
                         let eyz = e[2 * n + jz] * e[n + jy] * norm;
+                        let row = self.voxels.row(y as usize, z as usize);
                         for x in inside(0) {
                             let jx = (x - lo[0]) as usize;
                             if dyz + d2[jx] >= r2 {
@@ -379,7 +377,7 @@ impl<'s> Field<'s> {
                             }
                             // An absent voxel is transparent: it adds nothing (pre-classified
                             // only; post-classification stores every voxel).
-                            if let Some(v) = self.voxels.get(x as usize, y as usize, z as usize) {
+                            if let Some(v) = row.get(x as usize) {
                                 visit(v, eyz * e[jx]);
                             }
                         }
