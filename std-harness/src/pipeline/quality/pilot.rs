@@ -38,7 +38,8 @@
 //! candidate is decided there when its upper bound reaches DB (taken) or its lower bound,
 //! m − Z·s/√n·√(1 − n/N), does not (more pixels would not lift the estimate past it: rejected);
 //! otherwise the reference is marched through the other pixels too (through the same field,
-//! built once and held until then: 16 bytes a voxel, so two stages only where that fits the
+//! built once and held until then: at most 16 bytes a voxel (`reference::sparse` keeps only
+//! the blocks holding a voxel that can be seen), so two stages only where that bound fits the
 //! visible lists' budget) and the candidate, and every later one, is measured on all of them.
 //! A scene far from the target on either side costs a quarter of the reference, one near it
 //! the whole as before (the pilot reference took 0.01–0.21 s at 256² on the shared volumes,
