@@ -9,7 +9,9 @@
 //! the system for a large grid, not written here), and blocks are handed out in the order they are
 //! first stored to, so the pages touched are those of the blocks used and nothing is ever moved.
 //! Post-classification stores every voxel (a value below the transfer function's first opacity
-//! still weighs in a sample's interpolation), so every block is used there, as dense as before.
+//! still weighs in a sample's interpolation), so every block is used there: the grid's sides
+//! rounded up to whole blocks, ∏⌈dᵢ/8⌉·8 / ∏dᵢ of the dense size (1.0 for sides that are
+//! multiples of 8, 1.08 for 257³, at most 1.36 for sides of 65 and up).
 
 /// Voxels per block side (a block is 512 voxels, 8 KiB).
 pub(super) const SIDE: usize = 8;
