@@ -120,6 +120,8 @@ impl<'s> Field<'s> {
         scene: &ContinuousScene<'s>,
         sheet: &mut dyn FnMut(usize, &mut [f32]),
     ) -> Result<Self, CliError> {
+        // The reconstruction first: a kernel it cannot use is refused before any sheet is read.
+        let (reach, kernel) = reconstruction(scene)?;
         let f = scene.frame;
         let dims = f.dims;
         let n = dims.iter().product::<usize>();
@@ -204,23 +206,6 @@ impl<'s> Field<'s> {
         if let Some(n) = ring.last() {
             store(&ring, n);
         }
-        let (reach, kernel) = match (scene.reconstruction, *scene.kernel) {
-            (Reconstruction::Trilinear, _) => (1.0, None),
-            (Reconstruction::Kernel, Kernel::Gaussian { spread, sigmas }) => {
-                let r = f64::from(spread);
-                let norm = 1.0 / (r.powi(3) * super::integral_f64(scene.kernel));
-                let sigmas = f64::from(sigmas);
-                let k = sigmas * sigmas / (2.0 * r * r);
-                (r, Some((r, k, (-2.0 * k).exp(), norm)))
-            }
-            (Reconstruction::Kernel, other) => {
-                return Err(CliError::input(format!(
-                    "--reference continuous reconstructs with the kernel in 3D, which only a \
-                     Gaussian is ({other} is a footprint model): use a gaussian kernel or \
-                     --reconstruction trilinear"
-                )))
-            }
-        };
         // A voxel at x is read by samples within `reach` of it, so it makes the blocks of
         // x ± pad active: every block within ⌈pad / BLOCK⌉ blocks of one that holds it (a
         // superset, which only costs the march a few more looks at zero voxels).
@@ -392,6 +377,31 @@ impl<'s> Field<'s> {
             }
         }
     }
+}
+
+/// A reconstruction's reach (grid steps) and, for the kernel, its (R, k = sigmas² / (2R²),
+/// exp(−2k), 1 / (R³ ∫h)), as [`Field`] holds them.
+type KernelFactors = (f64, Option<(f64, f64, f64, f64)>);
+
+/// The reach and kernel factors of `scene`'s reconstruction; only a Gaussian reconstructs in 3D.
+fn reconstruction(scene: &ContinuousScene<'_>) -> Result<KernelFactors, CliError> {
+    Ok(match (scene.reconstruction, *scene.kernel) {
+        (Reconstruction::Trilinear, _) => (1.0, None),
+        (Reconstruction::Kernel, Kernel::Gaussian { spread, sigmas }) => {
+            let r = f64::from(spread);
+            let norm = 1.0 / (r.powi(3) * super::integral_f64(scene.kernel));
+            let sigmas = f64::from(sigmas);
+            let k = sigmas * sigmas / (2.0 * r * r);
+            (r, Some((r, k, (-2.0 * k).exp(), norm)))
+        }
+        (Reconstruction::Kernel, other) => {
+            return Err(CliError::input(format!(
+                "--reference continuous reconstructs with the kernel in 3D, which only a \
+                 Gaussian is ({other} is a footprint model): use a gaussian kernel or \
+                 --reconstruction trilinear"
+            )))
+        }
+    })
 }
 
 /// The blocks of a `blocks`-sized map (x fastest) within `r` blocks along every axis of one set
