@@ -96,7 +96,8 @@ pub(super) struct Taps {
     d2: Vec<f64>,
 }
 
-/// The voxels as the model reads them, in blocks allocated where a voxel is stored, and the block map.
+/// The voxels as the model reads them, in blocks allocated where a voxel is stored, and the
+/// block map.
 pub(super) struct Field<'s> {
     dims: [usize; 3],
     /// Pre: [α, αr, αg, αb] or [σ, σr, σg, σb], only those that can be seen (an absent voxel is
@@ -125,13 +126,12 @@ impl<'s> Field<'s> {
         let f = scene.frame;
         let dims = f.dims;
         let n = dims.iter().product::<usize>();
-        let cannot = || {
+        // Post-classification stores every voxel; the pre-classified models only those seen.
+        let mut voxels = SparseGrid::new(dims).ok_or_else(|| {
             CliError::input(format!(
                 "cannot allocate the continuous reference's {n} voxels"
             ))
-        };
-        // Post-classification stores every voxel; the pre-classified models only those seen.
-        let mut voxels = SparseGrid::new(dims).ok_or_else(cannot)?;
+        })?;
         // Opacity per world unit: the shader at an exponent of one.
         let lighting = Lighting::per_world_unit(f);
         let (len, na, nb) = f.sheet_shape();

@@ -76,8 +76,7 @@ impl SparseGrid {
     /// voxel there is zero).
     #[inline]
     pub(super) fn get(&self, x: usize, y: usize, z: usize) -> Option<&[f32; 4]> {
-        let s = self.slot[self.block_of([x, y, z])];
-        (s != ABSENT).then(|| &self.data[s as usize * VOXELS + local([x, y, z])])
+        self.row(y, z).get(x)
     }
 
     /// The row of voxels at `(y, z)` (inside the grid), for reading several of its voxels.
@@ -113,10 +112,10 @@ pub(super) struct Row<'g> {
     local: usize,
 }
 
-impl Row<'_> {
+impl<'g> Row<'g> {
     /// Voxel `x` of the row (inside the grid), as [`SparseGrid::get`].
     #[inline]
-    pub(super) fn get(&self, x: usize) -> Option<&[f32; 4]> {
+    pub(super) fn get(&self, x: usize) -> Option<&'g [f32; 4]> {
         let s = self.grid.slot[self.blocks + x / SIDE];
         (s != ABSENT).then(|| &self.grid.data[s as usize * VOXELS + self.local + x % SIDE])
     }
