@@ -66,7 +66,7 @@
 //! [`crate::plan::DEFAULT_TARGET_DB`], with other candidates: the frame as the flags ask for it
 //! (object slicing, its own table), read at the nearest phase first where that is a frame of its
 //! own (`--phase-lookup auto`, blended stencils: [`footprint::stencil::PhaseLookup`], one
-//! stencil row per pixel instead of four's blend: object re-renders 1.09–1.15× faster at 512² on
+//! stencil row per pixel instead of four's blend: object re-renders 1.01–1.22× faster at 512² on
 //! the peers' volumes, −0.01 to −0.44 dB against the continuous model, docs/modes.md), then
 //! blended, then the slabs, thickest first. Its chosen frame is kept in
 //! the choice ([`Choice::frame`]) and is the command's frame, not rendered again (unless no
