@@ -338,23 +338,14 @@ struct Budget<'a> {
 impl Budget<'_> {
     /// Takes `bytes` more; false (taking nothing) where that passes the limit.
     fn take(&self, bytes: usize) -> bool {
-        // A compare-exchange loop (what `fetch_update` does; newer toolchains deprecate that
-        // name for one older ones lack).
-        let mut seen = self.spent.load(Ordering::Relaxed);
-        loop {
-            let Some(total) = seen.checked_add(bytes).filter(|&t| t <= self.limit) else {
-                return false;
-            };
-            match self.spent.compare_exchange_weak(
-                seen,
-                total,
-                Ordering::Relaxed,
-                Ordering::Relaxed,
-            ) {
-                Ok(_) => return true,
-                Err(now) => seen = now,
-            }
-        }
+        // `fetch_update` is deprecated on nightly for `try_update` (stable 1.95 has both);
+        // the workspace's rust-version (1.88) has only the old name.
+        #[allow(deprecated)]
+        self.spent
+            .fetch_update(Ordering::Relaxed, Ordering::Relaxed, |s| {
+                s.checked_add(bytes).filter(|&t| t <= self.limit)
+            })
+            .is_ok()
     }
 }
 
