@@ -166,7 +166,6 @@ fn the_nearest_phase_is_refused_where_no_stencils_are_read() {
     let (o, j) = (s(&out), s(&json));
     for bad in [
         &["--slicing", "image"][..],
-        &["--accum", "fixed"],
         &["--perspective", "40"],
         &["--method", "direct"],
         &["--phases", "0"],
@@ -187,7 +186,13 @@ fn the_nearest_phase_is_refused_where_no_stencils_are_read() {
         assert_eq!(run(&a), 2, "{bad:?} is refused");
     }
     assert!(!out.exists(), "no image from a refused render");
-    for (lookup, want) in [("nearest", "nearest"), ("blend", "blend")] {
+    // Float object slicing and the fixed path's integer stencils read either way.
+    for (lookup, want, accum) in [
+        ("nearest", "nearest", "float"),
+        ("blend", "blend", "float"),
+        ("nearest", "nearest", "fixed"),
+        ("blend", "blend", "fixed"),
+    ] {
         let a = [
             "render",
             "-s",
@@ -198,6 +203,8 @@ fn the_nearest_phase_is_refused_where_no_stencils_are_read() {
             j,
             "--slicing",
             "object",
+            "--accum",
+            accum,
             "--phase-lookup",
             lookup,
         ];

@@ -610,3 +610,82 @@ fn grey_voxels_splat_as_the_per_channel_loop() {
     });
     assert!(checked >= 6, "{checked} configurations checked");
 }
+
+/// Integer stencils read at the nearest phase (`FixedStencils::with_phase_lookup`): a voxel
+/// anywhere in a pixel splats exactly what the blended stencils splat at the phase node nearest
+/// it (a + [f ≥ ½] per axis, f the Q8 fraction), bit for bit, where that node's Q24 position is
+/// exact (P a power of two); and for any P within the node bound of the table walk at that
+/// node. So the footprint is only moved, by at most 1/(2P) px per axis, and each voxel deposits
+/// what its stencil sums to. Narrow and blended footprints, renormalised ones included; an
+/// edged footprint ignores the lookup and is blended.
+#[test]
+fn nearest_phase_integer_stencils_are_the_nearest_nodes_blend() {
+    use footprint::stencil::PhaseLookup;
+    let value = [ONE / 3, ONE / 2, ONE / 4, ONE];
+    let (mut exact, mut nodes, mut edged) = (0, 0, 0);
+    let zooms = [0.6f32, 1.0, 1.7, 3.5, 6.0, 11.0];
+    with_stencils(&zooms, 64, |zoom, blended, _, table, st| {
+        let p = st.phases() as i64;
+        let nearest = st.with_phase_lookup(PhaseLookup::Nearest);
+        let wide = st.side() > footprint::stencil::NARROW_SIDE && !blended;
+        assert_eq!(
+            nearest.phase_lookup(),
+            if wide {
+                PhaseLookup::Blend
+            } else {
+                PhaseLookup::Nearest
+            }
+        );
+        let splat = |center: [i64; 2], how: u8| {
+            let mut acc = vec![[0i64; 4]; 64 * 64];
+            let mut img = ImageMut::new(&mut acc, 64, 64, 64).unwrap();
+            match how {
+                0 => nearest.splat(center, &value, &mut img, |_, _, _| {}),
+                1 => st.splat(center, &value, &mut img, |_, _, _| {}),
+                _ => fixed::splat::splat(table, center, &value, &mut img, |_, _, _| {}),
+            };
+            acc
+        };
+        for k in 0..61i64 {
+            let center = [
+                (31 << 24) + (k * 0x2F_5A3B + (k & 1) * (1 << 23)) % (1 << 24),
+                (32 << 24) + (k * 0x61_C88F + (k & 2) * (1 << 22)) % (1 << 24),
+            ];
+            if wide {
+                // Edged: blended whatever the lookup.
+                assert_eq!(splat(center, 0), splat(center, 1), "zoom {zoom} k {k}");
+                edged += 1;
+                continue;
+            }
+            // The nearest node per axis, as the splat picks it from the Q8 fraction.
+            let snap = |c: i64| {
+                let i = c >> 24;
+                let t = (c - (i << 24)) * p;
+                let cell = (t >> 24).min(p - 1);
+                let f = (t - (cell << 24)) >> 16;
+                (i << 24) + (((cell + i64::from(f >= 128)) << 24) / p)
+            };
+            let node = center.map(snap);
+            let got = splat(center, 0);
+            let what = format!("zoom {zoom} blended {blended} P {p} k {k}");
+            if p.count_ones() == 1 {
+                assert_eq!(got, splat(node, 1), "{what}: the node's blend");
+                exact += 1;
+            }
+            let walk = splat(node, 2);
+            let peak = walk.iter().map(|q| q[3]).max().unwrap() as f64;
+            let worst = walk
+                .iter()
+                .zip(&got)
+                .flat_map(|(a, b)| (0..4).map(move |c| (a[c] - b[c]).abs() as f64))
+                .fold(0.0, f64::max);
+            let bound = if p.count_ones() == 1 { 1e-5 } else { 2e-4 };
+            assert_le(worst, bound * peak, &what);
+            nodes += 1;
+        }
+    });
+    assert!(
+        exact >= 61 * 4 && nodes > exact && edged > 0,
+        "{exact} {nodes} {edged}"
+    );
+}

@@ -35,7 +35,7 @@ fn every_thread_count_gives_the_same_bits() {
     // Stencil splats (small and wide footprints, blended and nearest), the per-pixel table walk
     // (--phases 0), the direct method, fixed point; phong needs gradients; front to back composites under; a view whose
     // sheets run along i.
-    let cases: [&[&str]; 12] = [
+    let cases: [&[&str]; 13] = [
         // Perspective: a footprint per voxel, no band test.
         &["--view", "30,20,0", "--perspective", "60"],
         &[
@@ -73,6 +73,15 @@ fn every_thread_count_gives_the_same_bits() {
             "phong",
         ],
         &["--view", "30,20,0", "--accum", "fixed"],
+        // The fixed path's integer stencils read at the nearest phase.
+        &[
+            "--view",
+            "30,20,0",
+            "--accum",
+            "fixed",
+            "--phase-lookup",
+            "nearest",
+        ],
         &[
             "--view",
             "75,-40,20",

@@ -82,7 +82,9 @@ pub const DEFAULT_PHASES: usize = 32;
 ///   `verify`, 512², view 30,20,0): 80.8–86.8 dB against the f64 sheet reference on the shared
 ///   volumes instead of blending's 98.1–104.8, while the error against the continuous integral
 ///   (the opacity model) moved by −0.44 to −0.01 dB (`--phase-lookup`, docs/modes.md). Edged
-///   footprints ([`Plan::edged`]) are always blended: their phases are too few for it.
+///   footprints ([`Plan::edged`]) are always blended: their phases are too few for it. The
+///   fixed path's integer stencils read it the same way
+///   ([`crate::fixed::stencil::FixedStencils::with_phase_lookup`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum PhaseLookup {
     /// The bilinear blend of the four corner stencils (the default).
@@ -419,11 +421,7 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
 
     /// How a voxel's phase is read: [`PhaseLookup::Blend`] for an edged footprint.
     pub fn phase_lookup(&self) -> PhaseLookup {
-        if self.wide {
-            PhaseLookup::Blend
-        } else {
-            self.lookup
-        }
+        self.lookup.unless_edged(self.wide)
     }
 
     /// Box side B, pixels.

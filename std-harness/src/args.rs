@@ -395,8 +395,8 @@ pub struct RenderArgs {
     /// integer table (fixed, `fixed::stencil`) sampled per phase; 0 walks the table per pixel.
     #[arg(help_heading = "Method", long, default_value_t = footprint::stencil::DEFAULT_PHASES)]
     pub phases: usize,
-    /// Stencils read at the nearest phase (the footprint up to 1/(2P) px off) or blended from four;
-    /// `auto`: nearest where the default plan's pilot measures it at target (docs/modes.md).
+    /// Stencils (float or fixed) read at the nearest phase (up to 1/(2P) px off) or blended from
+    /// four; `auto`: nearest where the default plan's pilot measures it at target, else blended.
     #[arg(help_heading = "Method", long, value_enum, default_value = "auto")]
     pub phase_lookup: PhaseLookupArg,
     /// Compositing direction (default back-to-front; a pipe's views impose theirs).

@@ -119,8 +119,9 @@ pub struct Plan {
     pub table: Table,
     /// Sub-pixel phases of the stencils (0: walk the table).
     pub phases: usize,
-    /// How float sheets read the stencils at a voxel's phase (`--phase-lookup`); `None` (`auto`):
-    /// blended, unless the default plan's pilot chose the nearest (`pilot::choose_slicing`).
+    /// How sheets (float, or the fixed path's integer stencils) read the stencils at a voxel's
+    /// phase (`--phase-lookup`); `None` (`auto`): blended, unless the default plan's pilot chose
+    /// the nearest (`pilot::choose_slicing`; the fixed path has no pilot, so it blends).
     pub phase_lookup: Option<footprint::stencil::PhaseLookup>,
     /// Threads (bands of image rows), at least one.
     pub threads: usize,

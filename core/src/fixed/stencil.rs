@@ -12,6 +12,16 @@
 //! A voxel's weights are the bilinear blend of the four stencils around its phase, with Q8
 //! fractions: (Σ c_k s_k + 2¹⁵) >> 16, c_k summing to 2¹⁶.
 //!
+//! **Nearest phase** ([`FixedStencils::with_phase_lookup`], [`PhaseLookup::Nearest`]): a narrow
+//! or blended footprint may instead read the one corner stencil nearest the phase, (a + [f_x ≥
+//! ½], b + [f_y ≥ ½]) with the Q8 fractions f (f ≥ 128 exactly when the phase's fraction is at
+//! least ½, as the float stencils decide it). Its weights are that stencil's entries as they
+//! are, the same integers the blend gives at that corner's phase (there c = 2¹⁶, and
+//! (2¹⁶·s + 2¹⁵) >> 16 = s), so every voxel still deposits exactly what its stencil sums to; the
+//! footprint is placed up to 1/(2P) px off per axis, the float path's nearest error
+//! ([`crate::stencil::PhaseLookup`]). One entry read per pixel and no multiply of the blend. An
+//! edged footprint is always blended.
+//!
 //! **Narrow and wide.** A *narrow* footprint (box side ≤ [`crate::stencil::NARROW_SIDE`]) is
 //! blended over every pixel where a corner stencil is non-zero, as the float path does. A *wide*
 //! one (up to [`MAX_STENCIL_SIDE`] px, and [`MAX_STENCIL_FLOATS`] entries, with the fewer phases
@@ -35,7 +45,7 @@ use super::{is_grey, FixedTable, POS_FRAC};
 use crate::splat::{BufferError, ImageMut, SplatStats};
 use crate::stencil::walk::{self, corner_rows, SpanWalk};
 use crate::stencil::{
-    corner_offsets, nonzero_run, MAX_STENCIL_FLOATS, MAX_STENCIL_SIDE, NARROW_SIDE,
+    corner_offsets, nonzero_run, PhaseLookup, MAX_STENCIL_FLOATS, MAX_STENCIL_SIDE, NARROW_SIDE,
 };
 
 const HALF_POS: i64 = 1 << (POS_FRAC - 1);
@@ -100,6 +110,8 @@ pub struct FixedStencils<'a, const M: usize> {
     phases: usize,
     /// Box side above [`NARROW_SIDE`]: blended only inside all four corners' support.
     wide: bool,
+    /// How a voxel's phase is read ([`FixedStencils::with_phase_lookup`]; built blended).
+    lookup: PhaseLookup,
     /// The table the stencils were sampled from (a wide footprint's edge pixels read it).
     table: &'a FixedTable<M>,
     /// The largest |weight| a splat can give a pixel (the largest stencil entry, and for an edged
@@ -251,9 +263,21 @@ impl<'a, const M: usize> FixedStencils<'a, M> {
             side,
             phases,
             wide,
+            lookup: PhaseLookup::Blend,
             table,
             max_weight,
         })
+    }
+
+    /// These stencils read at each voxel's phase by `lookup` (the module docs, "Nearest
+    /// phase"); an edged footprint ignores it and is blended.
+    pub fn with_phase_lookup(self, lookup: PhaseLookup) -> Self {
+        Self { lookup, ..self }
+    }
+
+    /// How a voxel's phase is read: [`PhaseLookup::Blend`] for an edged footprint.
+    pub fn phase_lookup(&self) -> PhaseLookup {
+        self.lookup.unless_edged(self.wide)
     }
 
     /// Box side B, pixels.
@@ -314,11 +338,13 @@ impl<'a, const M: usize> FixedStencils<'a, M> {
         acc: &mut ImageMut<'_, [i64; 4]>,
         touched: impl FnMut(usize, usize, usize),
     ) -> SplatStats {
-        match (is_grey(value), self.wide) {
-            (true, true) => self.splat_as::<false, true, true>(center, value, acc, touched),
-            (true, false) => self.splat_as::<false, true, false>(center, value, acc, touched),
-            (false, true) => self.splat_as::<false, false, true>(center, value, acc, touched),
-            (false, false) => self.splat_as::<false, false, false>(center, value, acc, touched),
+        match (is_grey(value), self.mode()) {
+            (true, EDGED) => self.splat_as::<false, true, EDGED>(center, value, acc, touched),
+            (true, NEAREST) => self.splat_as::<false, true, NEAREST>(center, value, acc, touched),
+            (true, _) => self.splat_as::<false, true, BLENDED>(center, value, acc, touched),
+            (false, EDGED) => self.splat_as::<false, false, EDGED>(center, value, acc, touched),
+            (false, NEAREST) => self.splat_as::<false, false, NEAREST>(center, value, acc, touched),
+            (false, _) => self.splat_as::<false, false, BLENDED>(center, value, acc, touched),
         }
     }
 
@@ -333,21 +359,34 @@ impl<'a, const M: usize> FixedStencils<'a, M> {
         acc: &mut ImageMut<'_, [i64; 4]>,
         touched: impl FnMut(usize, usize, usize),
     ) -> SplatStats {
-        match (is_grey(value), self.wide) {
-            (true, true) => self.splat_as::<true, true, true>(center, value, acc, touched),
-            (true, false) => self.splat_as::<true, true, false>(center, value, acc, touched),
-            (false, true) => self.splat_as::<true, false, true>(center, value, acc, touched),
-            (false, false) => self.splat_as::<true, false, false>(center, value, acc, touched),
+        match (is_grey(value), self.mode()) {
+            (true, EDGED) => self.splat_as::<true, true, EDGED>(center, value, acc, touched),
+            (true, NEAREST) => self.splat_as::<true, true, NEAREST>(center, value, acc, touched),
+            (true, _) => self.splat_as::<true, true, BLENDED>(center, value, acc, touched),
+            (false, EDGED) => self.splat_as::<true, false, EDGED>(center, value, acc, touched),
+            (false, NEAREST) => self.splat_as::<true, false, NEAREST>(center, value, acc, touched),
+            (false, _) => self.splat_as::<true, false, BLENDED>(center, value, acc, touched),
+        }
+    }
+
+    /// How [`FixedStencils::splat_as`] reads this view's stencils: [`EDGED`], [`NEAREST`] or
+    /// [`BLENDED`].
+    fn mode(&self) -> u8 {
+        match (self.wide, self.phase_lookup()) {
+            (true, _) => EDGED,
+            (false, PhaseLookup::Nearest) => NEAREST,
+            (false, PhaseLookup::Blend) => BLENDED,
         }
     }
 
     /// The splat, with wrapping adds if `WRAP`; `GREY` for a grey voxel ([`super::is_grey`]), whose colour
     /// products it computes once per pixel: 7–9 % off the fixed splat of the walnut and the CT
-    /// head (`footprint bench --accum fixed`, 512², builds alternated); `WIDE` for stencils
-    /// blended only inside all four corners' support (`self.wide`, passed as a constant so the
-    /// narrow loop carries no edge test per pixel: fixed splat blobs 68.4–69.3 → 66.8–67.1 ms,
-    /// walnut 59.1–59.2 → 57.3–58.3 ms, CT head 71.4–72.2 → 64.4–65.1 ms, three rounds).
-    fn splat_as<const WRAP: bool, const GREY: bool, const WIDE: bool>(
+    /// head (`footprint bench --accum fixed`, 512², builds alternated); `MODE` [`EDGED`] for
+    /// stencils blended only inside all four corners' support (`self.wide`, passed as a constant
+    /// so the narrow loop carries no edge test per pixel: fixed splat blobs 68.4–69.3 → 66.8–67.1
+    /// ms, walnut 59.1–59.2 → 57.3–58.3 ms, CT head 71.4–72.2 → 64.4–65.1 ms, three rounds),
+    /// [`NEAREST`] for the nearest corner's entries as they are, [`BLENDED`] otherwise.
+    fn splat_as<const WRAP: bool, const GREY: bool, const MODE: u8>(
         &self,
         center: [i64; 2],
         value: &[u32; 4],
@@ -370,6 +409,12 @@ impl<'a, const M: usize> FixedStencils<'a, M> {
         let ((ka, fx), (kb, fy)) = (phase(center[0], ix), phase(center[1], iy));
         let side = self.side;
         let corners = corner_offsets(ka, kb, p, side * side);
+        // Nearest: the corner (a + [fx ≥ ½], b + [fy ≥ ½]) read alone (its entries as they are).
+        let corners = if MODE == NEAREST {
+            [corners[usize::from(fx >= 128) + 2 * usize::from(fy >= 128)]; 4]
+        } else {
+            corners
+        };
         let (c00, c10, c01, c11) = (
             (256 - fx) * (256 - fy),
             fx * (256 - fy),
@@ -399,7 +444,9 @@ impl<'a, const M: usize> FixedStencils<'a, M> {
             };
             for (k, d) in px.iter_mut().enumerate() {
                 let (a, b, c, e) = (r00[k], r10[k], r01[k], r11[k]);
-                let wt = if WIDE && (a == 0 || b == 0 || c == 0 || e == 0) {
+                let wt = if MODE == NEAREST {
+                    i64::from(a)
+                } else if MODE == EDGED && (a == 0 || b == 0 || c == 0 || e == 0) {
                     exact(k)
                 } else {
                     (c00 * i64::from(a)
@@ -440,9 +487,17 @@ impl<'a, const M: usize> FixedStencils<'a, M> {
     }
 }
 
+/// [`FixedStencils::splat_as`]'s modes: a narrow or blended footprint's four corners blended up
+/// to the edge,
+const BLENDED: u8 = 0;
+/// an edged one's blended inside all four corners' support and walked at the edge,
+const EDGED: u8 = 1;
+/// or a narrow or blended one read at its nearest corner.
+const NEAREST: u8 = 2;
+
 #[cfg(test)]
 mod tests {
-    use super::{FixedStencils, POS_FRAC};
+    use super::{FixedStencils, PhaseLookup, POS_FRAC};
     use crate::fixed::FixedTable;
 
     /// `exact_below`'s count of voxels whose box can hold one pixel is at least the true count,
@@ -465,6 +520,7 @@ mod tests {
                 side,
                 phases: 1,
                 wide: false,
+                lookup: PhaseLookup::Blend,
                 table: &table,
                 max_weight: 1000,
             };

@@ -9,7 +9,20 @@
 //! per-cell runs are found when the stencils are built ([`pack_runs`]). No floating point here:
 //! the integer path uses it under `deny(clippy::float_arithmetic)`.
 
-use super::cell_corners;
+use super::{cell_corners, PhaseLookup};
+
+impl PhaseLookup {
+    /// The lookup that stencils asked to read by this one use: [`PhaseLookup::Blend`] if `edged`
+    /// (an edged footprint's phases are too few for the nearest), else this one. The float and
+    /// the fixed stencils both decide it here.
+    pub(crate) fn unless_edged(self, edged: bool) -> Self {
+        if edged {
+            PhaseLookup::Blend
+        } else {
+            self
+        }
+    }
+}
 
 /// Where one voxel's box of stencil entries falls in an image of `width` × `height` pixels.
 #[derive(Clone, Copy, Debug)]

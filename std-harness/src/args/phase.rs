@@ -6,7 +6,7 @@ use footprint::stencil::PhaseLookup;
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum PhaseLookupArg {
     /// The default plan's pilot measures the nearest phase first and keeps it where it reaches
-    /// the target; blended everywhere else.
+    /// the target; blended everywhere else (the fixed path, which has no pilot, included).
     #[default]
     Auto,
     /// The bilinear blend of the four stencils around the phase.

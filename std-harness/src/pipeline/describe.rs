@@ -94,7 +94,7 @@ pub fn describe(p: &Prepared, args: &Inputs, plan: &Plan) -> Json {
 /// What drew the frame, resolved (defaults and `auto`s decided): `end` (`sheets`, `slabs`,
 /// `post`, `refined` or `reference`), `precision`, `slab` (voxel spacings; null but for slabs),
 /// `subsample` and `supersample` (factors), `lod` (level), `cull` (ε; null when off), `order`,
-/// `phase_lookup` (`blend` or `nearest`: how float sheets read the phase stencils).
+/// `phase_lookup` (`blend` or `nearest`: how sheets, float or fixed, read the phase stencils).
 pub fn plan_json(p: &Prepared, plan: &Plan) -> Json {
     let (end, slab) = match plan.end {
         End::Sheets(_) => ("sheets", f64::NAN),

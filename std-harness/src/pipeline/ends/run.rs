@@ -243,8 +243,9 @@ fn fixed_sheets<const N: usize>(
     } else {
         FixedStencils::build
     };
+    let lookup = plan.phase_lookup.unwrap_or_default();
     let path = match len.map(|_| build(&table, phases, &mut buffer)) {
-        Some(Ok(stencils)) => path.with_stencils(stencils),
+        Some(Ok(stencils)) => path.with_stencils(stencils.with_phase_lookup(lookup)),
         // --phases 0, the direct method, a footprint past the stencils' limits, or
         // renormalised weights too large for 32 bits: the walk serves this view.
         _ => path,
