@@ -46,7 +46,7 @@ pub use post::{
 pub use precision::{CompactPath, FixedPath, FloatPath, Precision, VoxelSplat};
 pub use refined::{key_spacings, rate_index, spacing_key, RefineTables, RefinedGrid, SPACING_KEYS};
 pub use scaled::{sheet_map, splat_scaled, ScaledFootprint};
-pub use shade_cache::{ShadeCacheEntry, SHADE_CACHE_LEN};
+pub use shade_cache::{ShadeCache, ShadeCacheEntry, SHADE_CACHE_LEN};
 pub use sheets::{gradient, SheetRing, SheetWindow};
 pub use slab_renderer::{SlabBuffers, SlabRenderer};
 pub use slabs::{SlabError, SlabSetup, SlabVoxel};
@@ -58,7 +58,6 @@ use crate::shade::{Lighting, OpacityTable, Sample, Shader};
 use crate::splat::{BufferError, ImageMut, Splatter};
 use band::{check_band, start_image, BandReach};
 use occlusion::Occlusion;
-use shade_cache::ShadeCache;
 
 /// The caller-owned buffers of a render, each [`FrameSetup::image_len`] long except `rows`
 /// (one per image row). `A` and `P` are the [`Precision`]'s accumulator and image pixels:

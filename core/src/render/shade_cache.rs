@@ -22,7 +22,7 @@ pub struct ShadeCacheEntry {
 }
 
 /// The memo over a caller's buffer (whose length is rounded down to a power of two).
-pub(super) struct ShadeCache<'a> {
+pub struct ShadeCache<'a> {
     entries: &'a mut [ShadeCacheEntry],
     mask: usize,
 }
@@ -30,7 +30,7 @@ pub(super) struct ShadeCache<'a> {
 impl<'a> ShadeCache<'a> {
     /// A memo for `shader` over `buffer`, emptied; `None` when the shading is not emission (the
     /// shaded value then depends on more than the sample) or the buffer is empty.
-    pub(super) fn new(shader: &Shader<'_>, buffer: &'a mut [ShadeCacheEntry]) -> Option<Self> {
+    pub fn new(shader: &Shader<'_>, buffer: &'a mut [ShadeCacheEntry]) -> Option<Self> {
         if !matches!(shader.shading, Shading::Emission) || buffer.is_empty() {
             return None;
         }
@@ -47,7 +47,7 @@ impl<'a> ShadeCache<'a> {
     /// shade then depends on the value alone), else, or on a miss, `shade()` (which must be the
     /// shader's result for this voxel).
     #[inline]
-    pub(super) fn shade(
+    pub fn shade(
         cache: Option<&mut Self>,
         value: f32,
         coloured: bool,
