@@ -325,9 +325,10 @@ impl<'a, const M: usize> FixedStencils<'a, M> {
 
     /// Spreads `value` (premultiplied RGBA, Q24) of a voxel projected to `center` (Q24 px,
     /// absolute) into `acc` (Q(24 + f), saturating adds), calling `touched(y, x0, x1)` for each
-    /// row it updated: the blend of the four stencils around the centre's sub-pixel phase.
+    /// row it updated: the blend of the four stencils around the centre's sub-pixel phase, or
+    /// the nearest one's entries ([`FixedStencils::with_phase_lookup`]).
     ///
-    /// Not inlined (nor is [`FixedStencils::splat_unsaturated`]): inlined, its eight instances
+    /// Not inlined (nor is [`FixedStencils::splat_unsaturated`]): inlined, its then eight instances
     /// raised the firmware's frame (which never splats through stencils) from 1976 to 2456 bytes
     /// of stack on Cortex-M3; the host called it out of line anyway.
     #[inline(never)]
@@ -338,14 +339,7 @@ impl<'a, const M: usize> FixedStencils<'a, M> {
         acc: &mut ImageMut<'_, [i64; 4]>,
         touched: impl FnMut(usize, usize, usize),
     ) -> SplatStats {
-        match (is_grey(value), self.mode()) {
-            (true, EDGED) => self.splat_as::<false, true, EDGED>(center, value, acc, touched),
-            (true, NEAREST) => self.splat_as::<false, true, NEAREST>(center, value, acc, touched),
-            (true, _) => self.splat_as::<false, true, BLENDED>(center, value, acc, touched),
-            (false, EDGED) => self.splat_as::<false, false, EDGED>(center, value, acc, touched),
-            (false, NEAREST) => self.splat_as::<false, false, NEAREST>(center, value, acc, touched),
-            (false, _) => self.splat_as::<false, false, BLENDED>(center, value, acc, touched),
-        }
+        self.splat_with::<false>(center, value, acc, touched)
     }
 
     /// [`FixedStencils::splat`] with wrapping adds, for a caller that has shown no pixel's sum
@@ -359,13 +353,26 @@ impl<'a, const M: usize> FixedStencils<'a, M> {
         acc: &mut ImageMut<'_, [i64; 4]>,
         touched: impl FnMut(usize, usize, usize),
     ) -> SplatStats {
+        self.splat_with::<true>(center, value, acc, touched)
+    }
+
+    /// [`FixedStencils::splat_as`] for this voxel's colour and this view's [`mode`](Self::mode),
+    /// with wrapping adds if `WRAP`: the one dispatch both splats share.
+    #[inline(always)]
+    fn splat_with<const WRAP: bool>(
+        &self,
+        center: [i64; 2],
+        value: &[u32; 4],
+        acc: &mut ImageMut<'_, [i64; 4]>,
+        touched: impl FnMut(usize, usize, usize),
+    ) -> SplatStats {
         match (is_grey(value), self.mode()) {
-            (true, EDGED) => self.splat_as::<true, true, EDGED>(center, value, acc, touched),
-            (true, NEAREST) => self.splat_as::<true, true, NEAREST>(center, value, acc, touched),
-            (true, _) => self.splat_as::<true, true, BLENDED>(center, value, acc, touched),
-            (false, EDGED) => self.splat_as::<true, false, EDGED>(center, value, acc, touched),
-            (false, NEAREST) => self.splat_as::<true, false, NEAREST>(center, value, acc, touched),
-            (false, _) => self.splat_as::<true, false, BLENDED>(center, value, acc, touched),
+            (true, EDGED) => self.splat_as::<WRAP, true, EDGED>(center, value, acc, touched),
+            (true, NEAREST) => self.splat_as::<WRAP, true, NEAREST>(center, value, acc, touched),
+            (true, _) => self.splat_as::<WRAP, true, BLENDED>(center, value, acc, touched),
+            (false, EDGED) => self.splat_as::<WRAP, false, EDGED>(center, value, acc, touched),
+            (false, NEAREST) => self.splat_as::<WRAP, false, NEAREST>(center, value, acc, touched),
+            (false, _) => self.splat_as::<WRAP, false, BLENDED>(center, value, acc, touched),
         }
     }
 
