@@ -4,7 +4,7 @@
 //! the plan's frame bit for bit, and the flags that leave nothing to choose checked to skip it.
 
 use footprint::stencil::PhaseLookup;
-use footprint_harness::args::parse_args;
+use footprint_harness::args::{parse_args, Supersample};
 use footprint_harness::metrics::compare;
 use footprint_harness::pipeline::stages::visible::FrameCache;
 use footprint_harness::pipeline::{prepare, render_continuous_ref, render_frame, Prepared};
@@ -102,6 +102,58 @@ fn slabs_are_taken_where_object_slicing_falls_short() {
     let (three, image3, _, _) = chosen(&a);
     assert_eq!(three.end, plan_chosen.end);
     assert!(image3 == image);
+}
+
+/// Where `--subsample` is unset and `auto` would render at 1/s of the size with s > 1 (the
+/// built-in scene magnified twice: s = 2), the pilot tries each candidate subsampled first and
+/// keeps the first that reaches the target: its frame is `--slicing object --phase-lookup nearest
+/// --subsample auto`'s, bit for bit, it reaches the target on the whole image, and it stays
+/// within a decibel of the full-size frame there. `--subsample 1` keeps the full size (a frame of
+/// its own), and flags that skip the pilot do not subsample.
+#[test]
+fn the_default_subsamples_where_the_footprints_allow_it() {
+    let base = ["--size", "160x160", "--zoom", "2", "--view", "30,20,0"];
+    let (plan_chosen, image, db, p) = chosen(&base);
+    assert_eq!(plan_chosen.subsample, Supersample::Auto);
+    assert!(matches!(plan_chosen.end, End::Sheets(_)));
+    assert_eq!(p.subsample_factor(&plan_chosen).unwrap(), 2);
+    assert!(db >= DEFAULT_TARGET_DB, "whole image {db:.2} dB");
+    let with = |extra: &[&'static str]| {
+        let mut a = base.to_vec();
+        a.extend_from_slice(extra);
+        a
+    };
+    let explicit = plan(
+        &parse_args(&with(&[
+            "--slicing",
+            "object",
+            "--phase-lookup",
+            "nearest",
+            "--subsample",
+            "auto",
+        ]))
+        .unwrap(),
+    )
+    .unwrap();
+    let again = render_frame(&p, &explicit, &mut FrameCache::default()).unwrap();
+    assert!(
+        again.image == image,
+        "the pilot's frame is the subsampled one"
+    );
+    let (full_plan, full_image, full_db, _) = chosen(&with(&["--subsample", "1"]));
+    assert_eq!(full_plan.subsample, Supersample::Fixed(1));
+    assert!(full_image != image, "subsampling moved no pixel");
+    assert!(
+        db > full_db - 1.0,
+        "subsampled {db:.2} dB, full size {full_db:.2} dB"
+    );
+    for skip in [&["--slicing", "object"][..], &["--quality", "40"]] {
+        let p = plan(&parse_args(&with(skip)).unwrap()).unwrap();
+        assert!(
+            !p.auto_subsample && p.subsample == Supersample::Fixed(1),
+            "{skip:?}"
+        );
+    }
 }
 
 /// Where the flags fix the end point or slabs cannot draw the frame there is no pilot: the JSON

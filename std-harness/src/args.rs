@@ -411,10 +411,10 @@ pub struct RenderArgs {
     /// 1/s of the size (plus a 2-pixel margin) and resamples it to the size with Catmull-Rom
     /// cubic interpolation (the harness's `pipeline::stages::subsample`); `auto` picks the largest s that
     /// keeps the footprints' shorter semi-axis at least 2 px at the lower resolution (Gaussian
-    /// kernels, orthographic views only; otherwise 1). 1, the default, is off. Measured cost in
-    /// accuracy: docs/modes.md, "Subsampling".
-    #[arg(help_heading = "Resolution", long, default_value = "1", value_parser = parse_supersample)]
-    pub subsample: Supersample,
+    /// kernels, orthographic views only; otherwise 1); 1 is off. Unset: 1, or `auto` where the
+    /// default plan's pilot measures it to reach its target (docs/modes.md, "Subsampling").
+    #[arg(help_heading = "Resolution", long, value_parser = parse_supersample)]
+    pub subsample: Option<Supersample>,
     /// Level of detail: a number N splats level N (each level averages 2x2x2 samples of the one
     /// above into one, the spacing doubled, carrying the block's colour; 0 = full resolution);
     /// `auto`, the default, the deepest level L with 4^L x (level 0's projected spacing) <= 3 px

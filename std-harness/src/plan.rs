@@ -138,6 +138,10 @@ pub struct Plan {
     /// ([`DEFAULT_TARGET_DB`]); the pipeline measures it on a pilot and returns the plan it chose,
     /// with this `None` (`pipeline::quality::choose::apply_quality`). `None`: `end` as it is.
     pub auto_slicing: Option<f64>,
+    /// `--subsample` left unset where the default plan's pilot runs (`auto_slicing`): the pilot
+    /// tries each candidate subsampled (`Supersample::Auto`) before it is tried at full size, and
+    /// keeps the first that reaches the target (`pipeline::quality::pilot::choose_slicing`).
+    pub auto_subsample: bool,
 }
 
 /// `--quality DB --quality-reference R`.
@@ -265,13 +269,14 @@ pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
         phases: args.phases,
         phase_lookup: args.phase_lookup.fixed(),
         threads: args.thread_count(),
-        subsample: args.subsample,
+        subsample: args.subsample.unwrap_or(Supersample::Fixed(1)),
         cull: args.cull.0,
         quality: args.quality.map(|target_db| Quality {
             target_db,
             reference: args.quality_reference,
         }),
         auto_slicing: auto::slicing_target(&end, args),
+        auto_subsample: args.subsample.is_none() && auto::slicing_target(&end, args).is_some(),
     })
 }
 
@@ -280,9 +285,9 @@ pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
 fn subsample_rules(args: &RenderArgs) -> Result<(), CliError> {
     let refuse = |flag: &str, why: &str| Err(CliError::input(format!("{flag}: {why}")));
     let factor = match args.subsample {
-        Supersample::Fixed(1) => None,
-        Supersample::Fixed(s) => Some(s.to_string()),
-        Supersample::Auto => Some("auto".to_string()),
+        None | Some(Supersample::Fixed(1)) => None,
+        Some(Supersample::Fixed(s)) => Some(s.to_string()),
+        Some(Supersample::Auto) => Some("auto".to_string()),
     };
     let Some(s) = factor else {
         return Ok(());

@@ -8,7 +8,9 @@
 //! `--classification post`, `--refine`, `--method reference`), when slabs cannot draw what they
 //! ask (`--accum fixed`, `--perspective`, `--stream`: a streamed volume is read once, and the
 //! pilot's reference needs it whole) or when `--quality` chooses instead. The frame decides the
-//! rest (a kernel with no slabs, a coarser level of detail): the pilot is skipped there.
+//! rest (a kernel with no slabs, a coarser level of detail): the pilot is skipped there. Where
+//! the pilot runs and `--subsample` is unset, it tries each candidate subsampled first
+//! ([`super::Plan::auto_subsample`]).
 
 use super::{End, Precision};
 use crate::args::{RenderArgs, SlicingArg};

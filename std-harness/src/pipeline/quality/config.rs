@@ -2,7 +2,7 @@
 //! thickness, and whether the grid is refined (`--refine 0`): what `footprint chart` sweeps and
 //! `--quality` chooses among, with the names the benches use.
 
-use crate::args::{AccumArg, LookupArg, MethodArg};
+use crate::args::{AccumArg, LookupArg, MethodArg, Supersample};
 use crate::plan::{End, Footprints, Plan, Precision};
 
 /// Slab thicknesses the chart sweeps with `--slicing image`, voxel spacings.
@@ -28,6 +28,10 @@ pub struct Config {
     /// Object slicing with the stencils read at the nearest phase (`--phase-lookup nearest`);
     /// only the default plan's pilot tries it ([`super::pilot::choose_slicing`]).
     pub nearest_phase: bool,
+    /// Rendered at 1/s of the size and resampled, s as `--subsample auto` picks it for the frame;
+    /// only the default plan's pilot tries it, where `--subsample` is unset and s > 1
+    /// ([`super::pilot::choose_slicing`]).
+    pub subsample: bool,
 }
 
 impl Config {
@@ -57,6 +61,7 @@ impl Config {
                             slab_quarters: None,
                             refine: false,
                             nearest_phase: false,
+                            subsample: false,
                         });
                     }
                 }
@@ -80,6 +85,7 @@ impl Config {
                 slab_quarters: Some((t * 4.0) as u16),
                 refine: false,
                 nearest_phase: false,
+                subsample: false,
             })
             .collect()
     }
@@ -91,13 +97,18 @@ impl Config {
 
     /// `n=65/bilinear/view/float/libm`, the bench naming; `image/slab=0.5/float/libm` for slabs;
     /// `n=65/bilinear/view/float/libm/refine=0` refined, `…/phase=nearest` read at the nearest
-    /// phase.
+    /// phase, `…/subsample=auto` subsampled.
     pub fn label(&self) -> String {
+        let sub = if self.subsample {
+            "/subsample=auto"
+        } else {
+            ""
+        };
         if let Some(t) = self.slab() {
-            return format!("image/slab={t}/float/{}", footprint::math::BACKEND);
+            return format!("image/slab={t}/float/{}{sub}", footprint::math::BACKEND);
         }
         format!(
-            "n={}/{}/{}/{}/{}{}{}",
+            "n={}/{}/{}/{}/{}{}{}{sub}",
             self.table,
             lookup_name(self.lookup),
             method_name(self.method),
@@ -141,6 +152,15 @@ impl Config {
             slab_quarters: None,
             refine: false,
             nearest_phase: plan.phase_lookup == Some(footprint::stencil::PhaseLookup::Nearest),
+            subsample: false,
+        }
+    }
+
+    /// This configuration subsampled ([`Config::subsample`]).
+    pub fn subsampled(&self) -> Config {
+        Config {
+            subsample: true,
+            ..*self
         }
     }
 
@@ -171,6 +191,9 @@ impl Config {
         };
         if self.nearest_phase {
             p.phase_lookup = Some(footprint::stencil::PhaseLookup::Nearest);
+        }
+        if self.subsample {
+            p.subsample = Supersample::Auto;
         }
         p.end = match (self.slab(), self.refine, base.end) {
             (_, true, _) => End::Refined {

@@ -68,7 +68,12 @@
 //! own (`--phase-lookup auto`, blended stencils: [`footprint::stencil::PhaseLookup`], one
 //! stencil row per pixel instead of four's blend: object re-renders 1.01–1.22× faster at 512² on
 //! the peers' volumes, −0.01 to −0.44 dB against the continuous model, docs/modes.md), then
-//! blended, then the slabs, thickest first. Its chosen frame is kept in
+//! blended, then the slabs, thickest first; where `--subsample` is unset and `auto` would render
+//! at 1/s of the size, s > 1, each of those subsampled first, in the same order, the full-size
+//! ones only if none of those reaches the target (1/s² of the pixel updates; −0.46 to +0.03 dB
+//! against the continuous model on docs/subsample-validation.md's 24 cases; the CT head's and
+//! the walnut's default re-renders 3.7× and 2.0× faster at 512², `footprint bench --frames 5
+//! --orbit 2 --threads 1`, with and without `--subsample 1`). Its chosen frame is kept in
 //! the choice ([`Choice::frame`]) and is the command's frame, not rendered again (unless no
 //! candidate reached the target: the most accurate is then rendered again).
 
@@ -258,6 +263,7 @@ pub fn choose_slicing(
     slabs.sort_by_key(|c| std::cmp::Reverse(c.slab_quarters));
     let mut object = base.clone();
     object.auto_slicing = None;
+    object.auto_subsample = false;
     let own = Config::of_plan(base);
     let mut candidates = Vec::new();
     if nearest_phase_differs(p, base) {
@@ -266,6 +272,15 @@ pub fn choose_slicing(
     }
     candidates.push((own, object.clone()));
     candidates.extend(slabs.into_iter().map(|c| (c, c.plan(&object))));
+    if subsampling_differs(p, base)? {
+        // Each candidate subsampled first (1/s² of its pixel updates), in the same order; the
+        // full-size ones follow only where none of those reaches the target.
+        let small: Vec<_> = candidates
+            .iter()
+            .map(|(c, _)| (c.subsampled(), c.subsampled().plan(&object)))
+            .collect();
+        candidates.splice(0..0, small);
+    }
     let mut run = Run::new(
         p,
         p,
@@ -285,6 +300,20 @@ fn nearest_phase_differs(p: &Prepared, base: &Plan) -> bool {
         && base.reads_phase_stencils()
         && p.frame.camera().is_none()
         && footprint::stencil::plan_for(&p.frame.footprint, base.phases).is_some_and(|s| !s.edged)
+}
+
+/// Whether the default plan may subsample `p` (`--subsample` unset, [`Plan::auto_subsample`]) and
+/// `--subsample auto` would render it at 1/s of the size with s > 1 (a Gaussian kernel, an
+/// orthographic view at level 0, footprints at least 2 px across their shorter semi-axis at 1/s;
+/// `crate::pipeline::stages::subsample::factor`): otherwise the subsampled frame is the
+/// full-size one.
+fn subsampling_differs(p: &Prepared, base: &Plan) -> Result<bool, CliError> {
+    if !base.auto_subsample {
+        return Ok(false);
+    }
+    let mut auto = base.clone();
+    auto.subsample = crate::args::Supersample::Auto;
+    Ok(p.subsample_factor(&auto)? > 1)
 }
 
 /// One pilot: the frames `p` renders, measured at sampled pixels against a continuous
