@@ -17,8 +17,8 @@
 # --opacity-unit-distance 1; VolPack's per-slice opacity equals it at unit spacing).
 #
 # Per volume and repetition, in this order: Footprint's default (`--slicing auto`: object slicing
-# where its pilot measures 44 dB against the continuous model, slabs otherwise; fresh includes the
-# pilot) on 1 and 2 threads, object slicing float 1 thread, float 2 threads, fixed 1 thread, float with --subsample auto on 1 and 2 threads, image-aligned slabs (--slicing image) on
+# where its pilot measures 44 dB against the continuous model, slabs otherwise, each subsampled
+# first where the footprints allow it; fresh includes the pilot) on 1 and 2 threads, object slicing float 1 thread, float 2 threads, fixed 1 thread, float with --subsample auto on 1 and 2 threads, image-aligned slabs (--slicing image) on
 # 1 and 2 threads, object slicing and slabs with occlusion culling (--cull 0.004) on 1 and 2
 # threads (each `footprint bench --frames N --orbit 2`: first_ms = fresh volume, median_ms =
 # re-render), post-classified slabs on 1 thread, VTK vtkFixedPointVolumeRayCastMapper 1 and 2
@@ -189,11 +189,13 @@ print(f"{name}: mean RGB  footprint {fp.mean():.2f}  vtk {vt.mean():.2f}  volpac
 Image.fromarray(np.concatenate([fp, vt, vp], 1)).resize((768, 256)).save(dest)
 PY
   for rep in $(seq 1 "$reps"); do
-    for cfg in "1 float 1 auto off" "2 float 1 auto off" "1 float 1 object off" "2 float 1 object off" "1 fixed 1 object off" "1 float auto object off" \
+    # SUB "-" leaves --subsample unset: the default plan's pilot may subsample.
+    for cfg in "1 float - auto off" "2 float - auto off" "1 float 1 object off" "2 float 1 object off" "1 fixed 1 object off" "1 float auto object off" \
                "2 float auto object off" "1 float 1 image off" "2 float 1 image off" "1 float 1 object $cull" \
                "2 float 1 object $cull" "1 float 1 image $cull" "2 float 1 image $cull"; do
       read -r th acc sub slicing cl <<<"$cfg"
-      "$fp" bench "${common[@]}" --threads "$th" --accum "$acc" --subsample "$sub" --slicing "$slicing" \
+      subarg=(); [ "$sub" != - ] && subarg=(--subsample "$sub")
+      "$fp" bench "${common[@]}" --threads "$th" --accum "$acc" "${subarg[@]}" --slicing "$slicing" \
         --cull "$cl" --json "$work/b.json" >/dev/null
       label=$acc; [ "$sub" = auto ] && label=$label-subsample; [ "$slicing" = auto ] && label=$label-default
       [ "$slicing" = image ] && label=$label-slabs; [ "$cl" != off ] && label=$label-cull

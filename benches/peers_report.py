@@ -70,7 +70,8 @@ lines = [
     "turned 2° further and reusing the visible-voxel lists. VTK: `vtkFixedPointVolumeRayCastMapper`, "
     "median frame after a warm-up frame. VolPack: pre-classified shear-warp, median frame; its one-off "
     "classification is excluded, as VolPack's own figures exclude it. Footprint's columns are its "
-    "default (`--slicing auto`, its pilot in the fresh frame) where this run measured it; *fixed* is "
+    "default (`--slicing auto`, its pilot in the fresh frame, subsampled where the pilot took it) where "
+    "this run measured it; *fixed* is "
     "object slicing, and fixed ÷ float compares it with float object slicing.",
     "",
     "| volume | Footprint fresh, 1 thread | re-render, 1 thread | re-render, 2 threads | fixed re-render, 1 thread | VTK 1 thread | VTK 2 threads | VolPack |",
@@ -132,7 +133,8 @@ if any(r["accum"] == "float-slabs" for r in rows):
         "",
         "Same repetitions, float. *Default* is `--slicing auto` (object slicing where a pilot of sampled rays "
         "measures it at 44 dB or more against the continuous model, the thickest slabs that reach it "
-        "otherwise; its fresh frame includes the pilot), *object* the paper's sheets, *slabs* image-aligned "
+        "otherwise, each tried at 1/s of the size first where the footprints allow it, `--subsample` unset; "
+        "its fresh frame includes the pilot), *object* the paper's sheets, *slabs* image-aligned "
         "slabs one voxel spacing thick (`--slicing image`), *cull* adds occlusion culling at ε = 1/255 "
         "(`--cull 0.004`: 8×8-pixel tiles whose every pixel reached opacity 1 − ε take nothing more, and "
         "voxels landing only on them are skipped; each such pixel stays within ε per channel), "
