@@ -7,7 +7,8 @@
 #    default flags: `verify --reference continuous` measures the whole image against the default
 #    (opacity) model; the JSON says what the pilot chose (`plan`), its bound on the pilot
 #    (`quality.predicted_db`) and the seconds of its reference and candidate renders. `chosen`
-#    is `sheets/nearest` where object slicing read at the nearest phase was kept, and the object
+#    is `sheets/nearest` where object slicing read at the nearest phase was kept (`/s=N` where it
+#    is subsampled at 1/N), and the object
 #    column is the first object-slicing candidate's bound (the nearest phase where it was tried).
 # 2. Cost: each volume at 512x512, view 30,20,0, emission, one thread, `bench --frames 3
 #    --orbit 2`, the default and `--slicing object` run alternately ROUNDS times; the minimum
@@ -37,6 +38,7 @@ j = json.load(open(sys.argv[1]))
 name, view, shading = sys.argv[2:]
 plan, q = j["plan"], j.get("quality")
 chosen = plan["end"] + ("/nearest" if plan.get("phase_lookup") == "nearest" else "")
+chosen += f"/s={int(plan['subsample'])}" if plan.get("subsample", 1) > 1 else ""
 slab = plan["slab"] if plan["slab"] is not None else ""
 if q:
     pilot = q["pilot"]
@@ -63,7 +65,7 @@ for vol in "$data"/*/*.nhdr; do
 import json,sys
 j=json.load(open('$tmp/b.json'))
 p=j['plan']
-print(f\"$name,$r,$slicing,{p['end']}{'/nearest' if p.get('phase_lookup') == 'nearest' else ''}{'' if p['slab'] is None else ' '+str(p['slab'])},{j['first_ms']:.1f},{j['median_ms']:.1f},{j['plan_ms']:.1f}\")" >> "$cost"
+print(f\"$name,$r,$slicing,{p['end']}{'/nearest' if p.get('phase_lookup') == 'nearest' else ''}{'/s='+str(int(p['subsample'])) if p.get('subsample', 1) > 1 else ''}{'' if p['slab'] is None else ' '+str(p['slab'])},{j['first_ms']:.1f},{j['median_ms']:.1f},{j['plan_ms']:.1f}\")" >> "$cost"
     done
   done
 done
