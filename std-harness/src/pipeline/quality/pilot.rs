@@ -12,9 +12,8 @@
 //!    pixel per cell, at a fixed pseudo-random position inside it, is taken (stratified
 //!    sampling: every part of the image is represented, and no sampling pattern can line up
 //!    with a periodic error). The continuous reference is marched through those pixels only
-//!    (each k×k block of a supersampled frame), converged by `verify --reference continuous`'s
-//!    rule with its first two passes nested (`reference::continuous`, "The pilot's march"),
-//!    about 1/S² of its cost.
+//!    (each k×k block of a supersampled frame), converged as `verify --reference continuous`
+//!    converges (`reference::continuous`), about 1/S² of its cost.
 //! 2. **Candidates**, cheapest first: object slicing with the table configuration the sheet
 //!    model picks for DB, then the one it picks for DB + [`TABLE_HEADROOM_DB`] (so that the
 //!    table's share of the error is negligible) if it differs; then, against `field` only
