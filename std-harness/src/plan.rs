@@ -255,6 +255,7 @@ pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
         }
     }
     subsample_rules(args)?;
+    let auto_slicing = auto::slicing_target(&end, args);
     Ok(Plan {
         end,
         table: Table {
@@ -275,8 +276,8 @@ pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
             target_db,
             reference: args.quality_reference,
         }),
-        auto_slicing: auto::slicing_target(&end, args),
-        auto_subsample: args.subsample.is_none() && auto::slicing_target(&end, args).is_some(),
+        auto_slicing,
+        auto_subsample: args.subsample.is_none() && auto_slicing.is_some(),
     })
 }
 

@@ -72,8 +72,8 @@
 //! at 1/s of the size, s > 1, each of those subsampled first, in the same order, the full-size
 //! ones only if none of those reaches the target (1/s² of the pixel updates; −0.46 to +0.03 dB
 //! against the continuous model on docs/subsample-validation.md's 24 cases; the CT head's and
-//! the walnut's default re-renders 3.7× and 2.0× faster at 512², `footprint bench --frames 5
-//! --orbit 2 --threads 1`, with and without `--subsample 1`). Its chosen frame is kept in
+//! the walnut's default re-renders 3.7× and 1.7× faster at 512², `footprint bench --frames 6
+//! --orbit 2 --threads 1` against `--subsample 1`, 4 pairs). Its chosen frame is kept in
 //! the choice ([`Choice::frame`]) and is the command's frame, not rendered again (unless no
 //! candidate reached the target: the most accurate is then rendered again).
 
@@ -277,7 +277,8 @@ pub fn choose_slicing(
         // full-size ones follow only where none of those reaches the target.
         let small: Vec<_> = candidates
             .iter()
-            .map(|(c, _)| (c.subsampled(), c.subsampled().plan(&object)))
+            .map(|(c, _)| c.subsampled())
+            .map(|c| (c, c.plan(&object)))
             .collect();
         candidates.splice(0..0, small);
     }
