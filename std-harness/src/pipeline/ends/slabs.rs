@@ -4,8 +4,10 @@
 //! 1. The visible lists (classified once per volume, as for sheets: [`crate::pipeline::stages::visible`]) are
 //!    shaded for one world unit of thickness and valued as the `--absorption` model reads them
 //!    ([`SlabSetup::voxel`]), placed on screen, and sorted by the slab each reaches
-//!    first in compositing order (counting sorts: the voxel order within a slab does not depend
-//!    on the thread count).
+//!    first in compositing order (one counting sort), in runs of sheets on threads of their own
+//!    ([`SlabVoxels`]: the order of splats does not depend on the thread count). On one thread
+//!    this was all of a re-render's classify phase and serial: 230-255 ms of the 256³ blobs' 284
+//!    ms frame on 16 threads at 512² (`benches/threads16.sh`, 2026-12-04).
 //! 2. The image is cut into blocks of rows whose slab accumulators fit the cache
 //!    ([`crate::pipeline::stages::blocks`]), each voxel listed in the blocks it reaches; threads
 //!    take blocks as they come free. A block walks the slabs in compositing order: the voxels
@@ -73,30 +75,23 @@ pub fn render_slabs(
         0.0
     };
     let t1 = Instant::now();
-    let voxels = slab_voxels(p, &setup, lists)?;
-
     let [w, h] = p.frame.size;
     let rows = block_rows(w, setup.ring(), std::mem::size_of::<[f32; 4]>());
     let ranges = blocks(h, rows);
-    let members = Members::of(voxels.voxels.len(), h, rows, |i| {
-        setup.rows_of(voxels.voxels[i].position[1])
-    })?;
+    let voxels = slab_voxels(p, &setup, lists, bands.threads, rows)?;
     let classify = classify_lists + t1.elapsed().as_secs_f64();
 
-    let (setup, table, sv, members) = (&setup, &*table, &voxels, &members);
+    let (setup, table, sv) = (&setup, &*table, &voxels);
     let threads = bands.threads.clamp(1, ranges.len().max(1));
     let timing = (start, classify, tables);
-    banded_frame(p, threads, timing, voxels.voxels.len(), |image| {
+    banded_frame(p, threads, timing, voxels.len(), |image| {
         on_blocks(
             image,
             w,
             &ranges,
             threads,
             p.background.as_deref(),
-            |b, rows, band, bg| {
-                let mine = members.of_block(b);
-                render_band(p, setup, table, sv, mine, bg, band, rows, bands.cull)
-            },
+            |b, rows, band, bg| render_band(p, setup, table, sv, b, bg, band, rows, bands.cull),
         )
     })
 }
@@ -138,31 +133,120 @@ where
     })
 }
 
-/// Every visible voxel as a [`SlabVoxel`], grouped by the compositing step at which it enters:
-/// its first slab front to back, its last back to front (a stable sort, so voxels keep the order
-/// of the sort before it: sheet order, then first slab).
+/// Every visible voxel as a [`SlabVoxel`], grouped by the compositing step at which it enters
+/// (its first slab front to back, its last back to front; within a step, by first slab, then in
+/// sheet order), cut into chunks of whole sheets that are classified, sorted and placed in blocks
+/// on threads of their own.
+///
+/// **Identity.** The chunks are runs of consecutive sheets, in order, and each is sorted stably
+/// by one key per (step, first slab) on its own; a block walks every chunk's voxels of one key,
+/// chunk after chunk, before the next key. That is the order of one stable sort of the whole
+/// list (step, first slab, sheet order), whatever the number of chunks: the same splats in the
+/// same order for every thread count.
 struct SlabVoxels {
-    voxels: Vec<SlabVoxel>,
-    /// `voxels[starts[k]..starts[k + 1]]` enter at step k (slab k front to back, slab
-    /// count − 1 − k back to front).
-    starts: Vec<usize>,
+    chunks: Vec<SlabChunk>,
 }
 
+/// The voxels of a run of sheets (see [`SlabVoxels`]).
+struct SlabChunk {
+    voxels: Vec<SlabVoxel>,
+    /// `voxels[starts[j]..starts[j + 1]]` have key j = step · [`key_span`] + the rank of their
+    /// first slab among those of the step (step k: slab k front to back, slab count − 1 − k back
+    /// to front).
+    starts: Vec<usize>,
+    /// The chunk's voxels reaching each block, as indices into `voxels`.
+    members: Members,
+}
+
+impl SlabVoxels {
+    fn len(&self) -> usize {
+        self.chunks.iter().map(|c| c.voxels.len()).sum()
+    }
+}
+
+/// Keys per compositing step: back to front, one per slab count a voxel can span (the ring), its
+/// first slab ordering the voxels of a step; front to back the step is the first slab.
+fn key_span(order: Order, setup: &SlabSetup) -> usize {
+    match order {
+        Order::FrontToBack => 1,
+        Order::BackToFront => setup.ring().max(1),
+    }
+}
+
+/// Shades, places and sorts the visible voxels of `lists` on up to `threads` threads (runs of
+/// sheets with about the same number of voxels each), and lists each run's voxels by the blocks
+/// of `rows` rows they reach.
 fn slab_voxels(
     p: &Prepared,
     setup: &SlabSetup,
     lists: &crate::pipeline::stages::visible::VisibleLists,
+    threads: usize,
+    rows: usize,
 ) -> Result<SlabVoxels, CliError> {
+    let runs = sheet_runs(p.frame.sheet_count(), threads, |s| {
+        lists.sheet(s).voxels.len()
+    });
+    let chunks: Vec<Result<SlabChunk, CliError>> = std::thread::scope(|scope| {
+        let tasks: Vec<_> = runs
+            .into_iter()
+            .map(|sheets| {
+                crate::threads::spawn(scope, move || slab_chunk(p, setup, lists, sheets, rows))
+            })
+            .collect();
+        tasks.into_iter().map(crate::threads::Task::join).collect()
+    });
+    Ok(SlabVoxels {
+        chunks: chunks.into_iter().collect::<Result<_, _>>()?,
+    })
+}
+
+/// Cuts sheets 0..`count` into at most `parts` runs of consecutive sheets holding about the same
+/// number of `voxels` each (none empty; one run, possibly empty, when there is nothing).
+fn sheet_runs(
+    count: usize,
+    parts: usize,
+    voxels: impl Fn(usize) -> usize,
+) -> Vec<std::ops::Range<usize>> {
+    let total: usize = (0..count).map(&voxels).sum();
+    let parts = parts.clamp(1, count.max(1));
+    let mut runs = Vec::with_capacity(parts);
+    let (mut start, mut seen) = (0, 0usize);
+    for s in 0..count {
+        seen += voxels(s);
+        // Close the run once it holds its share of the voxels seen so far.
+        if runs.len() + 1 < parts
+            && seen.saturating_mul(parts) >= total.saturating_mul(runs.len() + 1)
+        {
+            runs.push(start..s + 1);
+            start = s + 1;
+        }
+    }
+    if start < count || runs.is_empty() {
+        runs.push(start..count);
+    }
+    runs
+}
+
+/// One run of sheets' voxels: shaded for one world unit, placed on screen, sorted by step with
+/// one stable counting sort, and bucketed by block.
+fn slab_chunk(
+    p: &Prepared,
+    setup: &SlabSetup,
+    lists: &crate::pipeline::stages::visible::VisibleLists,
+    sheets: std::ops::Range<usize>,
+    rows: usize,
+) -> Result<SlabChunk, CliError> {
     let f = &p.frame;
     let shader = p.shader();
     // Opacity per world unit (the slab integrates the model's field along the ray itself).
     let lighting = Lighting::per_world_unit(f);
     let needs_gradient = shader.shading.needs_gradient();
+    let len: usize = sheets.clone().map(|s| lists.sheet(s).voxels.len()).sum();
     let mut placed: Vec<(SlabVoxel, (usize, usize))> = Vec::new();
     placed
-        .try_reserve_exact(lists.len())
+        .try_reserve_exact(len)
         .map_err(|_| CliError::input("cannot allocate the slab voxel list"))?;
-    for s in 0..f.sheet_count() {
+    for s in sheets {
         let sheet = lists.sheet(s);
         for (k, vox) in sheet.voxels.iter().enumerate() {
             let idx = f.grid_index(s, usize::from(vox.u), usize::from(vox.v));
@@ -181,16 +265,45 @@ fn slab_voxels(
             }
         }
     }
-    let count = setup.slab_count();
-    let (mut order, mut starts) = buckets(placed.iter().map(|(_, (a, _))| *a), count);
-    if p.order == Order::BackToFront {
-        let (by_last, s) = buckets(order.iter().map(|&i| count - 1 - placed[i].1 .1), count);
-        order = by_last.into_iter().map(|j| order[j]).collect();
-        starts = s;
+    let (count, span) = (setup.slab_count(), key_span(p.order, setup));
+    // One key per voxel whose order is (step, first slab); a stable sort keeps sheet order within
+    // a key. Front to back the step is the first slab. Back to front it is count − 1 − last, and
+    // a voxel spans d = last − first < `span` slabs (the ring holds them all), so first ascending
+    // is d descending: key = step · span + (span − 1 − d).
+    let key = |&(_, (a, b)): &(SlabVoxel, (usize, usize))| match p.order {
+        Order::FrontToBack => a,
+        Order::BackToFront => (count - 1 - b) * span + (span - 1 - (b - a).min(span - 1)),
+    };
+    let mut at = vec![0usize; count * span + 1];
+    for v in &placed {
+        at[key(v) + 1] += 1;
     }
-    Ok(SlabVoxels {
-        voxels: order.into_iter().map(|i| placed[i].0).collect(),
+    for j in 0..count * span {
+        at[j + 1] += at[j];
+    }
+    let starts = at.clone();
+    let mut voxels = crate::io::try_filled(
+        placed.len(),
+        SlabVoxel {
+            position: [0.0; 3],
+            value: Default::default(),
+        },
+        "the slab voxel list",
+    )?;
+    for v in &placed {
+        let k = key(v);
+        voxels[at[k]] = v.0;
+        at[k] += 1;
+    }
+    drop(placed);
+    let h = p.frame.size[1];
+    let members = Members::of(voxels.len(), h, rows, |i| {
+        setup.rows_of(voxels[i].position[1])
+    })?;
+    Ok(SlabChunk {
+        voxels,
         starts,
+        members,
     })
 }
 
@@ -218,14 +331,14 @@ pub(crate) fn buckets(
 
 /// One band (a block of rows): every slab in compositing order: the voxels that reach it first
 /// splatted (into every slab each overlaps), then the slab composited; occluded voxels culled at
-/// `cull`'s ε. `mine` lists the voxels that reach the band's rows, in the list's order.
+/// `cull`'s ε. The band is block `block` of the voxels' [`Members`].
 #[allow(clippy::too_many_arguments)]
 fn render_band(
     p: &Prepared,
     setup: &SlabSetup,
     table: &SectionTable<ROWS, COLUMNS>,
     sv: &SlabVoxels,
-    mine: &[u32],
+    block: usize,
     background: Option<&[[f32; 4]]>,
     image: &mut [[f32; 4]],
     rows: std::ops::Range<usize>,
@@ -252,12 +365,28 @@ fn render_band(
         renderer = renderer.with_occlusion(&mut occluded, eps)?;
     }
     let mut phases = Phases::default();
-    let mut mine = mine.iter().map(|&i| i as usize).peekable();
+    // Each chunk's voxels reaching the block, in the chunk's order.
+    let mut mine: Vec<_> = sv
+        .chunks
+        .iter()
+        .map(|c| {
+            c.members
+                .of_block(block)
+                .iter()
+                .map(|&i| i as usize)
+                .peekable()
+        })
+        .collect();
+    let span = key_span(p.order, setup);
     for k in 0..setup.slab_count() {
         let t0 = Instant::now();
-        // `mine` is in list order, so the voxels entering at step k come next.
-        while let Some(i) = mine.next_if(|&i| i < sv.starts[k + 1]) {
-            renderer.splat_voxel(&sv.voxels[i])?;
+        // Each chunk's list is in key order, so its voxels of step k come next, key by key.
+        for j in k * span..(k + 1) * span {
+            for (c, mine) in sv.chunks.iter().zip(&mut mine) {
+                while let Some(i) = mine.next_if(|&i| i < c.starts[j + 1]) {
+                    renderer.splat_voxel(&c.voxels[i])?;
+                }
+            }
         }
         let t1 = Instant::now();
         renderer.composite_next();
@@ -265,4 +394,43 @@ fn render_band(
         phases.composite += t1.elapsed().as_secs_f64();
     }
     Ok((renderer.finish(), phases))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::sheet_runs;
+
+    /// Runs tile the sheets in order, none empty, at most `parts` of them, and split the voxels
+    /// about evenly where the sheets allow it.
+    #[test]
+    fn sheet_runs_tile_the_sheets_with_about_equal_voxels() {
+        let weights: [&[usize]; 5] = [
+            &[],
+            &[0, 0, 0],
+            &[5; 40],
+            &[0, 0, 100, 0, 0, 1, 1, 1, 1, 90],
+            &[1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13],
+        ];
+        for w in weights {
+            for parts in [1usize, 2, 3, 7, 16, 100] {
+                let runs = sheet_runs(w.len(), parts, |s| w[s]);
+                assert!(
+                    !runs.is_empty() && runs.len() <= parts.max(1),
+                    "{w:?} {parts}"
+                );
+                assert_eq!(runs[0].start, 0);
+                assert_eq!(runs.last().map(|r| r.end), Some(w.len()));
+                assert!(runs.windows(2).all(|p| p[0].end == p[1].start));
+                if !w.is_empty() {
+                    assert!(
+                        runs.iter().all(|r| !r.is_empty()),
+                        "{w:?} {parts}: {runs:?}"
+                    );
+                }
+            }
+        }
+        // 40 equal sheets in 4 runs: 10 each.
+        let runs = sheet_runs(40, 4, |_| 5);
+        assert_eq!(runs, [0..10, 10..20, 20..30, 30..40]);
+    }
 }
