@@ -5,7 +5,7 @@
 
 use super::prepare::Prepared;
 use super::spares::Spares;
-use super::supply::{OnTheFly, SheetSupply};
+use super::supply::{BandLists, OnTheFly, SheetSupply};
 use super::visible::{Visible, VisibleLists};
 use crate::CliError;
 use footprint::composite::RowSpan;
@@ -175,7 +175,8 @@ where
         on_bands(image, p.frame.size, ranges, background, |rows, band, bg| {
             let r = match visible {
                 Visible::Kept(lists) => {
-                    render_band(p, path, bg, &mut &*lists, spares, band, rows, cull)
+                    let mut lists = BandLists::new(lists, &p.frame, rows.clone());
+                    render_band(p, path, bg, &mut lists, spares, band, rows, cull)
                 }
                 Visible::OnTheFly(v) if v.is_coloured() => {
                     let mut lists = OnTheFly::<Coloured>::new(p, v)?;

@@ -28,6 +28,94 @@ impl SheetSupply for &VisibleLists {
     }
 }
 
+/// The kept lists as one band of rows sees them: each sheet's voxels from the first row run
+/// that can reach the band to the last one that can (the rows between them whole), instead of
+/// the whole sheet. The core tests every voxel it is given against the band
+/// (`SheetRenderer::with_band`), so the voxels left out are only ones that test would refuse:
+/// the same splats in the same order, the same bits. On 16 bands a band was given every voxel of
+/// every sheet and refused most of them one by one.
+pub struct BandLists<'a> {
+    lists: &'a VisibleLists,
+    frame: &'a footprint::frame::FrameSetup,
+    /// Screen rows (pixel centres at y + 0.5) a voxel must reach: the band's, widened by the
+    /// footprint's half-height and the core's own margin (2 px), and one more pixel against the
+    /// rounding of the two computations of y. `None`: no cut (perspective, or the whole image).
+    reach: Option<(f32, f32)>,
+}
+
+impl<'a> BandLists<'a> {
+    /// `lists` for the band of image rows `rows` of `frame`.
+    pub fn new(
+        lists: &'a VisibleLists,
+        frame: &'a footprint::frame::FrameSetup,
+        rows: std::ops::Range<usize>,
+    ) -> Self {
+        let whole = rows.start == 0 && rows.end >= frame.size[1];
+        let margin = frame.footprint.half_extent[1] + 3.0;
+        let reach = (!whole && frame.camera().is_none() && margin.is_finite())
+            .then_some((rows.start as f32 - margin, rows.end as f32 + margin));
+        BandLists {
+            lists,
+            frame,
+            reach,
+        }
+    }
+
+    /// The voxel range of sheet `s` (indices into the lists' voxels) the band is given.
+    fn range(&self, s: usize) -> std::ops::Range<usize> {
+        let l = self.lists;
+        let all = l.offsets[s]..l.offsets[s + 1];
+        let Some((top, bottom)) = self.reach else {
+            return all;
+        };
+        // Screen y is affine in (u, v) on a sheet: y = y0 + ya·u + yb·v.
+        let f = self.frame;
+        let y = |u: usize, v: usize| f.affine_position(f.grid_index(s, u, v).map(|c| c as f32)).y;
+        let y0 = y(0, 0);
+        let (ya, yb) = (y(1, 0) - y0, y(0, 1) - y0);
+        let (mut first, mut last) = (None, all.start);
+        let mut at = all.start;
+        for run in &l.runs[l.run_offsets[s]..l.run_offsets[s + 1]] {
+            let base = y0 + yb * f32::from(run.v);
+            let (a, b) = (base + ya * f32::from(run.u0), base + ya * f32::from(run.u1));
+            let end = at + run.count as usize;
+            // `!` keeps a NaN run in.
+            if !(a.max(b) < top || a.min(b) > bottom) {
+                first.get_or_insert(at);
+                last = end;
+            }
+            at = end;
+        }
+        match first {
+            Some(first) => first..last,
+            None => all.start..all.start,
+        }
+    }
+}
+
+impl SheetSupply for BandLists<'_> {
+    fn sheet(&mut self, s: usize) -> Result<VisibleSheet<'_>, CliError> {
+        let r = self.range(s);
+        let l = self.lists;
+        fn part<'v>(v: &'v [[f32; 3]], r: &std::ops::Range<usize>) -> &'v [[f32; 3]] {
+            if v.is_empty() {
+                &[]
+            } else {
+                &v[r.clone()]
+            }
+        }
+        Ok(VisibleSheet {
+            voxels: &l.voxels[r.clone()],
+            gradients: part(&l.gradients, &r),
+            colours: part(&l.colours, &r),
+        })
+    }
+    /// Every visible voxel: the band could be given any (what `run_bands` reports as the frame's).
+    fn supplied(&self) -> u64 {
+        self.lists.len() as u64
+    }
+}
+
 /// A sample type a volume in memory gives a sheet of.
 pub trait ReadSheet: Sample + Default + Clone {
     /// Writes sheet `s` of `axis` of `volume` into `out`.
