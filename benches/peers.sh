@@ -24,7 +24,8 @@
 # re-render), post-classified slabs on 1 thread, VTK vtkFixedPointVolumeRayCastMapper 1 and 2
 # threads, VolPack pre-classified. Once per volume, each of those methods against the default
 # continuous model (`verify --reference continuous`) and its culled voxels: docs/perf/methods.csv.
-# The 16-core table comes from docs/perf/threads16.csv (measured on a lent machine). The
+# The 16-core table comes from docs/perf/threads16.csv (benches/threads16.sh and
+# benches/threads16_report.py, run on a lent machine). The
 # medians over the repetitions go to docs/performance.md as ratios; the raw rows to
 # docs/perf/peers.csv. After VolPack in each repetition, benches/floor.rs times the scene's
 # unavoidable work at 512² (its pixel updates and composites, counted by `footprint render --json`,

@@ -171,21 +171,41 @@ if any(r["accum"] == "float-slabs" for r in rows):
 if threads16_csv and os.path.exists(threads16_csv):
     t16 = list(csv.DictReader(open(threads16_csv)))
     if t16:
+        counts = [c[1:-3] for c in t16[0] if c.startswith("t") and c.endswith("_ms") and c[1:-3].isdigit()]
         lines += [
             "",
             "## Threads on 16 cores",
             "",
             f"Not measured by this run (a 16-core machine is lent to some sessions only): `{threads16_csv}`, "
-            f"measured on {t16[0]['machine']} at commit {t16[0]['commit']} ({t16[0]['date']}), "
-            "`footprint bench VOLUME --view 30,20,0 --frames 5 --orbit 2 --threads T`, median re-render; "
-            "volumes at their own files' values and the default transfer function. Target: 16 threads ≥ 10× one.",
+            f"made by `benches/threads16.sh` and `benches/threads16_report.py` on {t16[0]['machine']} at "
+            f"commit {t16[0]['commit']} ({t16[0]['date']}): `footprint bench VOLUME --view 30,20,0 --frames 5 "
+            "--orbit 2 --threads T`, the same u8 volumes and windows as above, median re-render; the thread "
+            "counts alternated within each row. *default* is `--slicing auto` (its plan in the second column: "
+            "s = the subsampling its pilot took), *object* `--slicing object --subsample 1`, *slabs* "
+            "`--slicing image --subsample 1`. Target: 16 threads ≥ 10× one at 512² and 1024². *serial at 16* "
+            "is the 16-thread frame outside its splat and composite phases: the tables, the slabs' classification "
+            "(on every thread since a8a3277), the resampling and the rest (thread start-up, the image's hand-over). The machine is "
+            "shared: the same binary's one-thread medians moved by up to 1.9× between two runs of the script "
+            "that day, so the ratio from the fastest re-render of each is given beside the medians'. The same script "
+            "at dd9a72d, before the slabs classified on every thread and the resampling stopped filling the image "
+            "first: `docs/perf/threads16_dd9a72d_long.csv`.",
             "",
-            "| volume | size | method | 1 thread | 16 threads | 16 ÷ 1 [≥ 10] |",
-            "|---|---|---|---|---|---|",
+            "| volume | size | method | plan | " + " | ".join(f"{c} thr" for c in counts)
+            + " | 2 ÷ 1 | 16 ÷ 1 [≥ 10] | 16 ÷ 1, fastest | serial at 16 |",
+            "|---|---|---|---|" + "---|" * len(counts) + "---|---|---|---|",
         ]
         for r in t16:
-            ms = lambda k: f"{float(r[k]):.1f} ms" if r[k] else "not kept"
-            lines.append(f"| {r['volume']} | {r['size']}² | {r['method']} | {ms('t1_ms')} | {ms('t16_ms')} | {float(r['speedup']):.1f}× |")
+            ms = lambda k: f"{float(r[k]):.1f} ms" if r.get(k) else "–"
+            serial = "–"
+            if r.get("t16_tables_ms"):
+                cl = float(r["t16_classify_ms"])
+                serial = (f"tables {float(r['t16_tables_ms']):.1f}, "
+                          + (f"classify {cl:.1f}, " if cl > 0 else "")
+                          + f"resample {float(r['t16_resample_ms']):.1f}, other {float(r['t16_other_ms']):.1f} ms")
+            lines.append(f"| {r['volume']} | {r['size']}² | {r['method']} | {r['plan']} | "
+                         + " | ".join(ms(f"t{c}_ms") for c in counts)
+                         + f" | {float(r['speedup2']):.2f}× | {float(r['speedup16']):.1f}× | "
+                         f"{float(r['speedup16_min']):.1f}× | {serial} |")
 
 prows = {r["volume"]: r for r in csv.DictReader(open(post_csv))} if post_csv else {}
 if any(r["accum"] == "float-post" for r in rows):
