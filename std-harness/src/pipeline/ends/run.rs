@@ -122,7 +122,7 @@ fn sheets_at<const N: usize>(
     let direct = plan.table.footprints == Footprints::Direct;
     let start = Instant::now();
     {
-        let generic = plan.table.generic::<N>(&p.kernel)?;
+        let generic = cache.tables.generic::<N>(&plan.table, &p.kernel)?;
         // Each path gets its own monomorphised sheet loop: no virtual call per pixel.
         let perspective = p.frame.camera().is_some();
         let (image, stats, mut phases, visible) = match precision {

@@ -10,5 +10,6 @@ pub mod spares;
 pub mod subsample;
 pub mod supersample;
 pub mod supply;
+pub mod tables;
 pub mod visible;
 pub mod window;

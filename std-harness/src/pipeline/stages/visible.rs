@@ -172,6 +172,8 @@ pub struct FrameCache {
     spares: Spares,
     /// The voxels post-classified frames splat (`--classification post`), once made.
     pub post: Option<PostSamples>,
+    /// The generic table, built once ([`super::tables`]).
+    pub tables: super::tables::TableCache,
 }
 
 impl FrameCache {
