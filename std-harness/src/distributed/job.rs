@@ -434,7 +434,8 @@ impl BrickFrame {
             Resample::None => image,
             Resample::Average { k } => supersample::to_output(image, self.size, k),
             Resample::Magnify { s, low } => {
-                subsample::magnify(&image, low, self.size, s, self.threads)?
+                let threads = subsample::resample_threads(self.threads, self.size);
+                subsample::magnify(&image, low, self.size, s, threads)?
             }
         };
         if let Some(bg) = &self.background {

@@ -159,6 +159,20 @@ pub fn taps(out: usize, low: usize, s: usize) -> Vec<(usize, [f32; 4])> {
         .collect()
 }
 
+/// Output pixels worth a thread of their own in [`magnify`]. Measured on the 16-core device
+/// machine (2026-12-04, `footprint bench --frames 8 --orbit 2 --threads 16`, default plan, two
+/// rounds): at 512² the resampling took 1.24-1.37 ms on 16 threads and 0.84-0.94 on 8; at 1024²
+/// 1.40-1.94 ms on 16 and 1.93-2.57 on 8, so 16 threads pay at 64 Ki pixels each and not at 16 Ki.
+const RESAMPLE_PIXELS: usize = 32 << 10;
+
+/// The threads [`magnify`] is worth to an `out`-sized image given `threads`: one per
+/// [`RESAMPLE_PIXELS`] output pixels at most (more start up slower than they work).
+pub fn resample_threads(threads: usize, out: (usize, usize)) -> usize {
+    threads
+        .min(out.0.saturating_mul(out.1) / RESAMPLE_PIXELS)
+        .max(1)
+}
+
 /// The `low` image (w × h, premultiplied RGBA) resampled to `out` with factor `s` on `threads`
 /// threads (the same values for any number): rows first, then columns; channels clamped at 0,
 /// opacity at 1 and each colour at its opacity (a valid premultiplied colour, as the renderer's

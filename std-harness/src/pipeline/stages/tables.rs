@@ -77,12 +77,17 @@ mod tests {
             let got = cache.generic::<33>(&table, &kernel).expect("built");
             assert!(*got == GenericTable::<33>::build(kernel), "{kernel:?}");
             let got = cache.generic::<17>(&table, &kernel).expect("built");
-            assert!(*got == GenericTable::<17>::build(kernel), "{kernel:?} at 17");
+            assert!(
+                *got == GenericTable::<17>::build(kernel),
+                "{kernel:?} at 17"
+            );
         }
         let from_file = Table {
             file: Some("/nonexistent/footprint-table.bin".into()),
             ..table
         };
-        assert!(cache.generic::<33>(&from_file, &Kernel::PAPER_GAUSSIAN).is_err());
+        assert!(cache
+            .generic::<33>(&from_file, &Kernel::PAPER_GAUSSIAN)
+            .is_err());
     }
 }
