@@ -188,7 +188,9 @@ if threads16_csv and os.path.exists(threads16_csv):
             "shared: the same binary's one-thread medians moved by up to 1.9× between two runs of the script "
             "that day, so the ratio from the fastest re-render of each is given beside the medians'. The same script "
             "at dd9a72d, before the slabs classified on every thread and the resampling stopped filling the image "
-            "first: `docs/perf/threads16_dd9a72d_long.csv`.",
+            "first: `docs/perf/threads16_dd9a72d_long.csv`; at 7e963b3, an hour before this run on a quieter "
+            "machine (the walnut's default re-render 11.0 ms on 16 threads there, 19.1 ms here): "
+            "`docs/perf/threads16_7e963b3_long.csv`.",
             "",
             "| volume | size | method | plan | " + " | ".join(f"{c} thr" for c in counts)
             + " | 2 ÷ 1 | 16 ÷ 1 [≥ 10] | 16 ÷ 1, fastest | serial at 16 |",

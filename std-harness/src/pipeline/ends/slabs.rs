@@ -5,7 +5,7 @@
 //!    shaded for one world unit of thickness and valued as the `--absorption` model reads them
 //!    ([`SlabSetup::voxel`]), placed on screen, and sorted by the slab each reaches
 //!    first in compositing order (one counting sort), in runs of sheets on threads of their own
-//!    ([`SlabVoxels`]: the order of splats does not depend on the thread count). On one thread
+//!    (`SlabVoxels`: the order of splats does not depend on the thread count). On one thread
 //!    this was all of a re-render's classify phase and serial: 230-255 ms of the 256³ blobs' 284
 //!    ms frame on 16 threads at 512² (`benches/threads16.sh`, 2026-12-04).
 //! 2. The image is cut into blocks of rows whose slab accumulators fit the cache

@@ -163,7 +163,7 @@ pub fn taps(out: usize, low: usize, s: usize) -> Vec<(usize, [f32; 4])> {
 /// machine (2026-12-04, `footprint bench --frames 8 --orbit 2 --threads 16`, default plan, two
 /// rounds): at 512² the resampling took 1.24-1.37 ms on 16 threads and 0.84-0.94 on 8; at 1024²
 /// 1.40-1.94 ms on 16 and 1.93-2.57 on 8, so 16 threads pay at 64 Ki pixels each and not at 16 Ki.
-const RESAMPLE_PIXELS: usize = 32 << 10;
+pub const RESAMPLE_PIXELS: usize = 32 << 10;
 
 /// The threads [`magnify`] is worth to an `out`-sized image given `threads`: one per
 /// [`RESAMPLE_PIXELS`] output pixels at most (more start up slower than they work).
@@ -270,33 +270,8 @@ pub fn magnify(
                         .filter(|(a, b)| a < b)
                         .fold((w, 0), |(a, b), &(x, y)| (a.min(x), b.max(y)));
                     let (a, b) = if a < b { (a, b) } else { (0, 0) };
-                    let (head, rest) = row.split_at_mut(a);
-                    for o in head.iter_mut().chain(rest[b - a..].iter_mut()) {
-                        o.write([0.0; 4]);
-                    }
                     let src = |k: usize| &ring[((first + k) % 4) * w..][..w];
-                    let (r0, r1, r2, r3) = (src(0), src(1), src(2), src(3));
-                    for (x, o) in row.iter_mut().enumerate().take(b).skip(a) {
-                        let mut px = [0.0f32; 4];
-                        for ch in 0..4 {
-                            let v = wt[0] * r0[x][ch]
-                                + wt[1] * r1[x][ch]
-                                + wt[2] * r2[x][ch]
-                                + wt[3] * r3[x][ch];
-                            px[ch] = if v > 0.0 { v } else { 0.0 };
-                        }
-                        if px[3] > 1.0 {
-                            px[3] = 1.0;
-                        }
-                        // Premultiplied: the cubic's overshoot at an edge must not leave a
-                        // colour above its opacity (the renderer's sheets never do).
-                        for ch in 0..3 {
-                            if px[ch] > px[3] {
-                                px[ch] = px[3];
-                            }
-                        }
-                        o.write(px);
-                    }
+                    write_row(row, (a, b), [src(0), src(1), src(2), src(3)], wt);
                 }
             });
         }
@@ -307,6 +282,40 @@ pub fn magnify(
     // A panic in a thread is carried on by the scope before this line.
     unsafe { out_img.set_len(w * h) };
     Ok(out_img)
+}
+
+/// Writes every pixel of output `row`: zeros outside columns a..b, and inside them the four
+/// resampled low rows `src` weighted by `wt`, clamped to a valid premultiplied colour (channels
+/// at 0, opacity at 1, each colour at its opacity).
+fn write_row(
+    row: &mut [std::mem::MaybeUninit<[f32; 4]>],
+    (a, b): (usize, usize),
+    src: [&[[f32; 4]]; 4],
+    wt: [f32; 4],
+) {
+    let (head, rest) = row.split_at_mut(a);
+    for o in head.iter_mut().chain(rest[b - a..].iter_mut()) {
+        o.write([0.0; 4]);
+    }
+    let [r0, r1, r2, r3] = src;
+    for (x, o) in row.iter_mut().enumerate().take(b).skip(a) {
+        let mut px = [0.0f32; 4];
+        for ch in 0..4 {
+            let v = wt[0] * r0[x][ch] + wt[1] * r1[x][ch] + wt[2] * r2[x][ch] + wt[3] * r3[x][ch];
+            px[ch] = if v > 0.0 { v } else { 0.0 };
+        }
+        if px[3] > 1.0 {
+            px[3] = 1.0;
+        }
+        // Premultiplied: the cubic's overshoot at an edge must not leave a colour above its
+        // opacity (the renderer's sheets never do).
+        for ch in 0..3 {
+            if px[ch] > px[3] {
+                px[ch] = px[3];
+            }
+        }
+        o.write(px);
+    }
 }
 
 #[cfg(test)]
