@@ -14,8 +14,10 @@
 //!    that reach slab j first (that reach the block) are splatted into every slab they overlap,
 //!    then slab j is composited (the core's ring of slab accumulators).
 //!
-//! **Memory.** 40 bytes per visible voxel (its [`SlabVoxel`] and slab range) on top of the
-//! visible lists, and 4 per voxel and block it reaches; per thread the ring of `SlabSetup::ring`
+//! **Memory.** 28 bytes per visible voxel (its [`SlabVoxel`]; 76 while a run of sheets sorts
+//! them) on top of the visible lists, and 4 per voxel and block it reaches; the sort's keys, 4
+//! bytes per slab and back to front per slab of the ring, per run of sheets (64 MiB at most
+//! together: `KEY_BYTES`); per thread the ring of `SlabSetup::ring`
 //! slab accumulators of the block it renders (16 bytes per pixel each: on an isotropic grid a
 //! kernel 1.6 voxels in radius spans at most 5 slabs of one spacing, 8 of half a spacing), and
 //! the 13 KiB section table. A slab of an oblique
@@ -153,7 +155,7 @@ struct SlabChunk {
     /// `voxels[starts[j]..starts[j + 1]]` have key j = step · [`key_span`] + the rank of their
     /// first slab among those of the step (step k: slab k front to back, slab count − 1 − k back
     /// to front).
-    starts: Vec<usize>,
+    starts: Vec<u32>,
     /// The chunk's voxels reaching each block, as indices into `voxels`.
     members: Members,
 }
@@ -163,6 +165,11 @@ impl SlabVoxels {
         self.chunks.iter().map(|c| c.voxels.len()).sum()
     }
 }
+
+/// The sort keys' bytes all runs of sheets may hold together ([`slab_voxels`]): the runs are
+/// fewer than the threads where a frame's keys would pass it (the order, and so the image, does
+/// not depend on how many there are).
+const KEY_BYTES: usize = 64 << 20;
 
 /// Keys per compositing step: back to front, one per slab count a voxel can span (the ring), its
 /// first slab ordering the voxels of a step; front to back the step is the first slab.
@@ -183,6 +190,13 @@ fn slab_voxels(
     threads: usize,
     rows: usize,
 ) -> Result<SlabVoxels, CliError> {
+    // Each run sorts by count · span keys of 4 bytes (up to 2^16 slabs of a ring of 40 on a
+    // hostile view: 10 MiB): at most KEY_BYTES of them together, whatever the thread count.
+    let keys = setup
+        .slab_count()
+        .saturating_mul(key_span(p.order, setup))
+        .max(1);
+    let threads = threads.min(KEY_BYTES / keys.saturating_mul(4)).max(1);
     let runs = sheet_runs(p.frame.sheet_count(), threads, |s| {
         lists.sheet(s).voxels.len()
     });
@@ -274,14 +288,19 @@ fn slab_chunk(
         Order::FrontToBack => a,
         Order::BackToFront => (count - 1 - b) * span + (span - 1 - (b - a).min(span - 1)),
     };
-    let mut at = vec![0usize; count * span + 1];
+    if u32::try_from(placed.len()).is_err() {
+        return Err(CliError::input(format!(
+            "{} voxels in one run of sheets: more than 2^32",
+            placed.len()
+        )));
+    }
+    let mut at = crate::io::try_filled(count * span + 1, 0u32, "the slab voxels' sort keys")?;
     for v in &placed {
         at[key(v) + 1] += 1;
     }
     for j in 0..count * span {
         at[j + 1] += at[j];
     }
-    let starts = at.clone();
     let mut voxels = crate::io::try_filled(
         placed.len(),
         SlabVoxel {
@@ -292,10 +311,14 @@ fn slab_chunk(
     )?;
     for v in &placed {
         let k = key(v);
-        voxels[at[k]] = v.0;
+        voxels[at[k] as usize] = v.0;
         at[k] += 1;
     }
     drop(placed);
+    // Each key's slot now holds where the next key starts: shifted by one, the starts again.
+    at.rotate_right(1);
+    at[0] = 0;
+    let starts = at;
     let h = p.frame.size[1];
     let members = Members::of(voxels.len(), h, rows, |i| {
         setup.rows_of(voxels[i].position[1])
@@ -383,7 +406,7 @@ fn render_band(
         // Each chunk's list is in key order, so its voxels of step k come next, key by key.
         for j in k * span..(k + 1) * span {
             for (c, mine) in sv.chunks.iter().zip(&mut mine) {
-                while let Some(i) = mine.next_if(|&i| i < c.starts[j + 1]) {
+                while let Some(i) = mine.next_if(|&i| i < c.starts[j + 1] as usize) {
                     renderer.splat_voxel(&c.voxels[i])?;
                 }
             }
