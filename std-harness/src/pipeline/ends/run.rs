@@ -271,9 +271,9 @@ fn fixed_sheets<const N: usize>(
 
 /// Stencil floats worth a thread of their own when the stencils are built. Measured on the
 /// 16-core device machine (2026-12-04, `footprint bench --frames 8 --orbit 2 --threads 16`,
-/// default plan, 512² and 1024², two rounds): the walnut's 143 033 floats took 1.38-1.71 ms on
-/// 16 threads, 0.96-1.01 on 2, 0.74-0.96 on 4 and 1.12-1.26 on 8; the CT head's were fastest on
-/// 4-8. Starting a thread there costs about what it samples in 10⁴ floats.
+/// default plan, 512² and 1024², two rounds, the stencils built on T threads): the walnut's
+/// tables phase took 1.38-1.71 ms with T = 16, 0.96-1.01 with 2, 0.74-0.96 with 4 and 1.12-1.26
+/// with 8; the CT head's was shortest with T = 4-8 (0.95-1.34 ms against 1.67-1.85 with 16).
 const STENCIL_FLOATS: usize = 32 << 10;
 
 /// The float path's phase stencils of `sampler` for `plan` in `buffer` (at most `plan.phases`

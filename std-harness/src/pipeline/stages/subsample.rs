@@ -161,8 +161,9 @@ pub fn taps(out: usize, low: usize, s: usize) -> Vec<(usize, [f32; 4])> {
 
 /// Output pixels worth a thread of their own in [`magnify`]. Measured on the 16-core device
 /// machine (2026-12-04, `footprint bench --frames 8 --orbit 2 --threads 16`, default plan, two
-/// rounds): at 512² the resampling took 1.24-1.37 ms on 16 threads and 0.84-0.94 on 8; at 1024²
-/// 1.40-1.94 ms on 16 and 1.93-2.57 on 8, so 16 threads pay at 64 Ki pixels each and not at 16 Ki.
+/// rounds, walnut and CT head): at 512² the resampling took 0.99-1.26 ms on 16 threads and
+/// 0.72-0.94 on 8; at 1024² 1.40-1.94 ms on 16 and 1.93-2.57 on 8, so 16 threads pay at 64 Ki
+/// pixels each and not at 16 Ki.
 pub const RESAMPLE_PIXELS: usize = 32 << 10;
 
 /// The threads [`magnify`] is worth to an `out`-sized image given `threads`: one per
