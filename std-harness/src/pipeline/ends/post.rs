@@ -342,9 +342,15 @@ fn place(p: &Prepared, setup: &PostSetup, s: &PostSamples) -> Result<Placed, Cli
             gradient: s.gradient[k],
         });
     }
-    let (order, starts) = super::slabs::buckets(keys.iter().copied(), count * rows);
+    let (voxels, starts) = super::slabs::counting_sort(
+        voxels.len(),
+        count * rows,
+        |i| keys[i],
+        |i| voxels[i],
+        "the post-classified frame's voxels",
+    )?;
     Ok(Placed {
-        voxels: order.into_iter().map(|i| voxels[i]).collect(),
+        voxels,
         starts: starts.into_iter().step_by(rows).collect(),
     })
 }

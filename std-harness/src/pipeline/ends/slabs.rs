@@ -15,7 +15,7 @@
 //!    then slab j is composited (the core's ring of slab accumulators).
 //!
 //! **Memory.** 28 bytes per visible voxel (its [`SlabVoxel`]; 76 while a run of sheets sorts
-//! them) on top of the visible lists, and 4 per voxel and block it reaches; the sort's keys, 4
+//! them) on top of the visible lists, and 4 per voxel and block it reaches; the sort's keys, 8
 //! bytes per slab and back to front per slab of the ring, per run of sheets (64 MiB at most
 //! together: `KEY_BYTES`); per thread the ring of `SlabSetup::ring`
 //! slab accumulators of the block it renders (16 bytes per pixel each: on an isotropic grid a
@@ -155,7 +155,7 @@ struct SlabChunk {
     /// `voxels[starts[j]..starts[j + 1]]` have key j = step · [`key_span`] + the rank of their
     /// first slab among those of the step (step k: slab k front to back, slab count − 1 − k back
     /// to front).
-    starts: Vec<u32>,
+    starts: Vec<usize>,
     /// The chunk's voxels reaching each block, as indices into `voxels`.
     members: Members,
 }
@@ -190,13 +190,13 @@ fn slab_voxels(
     threads: usize,
     rows: usize,
 ) -> Result<SlabVoxels, CliError> {
-    // Each run sorts by count · span keys of 4 bytes (up to 2^16 slabs of a ring of 40 on a
-    // hostile view: 10 MiB): at most KEY_BYTES of them together, whatever the thread count.
+    // Each run sorts by count · span keys of 8 bytes (up to 2^16 slabs of a ring of 40 on a
+    // hostile view: 20 MiB): at most KEY_BYTES of them together, whatever the thread count.
     let keys = setup
         .slab_count()
         .saturating_mul(key_span(p.order, setup))
         .max(1);
-    let threads = threads.min(KEY_BYTES / keys.saturating_mul(4)).max(1);
+    let threads = threads.min(KEY_BYTES / keys.saturating_mul(8)).max(1);
     let runs = sheet_runs(p.frame.sheet_count(), threads, |s| {
         lists.sheet(s).voxels.len()
     });
@@ -288,37 +288,14 @@ fn slab_chunk(
         Order::FrontToBack => a,
         Order::BackToFront => (count - 1 - b) * span + (span - 1 - (b - a).min(span - 1)),
     };
-    if u32::try_from(placed.len()).is_err() {
-        return Err(CliError::input(format!(
-            "{} voxels in one run of sheets: more than 2^32",
-            placed.len()
-        )));
-    }
-    let mut at = crate::io::try_filled(count * span + 1, 0u32, "the slab voxels' sort keys")?;
-    for v in &placed {
-        at[key(v) + 1] += 1;
-    }
-    for j in 0..count * span {
-        at[j + 1] += at[j];
-    }
-    let mut voxels = crate::io::try_filled(
+    let (voxels, starts) = counting_sort(
         placed.len(),
-        SlabVoxel {
-            position: [0.0; 3],
-            value: Default::default(),
-        },
+        count * span,
+        |i| key(&placed[i]),
+        |i| placed[i].0,
         "the slab voxel list",
     )?;
-    for v in &placed {
-        let k = key(v);
-        voxels[at[k] as usize] = v.0;
-        at[k] += 1;
-    }
     drop(placed);
-    // Each key's slot now holds where the next key starts: shifted by one, the starts again.
-    at.rotate_right(1);
-    at[0] = 0;
-    let starts = at;
     let h = p.frame.size[1];
     let members = Members::of(voxels.len(), h, rows, |i| {
         setup.rows_of(voxels[i].position[1])
@@ -330,26 +307,37 @@ fn slab_chunk(
     })
 }
 
-/// A stable counting sort of `keys` (each below `count`): the positions in key order, and where
-/// each key's run starts (`count + 1` entries).
-pub(crate) fn buckets(
-    keys: impl Iterator<Item = usize> + Clone,
+/// A stable counting sort of items 0..`n` by `key(i)` (each below `count`): the items, as
+/// `value(i)`, in key order (index order within a key), and where each key's run starts
+/// (`count + 1` entries). No index array: each value is written once into its place. Allocation
+/// failures are errors naming `what`.
+pub(crate) fn counting_sort<T: Copy>(
+    n: usize,
     count: usize,
-) -> (Vec<usize>, Vec<usize>) {
-    let mut starts = vec![0usize; count + 1];
-    for k in keys.clone() {
-        starts[k + 1] += 1;
+    key: impl Fn(usize) -> usize,
+    value: impl Fn(usize) -> T,
+    what: &str,
+) -> Result<(Vec<T>, Vec<usize>), CliError> {
+    let mut at = crate::io::try_filled(count + 1, 0usize, what)?;
+    for i in 0..n {
+        at[key(i) + 1] += 1;
     }
     for j in 0..count {
-        starts[j + 1] += starts[j];
+        at[j + 1] += at[j];
     }
-    let mut next = starts.clone();
-    let mut order = vec![0usize; starts[count]];
-    for (i, k) in keys.enumerate() {
-        order[next[k]] = i;
-        next[k] += 1;
+    let Some(fill) = (n > 0).then(|| value(0)) else {
+        return Ok((Vec::new(), at));
+    };
+    let mut sorted = crate::io::try_filled(n, fill, what)?;
+    for i in 0..n {
+        let k = key(i);
+        sorted[at[k]] = value(i);
+        at[k] += 1;
     }
-    (order, starts)
+    // Each key's slot now holds where the next key starts: shifted by one, the starts again.
+    at.rotate_right(1);
+    at[0] = 0;
+    Ok((sorted, at))
 }
 
 /// One band (a block of rows): every slab in compositing order: the voxels that reach it first
@@ -406,7 +394,7 @@ fn render_band(
         // Each chunk's list is in key order, so its voxels of step k come next, key by key.
         for j in k * span..(k + 1) * span {
             for (c, mine) in sv.chunks.iter().zip(&mut mine) {
-                while let Some(i) = mine.next_if(|&i| i < c.starts[j + 1] as usize) {
+                while let Some(i) = mine.next_if(|&i| i < c.starts[j + 1]) {
                     renderer.splat_voxel(&c.voxels[i])?;
                 }
             }
