@@ -6,4 +6,5 @@ pub mod field;
 pub mod level_pilot;
 pub mod model;
 pub mod pilot;
+pub mod pixel_sample;
 pub mod sampling;
