@@ -112,6 +112,31 @@ fn the_choice_reaches_its_target_with_the_cheapest_slicing_that_does() {
     assert!(c.config.slab().is_some());
 }
 
+/// The stages (`pilot.rs`, "Stages"): at 256² the sample is 4 096 pixels, the sixteenth 256. A
+/// target far below object slicing's error (about 26.5 dB here) is decided on the sixteenth alone (its bound past
+/// the target by more than the sixteenth's margin); one that needs slabs marches further.
+#[test]
+fn a_target_far_from_the_frame_is_decided_on_the_sixteenth() {
+    use footprint_harness::pipeline::quality::pilot::STAGE_MARGINS_DB;
+    let a = [HEART, "--size", "256x256", "--view", "30,20,0"];
+    let args = parse_args(&a).unwrap();
+    let p = prepare(&args).unwrap();
+    let low = choose_continuous(&p, &args, 15.0, Continuous).unwrap();
+    let pilot = low.pilot.as_ref().unwrap();
+    assert_eq!(pilot.first_pixels, 256);
+    assert_eq!(pilot.pixels, 256, "decided on the sixteenth: {pilot:?}");
+    assert!(low.predicted_db >= 15.0 + STAGE_MARGINS_DB[0], "{pilot:?}");
+    assert!(actual_db(&p, &plan_with(&args, &low.config)) >= 15.0);
+    let high = choose_continuous(&p, &args, 45.0, Continuous).unwrap();
+    let pilot = high.pilot.as_ref().unwrap();
+    assert!(
+        [256, 1024, 4096].contains(&pilot.pixels),
+        "a whole stage: {pilot:?}"
+    );
+    assert!(high.config.slab().is_some());
+    assert!(actual_db(&p, &plan_with(&args, &high.config)) >= 45.0);
+}
+
 fn pilot_estimate(c: &footprint_harness::pipeline::quality::model::Choice) -> f64 {
     let pilot = c.pilot.as_ref().unwrap();
     pilot

@@ -34,8 +34,9 @@ def flags(label):
         return ["--slicing", "image", "--slab", parts[1].split("=")[1]]
     method = "robust" if parts[2] == "view" else parts[2]
     refine = ["--refine", parts[5].split("=")[1]] if len(parts) > 5 else []
-    return ["--table", parts[0].split("=")[1], "--lookup", parts[1], "--method", method,
-            "--accum", parts[3]] + refine
+    # Object slicing said explicitly: the default, `--slicing auto`, would choose again.
+    return ["--slicing", "object", "--table", parts[0].split("=")[1], "--lookup", parts[1],
+            "--method", method, "--accum", parts[3]] + refine
 
 
 def source(volume):

@@ -498,7 +498,7 @@ pub struct Pilot {
     /// supersampling squared).
     pub pixels: usize,
     /// Of those, the first stage's: a candidate is measured on these alone unless that leaves
-    /// it undecided ([`super::pilot`], "Two stages").
+    /// it undecided ([`super::pilot`], "Stages").
     pub first_pixels: usize,
     /// Cell side S, pixels.
     pub stride: usize,

@@ -32,38 +32,54 @@
 //!    (N the image's pixels; the bound is m itself when every pixel is sampled). The first
 //!    candidate whose bound reaches DB is chosen; if none does, the most accurate one, said so.
 //!
-//! # Two stages
-//! Against the grid's own integral the reference is marched in two stages. The first takes the
-//! sampled pixels of the cells whose column and row are both even (a stratified sample of its
-//! own at twice the cell side, about a quarter; at least [`MIN_FIRST_STAGE`], else one stage). A
-//! candidate is decided there when its upper bound reaches DB + [`FIRST_STAGE_MARGIN_DB`]
-//! (taken) or its lower bound,
-//! m − Z·s/√n·√(1 − n/N), does not (more pixels would not lift the estimate past it: rejected);
-//! otherwise the reference is marched through the other pixels too (through the same field,
-//! built once and held until then: at most 16 bytes a voxel (`reference::sparse` keeps only
-//! the blocks holding a voxel that can be seen), so two stages only where that bound fits the
-//! visible lists' budget) and the candidate, and every later one, is measured on all of them.
-//! A scene far from the target on either side costs a quarter of the reference, one near it
-//! the whole as before (the pilot reference took 0.01–0.21 s at 256² on the shared volumes,
-//! `docs/perf/default-plan.csv`). Looking twice at Z = 3 leaves the chance of taking a
-//! candidate that misses DB at most twice one look's.
+//! # Stages
+//! Against the grid's own integral the reference is marched in stages ([`stages`]): first the
+//! sampled pixels of the cells whose column and row are both multiples of 4 (a stratified
+//! sample of its own at four times the cell side, about a sixteenth: 256 pixels at 256² and
+//! 512²), then those of the other cells whose column and row are both even (with the first, a
+//! quarter), then the rest; an early stage under [`MIN_FIRST_STAGE`] pixels is skipped. A
+//! candidate is decided on the pixels marched so far when its upper bound reaches DB plus that
+//! stage's margin ([`STAGE_MARGINS_DB`]: 5 dB on the sixteenth, 1 dB on the quarter, none on the
+//! whole sample: taken) or its lower bound, m − Z·s/√n·√(1 − n/N), does not reach DB (more
+//! pixels would not lift the estimate past it: rejected); otherwise the reference is marched
+//! through the next stage's pixels (through the same field, built once and held until the last
+//! stage: at most 16 bytes a voxel (`reference::sparse` keeps only the blocks holding a voxel
+//! that can be seen), so stages only where that bound fits the visible lists' budget) and the
+//! candidate, and every later one, is measured on all the pixels marched. A scene far from the
+//! target on either side costs a sixteenth of the reference, one near it the whole (the pilot
+//! reference took 0.00–0.08 s at 256² on the shared volumes, `docs/perf/default-plan.csv`).
+//! Looking three times at Z = 3 leaves the chance of taking a candidate that misses DB at most
+//! three times one look's, before the margins.
 //!
-//! **Why not a smaller first stage.** A first stage of a sixteenth (256 pixels at 512², then a
-//! quarter, then the rest) cut the pilot reference on the walnut and the CT head by half
-//! (`footprint bench --frames 1`, 512², 99–119 → 56–59 and 86–97 → 25–35 ms), but on
-//! `benches/default_plan.sh` it took object slicing for the CT head (30,20,0, emission, 256²)
-//! on a bound of 44.9 dB whose whole image measured 43.9 dB, where the quarter rejects it
-//! (41.6 dB on its 1 024 pixels) and takes slabs (60.2 dB). A sample of 256 can miss the few
-//! pixels that carry most of the squared error, and understate the standard error with them:
-//! the normal bound did not hold there.
+//! **Why margins.** A part of the sample can miss the few pixels that carry most of the squared
+//! error, and understate the standard error with them: the normal bound does not hold there.
+//! - *The sixteenth.* Taking a candidate there on its bound alone took object slicing for the
+//!   CT head (30,20,0, emission, 256²) on a bound of 44.9 dB whose whole image measured 43.9 dB.
+//!   With a 2 dB margin, over 72 choices (the shared volumes and the built-in scene at 32³, six
+//!   views, emission and Phong, 256², `docs/perf/pilot-sixteenth-2db.csv`: `verify --reference
+//!   continuous` with `STAGE_MARGINS_DB` set to [2, 1]) the sixteenth decided 40, and its bound
+//!   lay above the whole image's PSNR in 5 of them, by at most 2.37 dB (neghip, 75,-40,20,
+//!   emission: 48.59 against 46.22 dB; its estimate was 6.45 dB above the whole image at worst).
+//!   So the sixteenth takes a candidate only 5 dB past DB, twice that miss; 29 of those 40 had a
+//!   bound that far above 44 dB.
+//! - *The quarter.* With the pilot's march nested, the hydrogen orbital (CI's
+//!   `--quality-reference continuous` step: 256², 75,-40,20, `--quality 55`) had a bound of
+//!   55.0 dB on the quarter's 1 024 pixels for object slicing, and its whole image measured
+//!   54.53 dB. So the quarter takes a candidate only 1 dB (a factor of 1.26 in MSE, twice that
+//!   miss) past DB; nearer, the whole sample decides (it rejected that one at 53.2 dB).
 //!
-//! **Why a margin.** The quarter can miss them too: with the pilot's march nested, the hydrogen
-//! orbital (CI's `--quality-reference continuous` step: 256², 75,-40,20, `--quality 55`) had a
-//! first-stage bound of 55.0 dB on its 1 024 pixels for object slicing, and its whole image
-//! measured 54.53 dB. So the first stage takes a candidate only [`FIRST_STAGE_MARGIN_DB`] (a
-//! factor of 1.26 in MSE, twice that miss) past the target; nearer, the whole sample decides
-//! (it rejected that one at 53.2 dB). Rejecting on the first stage stays as it was: a wrong
-//! rejection costs time, never accuracy.
+//! Rejecting early needs no margin: a wrong rejection costs time, never accuracy.
+//!
+//! **What the sixteenth saved.** `footprint bench --frames 1 --threads 1`, 512², 30,20,0, the
+//! peers' volumes (docs/performance.md), 3 rounds alternated with 3568c24's binary, same plans
+//! (2026-12-05): the default's fresh frame on the CT head 46.7–50.1 → 24.5–26.4 ms (its pilot
+//! reference 11 ms on the sixteenth's 256 pixels), the blobs 132.1–144.5 → 114.4–116.4 ms, the
+//! walnut 62.0–65.5 → 62.8–67.1 ms (undecided on the sixteenth, taken on the quarter). On
+//! `benches/default_plan.sh` (20 cases, 256²) and CI's `--quality-reference continuous` step (20
+//! choices) every choice and every whole-image figure stayed the same, to the digit; over 71
+//! further `--quality 44` and `50` choices (`tools/validate_quality_continuous.py`, the shared
+//! volumes and the built-in scene at 24³, views 0,0,0, 120,60,0 and -45,10,30, 256²) none
+//! missed its target against the whole image.
 //!
 //! Under `--quality DB` the winner is rendered again by the command (its pilot render is not
 //! kept, as its choice may change the level), so `--quality DB --quality-reference continuous`
@@ -89,9 +105,9 @@
 
 use super::config::Config;
 use super::model::{self as quality, Choice, Estimate, Pilot};
-use super::pixel_sample::{decide, first_stage, Verdict};
+use super::pixel_sample::{decide, stages, Verdict};
 pub use super::pixel_sample::{
-    estimate, sample_pixels, FIRST_STAGE_MARGIN_DB, MIN_FIRST_STAGE, PILOT_RAYS, Z,
+    estimate, sample_pixels, MIN_FIRST_STAGE, PILOT_RAYS, STAGE_MARGINS_DB, Z,
 };
 use crate::args::QualityReferenceArg;
 use crate::pipeline::ends::continuous::{continuous_at, PilotReference};
@@ -106,7 +122,7 @@ use std::time::Instant;
 
 /// The bytes the pilot's continuous field holds for `volume` (each voxel's classified RGBA, 16
 /// bytes) and the budget it must fit: the visible lists' ([`list_budget`]). The default plan
-/// measures only where it fits, and the two stages hold the field only where it fits.
+/// measures only where it fits, and the stages hold the field only where it fits.
 ///
 /// [`list_budget`]: crate::pipeline::stages::visible::list_budget
 fn field_bytes(volume: &crate::io::volume::Volume) -> (usize, usize) {
@@ -280,29 +296,34 @@ fn subsampling_differs(p: &Prepared, base: &Plan) -> Result<bool, CliError> {
 }
 
 /// One pilot: the frames `p` renders, measured at sampled pixels against a continuous
-/// integral marched through those pixels (in two stages where it is `p`'s own).
+/// integral marched through those pixels (in stages where it is `p`'s own).
 struct Run<'a> {
     p: &'a Prepared,
     target_db: f64,
     reference: QualityReferenceArg,
     /// The side N of the finer field's sampling (`field` only).
     field_size: Option<usize>,
-    /// The sampled pixels, the first stage's first.
+    /// The sampled pixels, stage by stage ([`stages`]).
     pixels: Vec<[usize; 2]>,
     /// How many of `pixels` the first stage marched.
     first: usize,
+    /// Where each stage ends in `pixels`, and the margin it takes a candidate at, dB; the last
+    /// is the whole sample (margin 0).
+    stages: Vec<(usize, f64)>,
+    /// The index in `stages` of the last stage marched.
+    stage: usize,
     stride: usize,
     /// The reference at the first `reference_image.image.len()` of `pixels`.
     reference_image: crate::reference::continuous::Continuous,
     reference_seconds: f64,
-    /// The field the second stage marches, while there is one to march (two stages only).
+    /// The field the later stages march, while one is left to march (staged runs only).
     marcher: Option<PilotReference<'a>>,
 }
 
 impl<'a> Run<'a> {
     /// The pilot of `p`'s frame against the continuous integral of `against` (`p` itself, or
     /// the finer field), marched on `threads` threads through the sampled pixels: where
-    /// `against` is `p`, through the first stage's only, its field kept for the second
+    /// `against` is `p`, through the first stage's only, its field kept for the later ones
     /// ([`Run::widen`]; 16 bytes a voxel, held while the candidates render, so only where that
     /// fits the visible lists' budget: one stage otherwise).
     fn new(
@@ -320,17 +341,19 @@ impl<'a> Run<'a> {
                 let (field, budget) = field_bytes(v);
                 field <= budget
             });
-        let (pixels, first, reference_image, marcher) = if staged {
-            let (pixels, first) = first_stage(pixels, stride);
+        let (pixels, stages, reference_image, marcher) = if staged {
+            let (pixels, stages) = stages(pixels, stride);
+            let first = stages[0].0;
             let marcher = PilotReference::new(p, threads)?;
             let image = marcher.at(&pixels[..first])?;
             let marcher = (first < pixels.len()).then_some(marcher);
-            (pixels, first, image, marcher)
+            (pixels, stages, image, marcher)
         } else {
             let n = pixels.len();
             let (image, _) = continuous_at(against, &pixels, threads)?;
-            (pixels, n, image, None)
+            (pixels, vec![(n, 0.0)], image, None)
         };
+        let first = stages[0].0;
         Ok(Run {
             p,
             target_db,
@@ -338,6 +361,8 @@ impl<'a> Run<'a> {
             field_size: None,
             pixels,
             first,
+            stages,
+            stage: 0,
             stride,
             reference_image,
             reference_seconds: start.elapsed().as_secs_f64(),
@@ -358,15 +383,20 @@ impl<'a> Run<'a> {
         )
     }
 
-    /// Marches the reference through the second stage's pixels, if it has not yet: whether it
-    /// did (only ever for `p`'s own reference, [`Run::new`]). The field is dropped after.
+    /// Marches the reference through the next stage's pixels, if one is left: whether it did
+    /// (only ever for `p`'s own reference, [`Run::new`]). The field is dropped after the last.
     fn widen(&mut self) -> Result<bool, CliError> {
         let Some(marcher) = self.marcher.take() else {
             return Ok(false);
         };
         let start = Instant::now();
         let marched = self.reference_image.image.len();
-        let rest = marcher.at(&self.pixels[marched..])?;
+        self.stage += 1;
+        let end = self.stages[self.stage].0;
+        let rest = marcher.at(&self.pixels[marched..end])?;
+        if self.stage + 1 < self.stages.len() {
+            self.marcher = Some(marcher);
+        }
         self.reference_image.image.extend(rest.image);
         self.reference_image.converged &= rest.converged;
         self.reference_seconds += start.elapsed().as_secs_f64();
@@ -375,9 +405,9 @@ impl<'a> Run<'a> {
 
     /// Renders `candidates` (cheapest first) until one's bound reaches the target: that one's
     /// plan and the choice (the most accurate tried where none reaches it, said so, naming the
-    /// default plan or `--quality` as `by_default` says). A
-    /// candidate the first stage leaves undecided (its bound below the target, its lower bound
-    /// above) is measured again on every sampled pixel.
+    /// default plan or `--quality` as `by_default` says). A candidate an early stage leaves
+    /// undecided (its bound below the target plus the stage's margin, its lower bound above the
+    /// target) is measured again with the next stage's pixels added.
     fn measure(
         &mut self,
         candidates: Vec<(Config, Plan)>,
@@ -395,13 +425,17 @@ impl<'a> Run<'a> {
         let mut kept: Option<CoreFrame> = None;
         for (c, plan) in &candidates {
             let frame = render_frame(p, plan, &mut cache)?;
-            let mut e = self.estimate(&frame.image);
-            let first_stage = self.marcher.is_some();
-            if decide(&e, target_db, first_stage) == Verdict::Undecided && self.widen()? {
-                e = self.estimate(&frame.image);
-            }
+            // Stage by stage until decided; the last stage always decides.
+            let (e, verdict) = loop {
+                let e = self.estimate(&frame.image);
+                let margin = self.marcher.is_some().then(|| self.stages[self.stage].1);
+                let verdict = decide(&e, target_db, margin);
+                if verdict != Verdict::Undecided || !self.widen()? {
+                    break (e, verdict);
+                }
+            };
             tried.push((*c, e));
-            if decide(&e, target_db, false) == Verdict::Taken {
+            if verdict == Verdict::Taken {
                 kept = Some(frame);
                 chosen = Some(tried.len() - 1);
                 break;

@@ -1,5 +1,5 @@
 //! The pilot's sample of the image ([`super::pilot`]): which pixels it measures (one per cell,
-//! stratified, the first stage's first), its estimate of a candidate's error there, and the
+//! stratified, stage by stage), its estimate of a candidate's error there, and the
 //! verdict that estimate gives against a target. No rendering and no reference here: a leaf
 //! beside [`super::sampling`], tested on its own.
 
@@ -8,14 +8,16 @@ use super::sampling::{mix, Estimate};
 /// Rays the pilot aims at: the image is sampled once per cell of about W·H / `PILOT_RAYS`
 /// pixels.
 pub const PILOT_RAYS: usize = 4096;
-/// The fewest pixels a first stage measures on ([`super::pilot`], "Two stages"); below, one stage.
+/// The fewest pixels an early stage measures on ([`super::pilot`], "Stages"); a smaller one is
+/// not a stage.
 pub const MIN_FIRST_STAGE: usize = 256;
 /// Standard errors added to the sampled MSE before it is compared with the target.
 pub const Z: f64 = 3.0;
-/// How far past the target a candidate's bound must lie for the first stage alone to take it,
-/// dB ([`super::pilot`], "Two stages"): a quarter of the sample can miss the few pixels that
-/// carry most of the squared error, and understate its spread with them.
-pub const FIRST_STAGE_MARGIN_DB: f64 = 1.0;
+/// How far past the target a candidate's bound must lie for an early stage alone to take it,
+/// dB: on the sixteenth, then on the quarter ([`super::pilot`], "Stages" and "Why margins").
+/// A part of the sample can miss the few pixels that carry most of the squared error, and
+/// understate its spread with them; the smaller the part, the more it can miss.
+pub const STAGE_MARGINS_DB: [f64; 2] = [5.0, 1.0];
 
 /// The stratified sample of a `w`×`h` image for about `rays` pixels: one pixel per S×S cell
 /// (S = ⌈√(w·h / rays)⌉, at least 1), at a position inside the cell fixed by a hash of the
@@ -61,43 +63,55 @@ pub fn estimate(
     Estimate::of(&errors, total, Z)
 }
 
-/// `pixels` (one per `stride`-sided cell, row by row) reordered so that the first stage comes
-/// first: the pixels of the cells whose column and row are both even, a stratified sample of
-/// its own at twice the cell side (about a quarter); and how many those are. A sample too
-/// small to split (a first stage under [`MIN_FIRST_STAGE`]) is one stage.
-pub fn first_stage(pixels: Vec<[usize; 2]>, stride: usize) -> (Vec<[usize; 2]>, usize) {
-    let even =
-        |&[x, y]: &[usize; 2]| (x / stride).is_multiple_of(2) && (y / stride).is_multiple_of(2);
-    let (mut first, rest): (Vec<_>, Vec<_>) = pixels.into_iter().partition(even);
-    let n = first.len();
-    first.extend(rest);
-    let stage = if n < MIN_FIRST_STAGE { first.len() } else { n };
-    (first, stage)
+/// `pixels` (one per `stride`-sided cell, row by row) reordered stage by stage, and where each
+/// stage ends with the margin it takes a candidate at ([`STAGE_MARGINS_DB`]). First the pixels
+/// of the cells whose column and row are both multiples of 4 (a stratified sample of its own at
+/// four times the cell side, about a sixteenth), then those of the other cells whose column and
+/// row are both even (with the first, the same at twice the side, about a quarter), then the
+/// rest (margin 0: the last stage is the whole sample). An early stage under
+/// [`MIN_FIRST_STAGE`] pixels, or one that is already the whole sample, is not a stage.
+pub fn stages(pixels: Vec<[usize; 2]>, stride: usize) -> (Vec<[usize; 2]>, Vec<(usize, f64)>) {
+    let level = |&[x, y]: &[usize; 2]| {
+        let (cx, cy) = (x / stride, y / stride);
+        if cx.is_multiple_of(4) && cy.is_multiple_of(4) {
+            0
+        } else if cx.is_multiple_of(2) && cy.is_multiple_of(2) {
+            1
+        } else {
+            2
+        }
+    };
+    let mut ordered = Vec::with_capacity(pixels.len());
+    let mut ends = Vec::new();
+    for (l, margin) in STAGE_MARGINS_DB.into_iter().enumerate() {
+        ordered.extend(pixels.iter().filter(|p| level(p) == l));
+        if ordered.len() >= MIN_FIRST_STAGE && ordered.len() < pixels.len() {
+            ends.push((ordered.len(), margin));
+        }
+    }
+    ordered.extend(pixels.iter().filter(|p| level(p) == STAGE_MARGINS_DB.len()));
+    ends.push((ordered.len(), 0.0));
+    (ordered, ends)
 }
 
 /// What one estimate says of a candidate against `target_db` (dB).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Verdict {
-    /// Its bound reaches the target (on the first stage, [`FIRST_STAGE_MARGIN_DB`] past it).
+    /// Its bound reaches the target (on an early stage, that stage's margin past it).
     Taken,
     /// Even its lower bound falls short (or its error is NaN): more pixels would not help.
     Rejected,
-    /// Neither: on the first stage, to be measured on every sampled pixel.
+    /// Neither: on an early stage, to be measured on the next.
     Undecided,
 }
 
-/// The verdict on `e` against `target_db`, on the first stage or on the whole sample
-/// ([`super::pilot`], "Two stages" and "Why a margin"). On the whole sample a candidate not
-/// taken is rejected.
-pub fn decide(e: &Estimate, target_db: f64, first_stage: bool) -> Verdict {
-    let margin = if first_stage {
-        FIRST_STAGE_MARGIN_DB
-    } else {
-        0.0
-    };
-    if e.bound_db >= target_db + margin {
+/// The verdict on `e` against `target_db`: on an early stage (`margin`, dB, from
+/// [`STAGE_MARGINS_DB`]) or on the whole sample (`None`), where it is never undecided
+/// ([`super::pilot`], "Stages" and "Why margins").
+pub fn decide(e: &Estimate, target_db: f64, margin: Option<f64>) -> Verdict {
+    if e.bound_db >= target_db + margin.unwrap_or(0.0) {
         Verdict::Taken
-    } else if first_stage && e.hope_db >= target_db {
+    } else if margin.is_some() && e.hope_db >= target_db {
         Verdict::Undecided
     } else {
         Verdict::Rejected
@@ -126,51 +140,82 @@ mod tests {
     }
 
     #[test]
-    fn the_first_stage_is_a_coarser_stratified_sample_and_nothing_is_lost() {
-        for (w, h) in [(512, 512), (640, 480), (257, 100)] {
+    fn each_stage_is_a_coarser_stratified_sample_and_nothing_is_lost() {
+        for (w, h) in [(512, 512), (800, 600), (1024, 300), (256, 256)] {
             let (px, s) = sample_pixels(w, h, PILOT_RAYS);
-            let (ordered, first) = first_stage(px.clone(), s);
+            let (ordered, ends) = stages(px.clone(), s);
             let mut a = px.clone();
             let mut b = ordered.clone();
             a.sort_unstable();
             b.sort_unstable();
             assert_eq!(a, b, "{w}x{h}: the same pixels");
-            // One per cell of side 2S, every such cell represented.
-            let cells = w.div_ceil(2 * s) * h.div_ceil(2 * s);
-            assert_eq!(first, cells, "{w}x{h}");
-            let mut seen = std::collections::HashSet::new();
-            for &[x, y] in &ordered[..first] {
-                assert!(seen.insert((x / (2 * s), y / (2 * s))), "two in one cell");
+            // A sixteenth, a quarter and the whole, at the margins in that order.
+            let margins: Vec<f64> = ends.iter().map(|e| e.1).collect();
+            assert_eq!(margins, [5.0, 1.0, 0.0], "{w}x{h}");
+            assert_eq!(ends[2].0, px.len());
+            // Stage k (its pixels and all before) is one pixel per cell of side 4S, then 2S,
+            // every such cell represented.
+            for (k, side) in [(0, 4 * s), (1, 2 * s)] {
+                let end = ends[k].0;
+                assert_eq!(
+                    end,
+                    w.div_ceil(side) * h.div_ceil(side),
+                    "{w}x{h} stage {k}"
+                );
+                let mut seen = std::collections::HashSet::new();
+                for &[x, y] in &ordered[..end] {
+                    assert!(seen.insert((x / side, y / side)), "two in one cell");
+                    assert!((x / s) % (side / s) == 0 && (y / s) % (side / s) == 0);
+                }
             }
-            assert!(ordered[first..]
+            assert!(ordered[ends[1].0..]
                 .iter()
                 .all(|&[x, y]| (x / s) % 2 == 1 || (y / s) % 2 == 1));
         }
-        // Too few for two stages: one.
+        // A sixteenth under MIN_FIRST_STAGE is not a stage; the quarter is: 32x32 cells, and
+        // 640x480 (72x54 cells of 9 pixels: a sixteenth of 18x14 = 252, a quarter of 36x27).
+        let (px, s) = sample_pixels(32, 32, PILOT_RAYS);
+        let n = px.len();
+        assert_eq!(stages(px, s).1, [(256, 1.0), (n, 0.0)]);
+        let (px, s) = sample_pixels(640, 480, PILOT_RAYS);
+        let n = px.len();
+        assert_eq!(stages(px, s).1, [(36 * 27, 1.0), (n, 0.0)]);
+        // Too few for any early stage: one.
         let (px, s) = sample_pixels(20, 20, PILOT_RAYS);
         let n = px.len();
-        assert_eq!(first_stage(px, s).1, n);
+        assert_eq!(stages(px, s).1, [(n, 0.0)]);
+        // A one-pixel sample: one stage, not an early stage that is already the whole.
+        assert_eq!(stages(vec![[0, 0]], 1).1, [(1, 0.0)]);
     }
 
     #[test]
-    fn the_first_stage_takes_a_candidate_only_a_margin_past_the_target() {
+    fn an_early_stage_takes_a_candidate_only_its_margin_past_the_target() {
         let e = |bound_db, hope_db| Estimate {
             estimate_db: 0.5 * (bound_db + hope_db),
             bound_db,
             hope_db,
         };
-        let near = e(44.0 + 0.5 * FIRST_STAGE_MARGIN_DB, 50.0);
-        assert_eq!(decide(&near, 44.0, true), Verdict::Undecided);
-        assert_eq!(decide(&near, 44.0, false), Verdict::Taken);
-        let far = e(44.0 + FIRST_STAGE_MARGIN_DB, 50.0);
-        assert_eq!(decide(&far, 44.0, true), Verdict::Taken);
+        let [sixteenth, quarter] = STAGE_MARGINS_DB;
+        assert!(sixteenth > quarter && quarter > 0.0, "{STAGE_MARGINS_DB:?}");
+        // Between the quarter's margin and the sixteenth's: the sixteenth waits, the quarter
+        // and the whole sample take it.
+        let between = e(44.0 + 0.5 * (sixteenth + quarter), 60.0);
+        assert_eq!(decide(&between, 44.0, Some(sixteenth)), Verdict::Undecided);
+        assert_eq!(decide(&between, 44.0, Some(quarter)), Verdict::Taken);
+        assert_eq!(decide(&between, 44.0, None), Verdict::Taken);
+        let near = e(44.0 + 0.5 * quarter, 50.0);
+        assert_eq!(decide(&near, 44.0, Some(quarter)), Verdict::Undecided);
+        assert_eq!(decide(&near, 44.0, None), Verdict::Taken);
+        let far = e(44.0 + sixteenth, 60.0);
+        assert_eq!(decide(&far, 44.0, Some(sixteenth)), Verdict::Taken);
+        // Rejection needs no margin: a lower bound short of the target.
         let short = e(40.0, 43.9);
-        assert_eq!(decide(&short, 44.0, true), Verdict::Rejected);
+        assert_eq!(decide(&short, 44.0, Some(sixteenth)), Verdict::Rejected);
         let unsure = e(40.0, 44.0);
-        assert_eq!(decide(&unsure, 44.0, true), Verdict::Undecided);
-        assert_eq!(decide(&unsure, 44.0, false), Verdict::Rejected);
+        assert_eq!(decide(&unsure, 44.0, Some(sixteenth)), Verdict::Undecided);
+        assert_eq!(decide(&unsure, 44.0, None), Verdict::Rejected);
         let nan = e(f64::NAN, f64::NAN);
-        assert_eq!(decide(&nan, 44.0, true), Verdict::Rejected);
+        assert_eq!(decide(&nan, 44.0, Some(sixteenth)), Verdict::Rejected);
     }
 
     #[test]
