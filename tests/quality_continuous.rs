@@ -113,8 +113,9 @@ fn the_choice_reaches_its_target_with_the_cheapest_slicing_that_does() {
 }
 
 /// The stages (`pilot.rs`, "Stages"): at 256² the sample is 4 096 pixels, the sixteenth 256. A
-/// target far below object slicing's error (about 26.5 dB here) is decided on the sixteenth alone (its bound past
-/// the target by more than the sixteenth's margin); one that needs slabs marches further.
+/// target far below object slicing's error (about 26.5 dB here) is decided on the sixteenth
+/// alone (its bound past the target by more than the sixteenth's margin); one that needs slabs
+/// marches further.
 #[test]
 fn a_target_far_from_the_frame_is_decided_on_the_sixteenth() {
     use footprint_harness::pipeline::quality::pilot::STAGE_MARGINS_DB;

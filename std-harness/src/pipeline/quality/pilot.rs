@@ -305,8 +305,6 @@ struct Run<'a> {
     field_size: Option<usize>,
     /// The sampled pixels, stage by stage ([`stages`]).
     pixels: Vec<[usize; 2]>,
-    /// How many of `pixels` the first stage marched.
-    first: usize,
     /// Where each stage ends in `pixels`, and the margin it takes a candidate at, dB; the last
     /// is the whole sample (margin 0).
     stages: Vec<(usize, f64)>,
@@ -353,14 +351,12 @@ impl<'a> Run<'a> {
             let (image, _) = continuous_at(against, &pixels, threads)?;
             (pixels, vec![(n, 0.0)], image, None)
         };
-        let first = stages[0].0;
         Ok(Run {
             p,
             target_db,
             reference,
             field_size: None,
             pixels,
-            first,
             stages,
             stage: 0,
             stride,
@@ -484,7 +480,7 @@ impl<'a> Run<'a> {
             rejected,
             pilot: Some(Pilot {
                 pixels: self.reference_image.image.len(),
-                first_pixels: self.first,
+                first_pixels: self.stages[0].0,
                 stride: self.stride,
                 converged: self.reference_image.converged,
                 reference_seconds: self.reference_seconds,
