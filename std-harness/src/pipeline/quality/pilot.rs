@@ -105,7 +105,7 @@
 
 use super::config::Config;
 use super::model::{self as quality, Choice, Estimate, Pilot};
-use super::pixel_sample::{decide, stages, Verdict};
+use super::pixel_sample::{decide, stages, StageEnd, Verdict};
 pub use super::pixel_sample::{
     estimate, sample_pixels, MIN_FIRST_STAGE, PILOT_RAYS, STAGE_MARGINS_DB, Z,
 };
@@ -306,8 +306,8 @@ struct Run<'a> {
     /// The sampled pixels, stage by stage ([`stages`]).
     pixels: Vec<[usize; 2]>,
     /// Where each stage ends in `pixels`, and the margin it takes a candidate at, dB; the last
-    /// is the whole sample (margin 0).
-    stages: Vec<(usize, f64)>,
+    /// is the whole sample (`None`: no margin, and never undecided).
+    stages: Vec<StageEnd>,
     /// The index in `stages` of the last stage marched.
     stage: usize,
     stride: usize,
@@ -349,7 +349,7 @@ impl<'a> Run<'a> {
         } else {
             let n = pixels.len();
             let (image, _) = continuous_at(against, &pixels, threads)?;
-            (pixels, vec![(n, 0.0)], image, None)
+            (pixels, vec![(n, None)], image, None)
         };
         Ok(Run {
             p,
@@ -424,8 +424,7 @@ impl<'a> Run<'a> {
             // Stage by stage until decided; the last stage always decides.
             let (e, verdict) = loop {
                 let e = self.estimate(&frame.image);
-                let margin = self.marcher.is_some().then(|| self.stages[self.stage].1);
-                let verdict = decide(&e, target_db, margin);
+                let verdict = decide(&e, target_db, self.stages[self.stage].1);
                 if verdict != Verdict::Undecided || !self.widen()? {
                     break (e, verdict);
                 }

@@ -63,14 +63,19 @@ pub fn estimate(
     Estimate::of(&errors, total, Z)
 }
 
+/// Where a stage ends in the reordered sample, and the margin it takes a candidate at, dB
+/// (`None` for the whole sample).
+pub type StageEnd = (usize, Option<f64>);
+
 /// `pixels` (one per `stride`-sided cell, row by row) reordered stage by stage, and where each
-/// stage ends with the margin it takes a candidate at ([`STAGE_MARGINS_DB`]). First the pixels
-/// of the cells whose column and row are both multiples of 4 (a stratified sample of its own at
-/// four times the cell side, about a sixteenth), then those of the other cells whose column and
-/// row are both even (with the first, the same at twice the side, about a quarter), then the
-/// rest (margin 0: the last stage is the whole sample). An early stage under
-/// [`MIN_FIRST_STAGE`] pixels, or one that is already the whole sample, is not a stage.
-pub fn stages(pixels: Vec<[usize; 2]>, stride: usize) -> (Vec<[usize; 2]>, Vec<(usize, f64)>) {
+/// stage ends with the margin it takes a candidate at ([`STAGE_MARGINS_DB`]), as [`decide`]
+/// reads it. First the pixels of the cells whose column and row are both multiples of 4 (a
+/// stratified sample of its own at four times the cell side, about a sixteenth), then those of
+/// the other cells whose column and row are both even (with the first, the same at twice the
+/// side, about a quarter), then the rest (margin `None`: the last stage is the whole sample).
+/// An early stage under [`MIN_FIRST_STAGE`] pixels, or one that is already the whole sample, is
+/// not a stage.
+pub fn stages(pixels: Vec<[usize; 2]>, stride: usize) -> (Vec<[usize; 2]>, Vec<StageEnd>) {
     let level = |&[x, y]: &[usize; 2]| {
         let (cx, cy) = (x / stride, y / stride);
         if cx.is_multiple_of(4) && cy.is_multiple_of(4) {
@@ -86,11 +91,11 @@ pub fn stages(pixels: Vec<[usize; 2]>, stride: usize) -> (Vec<[usize; 2]>, Vec<(
     for (l, margin) in STAGE_MARGINS_DB.into_iter().enumerate() {
         ordered.extend(pixels.iter().filter(|p| level(p) == l));
         if ordered.len() >= MIN_FIRST_STAGE && ordered.len() < pixels.len() {
-            ends.push((ordered.len(), margin));
+            ends.push((ordered.len(), Some(margin)));
         }
     }
     ordered.extend(pixels.iter().filter(|p| level(p) == STAGE_MARGINS_DB.len()));
-    ends.push((ordered.len(), 0.0));
+    ends.push((ordered.len(), None));
     (ordered, ends)
 }
 
@@ -150,8 +155,8 @@ mod tests {
             b.sort_unstable();
             assert_eq!(a, b, "{w}x{h}: the same pixels");
             // A sixteenth, a quarter and the whole, at the margins in that order.
-            let margins: Vec<f64> = ends.iter().map(|e| e.1).collect();
-            assert_eq!(margins, [5.0, 1.0, 0.0], "{w}x{h}");
+            let margins: Vec<Option<f64>> = ends.iter().map(|e| e.1).collect();
+            assert_eq!(margins, [Some(5.0), Some(1.0), None], "{w}x{h}");
             assert_eq!(ends[2].0, px.len());
             // Stage k (its pixels and all before) is one pixel per cell of side 4S, then 2S,
             // every such cell represented.
@@ -176,16 +181,16 @@ mod tests {
         // 640x480 (72x54 cells of 9 pixels: a sixteenth of 18x14 = 252, a quarter of 36x27).
         let (px, s) = sample_pixels(32, 32, PILOT_RAYS);
         let n = px.len();
-        assert_eq!(stages(px, s).1, [(256, 1.0), (n, 0.0)]);
+        assert_eq!(stages(px, s).1, [(256, Some(1.0)), (n, None)]);
         let (px, s) = sample_pixels(640, 480, PILOT_RAYS);
         let n = px.len();
-        assert_eq!(stages(px, s).1, [(36 * 27, 1.0), (n, 0.0)]);
+        assert_eq!(stages(px, s).1, [(36 * 27, Some(1.0)), (n, None)]);
         // Too few for any early stage: one.
         let (px, s) = sample_pixels(20, 20, PILOT_RAYS);
         let n = px.len();
-        assert_eq!(stages(px, s).1, [(n, 0.0)]);
+        assert_eq!(stages(px, s).1, [(n, None)]);
         // A one-pixel sample: one stage, not an early stage that is already the whole.
-        assert_eq!(stages(vec![[0, 0]], 1).1, [(1, 0.0)]);
+        assert_eq!(stages(vec![[0, 0]], 1).1, [(1, None)]);
     }
 
     #[test]
