@@ -85,7 +85,7 @@ fn cuts_along_the_sheets_stay_bounded_and_the_order_matters() {
     let mut frames = Vec::new();
     for b in &layout.boxes {
         let (v, _) = job.brick(*b).unwrap();
-        frames.push(job.render(v, c.window).unwrap());
+        frames.push(job.render(v, c.window.map(|w| w as f32)).unwrap());
     }
     let mut reversed = frames[c.order[3]].image.clone();
     for &n in c.order[..3].iter().rev() {

@@ -414,6 +414,7 @@ fn pipe_source_reads_file_order_only() {
         dims: DIMS,
         ty: SampleType::U16,
         big_endian: false,
+        values: footprint_harness::io::volume::ValueMap::IDENTITY,
     };
     let mut file = FileSource::open(layout).unwrap();
     let bytes = le(&v);
@@ -460,6 +461,7 @@ fn pipe_source_reads_file_order_only() {
         dims: DIMS,
         ty: SampleType::U16,
         big_endian: false,
+        values: footprint_harness::io::volume::ValueMap::IDENTITY,
     };
     let mut file = FileSource::open(layout).unwrap();
     for (axis, &count) in DIMS.iter().enumerate() {

@@ -72,6 +72,8 @@ enum Expect {
     CheckFails(&'static str),
     /// Exit 0 and the output written: the documented success.
     Renders,
+    /// Ended by the case's signal (`More::signal`), leaving no output and no temporary.
+    Signalled,
 }
 
 struct Case {
@@ -93,7 +95,27 @@ struct Case {
     /// Run only against the release binary (`FOOTPRINT_BIN`): the case renders hundreds of
     /// millions of voxels, which a debug build does not do within the time limit.
     release_only: bool,
+    /// What the third campaign's cases add: links planted, standard output elsewhere, a signal.
+    more: More,
 }
+
+/// The third campaign's additions to a [`Case`] (issue 79).
+#[derive(Default)]
+struct More {
+    /// Run just before the process starts (plants links, makes FIFOs).
+    setup: Option<Setup>,
+    /// Standard output goes here instead of a pipe (`/dev/full`).
+    stdout: Option<PathBuf>,
+    /// Sent once `when` holds of the case folder (polled every millisecond): the case must then
+    /// end by that signal, as a command does whose default action ends it.
+    signal: Option<(i32, When)>,
+}
+
+/// What a case does to its folder before the run.
+type Setup = Box<dyn Fn(&Path)>;
+
+/// When a case's signal is sent: once this holds of the case folder.
+type When = fn(&Path) -> bool;
 
 type Check = Box<dyn Fn(&Path) -> Result<String, String>>;
 
@@ -110,6 +132,7 @@ impl Case {
             ulimit: "",
             check: None,
             release_only: false,
+            more: More::default(),
         }
     }
 
@@ -133,6 +156,9 @@ fn run_case(case: &Case, dir: &Path) -> Result<String, String> {
     for (path, bytes) in &case.before {
         std::fs::write(path, bytes).map_err(|e| e.to_string())?;
     }
+    if let Some(setup) = &case.more.setup {
+        setup(dir);
+    }
     let mut cmd = Command::new("sh");
     cmd.arg("-c")
         .arg(if case.ulimit.is_empty() {
@@ -154,9 +180,18 @@ fn run_case(case: &Case, dir: &Path) -> Result<String, String> {
             cmd.env("FOOTPRINT_CHILD", joined.join(&SEP.to_string()));
         }
     }
+    let stdout = match &case.more.stdout {
+        Some(path) => Stdio::from(
+            std::fs::OpenOptions::new()
+                .write(true)
+                .open(path)
+                .map_err(|e| format!("{}: {e}", path.display()))?,
+        ),
+        None => Stdio::piped(),
+    };
     cmd.current_dir(dir)
         .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
+        .stdout(stdout)
         .stderr(Stdio::piped());
     let start = Instant::now();
     let mut child = cmd.spawn().map_err(|e| format!("cannot start: {e}"))?;
@@ -166,9 +201,19 @@ fn run_case(case: &Case, dir: &Path) -> Result<String, String> {
     let writer = std::thread::spawn(move || {
         let _ = stdin.write_all(&input);
     });
+    let mut signalled = false;
     let status = loop {
         if let Some(s) = child.try_wait().map_err(|e| e.to_string())? {
             break s;
+        }
+        if let Some((signal, when)) = case.more.signal {
+            if !signalled && when(dir) {
+                // SAFETY: kill(2) on our own child's PID, which has not been reaped yet.
+                unsafe { libc_kill(child.id() as i32, signal) };
+                signalled = true;
+            }
+            std::thread::sleep(Duration::from_millis(1));
+            continue;
         }
         if start.elapsed() > TIME_LIMIT {
             let _ = child.kill();
@@ -185,6 +230,26 @@ fn run_case(case: &Case, dir: &Path) -> Result<String, String> {
     let out = child.wait_with_output().map_err(|e| e.to_string())?;
     let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
     let lines: Vec<&str> = stderr.lines().collect();
+    if let Expect::Signalled = case.expect {
+        use std::os::unix::process::ExitStatusExt as _;
+        let want = case.more.signal.map(|(sig, _)| sig);
+        if !signalled {
+            return Err(format!(
+                "the signal was never sent: {status}; stderr: {stderr}"
+            ));
+        }
+        if status.signal() != want {
+            return Err(format!(
+                "expected the end by signal {want:?}, got {status}; stderr: {stderr}"
+            ));
+        }
+        check_nothing_left(case, dir)?;
+        return Ok(format!(
+            "{:.2} s: ended by signal {}",
+            elapsed.as_secs_f64(),
+            want.unwrap_or(0)
+        ));
+    }
     let code = status
         .code()
         .ok_or_else(|| format!("killed by a signal ({status}); stderr: {stderr}"))?;
@@ -208,25 +273,38 @@ fn run_case(case: &Case, dir: &Path) -> Result<String, String> {
             .to_string(),
         _ => return Err(format!("exit {code}; stderr: {stderr}")),
     };
+    check_nothing_left(case, dir)?;
+    let note = match &case.check {
+        Some(check) => format!("{note}; {}", check(dir)?),
+        None => note,
+    };
+    Ok(format!("{:.2} s: {note}", elapsed.as_secs_f64()))
+}
+
+/// No file the case names in `gone`, and no temporary (`.NAME.tmp-…`), is in `dir`.
+fn check_nothing_left(case: &Case, dir: &Path) -> Result<(), String> {
     for f in &case.gone {
         if f.exists() {
             return Err(format!("{} was left behind", f.display()));
         }
     }
+    // Regular files only: a link planted at a temporary's name is not the run's.
     let leftovers: Vec<_> = std::fs::read_dir(dir)
         .unwrap()
         .filter_map(|e| e.ok())
+        .filter(|e| e.file_type().is_ok_and(|t| t.is_file()))
         .map(|e| e.file_name().to_string_lossy().into_owned())
         .filter(|n| n.contains(".tmp-"))
         .collect();
     if !leftovers.is_empty() {
         return Err(format!("temporaries left: {leftovers:?}"));
     }
-    let note = match &case.check {
-        Some(check) => format!("{note}; {}", check(dir)?),
-        None => note,
-    };
-    Ok(format!("{:.2} s: {note}", elapsed.as_secs_f64()))
+    Ok(())
+}
+
+extern "C" {
+    #[link_name = "kill"]
+    fn libc_kill(pid: i32, signal: i32) -> i32;
 }
 
 fn s(v: &str) -> String {
@@ -248,6 +326,7 @@ fn refused(name: &'static str, a: &[&str], want: &'static str, dir: &Path) -> Ca
         ulimit: "",
         check: None,
         release_only: false,
+        more: More::default(),
     }
 }
 
@@ -311,6 +390,7 @@ fn cases(dir: &Path) -> Vec<Case> {
         ulimit: "",
         check: None,
         release_only: false,
+        more: More::default(),
     });
 
     // An orbit of a pipe: every frame would read standard input again.
@@ -338,6 +418,7 @@ fn cases(dir: &Path) -> Vec<Case> {
         ulimit: "",
         check: None,
         release_only: false,
+        more: More::default(),
     });
 
     // XML nested 20 000 elements deep (140 KB).
@@ -379,6 +460,7 @@ fn cases(dir: &Path) -> Vec<Case> {
         ulimit: "",
         check: None,
         release_only: false,
+        more: More::default(),
     });
 
     // A valid 8³ NIfTI followed by 3 GiB of zeros in the same gzip stream: the documented
@@ -394,6 +476,7 @@ fn cases(dir: &Path) -> Vec<Case> {
         ulimit: "",
         check: None,
         release_only: false,
+        more: More::default(),
     });
 
     // A gzip NRRD declaring 8³ whose stream inflates to 3 GiB: cut off after 8³ + 1 bytes.
@@ -480,11 +563,12 @@ fn cases(dir: &Path) -> Vec<Case> {
         ulimit: "",
         check: None,
         release_only: false,
+        more: More::default(),
     });
     c.push(refused(
         "compare --max-diff NaN",
         &["compare", &good, &good, "--max-diff", "NaN"],
-        "--max-diff NaN",
+        "'NaN' is not finite",
         dir,
     ));
     let big = write("big.pfm", b"Pf\n100000 100000\n-1.0\n\0\0\0\0");
@@ -586,9 +670,26 @@ fn cases(dir: &Path) -> Vec<Case> {
         ulimit: "",
         check: None,
         release_only: false,
+        more: More::default(),
     });
     c.extend(second_campaign(dir));
+    c.extend(third::cases(dir));
     c
+}
+
+#[path = "hostile/third.rs"]
+mod third;
+
+/// `n` bytes of xorshift64 noise from `seed` (the same bytes every run).
+fn noise(n: usize, mut seed: u64) -> Vec<u8> {
+    (0..n)
+        .map(|_| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 56) as u8
+        })
+        .collect()
 }
 
 fn mkfifo(path: &Path) -> bool {
@@ -905,15 +1006,7 @@ fn second_campaign(dir: &Path) -> Vec<Case> {
     ));
     // 600³ u8 (216 MB) with Phong: the visible lists stay within their budget, past it the
     // bands classify as they go.
-    let mut seed = 0x2545_f491_4f6c_dd1du64;
-    let big: Vec<u8> = (0..600 * 600 * 600)
-        .map(|_| {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 56) as u8
-        })
-        .collect();
+    let big = noise(600 * 600 * 600, 0x2545_f491_4f6c_dd1d);
     write("v600.raw", &big);
     drop(big);
     for (name, lod) in [

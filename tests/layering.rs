@@ -74,9 +74,9 @@ fn rank(node: &str) -> u32 {
         "args" | "metrics" => 3,
         "scene" | "tf" => 2,
         "io" | "reference" => 1,
-        // Threads that may fail to start, and the one table-size dispatch: used by io, the
-        // reference and the pipeline alike.
-        "threads" | "dispatch" => 0,
+        // Threads that may fail to start, the one table-size dispatch, and a render's
+        // interruption from outside: used by io, the reference and the pipeline alike.
+        "threads" | "dispatch" | "cancel" => 0,
         other => panic!("module '{other}' has no layer: add it to tests/layering.rs"),
     }
 }

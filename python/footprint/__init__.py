@@ -9,7 +9,9 @@ Conventions (as the command line's):
 
 * A volume is x-fastest in memory: a C-order array is indexed ``volume[z, y, x]`` (its last axis
   is x), a Fortran-order array ``volume[x, y, z]``; both are read where they lie, without a copy.
-  Other layouts (a strided view) are copied once into C order.
+  A strided view keeps the convention of the array it views (its axis that steps least in
+  memory is x) and is copied once, x fastest. An array of the other byte order (``">u2"`` on
+  this machine) is copied once into the native order. docs/python.md states what each costs.
 * ``spacing`` is (x, y, z) in world units per voxel; ``size`` is (width, height) in pixels;
   ``view`` is VTK's camera, (azimuth, elevation, roll) in degrees.
 * Images are (height, width, 4) float32 premultiplied linear RGBA, top row first;
@@ -106,7 +108,16 @@ def _volume_of(volume: Any, spacing):
             raise ValueError("the ImageData's active scalars have several components: render one")
         return array.reshape(dims, order="F"), tuple(float(s) for s in volume.spacing)
     array = np.asarray(volume)
+    if array.dtype.byteorder not in ("=", "|") and array.dtype.byteorder != _NATIVE:
+        # Another byte order (np.fromfile(f, ">u2"), how raw CT files are read): one copy in
+        # the native order, keeping the layout (C, Fortran or the view's own), as large as the
+        # array itself.
+        array = array.astype(array.dtype.newbyteorder("="), order="K")
     return array, spacing
+
+
+#: The byte order numpy writes for this machine's native one.
+_NATIVE = "<" if np.little_endian else ">"
 
 
 def _image(image: np.ndarray, dtype) -> np.ndarray:
@@ -134,7 +145,10 @@ def render(
     from the data (Otsu threshold to the 99.5th percentile; ``footprint info`` prints it). ``tf``
     None: ``ct-bone-skin``, as ``footprint render`` on a file.
     Any other ``footprint render`` flag is a keyword (``shading="phong"``, ``threads=2``,
-    ``slicing="image"``, ``accum="fixed"``, ``lod=0``, ...).
+    ``slicing="image"``, ``accum="fixed"``, ``lod=0``, ...). ``out="x.png"`` (or ``.pfm``) and
+    ``json="x.json"`` also write the image and the summary as ``footprint render`` does (both or
+    neither; the paths are checked before rendering).
+    Ctrl-C interrupts the render within a sheet or slab and raises ``KeyboardInterrupt``.
     """
     array, spacing = _volume_of(volume, spacing)
     args = _common(size, view, tf, window, flags)
@@ -159,6 +173,8 @@ def render_stream(
     slices the renderer needs are held (three), so ``window`` must be given (a stream cannot be
     read twice to find its range) and the view must look within 45 degrees of the z axis.
     ``dims`` is (x, y, z), ``dtype`` the slices' sample type (each slice is converted to it).
+    An exception the iterable raises comes out as itself (``KeyboardInterrupt``, ``SystemExit``,
+    your own); the slices are taken from it on a thread of the renderer's, not the caller's.
     """
     if window is None:
         raise ValueError("render_stream needs window=(lo, hi): a stream cannot be read twice")

@@ -18,9 +18,6 @@
 use footprint_harness::args::{parse_args, RenderArgs};
 use footprint_harness::io::stream::{InMemory, Pipe};
 use footprint_harness::io::volume::{check_spacing, Data, Samples, Volume};
-use footprint_harness::pipeline::quality::choose::{apply_quality, chosen_frame};
-use footprint_harness::pipeline::stages::visible::FrameCache;
-use footprint_harness::pipeline::{prepare, render_ref};
 use footprint_harness::CliError;
 use numpy::{
     Element, PyArray1, PyArray3, PyArrayDyn, PyArrayMethods, PyReadonlyArray3,
@@ -102,11 +99,15 @@ fn with_typed<T: SampleKind, R>(
         )));
     }
     check_spacing(spacing).map_err(PyValueError::new_err)?;
-    let c_order = ro.is_c_contiguous();
-    let dims = if c_order || !ro.is_fortran_contiguous() {
-        [shape[2], shape[1], shape[0]]
-    } else {
+    let xyz = is_xyz(
+        ro.is_c_contiguous(),
+        ro.is_fortran_contiguous(),
+        ro.strides(),
+    );
+    let dims = if xyz {
         [shape[0], shape[1], shape[2]]
+    } else {
+        [shape[2], shape[1], shape[0]]
     };
     let (data, shared) = match ro.as_slice() {
         Ok(slice) => (
@@ -116,17 +117,36 @@ fn with_typed<T: SampleKind, R>(
             })),
             true,
         ),
-        // Strided: one copy, in C order (the logical order of the view's iterator).
-        Err(_) => (
-            Data::from(ro.as_array().iter().copied().collect::<Vec<T>>()),
-            false,
-        ),
+        // Strided: one copy, x fastest (for (x, y, z) the reversed axes' logical order).
+        Err(_) => {
+            let view = ro.as_array();
+            let copy: Vec<T> = if xyz {
+                view.reversed_axes().iter().copied().collect()
+            } else {
+                view.iter().copied().collect()
+            };
+            (Data::from(copy), false)
+        }
     };
     let volume = Volume::new(dims, spacing, T::samples(data));
     // `ro` (the read-only borrow) lives until `f` returns, and `f` drops the volume.
     let out = f(volume, shared);
     drop(ro);
     out
+}
+
+/// Whether an array with these flags and `strides` (bytes per step along each axis) is indexed
+/// (x, y, z): Fortran-contiguous, or a strided view whose first axis steps least in memory (a
+/// view of a Fortran-order array keeps its strides, so it keeps that array's convention). A
+/// C-contiguous array, and a view whose last axis steps least, is (z, y, x).
+fn is_xyz(c_contiguous: bool, f_contiguous: bool, strides: &[isize]) -> bool {
+    if c_contiguous {
+        return false;
+    }
+    if f_contiguous {
+        return true;
+    }
+    strides[0].unsigned_abs() < strides[2].unsigned_abs()
 }
 
 /// [`with_typed`] for whichever supported sample type `array` has.
@@ -165,27 +185,97 @@ fn parse(flags: &[String]) -> PyResult<RenderArgs> {
 /// A rendered image: premultiplied RGBA, row-major, top row first, and its (width, height).
 type Frame = (Vec<[f32; 4]>, (usize, usize));
 
+/// Runs `work` on a thread of its own with the GIL released, while this thread waits for it and
+/// every 50 ms runs Python's signal handlers (`PyErr_CheckSignals`: only the main thread's call
+/// does anything). An exception they raise (Ctrl-C's `KeyboardInterrupt`) asks the harness to
+/// stop (`footprint_harness::cancel`: renders end at their next sheet or slab), waits for `work`
+/// to end, and is raised as itself. `work`'s own error comes back as the harness's
+/// ([`py_err`]), or, where `raised` holds an exception Python code raised inside it (a stream's
+/// generator), as that exception.
+fn interruptible<R: Send>(
+    py: Python<'_>,
+    raised: Option<&Raised>,
+    work: impl FnOnce() -> Result<R, CliError> + Send,
+) -> PyResult<R> {
+    let (out, interrupt) = py.detach(|| {
+        std::thread::scope(|scope| {
+            let (tx, rx) = std::sync::mpsc::channel();
+            let worker = scope.spawn(move || {
+                let out = work();
+                let _ = tx.send(());
+                out
+            });
+            let mut interrupt: Option<PyErr> = None;
+            loop {
+                match rx.recv_timeout(std::time::Duration::from_millis(50)) {
+                    Ok(()) | Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => break,
+                    Err(std::sync::mpsc::RecvTimeoutError::Timeout) if interrupt.is_none() => {
+                        if let Err(e) = Python::attach(|py| py.check_signals()) {
+                            footprint_harness::cancel::request();
+                            interrupt = Some(e);
+                        }
+                    }
+                    Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {}
+                }
+            }
+            let out = worker
+                .join()
+                .unwrap_or_else(|p| std::panic::resume_unwind(p));
+            if interrupt.is_some() {
+                footprint_harness::cancel::clear();
+            }
+            (out, interrupt)
+        })
+    });
+    if let Some(e) = interrupt {
+        return Err(e);
+    }
+    out.map_err(|e| match raised.and_then(Raised::take) {
+        Some(err) => err,
+        None => py_err(e),
+    })
+}
+
+/// An exception raised by Python code the harness called (a stream's generator), kept to be
+/// raised again as itself: not as the harness's `ValueError` (Ctrl-C stays `KeyboardInterrupt`,
+/// `SystemExit` stays `SystemExit`).
+#[derive(Clone, Default)]
+struct Raised(Arc<std::sync::Mutex<Option<PyErr>>>);
+
+impl Raised {
+    fn keep(&self, e: PyErr) {
+        let mut slot = self
+            .0
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        slot.get_or_insert(e);
+    }
+    fn take(&self) -> Option<PyErr> {
+        self.0
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .take()
+    }
+}
+
 /// A loaded volume for Python: the array, its spacing (x, y, z) and its metadata.
 type Loaded<'py> = (Bound<'py, PyAny>, (f32, f32, f32), Bound<'py, PyDict>);
 
 /// The frame `args` describe, as `footprint render` renders it: premultiplied RGBA and its
-/// (width, height).
+/// (width, height); with `--out` or `--json` among the flags, the image and the summary are
+/// written as `render` writes them (checked before rendering, all or nothing).
 fn frame(args: &RenderArgs) -> Result<Frame, CliError> {
+    use footprint_harness::commands::render::{single, write_files};
+    footprint_harness::io::outputs::check_image_and_json(
+        args.out.as_deref(),
+        args.json.as_deref(),
+    )?;
     let asked = footprint_harness::plan::plan(args)?;
     let inputs = footprint_harness::plan::Inputs::from(args);
-    let (p, plan, mut choice) = apply_quality(prepare(args)?, &inputs, &asked)?;
-    let image = if plan.end == footprint_harness::plan::End::Reference {
-        render_ref(&p)?
-            .0
-            .iter()
-            .map(|c| c.map(|x| x as f32))
-            .collect()
-    } else {
-        // The default plan's pilot rendered the chosen frame whole already.
-        chosen_frame(&p, &plan, &mut choice, &mut FrameCache::default())?
-            .0
-            .image
-    };
+    let (image, summary, _) = single(args, &inputs, &asked)?;
+    if args.out.is_some() || args.json.is_some() {
+        write_files(args, args.out.as_deref(), &image, summary)?;
+    }
     Ok((image, args.size))
 }
 
@@ -213,6 +303,7 @@ fn render_array<'py>(
             // function's low end, where the command line asks for --window.
             let (lo, hi) = v.range();
             if lo == hi {
+                let lo = v.values.to_data(lo);
                 args.window = Some([lo, lo + lo.abs().max(1.0)]);
             }
         }
@@ -221,11 +312,11 @@ fn render_array<'py>(
             volume: Arc::clone(&v),
             name: "array".into(),
         });
-        let out = py.detach(|| frame(&args));
+        let out = interruptible(py, None, || frame(&args));
         args.memory = None;
         debug_assert_eq!(Arc::strong_count(&v), 1, "the volume outlives the call");
         drop(v);
-        out.map_err(py_err)
+        out
     })?;
     to_numpy(py, image, size)
 }
@@ -244,6 +335,8 @@ struct Slices {
     iter: Py<PyIterator>,
     buf: Vec<u8>,
     at: usize,
+    /// Where an exception the iterator raises is kept, to be raised again as itself.
+    raised: Raised,
 }
 
 impl std::io::Read for Slices {
@@ -265,7 +358,11 @@ impl std::io::Read for Slices {
                     self.at = 0;
                 }
                 Ok(None) => return Ok(0),
-                Err(e) => return Err(std::io::Error::other(e.to_string())),
+                Err(e) => {
+                    let text = e.to_string();
+                    self.raised.keep(e);
+                    return Err(std::io::Error::other(text));
+                }
             }
         }
         let n = out.len().min(self.buf.len() - self.at);
@@ -320,12 +417,14 @@ fn render_stream<'py>(
     ];
     all.extend(flags);
     let mut args = parse(&all)?;
+    let raised = Raised::default();
     args.stdin = Some(Pipe::new(Slices {
         iter: PyIterator::from_object(sheets)?.unbind(),
         buf: Vec::new(),
         at: 0,
+        raised: raised.clone(),
     }));
-    let (image, size) = py.detach(|| frame(&args)).map_err(py_err)?;
+    let (image, size) = interruptible(py, Some(&raised), || frame(&args))?;
     to_numpy(py, image, size)
 }
 

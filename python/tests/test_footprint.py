@@ -262,3 +262,90 @@ def test_uint8_images_and_image_data():
         footprint.render(ImageData(v, (1, 1.5, 2)), size=(40, 40), window=(0, 3500)),
         footprint.render(v, spacing=(1, 1.5, 2), size=(40, 40), window=(0, 3500)),
     )
+
+
+def test_views_keep_their_arrays_convention():
+    """A strided view of a Fortran-order (x, y, z) array is (x, y, z) too (the third hostile
+    campaign read it as (z, y, x), 1.0 apart), and a view of a C-order array (z, y, x)."""
+    v = blob()
+    f = np.asfortranarray(v.T)[2:26]  # x from 2 to 25 of the (x, y, z) array: not contiguous
+    assert not f.flags.c_contiguous and not f.flags.f_contiguous
+    want = footprint.render(np.ascontiguousarray(v[:, :, 2:26]), size=(48, 48), view=(30, 20, 0), window=(0, 3500))
+    assert np.array_equal(footprint.render(f, size=(48, 48), view=(30, 20, 0), window=(0, 3500)), want)
+    c = v[:, :, 2:26]
+    assert np.array_equal(footprint.render(c, size=(48, 48), view=(30, 20, 0), window=(0, 3500)), want)
+
+
+def test_other_byte_orders_render_the_native_picture():
+    v = blob()
+    want = footprint.render(v, size=(48, 48), view=(30, 20, 0), window=(0, 3500))
+    swapped = v.astype(v.dtype.newbyteorder("S"))
+    assert np.array_equal(footprint.render(swapped, size=(48, 48), view=(30, 20, 0), window=(0, 3500)), want)
+    fortran = np.asfortranarray(swapped.T)
+    assert np.array_equal(footprint.render(fortran, size=(48, 48), view=(30, 20, 0), window=(0, 3500)), want)
+
+
+def test_render_writes_out_and_json(tmp_path):
+    v = blob()
+    img = footprint.render(v, size=(40, 32), window=(0, 3500), out=tmp_path / "o.pfm", json=tmp_path / "o.json")
+    assert np.array_equal(read_pfm(tmp_path / "o.pfm"), img[..., :3])
+    import json as _json
+
+    summary = _json.loads((tmp_path / "o.json").read_text())
+    assert summary["size"] == [40, 32] and summary["out"] == str(tmp_path / "o.pfm")
+    footprint.render(v, size=(40, 32), window=(0, 3500), json=tmp_path / "only.json")
+    assert (tmp_path / "only.json").exists()
+    with pytest.raises(ValueError, match="cannot write .jpg"):
+        footprint.render(v, size=(40, 32), window=(0, 3500), out=tmp_path / "o.jpg")
+    assert not (tmp_path / "o.jpg").exists()
+
+
+def test_a_generators_exception_comes_out_as_itself():
+    """KeyboardInterrupt and SystemExit raised by the slices' iterable are raised again as
+    themselves, not as ValueError (which `except ValueError` would swallow)."""
+    v = blob()
+
+    def failing(exc):
+        def slices():
+            yield v[0]
+            yield v[1]
+            raise exc
+
+        return slices()
+
+    class Mine(Exception):
+        pass
+
+    for exc in (KeyboardInterrupt, SystemExit, Mine):
+        with pytest.raises(exc):
+            footprint.render_stream(failing(exc), (28, 20, 24), dtype=np.uint16, size=(32, 32), window=(0, 3500))
+
+
+def test_ctrl_c_interrupts_a_long_render():
+    """SIGINT half a second into a render that takes several seconds raises KeyboardInterrupt
+    within a sheet or slab, not when the frame ends (the third campaign waited 21 s)."""
+    script = textwrap.dedent(
+        """
+        import os, signal, threading, time, numpy as np, footprint
+        v = (np.random.default_rng(1).random((160, 160, 160)) * 255).astype(np.uint8)
+        t0 = time.perf_counter()
+        footprint.render(v, size=(64, 64), window=(0, 255), slicing="image", slab=1, threads=1)
+        small = time.perf_counter() - t0
+        threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGINT)).start()
+        t0 = time.perf_counter()
+        try:
+            footprint.render(v, size=(1536, 1536), window=(0, 255), slicing="image", slab=0.25, threads=1)
+            print("finished", time.perf_counter() - t0)
+        except KeyboardInterrupt:
+            print("interrupted", time.perf_counter() - t0)
+        # The harness is usable again afterwards.
+        footprint.render(v[:8, :8, :8], size=(16, 16), window=(0, 255))
+        print("again")
+        """
+    )
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    lines = out.stdout.split()
+    assert lines[0] == "interrupted", out.stdout
+    assert float(lines[1]) < 3.0, f"KeyboardInterrupt came {lines[1]} s after the render began"
+    assert lines[-1] == "again"

@@ -179,7 +179,7 @@ pub struct FootprintArgs {
     pub min_radius: f32,
     /// `--method paper` only: how close to 45° (degrees) the paper's rotation cheat nudges θ;
     /// 0 disables it, and the singular angle becomes a typed error.
-    #[arg(long, default_value_t = 0.01)]
+    #[arg(long, default_value_t = 0.01, value_parser = parse_finite_f32)]
     pub paper_cheat: f32,
 }
 
@@ -286,9 +286,9 @@ pub struct RenderArgs {
     pub tf: Option<String>,
     /// Value window LO,HI mapped onto the transfer function. Default for a volume: Otsu's
     /// threshold between background and foreground to the 99.5th percentile, from at most 2^20
-    /// strided samples (`footprint info` prints it); the built-in scene: the data's range.
-    #[arg(help_heading = "Picture", long, value_parser = parse_list::<2>, allow_hyphen_values = true)]
-    pub window: Option<[f32; 2]>,
+    /// strided samples (`footprint info` prints it); the built-in scene: the data's range. Data units, f64.
+    #[arg(help_heading = "Picture", long, value_parser = parse_list_f64::<2>, allow_hyphen_values = true)]
+    pub window: Option<[f64; 2]>,
     /// Shading: emission, phong, iso:VALUE (Levoy iso-surface at VALUE, data units), texture.
     #[arg(help_heading = "Picture", long, default_value = "emission")]
     pub shading: String,
@@ -454,7 +454,7 @@ pub struct RenderArgs {
     /// accumulation; with the continuous reference also the slab thickness). Against the sheet
     /// reference it aims at full resolution and also chooses the level of detail (`--lod auto`),
     /// measured on a pilot of image rows when the volume is minified.
-    #[arg(help_heading = "Speed and quality", long, conflicts_with_all = ["table", "lookup", "method", "accum", "table_file", "slab"])]
+    #[arg(help_heading = "Speed and quality", long, value_parser = parse_finite_f64, conflicts_with_all = ["table", "lookup", "method", "accum", "table_file", "slab"])]
     pub quality: Option<f64>,
     /// What --quality aims at: `sheets`, the f64 renderer of the volume's sheets at full
     /// resolution (the table's error predicted in milliseconds; a coarser level's measured on a
@@ -579,14 +579,14 @@ pub struct SplatArgs {
     #[arg(long, value_parser = parse_list::<9>, allow_hyphen_values = true)]
     pub view_matrix: Option<[f32; 9]>,
     /// Rotation about the screen x axis composed onto the view, degrees.
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = parse_finite_f32)]
     pub rotate_x: f32,
     /// Rotation about the screen y axis composed onto the view, degrees.
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = parse_finite_f32)]
     pub rotate_y: f32,
     /// Rotation about the view direction (screen z) composed onto the view, degrees; positive
     /// turns +x toward +y (clockwise on screen, y pointing down).
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = parse_finite_f32)]
     pub rotate_z: f32,
     /// Image size, WxH pixels.
     #[arg(short, long, default_value = "256x256", value_parser = parse_size)]

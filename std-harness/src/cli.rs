@@ -64,13 +64,18 @@ const RENDER_EXAMPLES: &str = "Examples:
 
 /// Runs the command line `args` (program name first); returns the process exit code: 0 success,
 /// 1 a check failed, 2 bad input or I/O error. Errors are printed to stderr as one line.
+/// SIGINT, SIGTERM and SIGHUP remove the command's temporaries before the process ends
+/// ([`crate::io::temporaries::remove_on_signals`]).
 pub fn run<I, T>(args: I) -> i32
 where
     I: IntoIterator<Item = T>,
     T: Into<OsString> + Clone,
 {
     crate::io::outputs::ignore_file_size_signal();
+    crate::io::temporaries::remove_on_signals();
     crate::io::forget_inputs();
+    // A failure left from an earlier command of this process (tests run many) is not this one's.
+    let _ = crate::stdout_failure();
     let cli = match Cli::try_parse_from(args) {
         Ok(cli) => cli,
         Err(e)
@@ -92,11 +97,20 @@ where
             return 2;
         }
     };
-    match dispatch(cli.command) {
+    // A report that could not be written is a failure, not a success (`info > /dev/full`).
+    let result = dispatch(cli.command).and_then(|()| match crate::stdout_failure() {
+        None => Ok(()),
+        Some(e) => Err(crate::CliError::input(format!(
+            "standard output: cannot write: {e}"
+        ))),
+    });
+    match result {
         Ok(()) => 0,
         Err(e) => {
-            use std::io::Write as _;
-            let _ = writeln!(std::io::stderr().lock(), "footprint: {e}");
+            if !e.said {
+                use std::io::Write as _;
+                let _ = writeln!(std::io::stderr().lock(), "footprint: {e}");
+            }
             e.code
         }
     }

@@ -14,7 +14,7 @@
 //!              └ args, metrics   shared argument structs; image comparisons
 //!                 └ scene, tf   the built-in volume; transfer functions
 //!                    └ io, reference   files and formats; the f64 reference
-//!                       └ dispatch, threads   N → const N (once); threads
+//!                       └ dispatch, threads, cancel   N → const N (once); threads; interruption
 //! ```
 //!
 //! - [`cli`]: the entry point [`run`].
@@ -28,20 +28,52 @@
 //! - [`io`]: volume formats, streaming sources, images, tables, JSON (written atomically).
 //! - [`dispatch`]: runtime table size → const generic.
 //! - [`threads`]: scoped threads that run their work inline where none can be started.
+//! - [`cancel`]: a render interrupted from outside (the Python package's Ctrl-C).
 
 // `!(x > y)` sends NaN down the rejecting branch, on purpose (as in the core).
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 /// `println!` that never panics: a closed stdout (`footprint … | head`) is not an error worth a
-/// crash, and the output files are already written by then.
+/// crash, and the output files are already written by then. Any other failure to write (a full
+/// disk, `> /dev/full`) is remembered ([`stdout_failure`]): the command line then exits 2 with
+/// it, instead of losing its report and saying it succeeded.
 #[macro_export]
 macro_rules! say {
     ($($arg:tt)*) => {{
         use std::io::Write as _;
         if !$crate::QUIET.load(std::sync::atomic::Ordering::Relaxed) {
-            let _ = writeln!(std::io::stdout().lock(), $($arg)*);
+            if let Err(e) = writeln!(std::io::stdout().lock(), $($arg)*) {
+                $crate::note_stdout_failure(e);
+            }
         }
     }};
+}
+
+/// The first failure to write standard output other than a closed pipe, if any (see [`say!`]).
+static STDOUT_FAILURE: std::sync::Mutex<Option<String>> = std::sync::Mutex::new(None);
+
+/// Remembers `e`, a failed write to standard output, unless it is a closed pipe (the reader
+/// has gone, as `| head` does: not an error).
+pub fn note_stdout_failure(e: std::io::Error) {
+    if e.kind() == std::io::ErrorKind::BrokenPipe {
+        return;
+    }
+    let mut failure = STDOUT_FAILURE
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    failure.get_or_insert_with(|| e.to_string());
+}
+
+/// Standard output flushed, and the first failure to write it since the last call (cleared).
+pub fn stdout_failure() -> Option<String> {
+    use std::io::Write as _;
+    if let Err(e) = std::io::stdout().lock().flush() {
+        note_stdout_failure(e);
+    }
+    STDOUT_FAILURE
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+        .take()
 }
 
 /// When set, [`say!`] prints nothing: a program calling the commands (the Python package) takes
@@ -58,6 +90,7 @@ macro_rules! warn {
 }
 
 pub mod args;
+pub mod cancel;
 pub mod charts;
 pub mod cli;
 pub mod commands;
@@ -83,6 +116,9 @@ pub struct CliError {
     pub message: String,
     /// 2 = bad input or I/O failure, 1 = a check (such as `compare --max-diff`) failed.
     pub code: i32,
+    /// Already printed to standard error (an MPI rank says its own failure at once, before the
+    /// job ends: `distributed::mpi::agree`); the command line does not print it again.
+    pub said: bool,
 }
 
 impl CliError {
@@ -91,6 +127,7 @@ impl CliError {
         CliError {
             message: one_line(message.into()),
             code: 2,
+            said: false,
         }
     }
     /// A check that ran and failed: exit code 1.
@@ -98,6 +135,7 @@ impl CliError {
         CliError {
             message: one_line(message.into()),
             code: 1,
+            said: false,
         }
     }
 }

@@ -474,7 +474,7 @@ pub struct Inputs {
     pub eye_distance: Option<f32>,
     /// Classification: `--tf`, `--window`, `--shading`.
     pub tf: Option<String>,
-    pub window: Option<[f32; 2]>,
+    pub window: Option<[f64; 2]>,
     pub shading: String,
     /// Picture: background, gamma, PNG depth.
     pub background: Background,

@@ -102,6 +102,15 @@ pub enum SlabError {
         /// The factor given.
         scale: usize,
     },
+    /// Post-classified slabs at least as deep as the volume's sample box along the view
+    /// ([`super::post::PostSetup::new`]): a slab samples each ray once, at its mid-plane, and
+    /// a mid-plane need not meet the volume at all (the frame would be empty).
+    ThickerThanVolume {
+        /// The thickness given, smallest grid spacings.
+        thickness: f32,
+        /// The sample box's depth along the view, smallest grid spacings.
+        depth: f32,
+    },
 }
 
 impl fmt::Display for SlabError {
@@ -127,6 +136,12 @@ impl fmt::Display for SlabError {
             ),
             Self::Singular => f.write_str("the view or grid is singular"),
             Self::ValueScale { scale } => write!(f, "value subsampling {scale} is outside 1..=64"),
+            Self::ThickerThanVolume { thickness, depth } => write!(
+                f,
+                "post-classified slabs {thickness} spacings thick are at least as deep as the \
+                 volume along this view ({depth:.3} spacings), and a slab samples each ray once, \
+                 at its mid-plane, which could miss the volume: give slabs thinner than that"
+            ),
         }
     }
 }

@@ -1,7 +1,21 @@
 //! Value parsers for the shared flags: lists, views, sizes, levels of detail, supersampling.
 
-/// Parses `a,b,c,…` into exactly `n` finite numbers.
+/// Parses `a,b,c,…` into exactly `n` finite numbers (f32: one past its range is refused).
 pub fn parse_list<const N: usize>(s: &str) -> Result<[f32; N], String> {
+    let wide = parse_list_f64::<N>(s)?;
+    let mut out = [0.0f32; N];
+    for (o, (w, p)) in out.iter_mut().zip(wide.iter().zip(s.split(','))) {
+        *o = *w as f32;
+        if !o.is_finite() {
+            return Err(format!("'{p}' is not finite"));
+        }
+    }
+    Ok(out)
+}
+
+/// Parses `a,b,…` into exactly `n` finite f64 numbers (`--window`: wide samples need f64 bounds,
+/// as u32 values 4 294 967 290 and 4 294 967 295 are one f32).
+pub fn parse_list_f64<const N: usize>(s: &str) -> Result<[f64; N], String> {
     let parts: Vec<&str> = s.split(',').collect();
     if parts.len() != N {
         return Err(format!(
@@ -9,15 +23,9 @@ pub fn parse_list<const N: usize>(s: &str) -> Result<[f32; N], String> {
             parts.len()
         ));
     }
-    let mut out = [0.0f32; N];
+    let mut out = [0.0f64; N];
     for (o, p) in out.iter_mut().zip(parts) {
-        *o = p
-            .trim()
-            .parse()
-            .map_err(|_| format!("'{p}' is not a number"))?;
-        if !o.is_finite() {
-            return Err(format!("'{p}' is not finite"));
-        }
+        *o = parse_finite_f64(p)?;
     }
     Ok(out)
 }
@@ -41,6 +49,27 @@ pub fn parse_view(s: &str) -> Result<[f32; 3], String> {
         return Ok(*a);
     }
     parse_list::<3>(s).map_err(|e| format!("{e} (or one of +x, -x, +y, -y, +z, -z)"))
+}
+
+/// Parses one finite number (NaN and infinities are refused: `--min-psnr nan` would pass or
+/// fail every check the same way, silently).
+pub fn parse_finite_f64(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        Ok(_) => Err(format!("'{s}' is not finite")),
+        Err(_) => Err(format!("'{s}' is not a number")),
+    }
+}
+
+/// [`parse_finite_f64`] for an f32 flag (also refusing a number past f32's range).
+pub fn parse_finite_f32(s: &str) -> Result<f32, String> {
+    let v = parse_finite_f64(s)?;
+    let f = v as f32;
+    if f.is_finite() {
+        Ok(f)
+    } else {
+        Err(format!("'{s}' is out of range"))
+    }
 }
 
 /// Parses `X,Y,Z` voxel spacing: three positive finite numbers (world units).

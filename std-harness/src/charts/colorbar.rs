@@ -22,8 +22,7 @@ pub fn panel(w: usize, h: usize) -> Option<(usize, usize, usize, usize)> {
 }
 
 /// A window value as a short label: at most 4 significant digits, no trailing zeros.
-fn label(v: f32) -> String {
-    let v = f64::from(v);
+fn label(v: f64) -> String {
     if v != 0.0 && !(1e-3..1e5).contains(&v.abs()) {
         return format!("{v:.2e}");
     }
@@ -47,7 +46,7 @@ pub fn draw(
     image: &mut [[f32; 4]],
     (w, h): (usize, usize),
     lut: &[[f32; 4]],
-    window: [f32; 2],
+    window: [f64; 2],
 ) -> Result<(), CliError> {
     let Some((x0, y0, pw, ph)) = panel(w, h) else {
         crate::warn!("--colorbar: a {w}x{h} image is too small for a legend (48x48 at least)");

@@ -7,13 +7,13 @@
 
 use super::plot::{plot_err, time_chart, time_spread, write_svg_png};
 use crate::args::{Lod, RenderArgs};
+use crate::io::outputs::Batch;
 use crate::metrics::compare;
 use crate::pipeline::stages::visible::FrameCache;
 use crate::pipeline::{prepare, render_frame, Prepared};
 use crate::CliError;
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use std::path::Path;
 
 /// The deepest level charted.
 pub const MAX_CHARTED: u32 = 6;
@@ -120,9 +120,14 @@ pub fn csv(rows: &[LevelRow], auto: u32) -> String {
 }
 
 /// `DIR/lod.svg` and `.png`: PSNR against level 0 over frame time, one point per level.
-pub fn write_chart(dir: &Path, rows: &[LevelRow], auto: u32, title: &str) -> Result<(), CliError> {
+pub fn write_chart(
+    out: &mut Batch,
+    rows: &[LevelRow],
+    auto: u32,
+    title: &str,
+) -> Result<(), CliError> {
     write_svg_png(
-        dir,
+        out,
         "lod",
         (900, 560),
         |r| draw(r, rows, auto, title),

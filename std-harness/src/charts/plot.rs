@@ -7,11 +7,11 @@ use super::stability::Curve;
 use super::sweep::Measured;
 use crate::args::{AccumArg, LookupArg, MethodArg};
 use crate::io;
+use crate::io::outputs::Batch;
 use crate::pipeline::quality::config::{accum_name, lookup_name, method_name, Config};
 use crate::CliError;
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use std::path::Path;
 
 static FONT: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
 
@@ -333,7 +333,7 @@ where
 }
 
 pub(crate) fn write_svg_png(
-    dir: &Path,
+    out: &mut Batch,
     stem: &str,
     size: (u32, u32),
     draw: impl Fn(&DrawingArea<SVGBackend<'_>, Shift>) -> Result<(), CliError>,
@@ -344,7 +344,7 @@ pub(crate) fn write_svg_png(
         let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
         draw(&root)?;
     }
-    io::write_atomic(&dir.join(format!("{stem}.svg")), svg.as_bytes())?;
+    out.add(&format!("{stem}.svg"), svg);
     let mut rgb = vec![0u8; size.0 as usize * size.1 as usize * 3];
     {
         let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
@@ -356,7 +356,7 @@ pub(crate) fn write_svg_png(
         .map(|[r, g, b]| [r, g, b, 1.0])
         .collect();
     let png = io::image::encode_png_rgb(&rgba, size.0 as usize, size.1 as usize)?;
-    io::write_atomic(&dir.join(format!("{stem}.png")), &png)?;
+    out.add(&format!("{stem}.png"), png);
     Ok(())
 }
 
@@ -457,10 +457,10 @@ pub fn time_spread<T>(rows: &[T], min: impl Fn(&T) -> f64, max: impl Fn(&T) -> f
     )
 }
 
-pub fn write_tradeoff(dir: &Path, rows: &[Measured], title: &str) -> Result<(), CliError> {
+pub fn write_tradeoff(out: &mut Batch, rows: &[Measured], title: &str) -> Result<(), CliError> {
     for (stem, truth) in [("tradeoff", false), ("tradeoff-continuous", true)] {
         write_svg_png(
-            dir,
+            out,
             stem,
             (1100, 650),
             |r| draw_tradeoff(r, rows, title, truth),
@@ -472,13 +472,13 @@ pub fn write_tradeoff(dir: &Path, rows: &[Measured], title: &str) -> Result<(), 
 
 /// `DIR/stability.svg` and `.png`, with the popping panel when it was swept.
 pub fn write_stability(
-    dir: &Path,
+    out: &mut Batch,
     curves: &[Vec<Curve>; 3],
     popping: Option<&Popping>,
 ) -> Result<(), CliError> {
     let width = if popping.is_some() { 2000 } else { 1500 };
     write_svg_png(
-        dir,
+        out,
         "stability",
         (width, 520),
         |r| draw_stability(r, curves, popping),

@@ -10,6 +10,7 @@ use super::plot::{
     draw_timed_points, median_min_max, plot_err, time_chart, time_spread, write_svg_png, TimedPoint,
 };
 use crate::args::{ClassificationArg, RenderArgs, Supersample};
+use crate::io::outputs::Batch;
 use crate::metrics::compare;
 use crate::pipeline::ends::continuous::render_continuous_as;
 use crate::pipeline::stages::visible::FrameCache;
@@ -18,7 +19,6 @@ use crate::reference::continuous::{Model, Reconstruction, DEFAULT_CAP};
 use crate::CliError;
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use std::path::Path;
 
 /// Slab thicknesses swept, smallest grid spacings.
 pub const SLABS: [f32; 7] = [2.0, 1.5, 1.0, 0.7, 0.5, 0.4, 0.3];
@@ -98,9 +98,9 @@ pub fn csv(rows: &[PostRow]) -> String {
 
 /// `DIR/post.svg` and `.png`: PSNR against the post-classified integral over frame time, one
 /// point per configuration, a colour per value subsampling; a dashed guide at the 44 dB target.
-pub fn write_chart(dir: &Path, rows: &[PostRow], title: &str) -> Result<(), CliError> {
+pub fn write_chart(out: &mut Batch, rows: &[PostRow], title: &str) -> Result<(), CliError> {
     write_svg_png(
-        dir,
+        out,
         "post",
         (900, 560),
         |r| draw(r, rows, title),

@@ -10,13 +10,13 @@ use super::plot::{
     draw_timed_points, median_min_max, plot_err, time_chart, time_spread, write_svg_png, TimedPoint,
 };
 use crate::args::RenderArgs;
+use crate::io::outputs::Batch;
 use crate::metrics::compare;
 use crate::pipeline::stages::visible::FrameCache;
 use crate::pipeline::{prepare, render_frame, Prepared};
 use crate::CliError;
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use std::path::Path;
 
 /// The thresholds swept (premultiplied RGBA differences).
 pub const THRESHOLDS: [f32; 7] = [0.5, 0.3, 0.2, 0.1, 0.05, 0.02, 0.0];
@@ -137,9 +137,9 @@ pub fn csv(rows: &[RefineRow]) -> String {
 
 /// `DIR/refine.svg` and `.png`: PSNR against the finer sampling over frame time, one point per
 /// threshold; dashed guides at twice the unrefined time and 3 dB above its PSNR (issue 15's bar).
-pub fn write_chart(dir: &Path, rows: &[RefineRow], title: &str) -> Result<(), CliError> {
+pub fn write_chart(out: &mut Batch, rows: &[RefineRow], title: &str) -> Result<(), CliError> {
     write_svg_png(
-        dir,
+        out,
         "refine",
         (900, 560),
         |r| draw(r, rows, title),

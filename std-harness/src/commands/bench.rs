@@ -33,7 +33,7 @@ pub struct BenchArgs {
     #[arg(long, default_value_t = 10)]
     pub frames: usize,
     /// Azimuth added per frame, degrees.
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = crate::args::parse_finite_f32)]
     pub orbit: f32,
 }
 

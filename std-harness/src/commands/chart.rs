@@ -3,13 +3,12 @@
 
 use crate::args::{ClassificationArg, Lod, RenderArgs};
 use crate::charts::{lod, plot, popping, post, refine, stability, sweep};
-use crate::io;
+use crate::io::outputs::Batch;
 use crate::pipeline::prepare;
 use crate::pipeline::quality::config::Config;
 use crate::pipeline::quality::model as quality;
 use crate::CliError;
 use clap::Args;
-use std::path::Path;
 
 #[derive(Args, Debug, Clone)]
 pub struct ChartArgs {
@@ -64,8 +63,9 @@ pub fn run(args: &ChartArgs) -> Result<(), CliError> {
     if args.runs == 0 {
         return Err(CliError::input("--runs must be at least 1"));
     }
-    std::fs::create_dir_all(&dir)
-        .map_err(|e| CliError::input(format!("{}: cannot create: {e}", dir.display())))?;
+    // Every file is written at the end, all or nothing (a folder that does not exist yet is
+    // created only then): a failure or a signal leaves no half-charted folder.
+    let mut out = Batch::new("--out", &dir)?;
     plot::register_font()?;
     let mut base = args.render.clone();
     base.out = None;
@@ -88,33 +88,34 @@ pub fn run(args: &ChartArgs) -> Result<(), CliError> {
         // Post-classification has its own trade-off (slab and value subsampling against the
         // post-classified integral); the pre-classified sweeps do not apply to it.
         let rows = post::sweep(&base, args.runs)?;
-        io::write_atomic(&dir.join("post.csv"), post::csv(&rows).as_bytes())?;
+        out.add("post.csv", post::csv(&rows));
         let title = format!(
             "{name}, {}x{}: post-classified frame time against error",
             base.size.0, base.size.1
         );
-        post::write_chart(&dir, &rows, &title)?;
+        post::write_chart(&mut out, &rows, &title)?;
     } else if args.refine_only {
-        refine_chart(&dir, &base, args)?;
+        refine_chart(&mut out, &base, args)?;
     } else {
         if !args.no_lod {
-            lod_chart(&dir, &base, &name, args.runs)?;
+            lod_chart(&mut out, &base, &name, args.runs)?;
         }
         if !args.lod_only {
-            tradeoff_chart(&dir, &base, &name, args.runs)?;
+            tradeoff_chart(&mut out, &base, &name, args.runs)?;
             if !args.no_stability {
-                stability_chart(&dir, &base, args)?;
+                stability_chart(&mut out, &base, args)?;
             }
         }
     }
+    out.commit()?;
     crate::say!("wrote {}", dir.display());
     Ok(())
 }
 
 /// The refinement sweep: refine.csv and its chart.
-fn refine_chart(dir: &Path, base: &RenderArgs, args: &ChartArgs) -> Result<(), CliError> {
+fn refine_chart(out: &mut Batch, base: &RenderArgs, args: &ChartArgs) -> Result<(), CliError> {
     let rows = refine::sweep(base, args.refine_reference, args.runs)?;
-    io::write_atomic(&dir.join("refine.csv"), refine::csv(&rows).as_bytes())?;
+    out.add("refine.csv", refine::csv(&rows));
     let title = format!(
         "built-in scene {n}^3 at {}x{}, against {r}^3: --refine, {} thread(s)",
         base.size.0,
@@ -123,7 +124,7 @@ fn refine_chart(dir: &Path, base: &RenderArgs, args: &ChartArgs) -> Result<(), C
         n = base.scene_size,
         r = args.refine_reference,
     );
-    refine::write_chart(dir, &rows, &title)?;
+    refine::write_chart(out, &rows, &title)?;
     for r in &rows {
         crate::say!(
             "refine {}: {} samples, {:.4} s ({:.2}x unrefined), {:.2} dB ({:+.2} dB)",
@@ -139,16 +140,16 @@ fn refine_chart(dir: &Path, base: &RenderArgs, args: &ChartArgs) -> Result<(), C
 }
 
 /// The levels-of-detail sweep: lod.csv and its chart.
-fn lod_chart(dir: &Path, base: &RenderArgs, name: &str, runs: usize) -> Result<(), CliError> {
+fn lod_chart(out: &mut Batch, base: &RenderArgs, name: &str, runs: usize) -> Result<(), CliError> {
     let (rows, auto) = lod::sweep(base, runs)?;
-    io::write_atomic(&dir.join("lod.csv"), lod::csv(&rows, auto).as_bytes())?;
+    out.add("lod.csv", lod::csv(&rows, auto));
     let title = format!(
         "{name}, {}x{}: levels of detail, {} thread(s)",
         base.size.0,
         base.size.1,
         base.thread_count()
     );
-    lod::write_chart(dir, &rows, auto, &title)?;
+    lod::write_chart(out, &rows, auto, &title)?;
     for r in &rows {
         crate::say!(
             "lod {}: {:?}, {:.4} s ({:.1}x level 0), {:.2} dB against level 0{}",
@@ -164,20 +165,25 @@ fn lod_chart(dir: &Path, base: &RenderArgs, name: &str, runs: usize) -> Result<(
 }
 
 /// The trade-off sweep over every configuration: tradeoff.csv, its chart and both frontiers.
-fn tradeoff_chart(dir: &Path, base: &RenderArgs, name: &str, runs: usize) -> Result<(), CliError> {
+fn tradeoff_chart(
+    out: &mut Batch,
+    base: &RenderArgs,
+    name: &str,
+    runs: usize,
+) -> Result<(), CliError> {
     let prepared = prepare(base)?;
     let mut configs = Config::for_frame(&prepared.frame);
     configs.extend(Config::slabs(&prepared.frame, &prepared.kernel));
     drop(prepared);
     let rows = sweep::sweep(base, &configs, runs)?;
-    io::write_atomic(&dir.join("tradeoff.csv"), sweep::csv(&rows).as_bytes())?;
+    out.add("tradeoff.csv", sweep::csv(&rows));
     let title = format!(
         "{name}, {}x{}: frame time against error ({} backend)",
         base.size.0,
         base.size.1,
         footprint::math::BACKEND
     );
-    plot::write_tradeoff(dir, &rows, &title)?;
+    plot::write_tradeoff(out, &rows, &title)?;
     print_frontier("Pareto frontier:", &rows, |r| r.pareto, |r| r.psnr_db);
     print_frontier(
         "Pareto frontier against the continuous integral:",
@@ -190,12 +196,9 @@ fn tradeoff_chart(dir: &Path, base: &RenderArgs, name: &str, runs: usize) -> Res
 
 /// The stability sweeps (rotation, anisotropy, footprint size) and, unless `--no-popping`, the
 /// popping sweep: stability.csv, popping.csv and their chart.
-fn stability_chart(dir: &Path, base: &RenderArgs, args: &ChartArgs) -> Result<(), CliError> {
+fn stability_chart(out: &mut Batch, base: &RenderArgs, args: &ChartArgs) -> Result<(), CliError> {
     let curves = stability::stability();
-    io::write_atomic(
-        &dir.join("stability.csv"),
-        stability::stability_csv(&curves).as_bytes(),
-    )?;
+    out.add("stability.csv", stability::stability_csv(&curves));
     let pop = if args.no_popping {
         None
     } else {
@@ -205,7 +208,7 @@ fn stability_chart(dir: &Path, base: &RenderArgs, args: &ChartArgs) -> Result<()
         // reference or slabs; a perspective view no slabs) charts without panel (d).
         match popping::popping(&a, crate::io::progress::sheets("popping")) {
             Ok(pop) => {
-                io::write_atomic(&dir.join("popping.csv"), pop.csv().as_bytes())?;
+                out.add("popping.csv", pop.csv());
                 for (k, name) in popping::NAMES.iter().enumerate() {
                     let (db, az) = pop.worst(k);
                     crate::say!("popping: {name:<21} largest change {db:.2} dB (PSNR) at {az:.1}°");
@@ -218,7 +221,7 @@ fn stability_chart(dir: &Path, base: &RenderArgs, args: &ChartArgs) -> Result<()
             }
         }
     };
-    plot::write_stability(dir, &curves, pop.as_ref())?;
+    plot::write_stability(out, &curves, pop.as_ref())?;
     for (panel, set) in ["rotation", "anisotropy", "footprint size"]
         .iter()
         .zip(&curves)

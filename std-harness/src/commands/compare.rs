@@ -14,11 +14,11 @@ pub struct CompareArgs {
     /// Reference image (PFM, of the same kind).
     pub b: PathBuf,
     /// Fail (exit 1) if max |A − B| / peak(B) exceeds this.
-    #[arg(long)]
+    #[arg(long, value_parser = crate::args::parse_finite_f64, allow_hyphen_values = true)]
     pub max_diff: Option<f64>,
     /// Fail (exit 1) if the PSNR of A against B, 10·log₁₀(1 / MSE) over every value (peak 1, the
     /// convention of `verify`), is below this many dB.
-    #[arg(long, value_name = "DB")]
+    #[arg(long, value_name = "DB", value_parser = crate::args::parse_finite_f64, allow_hyphen_values = true)]
     pub min_psnr: Option<f64>,
 }
 

@@ -76,15 +76,32 @@ pub fn run(command: &RenderCommandArgs) -> Result<(), CliError> {
         };
         return write(args, &out, &rgb, summary);
     }
-    let (p, plan, mut choice) = apply_quality(prepare(args)?, &inputs, &asked)?;
     if let Some(n) = command.orbit {
+        let (p, plan, _) = apply_quality(prepare(args)?, &inputs, &asked)?;
         return orbit(p, args, &plan, &out, usize::from(n), command.colorbar);
     }
-    let (mut rgb, summary) = if plan.end == End::Reference {
+    let (mut rgb, summary, p) = single(args, &inputs, &asked)?;
+    if command.colorbar {
+        colorbar::draw(&mut rgb, args.size, &p.lut, p.data_window())?;
+    }
+    write(args, &out, &rgb, summary)
+}
+
+/// One frame of `args` (with `inputs` and the plan `asked` resolved from them) as `footprint
+/// render` draws it without `--orbit`, `--colorbar` or a split: the premultiplied RGBA image at
+/// the output size, its JSON summary (without `out`) and what was prepared. What the Python
+/// package's `render` calls too.
+pub fn single(
+    args: &RenderArgs,
+    inputs: &Inputs,
+    asked: &Plan,
+) -> Result<(Vec<[f32; 4]>, crate::io::json::Json, Prepared), CliError> {
+    let (p, plan, mut choice) = apply_quality(prepare(args)?, inputs, asked)?;
+    let (rgb, summary) = if plan.end == End::Reference {
         let (img, secs) = render_ref(&p)?;
         let rgb: Vec<[f32; 4]> = img.iter().map(|c| c.map(|x| x as f32)).collect();
         crate::say!("{}: f64 reference render in {:.3} s", p.name, secs);
-        (rgb, describe(&p, &inputs, &plan).num("seconds", secs))
+        (rgb, describe(&p, inputs, &plan).num("seconds", secs))
     } else {
         // The default plan's pilot rendered the chosen frame whole already.
         let frame = chosen_frame(&p, &plan, &mut choice, &mut FrameCache::default())?.0;
@@ -127,7 +144,7 @@ pub fn run(command: &RenderCommandArgs) -> Result<(), CliError> {
             stats.pixel_updates,
             stats.pixels_composited
         );
-        let j = describe(&p, &inputs, &plan)
+        let j = describe(&p, inputs, &plan)
             .num("seconds", secs)
             .num("sheets", stats.sheets as f64)
             .num("voxels", stats.voxels as f64)
@@ -146,14 +163,11 @@ pub fn run(command: &RenderCommandArgs) -> Result<(), CliError> {
         Some(c) => summary.obj("quality", quality_json(c)),
         None => summary,
     };
-    if command.colorbar {
-        colorbar::draw(&mut rgb, args.size, &p.lut, p.window)?;
-    }
     let summary = match crate::distributed::peak_memory_bytes() {
         Some(m) => summary.num("peak_memory_bytes", m as f64),
         None => summary,
     };
-    write(args, &out, &rgb, summary)
+    Ok((rgb, summary, p))
 }
 
 /// Writes the image and the JSON summary (all or nothing).
@@ -163,14 +177,45 @@ fn write(
     rgb: &[[f32; 4]],
     summary: crate::io::json::Json,
 ) -> Result<(), CliError> {
-    let image = encode_rgb_for(out, rgb, args.size.0, args.size.1, args.png_style())?;
-    let summary = summary.str("out", &out.display().to_string()).finish();
-    let mut files = vec![(out, image.as_slice())];
+    write_files(args, Some(out), rgb, summary)
+}
+
+/// Writes the image to `out` (if any) and the JSON summary to `--json` (if given), all or
+/// nothing: what `render` writes, for a program that renders with [`single`] (Python's
+/// `render(out=..., json=...)`). Check the paths with [`crate::io::outputs::check_image_and_json`]
+/// before rendering.
+pub fn write_files(
+    args: &RenderArgs,
+    out: Option<&Path>,
+    rgb: &[[f32; 4]],
+    summary: crate::io::json::Json,
+) -> Result<(), CliError> {
+    let image = match out {
+        Some(o) => Some(encode_rgb_for(
+            o,
+            rgb,
+            args.size.0,
+            args.size.1,
+            args.png_style(),
+        )?),
+        None => None,
+    };
+    let summary = match out {
+        Some(o) => summary.str("out", &o.display().to_string()),
+        None => summary,
+    }
+    .finish();
+    let mut files = Vec::new();
+    if let (Some(o), Some(image)) = (out, &image) {
+        files.push((o, image.as_slice()));
+    }
     if let Some(j) = &args.json {
         files.push((j.as_path(), summary.as_bytes()));
     }
     outputs::write_all(&files)?;
-    crate::say!("wrote {}", out.display());
+    if let Some(o) = out {
+        crate::say!("wrote {}", o.display());
+    }
     Ok(())
 }
 
@@ -222,7 +267,7 @@ fn orbit(
         let mut f = render_frame(&p, plan, &mut cache)?;
         crate::say!("{}: frame {}/{n} in {:.3} s", p.name, k + 1, f.seconds);
         if bar {
-            colorbar::draw(&mut f.image, args.size, &p.lut, p.window)?;
+            colorbar::draw(&mut f.image, args.size, &p.lut, p.data_window())?;
         }
         Ok(f.image)
     })?;

@@ -118,7 +118,11 @@ impl Job {
         let raw = crate::pipeline::stages::load::raw_options(inputs)?;
         Ok(match (&inputs.memory, &inputs.volume) {
             (Some(_), _) => false,
-            (None, Some(path)) => seekable(path, raw.as_ref())?.is_none(),
+            (None, Some(path)) => {
+                // A file this rank cannot read is its error, not a sign to load it whole.
+                crate::io::regular_file_len(path)?;
+                seekable(path, raw.as_ref())?.is_none()
+            }
             (None, None) => true,
         })
     }
@@ -244,6 +248,18 @@ impl Job {
         Ok(f.sheet_axis)
     }
 
+    /// The grid and the sample type as every rank must see them (what
+    /// `super::mpi::agree_frame` compares): dims, grid-to-world matrix and type, not where the
+    /// samples are read from.
+    pub fn grid_description(&self) -> String {
+        let ty = match &self.source {
+            Source::Seekable { layout, .. } => format!("{:?}/{}", layout.ty, layout.big_endian),
+            Source::Whole { volume, .. } => format!("{}", Header::of(volume).ty),
+            Source::Elsewhere(h) => format!("{}", h.ty),
+        };
+        format!("{:?} {:?} {ty}", self.dims, self.grid().to_cols_array())
+    }
+
     /// The grid-to-world matrix.
     fn grid(&self) -> glam::Mat3 {
         match &self.source {
@@ -281,6 +297,8 @@ impl Job {
                         directions: *directions,
                         samples,
                         brick: Some(place),
+                        // Wide samples get the map all bricks agree on (`agreed_values`).
+                        values: crate::io::volume::ValueMap::IDENTITY,
                     },
                     bytes,
                 ))
@@ -306,12 +324,38 @@ impl Job {
         })
     }
 
-    /// The window every brick renders with: `--window`, or the default window of the whole
-    /// volume from every brick's [`WindowPart`] (the same range and sample one process takes,
-    /// so the same window).
-    pub fn window(&self, parts: Vec<WindowPart>) -> Result<[f32; 2], CliError> {
+    /// Whether the samples are wide (u32, i32, f64): their bricks must agree on one
+    /// [`ValueMap`](crate::io::volume::ValueMap) ([`Job::agreed_values`]).
+    pub fn is_wide(&self) -> bool {
+        match &self.source {
+            Source::Seekable { layout, .. } => crate::io::stream::is_wide(layout.ty),
+            Source::Whole { volume, .. } => !volume.values.is_identity() || volume.is_wide(),
+            Source::Elsewhere(h) => matches!(h.ty, 4 | 5 | 7),
+        }
+    }
+
+    /// The map every brick's values go through, from the whole volume's finite range in data
+    /// units (the union of the bricks' [`Volume::sample_range`]): what the volume loaded whole
+    /// gets ([`crate::io::volume::ValueMap::for_range`]).
+    pub fn agreed_values(&self, lo: f64, hi: f64) -> crate::io::volume::ValueMap {
+        if self.is_wide() {
+            crate::io::volume::ValueMap::for_range(lo, hi)
+        } else {
+            crate::io::volume::ValueMap::IDENTITY
+        }
+    }
+
+    /// The window every brick renders with, in the renderer's values (`values`, the map the
+    /// bricks agreed): `--window`, or the default window of the whole volume from every
+    /// brick's [`WindowPart`] (the same range and sample one process takes, so the same
+    /// window).
+    pub fn window(
+        &self,
+        parts: Vec<WindowPart>,
+        values: crate::io::volume::ValueMap,
+    ) -> Result<[f32; 2], CliError> {
         if let Some(w) = self.inputs.window {
-            return Ok(w);
+            return crate::pipeline::stages::window::check_given(w, values);
         }
         let range = parts
             .iter()
@@ -325,6 +369,7 @@ impl Job {
             ty: crate::io::volume::SampleType::F32,
             big_endian: false,
             pipe: None,
+            values: crate::io::volume::ValueMap::IDENTITY,
         };
         crate::pipeline::stages::window::default_window(
             &self.name,
@@ -346,11 +391,12 @@ impl Job {
     pub fn render(&self, brick: Volume, window: [f32; 2]) -> Result<BrickFrame, CliError> {
         let start = Instant::now();
         let mut inputs = self.inputs.clone();
+        // The window in data units, as a command line gives it (prepare maps it back).
+        inputs.window = Some(brick.values.window_to_data(window));
         inputs.memory = Some(InMemory {
             volume: Arc::new(brick),
             name: self.name.clone(),
         });
-        inputs.window = Some(window);
         let mut p = prepare(&(inputs, self.plan.clone()))?;
         let background = p.background_out.take();
         p.background = None;

@@ -201,20 +201,29 @@ fn balanced_node(
         return Ok(Node::Leaf(boxes.len() - 1));
     }
     let d = b.dims();
-    let axis = if d[sheet_axis] >= MIN_SHEETS * n {
-        sheet_axis
-    } else {
-        (0..3).rev().max_by_key(|&c| d[c]).unwrap_or(0)
-    };
-    if d[axis] < n {
+    if b.count() < n {
         return Err(CliError::input(format!(
             "{n} bricks do not fit a box of {}x{}x{} voxels (every brick needs a voxel): use \
              fewer ranks",
             d[0], d[1], d[2]
         )));
     }
-    let n1 = n / 2;
-    let at = b.lo[axis] + (d[axis] * n1 + n / 2) / n;
+    let axis = if d[sheet_axis] >= MIN_SHEETS * n {
+        sheet_axis
+    } else {
+        (0..3).rev().max_by_key(|&c| d[c]).unwrap_or(0)
+    };
+    let (at, n1) = if d[axis] >= n {
+        let n1 = n / 2;
+        (b.lo[axis] + (d[axis] * n1 + n / 2) / n, n1)
+    } else {
+        // Fewer voxels along the longest axis than bricks (4 or 8 bricks of a 2×2×2 volume):
+        // one slab of voxels along it takes as many bricks as it has voxels (at most n − 1),
+        // the rest the others. Each side has at least a voxel per brick, since the box has
+        // at least n voxels in all.
+        let area = b.count() / d[axis];
+        (b.lo[axis] + 1, area.min(n - 1))
+    };
     let (mut lo, mut hi) = (b, b);
     lo.hi[axis] = at;
     hi.lo[axis] = at;
@@ -321,6 +330,23 @@ mod tests {
         bad[0].hi[0] += 1;
         assert!(BrickLayout::from_boxes([17, 9, 11], bad).is_err());
         assert!(BrickLayout::balanced([2, 2, 1], 5, 2).is_err());
+        // Any count up to the voxels splits, however few voxels an axis has (the third
+        // campaign: 4 and 8 ranks on a 2×2×2 volume were refused, which --bricks 2,2,2 renders).
+        for (dims, most) in [
+            ([2, 2, 2], 8),
+            ([3, 2, 1], 6),
+            ([1, 1, 7], 7),
+            ([2, 3, 2], 12),
+        ] {
+            for n in 1..=most {
+                for axis in 0..3 {
+                    let l = BrickLayout::balanced(dims, n, axis).unwrap();
+                    assert_eq!(l.len(), n);
+                    tiles(&l);
+                }
+            }
+            assert!(BrickLayout::balanced(dims, most + 1, 2).is_err());
+        }
     }
 
     /// The order is a visibility order: checked against brute force, that no brick later in the

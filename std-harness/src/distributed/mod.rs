@@ -45,18 +45,31 @@ pub fn over(front: &mut [[f32; 4]], back: &[[f32; 4]]) {
 pub fn render_in_turn(job: &Job, layout: &BrickLayout) -> Result<Composited, CliError> {
     // One brick held at a time: a pass for the window's parts, then the bricks front to back,
     // each composited under what is in front of it as it comes (one image kept, not one each).
+    // Wide samples: one map for every brick, from the whole volume's range (a pass of its own).
+    let values = if job.is_wide() {
+        let mut range = (f64::INFINITY, f64::NEG_INFINITY);
+        for b in &layout.boxes {
+            let (lo, hi) = job.brick(*b)?.0.sample_range();
+            range = (range.0.min(lo), range.1.max(hi));
+        }
+        job.agreed_values(range.0, range.1)
+    } else {
+        crate::io::volume::ValueMap::IDENTITY
+    };
     let mut parts = Vec::with_capacity(layout.len());
     for b in &layout.boxes {
-        let (v, _) = job.brick(*b)?;
+        let (mut v, _) = job.brick(*b)?;
+        v.values = values;
         parts.extend(job.window_part(&v));
     }
-    let window = job.window(parts)?;
+    let window = job.window(parts, values)?;
     let order = layout.front_to_back(job.ray()?);
     let mut ranks = vec![RankStats::default(); layout.len()];
     let (mut acc, mut last) = (None::<Vec<[f32; 4]>>, None::<BrickFrame>);
     let mut composite = 0.0;
     for &n in &order {
-        let (v, bytes) = job.brick(layout.boxes[n])?;
+        let (mut v, bytes) = job.brick(layout.boxes[n])?;
+        v.values = values;
         let mut f = job.render(v, window)?;
         ranks[n] = RankStats {
             bytes_read: bytes,
@@ -84,17 +97,22 @@ pub fn render_in_turn(job: &Job, layout: &BrickLayout) -> Result<Composited, Cli
     }
     Ok(Composited {
         image,
-        window,
+        window: values.window_to_data(window),
         order,
         ranks,
     })
 }
 
+/// Most bricks `--bricks` renders in turn in one process: each is a whole frame rendered and
+/// composited (one voxel a brick of a 128³ volume took about 27 minutes before this cap).
+pub const MAX_BRICKS_IN_TURN: usize = 512;
+
 /// A composited frame and what each brick cost.
 pub struct Composited {
     /// Premultiplied RGBA at the output size, with the background under it.
     pub image: Vec<[f32; 4]>,
-    pub window: [f32; 2],
+    /// The window, in the data's units.
+    pub window: [f64; 2],
     /// The bricks front to back.
     pub order: Vec<usize>,
     /// Per brick (rank).
@@ -177,26 +195,35 @@ pub fn render_split(
         if let Some(universe) = self::mpi::init() {
             let world = universe.world();
             if world.size() > 1 {
-                // Refusals of the flags come out the same on every rank: each reports, none waits.
+                // Every step that can fail on one rank (its flags, its read, its render) is
+                // agreed by all before the next exchange (`mpi::agree`): a failure anywhere ends
+                // every rank with exit 2, each saying why, and none waits for one that has gone.
+                // The ranks must also agree on the frame before a byte is exchanged.
                 let job = self::mpi::job(&world, inputs, plan)?;
-                let layout = job.layout(world.size() as usize, bricks)?;
-                // A failure on one rank (its read, its render) would leave the others waiting in
-                // a collective: it says why and ends the whole job (MPI_Abort, exit code 2).
-                let c = match self::mpi::render(&world, &job, &layout) {
-                    Ok(Some(c)) => c,
-                    Ok(None) => return Ok(Some(None)),
-                    Err(e) => {
-                        crate::warn!("rank {} of {}: {e}", world.rank(), world.size());
-                        world.abort(2)
-                    }
-                };
-                return Ok(Some(Some(summary(&job, &layout, c, start, "mpi"))));
+                let layout = self::mpi::agree(
+                    &world,
+                    "splitting the volume",
+                    job.layout(world.size() as usize, bricks),
+                )?;
+                self::mpi::agree_frame(&world, &job, &layout)?;
+                return Ok(match self::mpi::render(&world, &job, &layout)? {
+                    Some(c) => Some(Some(summary(&job, &layout, c, start, "mpi"))),
+                    None => Some(None),
+                });
             }
         }
     }
     let Some(counts) = bricks else {
         return Ok(None);
     };
+    let n = counts.iter().fold(1usize, |a, &c| a.saturating_mul(c));
+    if n > MAX_BRICKS_IN_TURN {
+        return Err(CliError::input(format!(
+            "--bricks {},{},{} makes {n} bricks, each a whole frame rendered and composited in \
+             turn in this process: at most {MAX_BRICKS_IN_TURN} (under mpirun, one per rank)",
+            counts[0], counts[1], counts[2]
+        )));
+    }
     let job = Job::new(inputs, plan)?;
     let layout = job.layout(counts.iter().product(), Some(counts))?;
     let c = render_in_turn(&job, &layout)?;
@@ -226,7 +253,7 @@ fn summary(
         .arr_usize("size", &[job.inputs.size.0, job.inputs.size.1])
         .arr_usize("dims", &job.dims)
         .str("bricks_rendered", how)
-        .arr_f64("window", &[f64::from(c.window[0]), f64::from(c.window[1])])
+        .arr_f64("window", &c.window)
         .num("seconds", secs);
     let j = json(base, layout, &c);
     (c.image, j)

@@ -30,36 +30,147 @@ pub fn init() -> Option<mpi::environment::Universe> {
     mpi::initialize()
 }
 
+/// `result` as every rank agrees on it: `Ok` on every rank only where it is `Ok` on every rank.
+/// Otherwise each rank that failed keeps its own error and every other rank gets one naming the
+/// first rank that failed, so all of them leave the job together (none is left waiting in a
+/// collective for one that has gone: the third campaign's hang). `what` names the phase.
+/// A collective itself: every rank of `comm` must call it at the same point.
+pub fn agree<T>(
+    comm: &SimpleCommunicator,
+    what: &str,
+    result: Result<T, CliError>,
+) -> Result<T, CliError> {
+    // A rank that failed says why before the others can leave: once they do, mpirun ends the
+    // job, and a message still to be printed at exit would be lost.
+    let result = result.map_err(|e| {
+        use std::io::Write as _;
+        let mut err = std::io::stderr().lock();
+        let _ = writeln!(err, "footprint: {e}");
+        let _ = err.flush();
+        CliError { said: true, ..e }
+    });
+    let mine = if result.is_ok() {
+        i32::MAX
+    } else {
+        comm.rank()
+    };
+    let mut first = i32::MAX;
+    comm.all_reduce_into(&mine, &mut first, SystemOperation::min());
+    match result {
+        Ok(_) if first != i32::MAX => Err(CliError::input(format!(
+            "rank {first} of {} failed ({what}; its own message says why): every rank stops",
+            comm.size()
+        ))),
+        r => r,
+    }
+}
+
+/// Checks that every rank renders the same frame before a byte of volume or image is exchanged:
+/// the output size, the camera, the classification, the plan, the grid and sample type, and the
+/// bricks (a rank given other flags would otherwise send or expect buffers of another size).
+/// The description of each is hashed (FNV-1a, 64 bits) and the hashes all-gathered; a rank
+/// that differs is named on every rank. What only names the source (its path) may differ: ranks
+/// may read their own copies of one volume.
+pub fn agree_frame(
+    comm: &SimpleCommunicator,
+    job: &Job,
+    layout: &BrickLayout,
+) -> Result<(), CliError> {
+    let i = &job.inputs;
+    let description = format!(
+        "size {:?} view {:?} zoom {:?} matrix {:?} perspective {:?} eye {:?} tf {:?} window {:?} \
+         shading {:?} background {:?} gamma {:?} depth {} footprint {:?} absorption {:?} \
+         order {:?} supersample {:?} lod {:?} refine {} quality {} plan {:?} grid {} bricks {:?}",
+        i.size,
+        i.view,
+        i.zoom,
+        i.view_matrix,
+        i.perspective,
+        i.eye_distance,
+        i.tf,
+        i.window,
+        i.shading,
+        i.background,
+        i.gamma,
+        i.depth,
+        i.footprint,
+        i.absorption,
+        i.order,
+        i.supersample,
+        i.lod,
+        i.refine,
+        i.quality,
+        job.plan,
+        job.grid_description(),
+        layout.boxes,
+    );
+    let hash = description.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+    });
+    let mut all = vec![0u64; comm.size() as usize];
+    comm.all_gather_into(&hash, &mut all[..]);
+    match all.iter().position(|&h| h != all[0]) {
+        None => Ok(()),
+        Some(r) => Err(CliError::input(format!(
+            "the ranks were given different renders (rank {r} of {} differs from rank 0 in its \
+             size, view, classification, plan, grid or bricks): give every rank the same flags",
+            comm.size()
+        ))),
+    }
+}
+
 /// The job for `inputs` on this rank. A file read in part (raw samples at a known place) is
 /// opened by every rank; a volume that must be loaded whole (compressed, VTK, VTI, NIfTI, the
 /// built-in scene) is loaded by rank 0 alone, which broadcasts its grid ([`Header`]) and later
-/// sends each rank its brick ([`render`]). A failure to load on rank 0 ends the job
-/// (`MPI_Abort`): the others would wait for the grid.
+/// sends each rank its brick ([`render`]). Every step that can fail is agreed ([`agree`]) before
+/// the next collective, so a rank that cannot read its volume ends every rank's job with exit 2.
 pub fn job(
     comm: &SimpleCommunicator,
     inputs: &crate::plan::Inputs,
     plan: &crate::plan::Plan,
 ) -> Result<Job, CliError> {
-    if !Job::loads_whole(inputs)? {
-        return Job::new(inputs, plan);
+    let whole = agree(comm, "opening the volume", Job::loads_whole(inputs))?;
+    // Every rank must take the same path below: a volume one rank loads whole and another
+    // reads in part would leave them in different collectives.
+    let mut wholes = [0i32; 2];
+    comm.all_reduce_into(&i32::from(whole), &mut wholes[0], SystemOperation::min());
+    comm.all_reduce_into(&i32::from(whole), &mut wholes[1], SystemOperation::max());
+    if wholes[0] != wholes[1] {
+        // A rank that would load the volume whole may be one that cannot read it as the others
+        // do (an NRRD whose data file is missing): its own reason says more than the mismatch.
+        let mismatch = CliError::input(
+            "the ranks were given volumes of different kinds (a raw file one reads in part, \
+             another loads whole): give every rank the same volume",
+        );
+        return Err(match whole.then(|| Job::new(inputs, plan)) {
+            Some(Err(e)) => e,
+            _ => mismatch,
+        });
     }
-    super::job::check(inputs, plan)?;
+    if !whole {
+        return agree(comm, "opening the volume", Job::new(inputs, plan));
+    }
+    agree(comm, "checking the flags", super::job::check(inputs, plan))?;
     let root = comm.process_at_rank(0);
     let mut header = [0.0f64; 16];
-    if comm.rank() == 0 {
-        let job = Job::new(inputs, plan).unwrap_or_else(|e| {
-            crate::warn!("rank 0 of {}: {e}", comm.size());
-            comm.abort(2)
-        });
+    let loaded = if comm.rank() == 0 {
+        Job::new(inputs, plan).map(Some)
+    } else {
+        Ok(None)
+    };
+    let loaded = agree(comm, "loading the volume on rank 0", loaded)?;
+    if let Some(job) = &loaded {
         let From::Whole { volume, .. } = &job.source else {
             unreachable!("loads_whole said whole")
         };
         header = Header::of(volume).to_f64s();
-        root.broadcast_into(&mut header[..]);
-        return Ok(job);
     }
     root.broadcast_into(&mut header[..]);
-    Job::remote(inputs, plan, Header::from_f64s(&header))
+    let job = match loaded {
+        Some(job) => Ok(job),
+        None => Job::remote(inputs, plan, Header::from_f64s(&header)),
+    };
+    agree(comm, "opening the volume", job)
 }
 
 /// This rank's share of `job` split by `layout` (one brick per rank): reads its brick (or gets
@@ -72,17 +183,22 @@ pub fn render(
 ) -> Result<Option<Composited>, CliError> {
     let rank = comm.rank() as usize;
     let (brick, bytes) = match &job.source {
-        From::Seekable { .. } => job.brick(layout.boxes[rank])?,
+        From::Seekable { .. } => agree(comm, "reading a brick", job.brick(layout.boxes[rank]))?,
         From::Whole { .. } if comm.size() > 1 && rank == 0 => {
-            // Rank 0 holds the volume: each other rank's brick is cut and sent in turn.
+            // Rank 0 holds the volume: each other rank's brick is cut and sent in turn. A cut
+            // that fails (memory) while the others wait to receive ends the job (MPI_Abort).
             for (r, b) in layout.boxes.iter().enumerate().skip(1) {
-                let (v, _) = job.brick(*b)?;
+                let (v, _) = job.brick(*b).unwrap_or_else(|e| {
+                    crate::warn!("rank 0 of {}: {e}", comm.size());
+                    comm.abort(2)
+                });
                 send_samples(&comm.process_at_rank(r as i32), &v.samples);
             }
-            job.brick(layout.boxes[0])?
+            agree(comm, "cutting the bricks", job.brick(layout.boxes[0]))?
         }
-        From::Whole { .. } => job.brick(layout.boxes[rank])?,
+        From::Whole { .. } => agree(comm, "reading a brick", job.brick(layout.boxes[rank]))?,
         From::Elsewhere(h) => {
+            // As many samples of the agreed type as the agreed brick holds: what rank 0 sends.
             let place = BrickPlace::around(layout.boxes[rank], job.dims);
             let samples = receive_samples(&comm.process_at_rank(0), h.ty, place.stored.count());
             let volume = Volume {
@@ -91,8 +207,10 @@ pub fn render(
                 directions: h.directions,
                 samples,
                 brick: Some(place),
+                // Set from the whole volume's range with the others' (`render_brick`).
+                values: crate::io::volume::ValueMap::IDENTITY,
             };
-            (volume, 0)
+            agree(comm, "cutting the bricks", Ok((volume, 0)))?
         }
     };
     render_brick(comm, job, layout, brick, bytes)
@@ -179,6 +297,7 @@ pub fn render_in_situ(
         directions: crate::io::volume::AXIS_ALIGNED,
         samples,
         brick: Some(BrickPlace { stored, owned }),
+        values: crate::io::volume::ValueMap::IDENTITY,
     };
     inputs.memory = Some(crate::io::stream::InMemory {
         volume: std::sync::Arc::new(volume.clone()),
@@ -219,12 +338,26 @@ fn render_brick(
     comm: &SimpleCommunicator,
     job: &Job,
     layout: &BrickLayout,
-    brick: Volume,
+    mut brick: Volume,
     bytes: u64,
 ) -> Result<Option<Composited>, CliError> {
-    let window = agree_window(comm, job, &brick)?;
-    let mut frame = job.render(brick, window)?;
-    let order = layout.front_to_back(job.ray()?);
+    // Wide samples: every rank maps its brick as the volume loaded whole would be mapped, from
+    // the whole volume's range (all-reduced in f64).
+    brick.values = if job.is_wide() {
+        let (lo, hi) = brick.sample_range();
+        let (mut all_lo, mut all_hi) = (0.0f64, 0.0f64);
+        comm.all_reduce_into(&lo, &mut all_lo, SystemOperation::min());
+        comm.all_reduce_into(&hi, &mut all_hi, SystemOperation::max());
+        job.agreed_values(all_lo, all_hi)
+    } else {
+        crate::io::volume::ValueMap::IDENTITY
+    };
+    let values = brick.values;
+    let window = agree(comm, "the window", agree_window(comm, job, &brick))?;
+    let rendered = job
+        .render(brick, window)
+        .and_then(|frame| Ok((frame, layout.front_to_back(job.ray()?))));
+    let (mut frame, order) = agree(comm, "rendering a brick", rendered)?;
     // Every rank's render done: the composite time that follows is compositing, not waiting.
     comm.barrier();
     let start = Instant::now();
@@ -257,7 +390,7 @@ fn render_brick(
         .collect();
     Ok(Some(Composited {
         image,
-        window,
+        window: values.window_to_data(window),
         order,
         ranks,
     }))
@@ -271,7 +404,7 @@ fn agree_window(
     brick: &Volume,
 ) -> Result<[f32; 2], CliError> {
     let Some(part) = job.window_part(brick) else {
-        return job.window(Vec::new());
+        return job.window(Vec::new(), brick.values);
     };
     let (mut lo, mut hi) = (0.0f32, 0.0f32);
     comm.all_reduce_into(&part.range.0, &mut lo, SystemOperation::min());
@@ -293,10 +426,13 @@ fn agree_window(
         let mut part_mut = PartitionMut::new(&mut sample[..], &counts[..], &displs[..]);
         comm.all_gather_varcount_into(&part.sample[..], &mut part_mut);
     }
-    job.window(vec![super::WindowPart {
-        range: (lo, hi),
-        sample,
-    }])
+    job.window(
+        vec![super::WindowPart {
+            range: (lo, hi),
+            sample,
+        }],
+        brick.values,
+    )
 }
 
 /// Composites every rank's `image` in the front-to-back `order` of ranks by binary swap (with a

@@ -78,6 +78,8 @@ pub fn crop(volume: &Volume, place: BrickPlace) -> Result<Volume, CliError> {
         directions: volume.directions,
         samples,
         brick: Some(place),
+        // The whole volume's: a brick's values are the volume's.
+        values: volume.values,
     })
 }
 
@@ -146,6 +148,7 @@ mod tests {
             dims,
             ty: super::super::volume::SampleType::U16,
             big_endian: false,
+            values: super::super::volume::ValueMap::IDENTITY,
         };
         let whole = Volume::new(dims, [1.0; 3], Samples::U16(data.into()));
         for owned in [

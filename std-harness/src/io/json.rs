@@ -38,6 +38,10 @@ impl Json {
     pub fn num(self, key: &str, v: f64) -> Self {
         self.push(key, number(v))
     }
+    /// A `null` field (a value that does not exist, such as the window of data render refuses).
+    pub fn null(self, key: &str) -> Self {
+        self.push(key, Value::Null)
+    }
     /// A boolean field.
     pub fn bool(self, key: &str, v: bool) -> Self {
         self.push(key, Value::from(v))

@@ -10,6 +10,8 @@ pub mod outputs;
 pub mod progress;
 pub mod stream;
 pub mod table;
+pub mod temporaries;
+pub mod values;
 pub mod volume;
 
 use crate::CliError;

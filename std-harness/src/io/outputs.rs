@@ -20,17 +20,22 @@
 //! data file, a `--tf` file; through symbolic or hard links alike): [`check`] refuses the inputs
 //! its command names, and [`write_all`] every file read since (`crate::io::is_input`).
 //!
-//! **Names.** The temporary is `.NAME.tmp-PID`; where that would pass a file name's 255 bytes,
-//! `NAME` is cut and a hash of the whole name added (`.PREFIX~HASH.tmp-PID`), so any name the
-//! file system takes can be written. A file-size limit (`ulimit -f`) makes the write fail with
-//! an error instead of killing the process ([`ignore_file_size_signal`]), so the temporary is
-//! removed as after any failed write.
+//! **Temporaries.** An output is written to `.NAME.tmp-PID.RANDOM` beside it, created
+//! exclusively (`O_EXCL`: never through a link, never over an existing file) under a name no one
+//! can predict ([`super::temporaries`]); where `.NAME.tmp-` would pass a file name's 255 bytes,
+//! `NAME` is cut and a hash of the whole name added (`.PREFIX~HASH.tmp-`), so any name the file
+//! system takes can be written. A file-size limit (`ulimit -f`) makes the write fail with an
+//! error instead of killing the process ([`ignore_file_size_signal`]), so the temporary is
+//! removed as after any failed write; SIGINT, SIGTERM and SIGHUP remove it before the process
+//! ends ([`super::temporaries::remove_on_signals`]).
 //!
 //! **After SIGKILL.** A kill between a temporary's creation and its rename leaves
 //! the temporary beside the output (never a partial `NAME`). The next run that writes `NAME`
-//! removes such leftovers ([`clean_leftovers`]): those whose process no longer runs (on Linux,
-//! no `/proc/PID`), or, where that cannot be told, that are more than a day old.
+//! removes such leftovers ([`clean_leftovers`]): regular files (never a link) whose process no
+//! longer runs (on Linux, no `/proc/PID`), or, where that cannot be told, that are more than a
+//! day old.
 
+use super::temporaries::Temporary;
 use crate::CliError;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -81,8 +86,8 @@ const NAME_MAX: usize = 255;
 /// prefix could pass [`NAME_MAX`], `.PREFIX~HASH.tmp-` with `NAME` cut on a character boundary
 /// and the FNV-1a hash of the whole name (see the module docs).
 fn temporary_prefix(name: &str) -> String {
-    // Room for the PID (at most 10 digits) after the prefix.
-    const PID: usize = 10;
+    // Room after the prefix for the PID (at most 10 digits), a dot and 8 random characters.
+    const PID: usize = 10 + 1 + 8;
     let plain = format!(".{name}.tmp-");
     if plain.len() + PID <= NAME_MAX {
         return plain;
@@ -98,16 +103,13 @@ fn temporary_prefix(name: &str) -> String {
     format!(".{}{tail}", &name[..cut])
 }
 
-/// The temporary name `path` is written under before its rename.
-fn temporary(path: &Path) -> Result<PathBuf, CliError> {
+/// A new temporary beside `path`, the name `path` is written under before its rename (see the
+/// module docs).
+fn temporary(path: &Path) -> Result<Temporary, std::io::Error> {
     let name = path
         .file_name()
-        .ok_or_else(|| CliError::input(format!("{}: not a file name", path.display())))?;
-    Ok(folder(path).join(format!(
-        "{}{}",
-        temporary_prefix(&name.to_string_lossy()),
-        std::process::id()
-    )))
+        .ok_or_else(|| std::io::Error::new(std::io::ErrorKind::InvalidInput, "not a file name"))?;
+    Temporary::create(folder(path), &temporary_prefix(&name.to_string_lossy()))
 }
 
 /// Makes a write past the file-size limit (`ulimit -f`) fail with an error (EFBIG) instead of
@@ -136,13 +138,16 @@ pub fn clean_leftovers(path: &Path) -> usize {
     let mut removed = 0;
     for e in entries.flatten() {
         let file = e.file_name().to_string_lossy().into_owned();
+        // `.NAME.tmp-PID.RANDOM` (and `.NAME.tmp-PID`, as runs before 2026-12-06 named them).
         let Some(pid) = file
             .strip_prefix(&prefix)
+            .and_then(|p| p.split('.').next())
             .and_then(|p| p.parse::<u32>().ok())
         else {
             continue;
         };
-        if pid == own {
+        // Only what a run of ours can have left: a regular file (a link is never one).
+        if pid == own || !e.file_type().is_ok_and(|t| t.is_file()) {
             continue;
         }
         let stale = if proc_fs {
@@ -204,16 +209,13 @@ pub fn check(outputs: &[Planned<'_>]) -> Result<(), CliError> {
                 dir.display()
             )));
         } else {
-            // Probe: the same temporary name the write will use, created and removed.
-            let tmp = temporary(o.path)?;
-            std::fs::File::create(&tmp)
-                .and_then(|_| std::fs::remove_file(&tmp))
-                .map_err(|e| {
-                    CliError::input(format!(
-                        "{flag} {shown}: cannot write in {}: {e}",
-                        dir.display()
-                    ))
-                })?;
+            // Probe: a temporary as the write will make one, created and removed.
+            temporary(o.path).map(drop).map_err(|e| {
+                CliError::input(format!(
+                    "{flag} {shown}: cannot write in {}: {e}",
+                    dir.display()
+                ))
+            })?;
         }
         for other in &outputs[..i] {
             if same_file(other.path, o.path) {
@@ -243,64 +245,136 @@ pub fn write_all<B: AsRef<[u8]>>(files: &[(&Path, B)]) -> Result<(), CliError> {
             path.display()
         )));
     }
-    let mut written: Vec<(PathBuf, &Path)> = Vec::with_capacity(files.len());
-    let cleanup = |written: &[(PathBuf, &Path)]| {
-        for (tmp, _) in written {
-            let _ = std::fs::remove_file(tmp);
-        }
-    };
+    // Each temporary is removed when dropped: on any early return below, none stays.
+    let mut written: Vec<(Temporary, &Path)> = Vec::with_capacity(files.len());
     for (path, bytes) in files.iter().filter(|(p, _)| !is_special(p)) {
         let (path, bytes) = (*path, bytes.as_ref());
-        let tmp = match temporary(path) {
-            Ok(t) => t,
+        let result = temporary(path).and_then(|mut tmp| {
+            tmp.file().write_all(bytes)?;
+            tmp.file().sync_all()?;
+            Ok(tmp)
+        });
+        match result {
+            Ok(tmp) => written.push((tmp, path)),
             Err(e) => {
-                cleanup(&written);
-                return Err(e);
+                return Err(CliError::input(format!(
+                    "{}: cannot write: {e} (no output written)",
+                    path.display()
+                )))
             }
-        };
-        let result = (|| {
-            let mut f = std::fs::File::create(&tmp)?;
-            f.write_all(bytes)?;
-            f.sync_all()
-        })();
-        if let Err(e) = result {
-            let _ = std::fs::remove_file(&tmp);
-            cleanup(&written);
-            return Err(CliError::input(format!(
-                "{}: cannot write: {e} (no output written)",
-                path.display()
-            )));
         }
-        written.push((tmp, path));
     }
     for (path, bytes) in files.iter().filter(|(p, _)| is_special(p)) {
-        let result = std::fs::OpenOptions::new()
-            .write(true)
-            .open(path)
-            .and_then(|mut f| f.write_all(bytes.as_ref()).and_then(|()| f.flush()));
+        let result = write_in_place(path, bytes.as_ref());
         if let Err(e) = result {
-            cleanup(&written);
             return Err(CliError::input(format!(
                 "{}: cannot write: {e} (no file output written)",
                 path.display()
             )));
         }
     }
-    for (k, (tmp, path)) in written.iter().enumerate() {
-        if let Err(e) = std::fs::rename(tmp, path) {
-            cleanup(&written[k..]);
-            return Err(CliError::input(format!(
-                "{}: cannot write: {e}",
-                path.display()
-            )));
-        }
+    for (tmp, path) in written {
+        tmp.persist(path)
+            .map_err(|e| CliError::input(format!("{}: cannot write: {e}", path.display())))?;
     }
     Ok(())
+}
+
+/// Writes `bytes` into a device or pipe that is already there (see the module docs): opened
+/// without creating or truncating, and refused if what was opened turns out to be a regular file
+/// (swapped in since it was looked at).
+fn write_in_place(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let mut f = std::fs::OpenOptions::new().write(true).open(path)?;
+    if f.metadata()?.is_file() {
+        return Err(std::io::Error::other(
+            "became a regular file since it was checked",
+        ));
+    }
+    f.write_all(bytes)?;
+    f.flush()
 }
 
 /// Writes one file atomically (temporary beside it, then rename).
 pub fn write_one(path: &Path, bytes: &[u8]) -> Result<(), CliError> {
     write_all(&[(path, bytes)])
+}
+
+/// Files a command writes into one folder (`chart --out DIR`), all at the end, all or nothing:
+/// gathered in memory as the work goes, then written by [`write_all`]. A folder that does not
+/// exist is created only then, and removed again (with any folder created above it) if a write
+/// fails or a signal ends the process first ([`super::temporaries::Folder`]).
+pub struct Batch {
+    dir: PathBuf,
+    files: Vec<(PathBuf, Vec<u8>)>,
+}
+
+impl Batch {
+    /// A batch for `dir`, checked before any work: `dir` is a folder, or does not exist and its
+    /// nearest existing ancestor is a folder this process can write in.
+    pub fn new(flag: &str, dir: &Path) -> Result<Batch, CliError> {
+        let shown = dir.display();
+        let mut at = dir;
+        while !at.exists() {
+            match at.parent() {
+                Some(p) if !p.as_os_str().is_empty() => at = p,
+                _ => {
+                    at = Path::new(".");
+                    break;
+                }
+            }
+        }
+        if !at.is_dir() {
+            return Err(CliError::input(format!(
+                "{flag} {shown}: {} is not a directory",
+                at.display()
+            )));
+        }
+        Temporary::create(at, ".footprint-probe.tmp-")
+            .map(drop)
+            .map_err(|e| {
+                CliError::input(format!(
+                    "{flag} {shown}: cannot write in {}: {e}",
+                    at.display()
+                ))
+            })?;
+        Ok(Batch {
+            dir: dir.to_path_buf(),
+            files: Vec::new(),
+        })
+    }
+
+    /// Adds `DIR/name`.
+    pub fn add(&mut self, name: &str, bytes: impl Into<Vec<u8>>) {
+        self.files.push((self.dir.join(name), bytes.into()));
+    }
+
+    /// The folder.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// Writes every file added (see the type's docs).
+    pub fn commit(self) -> Result<(), CliError> {
+        let created = if self.dir.is_dir() {
+            None
+        } else {
+            Some(
+                super::temporaries::Folder::create_all(&self.dir).map_err(|e| {
+                    CliError::input(format!("{}: cannot create: {e}", self.dir.display()))
+                })?,
+            )
+        };
+        let files: Vec<(&Path, &[u8])> = self
+            .files
+            .iter()
+            .map(|(p, b)| (p.as_path(), b.as_slice()))
+            .collect();
+        write_all(&files)?;
+        if let Some(folder) = created {
+            folder.done();
+        }
+        Ok(())
+    }
 }
 
 /// [`check`] for the usual pair: a colour image (`--out`, `.png` or `.pfm`) and a JSON summary

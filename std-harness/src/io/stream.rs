@@ -2,7 +2,7 @@
 //! a few sheets at a time, and a pipe read in file order. File and pipe keep memory bounded by a
 //! few sheets whatever the volume's size.
 
-use crate::io::volume::{SampleType, Volume};
+use crate::io::volume::{SampleType, ValueMap, Volume};
 use crate::CliError;
 use footprint::lod::Coloured;
 use footprint::render::RenderError;
@@ -17,18 +17,37 @@ impl From<RenderError> for CliError {
     }
 }
 
-/// Decodes `bytes` (a whole number of samples of `ty`) into f32s.
-pub fn decode_into(bytes: &[u8], ty: SampleType, big_endian: bool, out: &mut [f32]) {
+/// Decodes `bytes` (a whole number of samples of `ty`) into f32s, wide samples (u32, i32, f64)
+/// through `values` ([`ValueMap`], in f64; the identity leaves every value as `as f32` makes it).
+pub fn decode_into(
+    bytes: &[u8],
+    ty: SampleType,
+    big_endian: bool,
+    values: ValueMap,
+    out: &mut [f32],
+) {
+    decode_with(bytes, ty, big_endian, out, |x| values.apply(x));
+}
+
+/// Decodes `bytes` (a whole number of samples of `ty`), each sample exactly as f64, into `out`
+/// through `to`.
+fn decode_with<O>(
+    bytes: &[u8],
+    ty: SampleType,
+    big_endian: bool,
+    out: &mut [O],
+    to: impl Fn(f64) -> O,
+) {
     macro_rules! conv {
         ($t:ty) => {{
             const N: usize = std::mem::size_of::<$t>();
             for (o, c) in out.iter_mut().zip(bytes.chunks_exact(N)) {
                 let a: [u8; N] = c.try_into().expect("chunk of N bytes");
-                *o = (if big_endian {
+                *o = to(f64::from(if big_endian {
                     <$t>::from_be_bytes(a)
                 } else {
                     <$t>::from_le_bytes(a)
-                }) as f32;
+                }));
             }
         }};
     }
@@ -42,6 +61,12 @@ pub fn decode_into(bytes: &[u8], ty: SampleType, big_endian: bool, out: &mut [f3
         SampleType::F32 => conv!(f32),
         SampleType::F64 => conv!(f64),
     }
+}
+
+/// Whether samples of `ty` may need a [`ValueMap`] other than the identity (f32 does not hold
+/// every u32, i32 or f64).
+pub fn is_wide(ty: SampleType) -> bool {
+    matches!(ty, SampleType::U32 | SampleType::I32 | SampleType::F64)
 }
 
 /// A volume already in memory.
@@ -84,6 +109,9 @@ pub struct Layout {
     pub dims: [usize; 3],
     pub ty: SampleType,
     pub big_endian: bool,
+    /// How the samples become the renderer's values ([`ValueMap`]; the identity but for wide
+    /// samples, set from the range pass or the window: `pipeline::stages::load`).
+    pub values: ValueMap,
 }
 
 /// Budget for the file source's sheet cache, bytes.
@@ -149,10 +177,11 @@ impl FileSource {
     /// Loads sheets [first, first + count) of `axis` into the cache.
     fn fill(&mut self, axis: usize, first: usize, count: usize) -> Result<(), CliError> {
         let [nx, ny, nz] = self.layout.dims;
-        let (ty, be, size) = (
+        let (ty, be, size, values) = (
             self.layout.ty,
             self.layout.big_endian,
             self.layout.ty.size(),
+            self.layout.values,
         );
         let (a, b) = footprint::geometry::in_sheet_axes(axis);
         let (na, nb) = (self.layout.dims[a], self.layout.dims[b]);
@@ -163,7 +192,7 @@ impl FileSource {
                 // z-slices are contiguous: one read for the chunk.
                 self.read_at((first * nx * ny * size) as u64, count * nx * ny * size)?;
                 let bytes = std::mem::take(&mut self.bytes);
-                decode_into(&bytes, ty, be, &mut self.cache);
+                decode_into(&bytes, ty, be, values, &mut self.cache);
                 self.bytes = bytes;
             }
             1 => {
@@ -172,7 +201,7 @@ impl FileSource {
                 let mut row = super::try_filled(count * nx, 0.0f32, "rows of the volume")?;
                 for k in 0..nz {
                     self.read_at(((k * ny + first) * nx * size) as u64, count * nx * size)?;
-                    decode_into(&self.bytes, ty, be, &mut row);
+                    decode_into(&self.bytes, ty, be, values, &mut row);
                     for s in 0..count {
                         self.cache[s * len + k * nx..s * len + (k + 1) * nx]
                             .copy_from_slice(&row[s * nx..(s + 1) * nx]);
@@ -185,7 +214,7 @@ impl FileSource {
                 let mut slice = super::try_filled(nx * ny, 0.0f32, "a z-slice of the volume")?;
                 for k in 0..nz {
                     self.read_at((k * nx * ny * size) as u64, nx * ny * size)?;
-                    decode_into(&self.bytes, ty, be, &mut slice);
+                    decode_into(&self.bytes, ty, be, values, &mut slice);
                     for j in 0..ny {
                         for s in 0..count {
                             self.cache[s * len + k * ny + j] = slice[j * nx + first + s];
@@ -242,6 +271,7 @@ pub struct PipeSource<R: Read> {
     dims: [usize; 3],
     ty: SampleType,
     big_endian: bool,
+    values: ValueMap,
     next: usize,
     bytes: Vec<u8>,
     /// `bytes` hold z-slice `next`, read by [`PipeSource::prime`].
@@ -250,18 +280,25 @@ pub struct PipeSource<R: Read> {
 }
 
 impl<R: Read> PipeSource<R> {
-    /// A source of `dims` samples of `ty` read from `reader`, z-slice after z-slice.
+    /// A source of `dims` samples of `ty` read from `reader`, z-slice after z-slice (identity
+    /// values: [`PipeSource::with_values`]).
     pub fn new(reader: R, dims: [usize; 3], ty: SampleType, big_endian: bool, name: &str) -> Self {
         PipeSource {
             reader,
             dims,
             ty,
             big_endian,
+            values: ValueMap::IDENTITY,
             next: 0,
             bytes: Vec::new(),
             primed: false,
             name: name.into(),
         }
+    }
+
+    /// The same source with wide samples mapped through `values`.
+    pub fn with_values(self, values: ValueMap) -> Self {
+        PipeSource { values, ..self }
     }
 
     /// Reads the next z-slice's bytes now (before any sheet buffer exists): a stream that ends
@@ -322,7 +359,7 @@ impl<R: Read> SheetSource for PipeSource<R> {
             )));
         }
         self.prime()?;
-        decode_into(&self.bytes, self.ty, self.big_endian, out);
+        decode_into(&self.bytes, self.ty, self.big_endian, self.values, out);
         self.primed = false;
         self.next += 1;
         Ok(())
@@ -334,23 +371,31 @@ impl<R: Read> SheetSource for PipeSource<R> {
 }
 
 /// Smallest and largest finite sample of a streamed file, read sequentially in chunks of at most
-/// 4 MiB (however large a sheet is: a 32768² slice costs no more than a small one).
+/// 4 MiB (however large a sheet is: a 32768² slice costs no more than a small one), as values
+/// through `layout.values`.
 pub fn file_range(layout: &Layout) -> Result<(f32, f32), CliError> {
-    file_summary(layout).map(|(range, _)| range)
+    file_summary(layout).map(|(range, _, _)| range)
 }
+
+/// What [`file_summary`] finds: the finite range and the strided sample, as values, and the map
+/// that makes them values.
+pub type FileSummary = ((f32, f32), Vec<f32>, ValueMap);
 
 /// [`file_range`] and, in the same pass, the finite values at every
 /// [`sample_stride`](crate::io::volume::sample_stride)th index, ascending: the same sample as
 /// [`Volume::strided_sample`](crate::io::volume::Volume::strided_sample) of the file loaded whole.
-pub fn file_summary(layout: &Layout) -> Result<((f32, f32), Vec<f32>), CliError> {
+/// The pass is made in f64; the map wide samples need is decided from its range
+/// ([`ValueMap::for_range`], what the file loaded whole would get) and returned third, and the
+/// range and sample are given through it.
+pub fn file_summary(layout: &Layout) -> Result<FileSummary, CliError> {
     let src = FileSource::open(layout.clone())?;
     let size = layout.ty.size();
     let total = crate::io::volume::byte_len(layout.dims, layout.ty)
         .map_err(|e| crate::io::volume::at(&layout.path, e))?;
     let per = (RANGE_CHUNK_BYTES / size).max(1);
     let mut bytes = super::try_filled(per * size, 0u8, "the range pass's chunk")?;
-    let mut values = super::try_filled(per, 0.0f32, "the range pass's chunk")?;
-    let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+    let mut values = super::try_filled(per, 0.0f64, "the range pass's chunk")?;
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     let mut done = 0usize;
     let step = crate::io::volume::sample_stride(total / size);
     let mut sample = Vec::new();
@@ -359,11 +404,12 @@ pub fn file_summary(layout: &Layout) -> Result<((f32, f32), Vec<f32>), CliError>
         src.file
             .read_exact_at(&mut bytes[..n], layout.offset + done as u64)
             .map_err(|e| CliError::input(format!("{}: read failed: {e}", layout.path.display())))?;
-        decode_into(
+        decode_with(
             &bytes[..n],
             layout.ty,
             layout.big_endian,
             &mut values[..n / size],
+            |x| x,
         );
         let first = done / size;
         for (i, &v) in values[..n / size].iter().enumerate() {
@@ -377,8 +423,19 @@ pub fn file_summary(layout: &Layout) -> Result<((f32, f32), Vec<f32>), CliError>
         }
         done += n;
     }
+    let map = if is_wide(layout.ty) {
+        ValueMap::for_range(lo, hi)
+    } else {
+        ValueMap::IDENTITY
+    };
+    let mut sample: Vec<f32> = sample.into_iter().map(|v| map.apply(v)).collect();
     sample.sort_by(f32::total_cmp);
-    Ok(((lo, hi), sample))
+    let range = if lo <= hi {
+        (map.apply(lo), map.apply(hi))
+    } else {
+        (f32::INFINITY, f32::NEG_INFINITY)
+    };
+    Ok((range, sample, map))
 }
 
 /// The most bytes [`file_range`] reads at a time (4 MiB).

@@ -8,6 +8,8 @@ use crate::CliError;
 use footprint::lod::Coloured;
 use std::path::Path;
 
+pub use super::values::ValueMap;
+
 /// Sample storage, by type.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Samples {
@@ -150,6 +152,10 @@ pub struct Volume {
     /// [`BrickPlace::owned`] are rendered. Sheets read from it are the whole volume's, NaN
     /// (missing, transparent) outside the stored box.
     pub brick: Option<BrickPlace>,
+    /// How samples become the renderer's f32 values ([`ValueMap`]): the identity unless wide
+    /// samples need rebasing ([`ValueMap::for_samples`], set by the loaders and
+    /// [`Volume::new`]).
+    pub values: ValueMap,
 }
 
 /// The identity orientation.
@@ -162,6 +168,7 @@ impl Volume {
             dims,
             spacing,
             directions: AXIS_ALIGNED,
+            values: ValueMap::for_samples(&samples),
             samples,
             brick: None,
         }
@@ -202,10 +209,10 @@ impl Volume {
             Samples::I8(v) => f32::from(v[n]),
             Samples::U16(v) => f32::from(v[n]),
             Samples::I16(v) => f32::from(v[n]),
-            Samples::U32(v) => v[n] as f32,
-            Samples::I32(v) => v[n] as f32,
+            Samples::U32(v) => self.values.apply(f64::from(v[n])),
+            Samples::I32(v) => self.values.apply(f64::from(v[n])),
             Samples::F32(v) => v[n],
-            Samples::F64(v) => v[n] as f32,
+            Samples::F64(v) => self.values.apply(v[n]),
             Samples::Coloured(v) => v[n].value,
         }
     }
@@ -270,28 +277,11 @@ impl Volume {
     /// Smallest and largest finite sample (of those stored, for a brick); (+∞, −∞) when no
     /// sample is finite.
     pub fn range(&self) -> (f32, f32) {
-        // One loop per sample type (the type settled once, not per sample).
-        fn over<T: Copy>(v: &[T], to: impl Fn(T) -> f32) -> (f32, f32) {
-            v.iter()
-                .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &x| {
-                    let v = to(x);
-                    if v.is_finite() {
-                        (lo.min(v), hi.max(v))
-                    } else {
-                        (lo, hi)
-                    }
-                })
-        }
-        match &self.samples {
-            Samples::U8(v) => over(v, f32::from),
-            Samples::I8(v) => over(v, f32::from),
-            Samples::U16(v) => over(v, f32::from),
-            Samples::I16(v) => over(v, f32::from),
-            Samples::U32(v) => over(v, |x| x as f32),
-            Samples::I32(v) => over(v, |x| x as f32),
-            Samples::F32(v) => over(v, |x| x),
-            Samples::F64(v) => over(v, |x| x as f32),
-            Samples::Coloured(v) => over(v, |x| x.value),
+        // The values' range is the samples' mapped: the map is monotone, and keeps every
+        // finite sample finite (`ValueMap::for_range`).
+        match self.sample_range() {
+            (lo, hi) if lo <= hi => (self.values.apply(lo), self.values.apply(hi)),
+            _ => (f32::INFINITY, f32::NEG_INFINITY),
         }
     }
 
@@ -318,7 +308,7 @@ impl Volume {
         to: impl Fn(f32) -> O,
     ) {
         match self.brick {
-            None => copy_as(&self.samples, self.dims, axis, sheets, out, to),
+            None => copy_as(&self.samples, self.values, self.dims, axis, sheets, out, to),
             Some(b) => self.brick_sheets_as(b, axis, sheets, out, to),
         }
     }
@@ -344,7 +334,15 @@ impl Volume {
                 continue;
             }
             let local = s - b.stored.lo[axis];
-            copy_as(&self.samples, sd, axis, local..local + 1, &mut part, &to);
+            copy_as(
+                &self.samples,
+                self.values,
+                sd,
+                axis,
+                local..local + 1,
+                &mut part,
+                &to,
+            );
             for (v, row) in part.chunks_exact_mut(sd[a]).enumerate() {
                 let start = (b.stored.lo[c] + v) * na + b.stored.lo[a];
                 sheet[start..start + sd[a]].swap_with_slice(row);
@@ -371,9 +369,11 @@ impl Volume {
 }
 
 /// Sheets `sheets` of `axis` of `samples` laid out with `dims`, one after another into `out`,
-/// each sample's value (as f32) through `to` (the one per-type copy behind every sheet read).
+/// each sample's value (as f32, wide samples through `values`) through `to` (the one per-type
+/// copy behind every sheet read).
 fn copy_as<O>(
     samples: &Samples,
+    values: ValueMap,
     d: [usize; 3],
     a: usize,
     s: std::ops::Range<usize>,
@@ -386,10 +386,10 @@ fn copy_as<O>(
         Samples::I8(v) => copy_sheets(v, d, a, s, out, |x| to(f32::from(x))),
         Samples::U16(v) => copy_sheets(v, d, a, s, out, |x| to(f32::from(x))),
         Samples::I16(v) => copy_sheets(v, d, a, s, out, |x| to(f32::from(x))),
-        Samples::U32(v) => copy_sheets(v, d, a, s, out, |x| to(x as f32)),
-        Samples::I32(v) => copy_sheets(v, d, a, s, out, |x| to(x as f32)),
+        Samples::U32(v) => copy_sheets(v, d, a, s, out, |x| to(values.apply(f64::from(x)))),
+        Samples::I32(v) => copy_sheets(v, d, a, s, out, |x| to(values.apply(f64::from(x)))),
         Samples::F32(v) => copy_sheets(v, d, a, s, out, &to),
-        Samples::F64(v) => copy_sheets(v, d, a, s, out, |x| to(x as f32)),
+        Samples::F64(v) => copy_sheets(v, d, a, s, out, |x| to(values.apply(x))),
         Samples::Coloured(v) => copy_sheets(v, d, a, s, out, |x| to(x.value)),
     }
 }
@@ -510,7 +510,7 @@ pub fn sample_stride(n: usize) -> usize {
 
 #[cfg(test)]
 mod tests {
-    use super::{Samples, Volume};
+    use super::{Samples, ValueMap, Volume};
 
     /// `range` gives, for every sample type, the smallest and largest finite value as f32, the
     /// same as reading each sample through `value`.
@@ -543,11 +543,21 @@ mod tests {
                 ),
                 (-2.5, 0.5),
             ),
+            // 1e300 is past f32's range: the samples are rebased (not made infinite, so
+            // missing, as the third hostile campaign found), and the range is the values'.
             (
                 vol(
                     Samples::F64(vec![1e300, 3.0, f64::NEG_INFINITY, 1.5].into()),
                     4,
                 ),
+                {
+                    let m = ValueMap::for_range(1.5, 1e300);
+                    assert!(!m.is_identity());
+                    (m.apply(1.5), m.apply(1e300))
+                },
+            ),
+            (
+                vol(Samples::F64(vec![3.0, f64::NEG_INFINITY, 1.5].into()), 3),
                 (1.5, 3.0),
             ),
             (

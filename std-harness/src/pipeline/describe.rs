@@ -33,7 +33,7 @@ pub fn describe(p: &Prepared, args: &Inputs, plan: &Plan) -> Json {
         .bool("streamed", p.volume().is_none())
         .str("shading", &args.shading)
         .str("tf", &p.tf_name)
-        .arr_f64("window", &p.window.map(f64::from))
+        .arr_f64("window", &p.data_window())
         .str("sheet_axis", ["i", "j", "k"][f.sheet_axis])
         .str("slicing", plan.slicing())
         .str("classification", plan.classification())

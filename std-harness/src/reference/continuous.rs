@@ -118,12 +118,7 @@ fn march(
     // Grid steps to world: G = ((G⁻ᵀ)⁻¹)ᵀ.
     let grid = f.grid_inverse_transpose.as_dmat3().inverse().transpose();
     let camera = f.camera().copied();
-    let lo = DVec3::splat(-field.extent());
-    let hi = DVec3::new(
-        (f.dims[0] - 1) as f64 + field.extent(),
-        (f.dims[1] - 1) as f64 + field.extent(),
-        (f.dims[2] - 1) as f64 + field.extent(),
-    );
+    let (lo, hi) = field.bounds();
     let threads = scene.threads.max(1);
     let count = rays.count(f);
     let mut image = vec![[0.0f64; 4]; count];

@@ -12,7 +12,8 @@
 //!   has opacity α per world unit and premultiplied colour, marched as [α, αr, αg, αb] (light
 //!   keeps (1 − α)^dl). This is what ray casters such as VTK's compute (they interpolate
 //!   gradients the same way). Samples only exist inside the voxel box (the grid's own extent:
-//!   nothing is extrapolated past its faces); a NaN value is a missing sample (weight zero) and a
+//!   nothing is extrapolated past its faces; along an axis one voxel thick, that voxel's cell,
+//!   one grid step deep); a NaN value is a missing sample (weight zero) and a
 //!   sample whose weights are all missing is transparent.
 
 use super::sparse::SparseGrid;
@@ -231,12 +232,24 @@ impl<'s> Field<'s> {
         })
     }
 
-    /// How far past the voxel box the field reaches, grid steps: the reconstruction's reach for
-    /// pre-classified voxels, none for post-classification (samples only inside the grid).
-    pub(super) fn extent(&self) -> f64 {
+    /// Where the field can be non-zero, grid coordinates (lowest, highest per axis): the voxel
+    /// box grown by the reconstruction's reach for pre-classified voxels; for
+    /// post-classification the box samples exist in, the grid's own extent (one grid step deep,
+    /// the voxel's cell, along an axis one voxel thick: `footprint::render::post::sample_box`,
+    /// which the renderer uses too).
+    pub(super) fn bounds(&self) -> (DVec3, DVec3) {
         match self.model {
-            Model::Pre(_) => self.reach,
-            Model::Post => 0.0,
+            Model::Pre(_) => (
+                DVec3::splat(-self.reach),
+                DVec3::from_array(self.dims.map(|d| (d - 1) as f64 + self.reach)),
+            ),
+            Model::Post => {
+                let (lo, hi) = footprint::render::post::sample_box(self.dims);
+                (
+                    DVec3::from_array(lo.map(f64::from)),
+                    DVec3::from_array(hi.map(f64::from)),
+                )
+            }
         }
     }
 

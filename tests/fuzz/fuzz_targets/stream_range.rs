@@ -1,11 +1,13 @@
 #![no_main]
 //! Fuzz target: a streamed file's data path. The first bytes choose the sample type, byte order,
-//! dimensions (1 to 8 each) and offset; the rest is the file. The range pass (`file_range`, in
-//! chunks) finds the smallest and largest finite sample that decoding the whole file finds, and
-//! the file source delivers every sheet along every axis as the decoded volume holds it; a file
-//! too short for its layout is refused in one line.
+//! dimensions (1 to 8 each) and offset; the rest is the file. The range pass (`file_summary`, in
+//! chunks, in f64) finds the value map wide samples need and, through it, the smallest and
+//! largest finite value that decoding the whole file with that map finds; the file source with
+//! that map delivers every sheet along every axis as the decoded volume holds it; a file too
+//! short for its layout is refused in one line.
 use footprint::source::SheetSource;
-use footprint_harness::io::stream::{decode_into, file_range, FileSource, Layout};
+use footprint_harness::io::stream::{decode_into, file_summary, FileSource, Layout};
+use footprint_harness::io::volume::ValueMap;
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
@@ -18,26 +20,27 @@ fuzz_target!(|data: &[u8]| {
     let offset = u64::from(head[4] % 16);
     let path = footprint_fuzz::scratch().join("stream_range.raw");
     std::fs::write(&path, body).expect("scratch file");
-    let layout = Layout {
+    let mut layout = Layout {
         path,
         offset,
         dims,
         ty,
         big_endian,
+        values: ValueMap::IDENTITY,
     };
     let n = dims.iter().product::<usize>();
     let need = n * ty.size();
     let fits = offset as usize + need <= body.len();
-    let range = file_range(&layout);
-    let Ok((lo, hi)) = range else {
-        let e = range.unwrap_err().to_string();
+    let summary = file_summary(&layout);
+    let Ok(((lo, hi), _, values)) = summary else {
+        let e = summary.unwrap_err().to_string();
         assert!(!fits, "a file that holds its layout is read: {e}");
         assert!(!e.contains('\n'));
         return;
     };
     assert!(fits, "a short file is refused");
     let mut all = vec![0.0f32; n];
-    decode_into(&body[offset as usize..][..need], ty, big_endian, &mut all);
+    decode_into(&body[offset as usize..][..need], ty, big_endian, values, &mut all);
     let finite = all.iter().copied().filter(|v| v.is_finite());
     let want = finite.fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), v| {
         (a.min(v), b.max(v))
@@ -46,6 +49,7 @@ fuzz_target!(|data: &[u8]| {
         (lo.to_bits(), hi.to_bits()),
         (want.0.to_bits(), want.1.to_bits())
     );
+    layout.values = values;
     let mut src = FileSource::open(layout).expect("the layout fits");
     let [nx, ny, _] = dims;
     let at = |i: usize, j: usize, k: usize| all[i + nx * (j + ny * k)];

@@ -27,8 +27,9 @@
 //! α_L = 1 − (1 − α)^L, colour the shaded straight colour × α_L. This is the midpoint rule of
 //! the post-classified emission–absorption integral with step L (what ray casters compute),
 //! second order in L. Samples exist only inside the voxel box (grid coordinates in
-//! [0, dims − 1] on every axis, as the continuous reference): a slab that the ray leaves or enters
-//! inside it is held over the part of its chord inside the box.
+//! [0, dims − 1] on every axis, as the continuous reference; [−½, ½] along an axis one voxel
+//! thick, [`sample_box`]): a slab that the ray leaves or enters inside it is held over the
+//! part of its chord inside the box.
 //!
 //! Front to back, a pixel whose opacity has reached exactly one is not classified again (exact,
 //! not a threshold). A sample whose value is at or below the classifier's transparent bound is not
@@ -62,7 +63,9 @@ use glam::Vec3;
 mod setup;
 
 use setup::{cell_of, pixels_of_cell};
-pub use setup::{Classify, PostSetup, ShadedLayers, WeightTable, MAX_VALUE_SCALE, WEIGHT_NODES};
+pub use setup::{
+    sample_box, Classify, PostSetup, ShadedLayers, WeightTable, MAX_VALUE_SCALE, WEIGHT_NODES,
+};
 
 /// One voxel to splat: where it lands, its value and its world gradient.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -139,22 +139,54 @@ pub struct PostSetup {
     /// Screen (pixels, depth) → grid coordinates: g = to_grid·(s − origin).
     to_grid: Mat3,
     origin: Vec3,
-    /// Largest grid coordinate per axis (dims − 1).
+    /// The sample box per axis, grid coordinates: [0, dims − 1], or [−½, ½] along an axis one
+    /// voxel thick (see [`sample_box`]).
+    bottom: [f32; 3],
     top: [f32; 3],
+    /// Largest grid index per axis (dims − 1).
+    last: [usize; 3],
+}
+
+/// Where post-classified samples exist along each axis of a grid of `dims` voxels, grid
+/// coordinates: the voxel centres' extent [0, dims − 1], except along an axis one voxel thick,
+/// where that extent has no depth: there the box is the voxel's own cell, [−½, ½], one grid step
+/// deep, as deep as two voxels' extent (and as much as a pre-classified voxel's footprint
+/// integrates). The continuous reference uses the same box.
+pub fn sample_box(dims: [usize; 3]) -> ([f32; 3], [f32; 3]) {
+    let thin = |d: usize| d <= 1;
+    (
+        dims.map(|d| if thin(d) { -0.5 } else { 0.0 }),
+        dims.map(|d| if thin(d) { 0.5 } else { (d - 1) as f32 }),
+    )
 }
 
 impl PostSetup {
     /// Slabs `thickness` smallest grid spacings thick for `frame` (orthographic), `kernel` a
     /// Gaussian, values at the image's size. Errors as [`SlabSetup::new`].
+    ///
+    /// Slabs must be thinner than the sample box is deep along the view
+    /// ([`SlabError::ThickerThanVolume`]): slabs are cut from the box's centre, so then the two
+    /// mid-planes beside the centre lie inside the box's depth range.
     pub fn new(frame: &FrameSetup, kernel: &Kernel, thickness: f32) -> Result<Self, SlabError> {
         let slab = SlabSetup::new(frame, kernel, thickness)?;
+        let (bottom, top) = sample_box(frame.dims);
+        let z = frame.grid_to_screen.row(2);
+        let depth: f32 = (0..3).map(|a| z[a].abs() * (top[a] - bottom[a])).sum();
+        if !(slab.thickness < depth) {
+            return Err(SlabError::ThickerThanVolume {
+                thickness,
+                depth: depth / slab.thickness * thickness,
+            });
+        }
         Ok(PostSetup {
             full: slab,
             low: slab,
             scale: 1,
             to_grid: frame.grid_to_screen.inverse(),
             origin: frame.origin,
-            top: frame.dims.map(|d| (d - 1) as f32),
+            bottom: sample_box(frame.dims).0,
+            top: sample_box(frame.dims).1,
+            last: frame.dims.map(|d| d.saturating_sub(1)),
         })
     }
 
@@ -228,14 +260,14 @@ impl PostSetup {
         // Depth offsets from the slab's front, in [0, t], where every grid coordinate is in range.
         let (mut lo, mut hi) = (0.0f32, t);
         for a in 0..3 {
-            let (g, da, top) = (g0[a], d[a], self.top[a]);
+            let (g, da, bottom, top) = (g0[a], d[a], self.bottom[a], self.top[a]);
             if da.abs() < 1e-12 {
-                if !(g >= 0.0 && g <= top) {
+                if !(g >= bottom && g <= top) {
                     return (0.0, [0; 3]);
                 }
                 continue;
             }
-            let (u, v) = ((0.0 - g) / da, (top - g) / da);
+            let (u, v) = ((bottom - g) / da, (top - g) / da);
             lo = lo.max(u.min(v));
             hi = hi.min(u.max(v));
         }
@@ -243,7 +275,7 @@ impl PostSetup {
         let mid = g0 + d * (0.5 * t);
         // Rounded to the nearest voxel: the coordinate is at least −½ here, so truncation of
         // the non-negative value + ½ rounds.
-        let near = |a: usize| ((mid[a] + 0.5).max(0.0) as usize).min(self.top[a] as usize);
+        let near = |a: usize| ((mid[a] + 0.5).max(0.0) as usize).min(self.last[a]);
         (fraction.min(1.0), [near(0), near(1), near(2)])
     }
 }

@@ -29,7 +29,7 @@ pub struct VerifyArgs {
     /// Exit with code 1 if the PSNR is below this, dB: against the continuous integral with
     /// `--reference continuous` (of the finer sampling with `--reference field`); against full resolution (the f64 reference of level 0) when a
     /// coarser level was rendered; else the overall figure against the same sheets.
-    #[arg(long)]
+    #[arg(long, value_parser = crate::args::parse_finite_f64, allow_hyphen_values = true)]
     pub min_psnr: Option<f64>,
     /// Also write the reference render here (`.png` or `.pfm`, as `--out`): the reference
     /// `--reference` chose.

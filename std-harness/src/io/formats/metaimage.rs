@@ -228,11 +228,13 @@ pub fn load(path: &Path) -> Result<Volume, CliError> {
             ))
         })?
     };
+    let samples = decode(&body, h.ty, h.big_endian).map_err(err)?;
     Ok(Volume {
         dims: h.dims,
         spacing: h.spacing,
         directions: h.directions,
-        samples: decode(&body, h.ty, h.big_endian).map_err(err)?,
+        values: crate::io::volume::ValueMap::for_samples(&samples),
+        samples,
         brick: None,
     })
 }

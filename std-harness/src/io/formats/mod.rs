@@ -128,6 +128,7 @@ pub fn raw_data_at(path: &Path, h: RawHeader<'_>) -> Result<Streamable, CliError
         dims,
         ty,
         big_endian,
+        values: crate::io::volume::ValueMap::IDENTITY,
     };
     Ok(Streamable {
         layout,

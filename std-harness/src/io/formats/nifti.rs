@@ -501,6 +501,7 @@ pub fn load(path: &Path) -> Result<Volume, CliError> {
         dims: h.dims,
         spacing: h.spacing,
         directions: h.directions,
+        values: crate::io::volume::ValueMap::for_samples(&samples),
         samples,
         brick: None,
     })

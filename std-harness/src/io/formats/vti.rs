@@ -495,6 +495,7 @@ pub fn load(path: &Path, array: Option<&str>) -> Result<Volume, CliError> {
         dims: h.dims,
         spacing: h.spacing,
         directions: h.directions,
+        values: crate::io::volume::ValueMap::for_samples(&samples),
         samples,
         brick: None,
     })

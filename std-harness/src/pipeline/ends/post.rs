@@ -15,8 +15,11 @@
 //!    thread count); each thread owns a band of image rows and walks the slabs in that order, splatting
 //!    the voxels that enter at each slab, then classifying and compositing it.
 //!
-//! **Memory.** 28 bytes per kept voxel (grid index, value, gradient) and 36 per frame (its
-//! [`PostVoxel`] and first slab); per band a ring of slab accumulators of 20 bytes per pixel.
+//! **Memory.** Finding the voxels takes a bit per voxel and a few planes of distances
+//! (`near_visible`); keeping them, 28 bytes per kept voxel (grid index, value, gradient),
+//! refused with a reason past the visible lists' budget before any is kept, and 36 per frame
+//! (its [`PostVoxel`] and first slab); per band a ring of slab accumulators of 20 bytes per
+//! pixel. Every one of these is asked of memory fallibly: a refusal is an error, never an abort.
 //! A streamed volume is refused (an oblique slab crosses every sheet), as are fixed-point
 //! accumulation and colour-carrying levels of detail (their colours are pre-classified).
 
@@ -148,7 +151,6 @@ fn post_samples(
 ) -> Result<PostSamples, CliError> {
     let f = &p.frame;
     let dims = f.dims;
-    let n: usize = dims.iter().product();
     let shader = p.shader();
     let clear = shader.transparent_at_or_below();
     let needs_gradient = shader.shading.needs_gradient();
@@ -158,22 +160,10 @@ fn post_samples(
         let i = f.grid_index(s, u, v);
         (i[2] * dims[1] + i[1]) * dims[0] + i[0]
     };
-    // The visible mask, then its dilation.
-    let mut mask = crate::io::try_filled(n, false, "the post-classification mask")?;
-    let mut sheet = vec![0.0f32; len];
-    for s in 0..f.sheet_count() {
-        volume.sheet_into(axis, s, &mut sheet);
-        for v in 0..nb {
-            for u in 0..na {
-                // NaN compares false: missing, not visible.
-                if sheet[v * na + u] > clear {
-                    mask[grid(s, u, v)] = true;
-                }
-            }
-        }
-    }
-    dilate(&mut mask, dims, 2.0 * p.kernel.spread());
-    let count = mask.iter().filter(|&&m| m).count();
+    // The voxels near a visible value, one bit each (no full-volume distance map: the third
+    // campaign's abort).
+    let near = near_visible(volume, clear, 2.0 * p.kernel.spread())?;
+    let count = near.count;
     if count.saturating_mul(BYTES_PER_SAMPLE) > budget {
         return Err(CliError::input(format!(
             "{}: --classification post keeps the {count} voxels near visible values in memory \
@@ -201,7 +191,7 @@ fn post_samples(
         for v in 0..nb {
             for u in 0..na {
                 let value = window.current[v * na + u];
-                if !mask[grid(s, u, v)] || !value.is_finite() {
+                if !near.get(grid(s, u, v)) || !value.is_finite() {
                     continue;
                 }
                 let g = if needs_gradient {
@@ -230,43 +220,102 @@ fn post_samples(
     Ok(out)
 }
 
-/// Keeps the cells of `mask` whose Euclidean distance to a set cell (in grid steps) is below
-/// `reach`: the squared distance transform of Felzenszwalb and Huttenlocher (2012), one exact
-/// pass of lower envelopes of parabolas per axis.
-fn dilate(mask: &mut [bool], dims: [usize; 3], reach: f32) {
-    const FAR: f32 = 1e20;
-    let mut d: Vec<f32> = mask.iter().map(|&m| if m { 0.0 } else { FAR }).collect();
-    let stride = [1, dims[0], dims[0] * dims[1]];
-    let n = dims.iter().copied().max().unwrap_or(0);
-    let (mut f, mut out, mut v, mut z) = (
-        vec![0.0f32; n],
-        vec![0.0f32; n],
-        vec![0usize; n],
-        vec![0.0f32; n + 1],
-    );
-    for a in 0..3 {
-        let (o1, o2) = ((a + 1) % 3, (a + 2) % 3);
-        let len = dims[a];
-        for j in 0..dims[o2] {
-            for i in 0..dims[o1] {
-                let base = i * stride[o1] + j * stride[o2];
-                for (k, fk) in f[..len].iter_mut().enumerate() {
-                    *fk = d[base + k * stride[a]];
-                }
-                envelope(&f[..len], &mut out[..len], &mut v, &mut z);
-                for (k, o) in out[..len].iter().enumerate() {
-                    d[base + k * stride[a]] = *o;
-                }
-            }
-        }
-    }
-    let r2 = reach * reach;
-    for (m, dist) in mask.iter_mut().zip(&d) {
-        *m = *dist < r2;
+/// One bit per voxel (x fastest): the voxels [`near_visible`] keeps, and how many.
+struct Near {
+    bits: Vec<u64>,
+    count: usize,
+}
+
+impl Near {
+    fn get(&self, i: usize) -> bool {
+        self.bits[i / 64] >> (i % 64) & 1 == 1
     }
 }
 
-/// `out[p]` = min over q of (p − q)² + f[q] over the sites with f[q] below [`dilate`]'s FAR (FAR
+/// The voxels whose Euclidean distance (in grid steps) to a voxel valued above `clear` (NaN never
+/// is) is below `reach`, in bounded memory: a bit per voxel and a window of planes.
+///
+/// Each z-slice's squared in-plane distance to its visible voxels is exact (the distance transform
+/// of Felzenszwalb and Huttenlocher (2012): one pass of lower envelopes of parabolas along x, one
+/// along y), and the squared distance in 3-D is the least of dz² plus the in-plane distance of
+/// the slice dz away. Only |dz| < `reach` can give less than `reach`², so the slices are held
+/// in a ring of 2⌈reach⌉ − 1 planes, and each slice's bits are set once the planes up to
+/// ⌈reach⌉ − 1 beyond it are in. Memory: n/8 bytes and the ring (4 bytes a voxel of a plane).
+fn near_visible(
+    volume: &crate::io::volume::Volume,
+    clear: f32,
+    reach: f32,
+) -> Result<Near, CliError> {
+    const FAR: f32 = 1e20;
+    let [nx, ny, nz] = volume.dims;
+    let (plane, n) = (nx * ny, nx * ny * nz);
+    let mut bits = crate::io::try_filled(n.div_ceil(64), 0u64, "the post-classification mask")?;
+    if !(reach > 0.0) {
+        return Ok(Near { bits, count: 0 });
+    }
+    let r2 = reach * reach;
+    // |dz| ≤ dz_max ⇔ dz² < reach².
+    let dz_max = ((reach.ceil() as usize).saturating_sub(1)).min(nz);
+    let width = 2 * dz_max + 1;
+    let mut ring = crate::io::try_filled(
+        width.saturating_mul(plane),
+        FAR,
+        "the post-classification distance planes",
+    )?;
+    let mut sheet = vec![0.0f32; plane];
+    let m = nx.max(ny);
+    let (mut f, mut out, mut v, mut z) = (
+        vec![0.0f32; m],
+        vec![0.0f32; m],
+        vec![0usize; m],
+        vec![0.0f32; m + 1],
+    );
+    let mut count = 0;
+    // Slice `k` in, then slice `k − dz_max` out (its window complete).
+    for k in 0..nz + dz_max {
+        if k < nz {
+            volume.sheet_into(2, k, &mut sheet);
+            let d = &mut ring[(k % width) * plane..][..plane];
+            for (di, &s) in d.iter_mut().zip(&sheet) {
+                *di = if s > clear { 0.0 } else { FAR };
+            }
+            for row in d.chunks_exact_mut(nx) {
+                f[..nx].copy_from_slice(row);
+                envelope(&f[..nx], &mut out[..nx], &mut v, &mut z);
+                row.copy_from_slice(&out[..nx]);
+            }
+            for x in 0..nx {
+                for y in 0..ny {
+                    f[y] = d[y * nx + x];
+                }
+                envelope(&f[..ny], &mut out[..ny], &mut v, &mut z);
+                for y in 0..ny {
+                    d[y * nx + x] = out[y];
+                }
+            }
+        }
+        let Some(at) = k.checked_sub(dz_max) else {
+            continue;
+        };
+        let (lo, hi) = (at.saturating_sub(dz_max), (at + dz_max).min(nz - 1));
+        for i in 0..plane {
+            let least = (lo..=hi)
+                .map(|s| {
+                    let dz = s.abs_diff(at) as f32;
+                    dz * dz + ring[(s % width) * plane + i]
+                })
+                .fold(FAR, f32::min);
+            if least < r2 {
+                let g = at * plane + i;
+                bits[g / 64] |= 1 << (g % 64);
+                count += 1;
+            }
+        }
+    }
+    Ok(Near { bits, count })
+}
+
+/// `out[p]` = min over q of (p − q)² + f[q] over the sites with f[q] below [`near_visible`]'s FAR (FAR
 /// where there are none): the lower envelope of the parabolas rooted at the sites; `v` and `z`
 /// are scratch of at least `f.len()` (+1) entries.
 fn envelope(f: &[f32], out: &mut [f32], v: &mut [usize], z: &mut [f32]) {
@@ -398,6 +447,7 @@ fn render_band(
     )?;
     let mut phases = Phases::default();
     for k in 0..slabs.slab_count() {
+        crate::cancel::check()?;
         let t0 = Instant::now();
         for v in &sv.voxels[sv.starts[k]..sv.starts[k + 1]] {
             if reaches(v) {
@@ -414,32 +464,53 @@ fn render_band(
 
 #[cfg(test)]
 mod tests {
+    use crate::io::volume::{Samples, Volume};
+
+    /// The kept voxels are exactly those whose Euclidean distance to a visible one is below the
+    /// reach (brute force over every voxel), for reaches below, at and past whole steps and
+    /// volumes thinner than the window (one voxel along z, and along every axis).
     #[test]
-    fn dilation_is_the_euclidean_distance_below_the_reach() {
-        let dims = [9usize, 7, 6];
-        let n = dims.iter().product::<usize>();
-        let set = [(1usize, 1usize, 1usize), (7, 5, 4), (4, 0, 5)];
-        let mut mask = vec![false; n];
-        for &(x, y, z) in &set {
-            mask[(z * dims[1] + y) * dims[0] + x] = true;
-        }
-        for reach in [0.5f32, 1.0, 2.3, 3.2] {
-            let mut m = mask.clone();
-            super::dilate(&mut m, dims, reach);
-            for z in 0..dims[2] {
-                for y in 0..dims[1] {
-                    for x in 0..dims[0] {
-                        let d2 = set
-                            .iter()
-                            .map(|&(a, b, c)| {
-                                let d = |p: usize, q: usize| (p as f32 - q as f32).powi(2);
-                                d(x, a) + d(y, b) + d(z, c)
-                            })
-                            .fold(f32::INFINITY, f32::min);
-                        let got = m[(z * dims[1] + y) * dims[0] + x];
-                        assert_eq!(got, d2 < reach * reach, "({x},{y},{z}) reach {reach}");
+    fn near_visible_is_the_euclidean_distance_below_the_reach() {
+        for (dims, set) in [
+            (
+                [9usize, 7, 6],
+                vec![(1usize, 1usize, 1usize), (7, 5, 4), (4, 0, 5)],
+            ),
+            ([5, 4, 1], vec![(2, 1, 0)]),
+            ([1, 1, 1], vec![(0, 0, 0)]),
+            ([3, 1, 8], vec![(0, 0, 7), (2, 0, 0)]),
+            ([6, 6, 6], vec![]),
+        ] {
+            let n = dims.iter().product::<usize>();
+            let mut values = vec![0.0f32; n];
+            for &(x, y, z) in &set {
+                values[(z * dims[1] + y) * dims[0] + x] = 1.0;
+            }
+            let volume = Volume::new(dims, [1.0; 3], Samples::F32(values.into()));
+            for reach in [0.5f32, 1.0, 2.0, 2.3, 3.2, 7.5] {
+                let near = super::near_visible(&volume, 0.5, reach).unwrap();
+                let mut count = 0;
+                for z in 0..dims[2] {
+                    for y in 0..dims[1] {
+                        for x in 0..dims[0] {
+                            let d2 = set
+                                .iter()
+                                .map(|&(a, b, c)| {
+                                    let d = |p: usize, q: usize| (p as f32 - q as f32).powi(2);
+                                    d(x, a) + d(y, b) + d(z, c)
+                                })
+                                .fold(f32::INFINITY, f32::min);
+                            let got = near.get((z * dims[1] + y) * dims[0] + x);
+                            assert_eq!(
+                                got,
+                                d2 < reach * reach,
+                                "{dims:?} ({x},{y},{z}) reach {reach}"
+                            );
+                            count += usize::from(got);
+                        }
                     }
                 }
+                assert_eq!(near.count, count);
             }
         }
     }

@@ -369,6 +369,7 @@ fn run_sheets<P: Precision>(
             ty,
             big_endian,
             pipe,
+            values,
         } => {
             let (reader, name): (Box<dyn std::io::Read>, _) = match pipe {
                 Some(pipe) => (
@@ -385,7 +386,8 @@ fn run_sheets<P: Precision>(
                 *ty,
                 *big_endian,
                 name,
-            );
+            )
+            .with_values(*values);
             src.prime()?;
             Some(src)
         }
@@ -497,6 +499,7 @@ impl<S: SheetSource<Error = CliError>, F: FnMut(usize, usize)> SheetSource for R
         index: usize,
         out: &mut [S::Sample],
     ) -> Result<(), CliError> {
+        crate::cancel::check()?;
         self.source.read_sheet(axis, index, out)?;
         let p = &mut *self.progress;
         p.done += 1;

@@ -390,6 +390,7 @@ fn render_band(
         .collect();
     let span = key_span(p.order, setup);
     for k in 0..setup.slab_count() {
+        crate::cancel::check()?;
         let t0 = Instant::now();
         // Each chunk's list is in key order, so its voxels of step k come next, key by key.
         for j in k * span..(k + 1) * span {

@@ -375,6 +375,7 @@ where
     }
     let mut phases = Phases::default();
     for k in 0..f.sheet_count() {
+        crate::cancel::check()?;
         let s = f.sheet_at(p.order, k);
         let t0 = Instant::now();
         renderer.splat_visible_sheet(s, lists.sheet(s)?)?;

@@ -3,6 +3,7 @@
 
 use crate::io::formats::{self, raw::RawOptions};
 use crate::io::stream::{file_summary, is_stdin, Layout, Pipe};
+use crate::io::volume::ValueMap;
 use crate::io::volume::{SampleType, Volume};
 use crate::plan::Inputs;
 use crate::{io, scene, CliError};
@@ -24,7 +25,31 @@ pub enum Voxels {
         big_endian: bool,
         /// What to read instead of standard input (`Inputs::stdin`).
         pipe: Option<Pipe>,
+        /// How wide samples become values: from the window a pipe must be given
+        /// ([`stream_values`]).
+        values: ValueMap,
     },
+}
+
+impl Voxels {
+    /// How the samples become the renderer's values ([`ValueMap`]), whatever carries them.
+    pub fn values(&self) -> ValueMap {
+        match self {
+            Voxels::Memory(v) => v.values,
+            Voxels::File(layout) => layout.values,
+            Voxels::Stdin { values, .. } => *values,
+        }
+    }
+}
+
+/// The map of a stream of `ty` samples that is read once, without a range pass: the identity,
+/// or for wide samples (u32, i32, f64) the one [`ValueMap::for_range`] gives the window `window`
+/// (data units), so the window's arithmetic is kept in f64.
+pub fn stream_values(ty: SampleType, window: Option<[f64; 2]>) -> ValueMap {
+    match window {
+        Some([lo, hi]) if crate::io::stream::is_wide(ty) => ValueMap::for_range(lo, hi),
+        _ => ValueMap::IDENTITY,
+    }
 }
 
 /// The raw-file options from `--dims`, `--type`, `--endian`, `--spacing`, if `--dims` was given.
@@ -172,6 +197,7 @@ fn load_stream(
             ty: o.ty,
             big_endian: o.big_endian,
             pipe: args.stdin.clone(),
+            values: stream_values(o.ty, args.window),
         };
         return Ok(Loaded {
             voxels,
@@ -183,16 +209,20 @@ fn load_stream(
         });
     }
     let formats::Streamable {
-        layout,
+        mut layout,
         spacing,
         directions,
     } = raw_layout(stream, raw.as_ref())?;
     let col = |c: usize| Vec3::from_array(directions[c]) * spacing[c];
     let grid = Mat3::from_cols(col(0), col(1), col(2));
+    // Wide samples get the map the file loaded whole would get (from the range pass), or,
+    // with --window (no range pass), the window's.
     let (range, sample) = if args.window.is_none() {
-        let (range, sample) = file_summary(&layout)?;
+        let (range, sample, values) = file_summary(&layout)?;
+        layout.values = values;
         (Some(range), Some(sample))
     } else {
+        layout.values = stream_values(layout.ty, args.window);
         (None, None)
     };
     Ok(Loaded {
@@ -223,6 +253,7 @@ pub(crate) fn raw_layout(
                 dims: o.dims,
                 ty: o.ty,
                 big_endian: o.big_endian,
+                values: crate::io::volume::ValueMap::IDENTITY,
             },
             spacing: o.spacing,
             directions: crate::io::volume::AXIS_ALIGNED,

@@ -9,6 +9,8 @@
 
 use super::load::{load_background, load_voxels, Loaded, Voxels};
 use super::supersample;
+pub use super::window::outside_data_warnings;
+use super::window::values_shading;
 use crate::args::Lod;
 use crate::io::volume::Volume;
 use crate::plan::Plan;
@@ -44,33 +46,6 @@ pub fn parse_shading(s: &str, min_spacing: f32) -> Result<Shading, CliError> {
     })
 }
 
-/// The warnings for an iso value outside the data's range `[lo, hi]` (no surface can show) and
-/// for a `--window` that misses that range entirely (every voxel maps to one end of the transfer
-/// function). `prepare` prints them (`footprint: warning: …`) and goes on.
-pub fn outside_data_warnings(
-    shading: &Shading,
-    window: Option<[f32; 2]>,
-    (lo, hi): (f32, f32),
-) -> Vec<String> {
-    let mut out = Vec::new();
-    if let Shading::Iso { value, .. } = shading {
-        if !(*value >= lo && *value <= hi) {
-            out.push(format!(
-                "iso value {value} lies outside the data's range [{lo}, {hi}]: no surface will show"
-            ));
-        }
-    }
-    if let Some([a, b]) = window {
-        if b < lo || a > hi {
-            out.push(format!(
-                "--window {a},{b} lies outside the data's range [{lo}, {hi}]: every voxel maps to \
-                 one end of the transfer function"
-            ));
-        }
-    }
-    out
-}
-
 /// A render, set up and ready to run: the volume, the frame, the shading. A clone shares the
 /// volume in memory.
 #[derive(Clone)]
@@ -87,6 +62,8 @@ pub struct Prepared {
     pub level: u32,
     pub frame: FrameSetup,
     pub lut: Vec<[f32; 4]>,
+    /// The window in the renderer's values (the data's through `voxels.values()`: the data's
+    /// own units but for rebased wide samples; [`Prepared::data_window`] gives it in those).
     pub window: [f32; 2],
     pub shading: Shading,
     pub tf_name: String,
@@ -107,6 +84,12 @@ pub struct Prepared {
 }
 
 impl Prepared {
+    /// The window in the data's own units (as `--window` takes it and the JSON and the legend
+    /// report it).
+    pub fn data_window(&self) -> [f64; 2] {
+        self.voxels.values().window_to_data(self.window)
+    }
+
     /// The same volume, transfer function and shading seen with `args`' view (`--view`, `--zoom`,
     /// `--view-matrix`, `--size`): only the frame is set up again, nothing is loaded. The
     /// compositing order and the level of detail stay as prepared.
@@ -454,22 +437,22 @@ pub fn prepare_as_asked(args: &Inputs) -> Result<Prepared, CliError> {
     let order = compositing_order(args, &voxels, &frame)?;
     let tf_name = tf_name(args);
     let lut = tf::lut(&tf::load(&tf_name)?);
+    let values = voxels.values();
     let window = match args.window {
-        Some(w) => w,
+        Some(w) => super::window::check_given(w, values)?,
         None => super::window::default_window(&name, range, &voxels, sample.as_deref())?,
     };
-    if !(window[1] > window[0]) {
-        return Err(CliError::input(format!(
-            "--window {},{}: HI must exceed LO",
-            window[0], window[1]
-        )));
-    }
-    let shading = parse_shading(
+    let shading = values_shading(
+        parse_shading(
+            &args.shading,
+            frame.spacing.iter().copied().fold(f32::INFINITY, f32::min),
+        )?,
         &args.shading,
-        frame.spacing.iter().copied().fold(f32::INFINITY, f32::min),
-    )?;
+        values,
+    );
     if let Some((lo, hi)) = range {
-        for w in outside_data_warnings(&shading, args.window, (lo, hi)) {
+        let given = args.window.map(|_| window);
+        for w in outside_data_warnings(&shading, given, (lo, hi)) {
             crate::warn!("{w}");
         }
     }

@@ -14,7 +14,9 @@
 
 use super::load::Voxels;
 use crate::io::volume::SampleType;
+use crate::io::volume::ValueMap;
 use crate::CliError;
+use footprint::shade::Shading;
 
 /// The window for a render without `--window`: [`auto_window`] of a user's volume's `sample`;
 /// else (the built-in scene, or no sample spans a range) the data's `range`; for a pipe, which
@@ -48,6 +50,13 @@ pub(crate) fn default_window(
             ))
         }
     };
+    range_window(name, lo, hi)
+}
+
+/// The window of data whose finite samples span `lo`..=`hi` when no sample gives one
+/// ([`auto_window`]): that range, refused where it is empty (no finite sample: `lo > hi`) or
+/// a single value. What `render` does, and what `info` reports it would do.
+pub(crate) fn range_window(name: &str, lo: f32, hi: f32) -> Result<[f32; 2], CliError> {
     if lo > hi {
         // `range` of data without one finite sample.
         return Err(CliError::input(format!(
@@ -60,6 +69,27 @@ pub(crate) fn default_window(
         )));
     }
     Ok([lo, hi])
+}
+
+/// `--window LO,HI` (data units, f64) as `render` checks it, in the renderer's values
+/// (through `values`): HI must exceed LO (both finite: the parser refuses anything else), and
+/// stay above it as f32 values.
+pub(crate) fn check_given(window: [f64; 2], values: ValueMap) -> Result<[f32; 2], CliError> {
+    if !(window[1] > window[0]) {
+        return Err(CliError::input(format!(
+            "--window {},{}: HI must exceed LO",
+            window[0], window[1]
+        )));
+    }
+    let w = values.window_from_data(window);
+    if !(w[1] > w[0]) || !w[0].is_finite() || !w[1].is_finite() {
+        return Err(CliError::input(format!(
+            "--window {},{}: f32 values cannot tell LO from HI at this magnitude (the samples \
+             are not wide enough to be rebased): widen the window",
+            window[0], window[1]
+        )));
+    }
+    Ok(w)
 }
 
 /// The percentiles of the robust range, in percent.
@@ -121,6 +151,59 @@ pub fn auto_window(sorted: &[f32]) -> Option<[f32; 2]> {
     } else {
         [lo, hi]
     })
+}
+
+/// `shading` (parsed from `text`) with an iso value in the renderer's values: the data's, read
+/// again in f64 and mapped through `values` where wide samples are rebased.
+pub(crate) fn values_shading(shading: Shading, text: &str, values: ValueMap) -> Shading {
+    match shading {
+        Shading::Iso {
+            value,
+            opacity,
+            thickness,
+            phong,
+        } if !values.is_identity() => {
+            let exact = text
+                .trim()
+                .strip_prefix("iso:")
+                .and_then(|v| v.trim().parse::<f64>().ok())
+                .unwrap_or(f64::from(value));
+            Shading::Iso {
+                value: values.from_data(exact),
+                opacity,
+                thickness,
+                phong,
+            }
+        }
+        other => other,
+    }
+}
+
+/// The warnings for an iso value outside the data's range `[lo, hi]` (no surface can show) and
+/// for a `--window` that misses that range entirely (every voxel maps to one end of the transfer
+/// function). `prepare` prints them (`footprint: warning: …`) and goes on.
+pub fn outside_data_warnings(
+    shading: &Shading,
+    window: Option<[f32; 2]>,
+    (lo, hi): (f32, f32),
+) -> Vec<String> {
+    let mut out = Vec::new();
+    if let Shading::Iso { value, .. } = shading {
+        if !(*value >= lo && *value <= hi) {
+            out.push(format!(
+                "iso value {value} lies outside the data's range [{lo}, {hi}]: no surface will show"
+            ));
+        }
+    }
+    if let Some([a, b]) = window {
+        if b < lo || a > hi {
+            out.push(format!(
+                "--window {a},{b} lies outside the data's range [{lo}, {hi}]: every voxel maps to \
+                 one end of the transfer function"
+            ));
+        }
+    }
+    out
 }
 
 #[cfg(test)]
