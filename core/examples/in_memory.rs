@@ -33,9 +33,6 @@ pub fn render_png(path: &str) -> Result<(), Box<dyn std::error::Error>> {
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    render_png(
-        &std::env::args()
-            .nth(1)
-            .unwrap_or_else(|| "in_memory.png".into()),
-    )
+    let path = std::env::args().nth(1);
+    render_png(path.as_deref().unwrap_or("in_memory.png"))
 }
