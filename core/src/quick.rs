@@ -31,11 +31,12 @@ use crate::kernel::Kernel;
 use crate::render::{FloatPath, RenderBuffers, RenderStats, SheetRenderer, SheetRing};
 use crate::shade::{Sample, Shader, Shading, TransferFunction, OPACITY_TABLE_LEN};
 use crate::source::render_from;
+use crate::splat::BufferError;
 use crate::splat::Splatter;
 use crate::stencil::{self, Stencils};
 use crate::table::{GenericTable, Lookup, ViewTable};
 use crate::volume::MemoryVolume;
-use crate::{BufferError, Error};
+use crate::Error;
 
 /// Everything a frame needs besides the data and the buffers. [`Settings::new`] gives
 /// `footprint render`'s defaults; change fields with struct-update syntax.

@@ -57,51 +57,10 @@ pub fn classify_sheet<T: Sample>(
     gradients: &mut [[f32; 3]],
     colours: &mut [[f32; 3]],
 ) -> Result<usize, RenderError> {
-    let count = frame.sheet_count();
-    if index >= count {
-        return Err(RenderError::SheetIndex { index, count });
-    }
-    let (len, na, nb) = frame.sheet_shape();
-    if na > 1 << 16 || nb > 1 << 16 {
-        return Err(BufferError::TooLarge {
-            width: na,
-            height: nb,
-        }
-        .into());
-    }
-    for got in [
-        Some(window.current.len()),
-        window.lower.map(<[T]>::len),
-        window.upper.map(<[T]>::len),
-    ]
-    .into_iter()
-    .flatten()
-    {
-        if got != len {
-            return Err(RenderError::SheetLength { expected: len, got });
-        }
-    }
     let needs_gradient = shader.shading.needs_gradient();
-    let room = if needs_gradient {
-        voxels.len().min(gradients.len())
-    } else {
-        voxels.len()
-    };
-    if room < len {
-        return Err(BufferError::TooSmall {
-            needed: len,
-            got: room,
-        }
-        .into());
-    }
     let coloured = T::COLOURED;
-    if coloured && colours.len() < len {
-        return Err(BufferError::TooSmall {
-            needed: len,
-            got: colours.len(),
-        }
-        .into());
-    }
+    let lengths = [voxels.len(), gradients.len(), colours.len()];
+    let (na, nb) = check_sheet(frame, index, &window, lengths, needs_gradient)?;
     // Values the transfer function makes transparent whatever the gradient are skipped with one
     // comparison (exact: the bound is where its lookup's opacity stops being 0).
     let clear = shader.transparent_at_or_below();
@@ -177,4 +136,61 @@ pub fn classify_sheet<T: Sample>(
         }
     }
     Ok(n)
+}
+
+/// [`classify_sheet`]'s preconditions: `index` a sheet of `frame`, every sheet of `window` a
+/// whole sheet long, the sheet at most 65 536 voxels along each axis, and room for a whole
+/// sheet in the voxels (`lengths[0]`), the gradients (`lengths[1]`, where `needs_gradient`) and
+/// the colours (`lengths[2]`, for a coloured sample type). The sheet's shape (na, nb) if so.
+fn check_sheet<T: Sample>(
+    frame: &FrameSetup,
+    index: usize,
+    window: &SheetWindow<'_, T>,
+    [voxels, gradients, colours]: [usize; 3],
+    needs_gradient: bool,
+) -> Result<(usize, usize), RenderError> {
+    let count = frame.sheet_count();
+    if index >= count {
+        return Err(RenderError::SheetIndex { index, count });
+    }
+    let (len, na, nb) = frame.sheet_shape();
+    if na > 1 << 16 || nb > 1 << 16 {
+        return Err(BufferError::TooLarge {
+            width: na,
+            height: nb,
+        }
+        .into());
+    }
+    for got in [
+        Some(window.current.len()),
+        window.lower.map(<[T]>::len),
+        window.upper.map(<[T]>::len),
+    ]
+    .into_iter()
+    .flatten()
+    {
+        if got != len {
+            return Err(RenderError::SheetLength { expected: len, got });
+        }
+    }
+    let room = if needs_gradient {
+        voxels.min(gradients)
+    } else {
+        voxels
+    };
+    if room < len {
+        return Err(BufferError::TooSmall {
+            needed: len,
+            got: room,
+        }
+        .into());
+    }
+    if T::COLOURED && colours < len {
+        return Err(BufferError::TooSmall {
+            needed: len,
+            got: colours,
+        }
+        .into());
+    }
+    Ok((na, nb))
 }

@@ -49,7 +49,7 @@ impl<'a> CompactStencils<'a> {
     /// Samples `frame`'s footprint through `sampler` (its weight in px⁻² at a screen offset,
     /// e.g. a [`crate::splat::Direct`] over a generic table in flash: no view table in RAM) at
     /// the centre of each of `phases`² phase cells, into `buffer` (at least [`len_for`] long).
-    pub fn build<S: crate::Sampler + ?Sized>(
+    pub fn build<S: crate::splat::Sampler + ?Sized>(
         frame: &FrameSetup,
         sampler: &S,
         phases: usize,
@@ -122,7 +122,7 @@ impl From<CompactError> for Fill {
 }
 
 /// Samples and quantises every phase stencil at weight fraction `frac` into `out`.
-fn fill<S: crate::Sampler + ?Sized>(
+fn fill<S: crate::splat::Sampler + ?Sized>(
     frame: &FrameSetup,
     sampler: &S,
     phases: usize,

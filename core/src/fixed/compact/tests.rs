@@ -6,8 +6,11 @@
 use super::*;
 use crate::frame::FrameSetup;
 use crate::geometry::FootprintOptions;
+use crate::geometry::{Grid, View};
+use crate::kernel::Kernel;
 use crate::splat::Direct;
-use crate::{GenericTable, Grid, Kernel, Lookup, Sampler, View};
+use crate::splat::Sampler;
+use crate::table::{GenericTable, Lookup};
 use glam::Mat3;
 use std::vec;
 

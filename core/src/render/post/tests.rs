@@ -25,9 +25,9 @@ fn cells_partition_the_pixels() {
 
 #[test]
 fn weight_table_follows_the_gaussian() {
-    let kernel = crate::Kernel::gaussian(1.6, 2.5).unwrap();
+    let kernel = crate::kernel::Kernel::gaussian(1.6, 2.5).unwrap();
     let t = WeightTable::<WEIGHT_NODES>::new(&kernel).unwrap();
-    let crate::Kernel::Gaussian { sigmas, .. } = kernel else {
+    let crate::kernel::Kernel::Gaussian { sigmas, .. } = kernel else {
         unreachable!()
     };
     for i in 0..=1000 {
