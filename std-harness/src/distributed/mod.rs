@@ -104,7 +104,7 @@ pub fn render_in_turn(job: &Job, layout: &BrickLayout) -> Result<Composited, Cli
 }
 
 /// Most bricks `--bricks` renders in turn in one process: each is a whole frame rendered and
-/// composited (one voxel a brick of a 128³ volume took about 27 minutes before this cap).
+/// composited (one voxel a brick took about 27 minutes in the third hostile campaign).
 pub const MAX_BRICKS_IN_TURN: usize = 512;
 
 /// A composited frame and what each brick cost.
