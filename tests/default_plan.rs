@@ -164,7 +164,7 @@ fn nothing_is_measured_where_there_is_nothing_to_choose() {
     let (out, json) = (d.join("o.png"), d.join("o.json"));
     let cases: [&[&str]; 5] = [
         &[HEART, "--slicing", "object"],
-        &["--stream", HEART],
+        &["--stream", HEART, "--slicing", "object", "--lod", "0"],
         &[HEART, "--perspective", "40"],
         &[HEART, "--accum", "fixed"],
         &[HEART, "--kernel", "bilinear"],

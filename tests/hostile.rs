@@ -1119,8 +1119,8 @@ fn second_campaign(dir: &Path) -> Vec<Case> {
         "ElementNumberOfChannels",
     ));
     // An NRRD whose header holds a 100 KiB comment before its fields: streamed equals loaded
-    // (with `--slicing object`, what a streamed volume renders: it has no pilot to measure
-    // slabs or the nearest phase with).
+    // (with `--slicing object --lod 0`, which leave a pilot nothing to choose, so the stream is
+    // read three sheets at a time rather than held: `pipeline::stages::hold`).
     let comment = format!("# {}\n", "x".repeat(100 << 10));
     let long = format!(
         "NRRD0004\n{comment}type: float\ndimension: 3\nsizes: 32 32 12\nendian: little\nencoding: raw\ndata file: {HEART_RAW}\n"
@@ -1133,6 +1133,8 @@ fn second_campaign(dir: &Path) -> Vec<Case> {
             &long,
             "--slicing",
             "object",
+            "--lod",
+            "0",
             "--size",
             "64x64",
             "--out",
@@ -1146,6 +1148,10 @@ fn second_campaign(dir: &Path) -> Vec<Case> {
                 "render",
                 "--stream",
                 &long,
+                "--slicing",
+                "object",
+                "--lod",
+                "0",
                 "--size",
                 "64x64",
                 "--out",

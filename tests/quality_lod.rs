@@ -168,15 +168,18 @@ fn quality_meets_its_target_where_voxel_scale_detail_breaks_levels() {
 }
 
 #[test]
-fn streamed_and_perspective_renders_keep_level_0_and_refuse_an_explicit_level() {
-    for first in [&["--stream", HEADSQ][..], &[HEADSQ, "--perspective", "40"]] {
+fn perspective_keeps_level_0_a_held_stream_chooses_as_its_file_and_explicit_levels_are_refused() {
+    let chosen_level = |first: &[&str]| {
         let mut a = first.to_vec();
         a.extend_from_slice(&["--size", "32x32", "--quality", "40"]);
         let args = parse_args(&a).unwrap();
         let (p, chosen, choice) = apply_quality(prepare(&args).unwrap(), &args).unwrap();
-        assert_eq!((p.level, choice.unwrap().level), (0, 0), "{first:?}");
         assert!(render_core(&p, &chosen).is_ok());
-    }
+        (p.level, choice.unwrap().level)
+    };
+    assert_eq!(chosen_level(&[HEADSQ, "--perspective", "40"]), (0, 0));
+    // A stream --quality can measure is held whole (`pipeline::stages::hold`): the file's choice.
+    assert_eq!(chosen_level(&["--stream", HEADSQ]), chosen_level(&[HEADSQ]));
     // An explicit level cannot be measured on a stream, nor placed for a perspective view.
     let streamed = refusal(&["--stream", HEADSQ, "--lod", "1"]);
     assert!(streamed.contains("streamed"), "{streamed}");

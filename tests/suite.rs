@@ -34,6 +34,7 @@ mod real_writers;
 mod refine;
 mod render;
 mod rotation_45;
+mod same_picture;
 mod single_sample;
 mod slabs;
 mod stencils;

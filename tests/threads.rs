@@ -175,8 +175,12 @@ fn cached_lists_render_what_a_full_scan_renders() {
                 ];
                 let mut loaded = vec![r];
                 loaded.extend_from_slice(&common);
+                // Nothing left to a pilot, so the stream is not held (`pipeline::stages::hold`).
+                let fixed = ["--slicing", "object", "--lod", "0"];
+                loaded.extend_from_slice(&fixed);
                 let mut streamed = vec!["--stream", r];
                 streamed.extend_from_slice(&common);
+                streamed.extend_from_slice(&fixed);
                 let render_with = |a: &[&str], cache: &mut FrameCache| {
                     let args = parse_args(a).unwrap();
                     let p = prepare(&args).unwrap();

@@ -140,25 +140,46 @@ def test_a_generator_streamed_equals_the_array_rendered():
     # view looks along -k (0,0,0 and 30,20,0), front to back from the other side (180,0,0).
     for view, order in [((0, 0, 0), "back-to-front"), ((30, 20, 0), "back-to-front"), ((180, 0, 0), "front-to-back")]:
         taken.clear()
+        # With nothing left to a pilot the stream is read three slices at a time.
         s = footprint.render_stream(
-            slices(), (28, 20, 24), spacing=(1, 1.5, 2), dtype=np.uint16, size=(80, 64), view=view, window=(0, 3500)
+            slices(), (28, 20, 24), spacing=(1, 1.5, 2), dtype=np.uint16, size=(80, 64), view=view,
+            window=(0, 3500), slicing="object", lod=0,
         )
-        # A stream has no pilot (it is read once): it renders what slicing="object" renders.
         a = footprint.render(
-            v, spacing=(1, 1.5, 2), size=(80, 64), view=view, window=(0, 3500), order=order, slicing="object"
+            v, spacing=(1, 1.5, 2), size=(80, 64), view=view, window=(0, 3500), order=order, slicing="object", lod=0
         )
         assert taken == list(range(24))
         assert np.array_equal(s, a), view
 
 
+def test_a_generator_with_default_flags_renders_the_arrays_picture():
+    """Same evidence, same plan: with the default flags the stream is held (the pilot needs the
+    volume) and renders render()'s picture byte for byte, any view (issue 76)."""
+    v = blob()
+    for view in [(30, 20, 0), (90, 0, 0)]:
+        for size in [(128, 128), (96, 64)]:
+            s = footprint.render_stream(
+                iter(v), (28, 20, 24), spacing=(1, 1.5, 2), dtype=np.uint16, size=size, view=view, window=(0, 3500)
+            )
+            a = footprint.render(v, spacing=(1, 1.5, 2), size=size, view=view, window=(0, 3500))
+            assert np.array_equal(s, a), (view, size)
+
+
 def test_a_stream_is_read_as_it_renders():
-    """Only the slices the renderer needs are held: a generator that ends early is an error
+    """Only the slices the renderer needs are held (nothing left to a pilot): a generator that ends early is an error
     before the whole volume could have been gathered, and a side view is refused as a pipe's."""
     v = blob()
     with pytest.raises(ValueError, match="ended"):
+        footprint.render_stream(
+            iter([v[0], v[1]]), (28, 20, 24), dtype=np.uint16, size=(32, 32), window=(0, 1), slicing="object", lod=0
+        )
+    with pytest.raises(ValueError, match="ended"):  # held (the default flags): the same refusal
         footprint.render_stream(iter([v[0], v[1]]), (28, 20, 24), dtype=np.uint16, size=(32, 32), window=(0, 1))
     with pytest.raises(ValueError, match="45"):
-        footprint.render_stream(iter(v), (28, 20, 24), dtype=np.uint16, size=(32, 32), view=(90, 0, 0), window=(0, 1))
+        footprint.render_stream(
+            iter(v), (28, 20, 24), dtype=np.uint16, size=(32, 32), view=(90, 0, 0), window=(0, 1),
+            slicing="object", lod=0,
+        )
     with pytest.raises(ValueError, match="window"):
         footprint.render_stream(iter(v), (28, 20, 24), dtype=np.uint16)
 

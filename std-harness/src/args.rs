@@ -328,9 +328,9 @@ pub struct RenderArgs {
     /// must exceed --scene-size).
     #[arg(help_heading = "Input", long, value_name = "N", default_value_t = 128, value_parser = parse_scene_size)]
     pub field_size: usize,
-    /// Stream the volume a few sheets at a time instead of loading it: a raw file (with --dims and
-    /// --type), an NRRD with raw encoding or an uncompressed MetaImage; `-` reads raw z-slices from
-    /// standard input in file order (needs --dims and --type).
+    /// Stream the volume a few sheets at a time: raw (with --dims and --type), NRRD with raw
+    /// encoding, uncompressed MetaImage; `-`: raw z-slices on standard input (needs --dims, --type).
+    /// Held whole where a pilot needs it and it fits, for the file's picture (docs/cli.md).
     #[arg(help_heading = "Input", long)]
     pub stream: Option<PathBuf>,
     /// Raw volumes: dimensions X,Y,Z.
@@ -358,8 +358,8 @@ pub struct RenderArgs {
     /// pilot of sampled rays measures it at 44 dB or more against the continuous model, else the
     /// thickest slabs that reach it (docs/modes.md, "The default plan"). Image slicing needs a
     /// gaussian kernel, float accumulation, an orthographic view and the volume in memory; where
-    /// it cannot run, or with --accum fixed, --refine, --quality or --stream, `auto` is object
-    /// slicing without a pilot. [default: auto]
+    /// it cannot run, or with --accum fixed, --refine, --quality or a stream too large to hold,
+    /// `auto` is object slicing without a pilot. [default: auto]
     #[arg(help_heading = "Method", long, value_enum)]
     pub slicing: Option<SlicingArg>,
     /// With --slicing image: slab thickness along the view ray, in voxel spacings (the smallest
@@ -419,7 +419,7 @@ pub struct RenderArgs {
     /// above into one, the spacing doubled, carrying the block's colour; 0 = full resolution);
     /// `auto`, the default, the deepest level L with 4^L x (level 0's projected spacing) <= 3 px
     /// (docs/modes.md, "Levels of detail") that a pilot of image rows also measures within 40 dB
-    /// of level 0 (a volume in memory; a stream keeps the spacing rule alone). Orthographic views only (`auto` keeps a perspective view, and
+    /// of level 0 (a volume or a file stream; a pipe too large to hold keeps the spacing rule alone). Orthographic views only (`auto` keeps a perspective view, and
     /// --refine, at level 0). The f64 reference `verify` compares with renders the same level
     /// (and, for a level >= 1, also level 0: `full res`); the continuous reference integrates
     /// full resolution (`auto` then means level 0). With --quality, `auto` means the level the

@@ -1,20 +1,40 @@
 //! `prepare`, the pipeline's entry: load and set up everything the command line describes
-//! ([`super::stages::prepare::prepare_as_asked`]), with `--lod auto` validated on a pilot where it can be
+//! ([`super::stages::prepare::prepare_as_asked`]; a stream a pilot needs held whole first,
+//! [`super::stages::hold`]), with `--lod auto` validated on a pilot where it can be
 //! ([`super::quality::level_pilot::validated_auto`]).
 
 use super::quality::level_pilot::validated_auto;
+use super::stages::hold::held;
 use super::stages::prepare::{prepare_as_asked, Prepared};
 use crate::args::Lod;
+use crate::io::stream::is_stdin;
 use crate::plan::{Inputs, Request};
 use crate::CliError;
 
-/// Loads and sets up everything `request` describes (its [`Inputs`]). `--lod auto` on a volume
-/// in memory keeps a coarser level only where a pilot, rendered with the request's plan,
-/// measures it close to level 0; a stream keeps the geometric rule alone (it cannot be read
-/// twice, and a file stream would be read once per level).
+/// Loads and sets up everything `request` describes (its [`Inputs`]). `--lod auto` keeps a
+/// coarser level only where a pilot, rendered with the request's plan, measures it close to
+/// level 0: on a volume in memory, or on a file streamed (read once per level tried); a pipe
+/// keeps the geometric rule alone (it cannot be read twice).
+///
+/// A stream that a pilot needs is first read whole where it fits ([`super::stages::hold`]), so
+/// that it is prepared, planned and rendered as the file it is would be.
 pub fn prepare<R: Request + ?Sized>(request: &R) -> Result<Prepared, CliError> {
-    let args = request.inputs();
-    if args.lod != Lod::Auto || args.quality || args.stream.is_some() {
+    let mut args = request.inputs();
+    // (A plan the flags refuse is refused by the command, with the stream's reasons.)
+    if let (Some(_), Ok(plan)) = (&args.stream, request.plan()) {
+        if let Some(memory) = held(&args, &plan)? {
+            args = Inputs {
+                memory: Some(memory),
+                stream: None,
+                dims: None,
+                sample_type: None,
+                ..args
+            };
+        }
+    }
+    // A pipe is read once: it keeps the spacing rule's level (a file stream is measured as it
+    // streams).
+    if args.lod != Lod::Auto || args.quality || args.stream.as_deref().is_some_and(is_stdin) {
         return prepare_as_asked(&args);
     }
     let at_full = Inputs {

@@ -10,7 +10,9 @@
 //! ```
 //!
 //! - [`stages`]: from the inputs to a [`Prepared`] render, and what a frame is split into:
-//!   [`stages::load`] (where the voxels come from), [`stages::window`], [`stages::prepare`],
+//!   [`stages::load`] (where the voxels come from), [`stages::hold`] (a stream the default
+//!   plan's pilot needs, read whole by [`entry::prepare`] first: the file's plan and picture),
+//!   [`stages::window`], [`stages::prepare`],
 //!   [`stages::lod`] (levels of detail), [`stages::supersample`] and [`stages::subsample`],
 //!   [`stages::visible`] (visible-voxel lists kept across frames), [`stages::spares`],
 //!   [`stages::supply`], [`stages::bands`] (bands of rows, byte-identical for any count),

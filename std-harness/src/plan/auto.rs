@@ -6,9 +6,9 @@
 //! (`pipeline::quality::pilot::choose_slicing`). The flags decide only whether there is a choice
 //! to make: there is none when they fix the end point (`--slicing object|image`,
 //! `--classification post`, `--refine`, `--method reference`), when slabs cannot draw what they
-//! ask (`--accum fixed`, `--perspective`, `--stream`: a streamed volume is read once, and the
-//! pilot's reference needs it whole) or when `--quality` chooses instead. The frame decides the
-//! rest (a kernel with no slabs, a coarser level of detail): the pilot is skipped there. Where
+//! ask (`--accum fixed`, `--perspective`) or when `--quality` chooses instead. The frame decides the
+//! rest (a kernel with no slabs, a coarser level of detail, a stream too large to hold whole,
+//! `pipeline::stages::hold`): the pilot is skipped there. Where
 //! the pilot runs and `--subsample` is unset, it tries each candidate subsampled first
 //! ([`super::Plan::auto_subsample`]).
 
@@ -23,7 +23,9 @@ pub const DEFAULT_TARGET_DB: f64 = 44.0;
 /// alone resolved) is float sheets; `None` otherwise.
 pub fn slicing_target(end: &End, args: &RenderArgs) -> Option<f64> {
     let open = matches!(args.slicing, None | Some(SlicingArg::Auto));
-    let drawable = args.perspective.is_none() && args.stream.is_none();
+    // A stream the pilot needs is held whole where it fits (`pipeline::stages::hold`); one
+    // that is not has no volume to measure, and `choose_slicing` keeps object slicing.
+    let drawable = args.perspective.is_none();
     (open && drawable && args.quality.is_none() && *end == End::Sheets(Precision::Float))
         .then_some(DEFAULT_TARGET_DB)
 }

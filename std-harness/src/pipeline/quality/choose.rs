@@ -17,7 +17,7 @@
 //! the references) and t(L) the chosen configuration's at level L. A level is accepted when that
 //! holds with t(L) = t₀(L) (the pilot's own table is always available); the deepest accepted level
 //! is rendered, with the cheapest configuration whose t(L) fits what is left. A level is never
-//! chosen for a perspective view or a streamed volume (read once; an explicit `--lod N` with
+//! chosen for a perspective view or a stream too large to hold whole (`pipeline::stages::hold`; an explicit `--lod N` with
 //! `--quality` is refused there), and `auto` tries nothing where level 0's samples are already
 //! more than a pixel apart.
 //!

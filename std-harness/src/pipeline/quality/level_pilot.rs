@@ -25,10 +25,11 @@
 //! ([`super::choose`]) splits the target between the level and the table.
 
 use super::sampling::{mix, Estimate};
-use crate::io::stream::{ColouredMemorySource, MemorySource};
+use crate::io::stream::{ColouredMemorySource, FileSource, MemorySource};
 use crate::io::try_filled;
 use crate::pipeline::ends::run::{build_stencils, stencil_len};
 use crate::pipeline::stages::load::Voxels;
+use crate::pipeline::stages::lod::{averaging_for, with_level};
 use crate::pipeline::stages::prepare::Prepared;
 use crate::pipeline::stages::supersample::downsample;
 use crate::plan::Inputs;
@@ -98,16 +99,17 @@ pub fn row_estimate(got: &[[f32; 4]], want: &[[f32; 4]], w: usize, height: usize
     Estimate::of(&per_row, height, Z)
 }
 
-/// The core's float render of `p` (in memory) at output rows `rows` only, with `plan`'s table
-/// size, lookup and phases through the view table (the robust method): `rows.len()` rows of the
-/// output width, in the order given. Each equals that row of the whole frame's float render with
-/// the same plan, bit for bit.
+/// The core's float render of `p` (in memory, or streamed from a file: each thread reads it once,
+/// coarsened as it streams at a level ≥ 1) at output rows `rows` only, with `plan`'s table size,
+/// lookup and phases through the view table (the robust method): `rows.len()` rows of the output
+/// width, in the order given. Each equals that row of the whole frame's float render with the
+/// same plan, bit for bit.
 pub fn render_rows(p: &Prepared, plan: &Plan, rows: &[usize]) -> Result<Vec<[f32; 4]>, CliError> {
-    let Voxels::Memory(volume) = &p.voxels else {
+    if let Voxels::Stdin { .. } = &p.voxels {
         return Err(CliError::input(
-            "the level pilot renders a volume in memory: drop --stream",
+            "the level pilot renders a volume in memory or a file: a pipe is read once",
         ));
-    };
+    }
     let h = p.out_size().1;
     if let Some(&y) = rows.iter().find(|&&y| y >= h) {
         return Err(CliError::input(format!(
@@ -118,18 +120,12 @@ pub fn render_rows(p: &Prepared, plan: &Plan, rows: &[usize]) -> Result<Vec<[f32
     struct Rows<'a> {
         p: &'a Prepared,
         plan: &'a Plan,
-        volume: &'a crate::io::volume::Volume,
         rows: &'a [usize],
     }
     impl crate::dispatch::TableSize for Rows<'_> {
         type Output = Vec<[f32; 4]>;
         fn run<const N: usize>(self) -> Result<Vec<[f32; 4]>, CliError> {
-            let Rows {
-                p,
-                plan,
-                volume,
-                rows,
-            } = self;
+            let Rows { p, plan, rows } = self;
             let (f, k, w) = (&p.frame, p.supersample, p.out_size().0);
             let lookup = plan.table.lookup;
             let generic = plan.table.generic::<N>(&p.kernel)?;
@@ -143,14 +139,19 @@ pub fn render_rows(p: &Prepared, plan: &Plan, rows: &[usize]) -> Result<Vec<[f32
             // stencils where the footprint allows them, read by the plan's phase lookup, else
             // the view table.
             let len = stencil_len(p, plan.phases);
-            let threads = plan.threads;
+            // A file streams once for all the rows: more threads would each read it whole and
+            // hold a sheet cache of their own (8 MiB, `crate::io::stream::CACHE_BYTES`).
+            let threads = match p.voxels {
+                Voxels::File(_) => 1,
+                _ => plan.threads,
+            };
             let bands = match len {
                 Some(len) => {
                     let mut buffer = vec![0.0f32; len];
                     let stencils = build_stencils(&*table, plan, &mut buffer)?;
-                    split_rows(p, &stencils, volume, rows, threads)?
+                    split_rows(p, &stencils, rows, threads)?
                 }
-                None => split_rows(p, &*table, volume, rows, threads)?,
+                None => split_rows(p, &*table, rows, threads)?,
             };
             let mut out = Vec::with_capacity(rows.len() * w);
             for band in bands {
@@ -159,21 +160,15 @@ pub fn render_rows(p: &Prepared, plan: &Plan, rows: &[usize]) -> Result<Vec<[f32
             Ok(out)
         }
     }
-    let work = Rows {
-        p,
-        plan,
-        volume,
-        rows,
-    };
+    let work = Rows { p, plan, rows };
     crate::dispatch::with_size(plan.table.size, work)
 }
 
 /// [`bands_from`] with `rows` split between `threads` cores, each reading the sheets for its
-/// own rows.
+/// own rows (from memory, or from the file, coarsened as it streams at a level ≥ 1).
 fn split_rows<S: Splatter + Sync + ?Sized>(
     p: &Prepared,
     sampler: &S,
-    volume: &crate::io::volume::Volume,
     rows: &[usize],
     threads: usize,
 ) -> Result<Vec<Vec<[f32; 4]>>, CliError> {
@@ -181,18 +176,33 @@ fn split_rows<S: Splatter + Sync + ?Sized>(
         .len()
         .div_ceil(threads.clamp(1, rows.len().max(1)))
         .max(1);
+    let part_of = |part: &[usize]| match &p.voxels {
+        Voxels::Memory(v) if v.is_coloured() => {
+            bands_from(p, sampler, &mut ColouredMemorySource(v), part)
+        }
+        Voxels::Memory(v) => bands_from(p, sampler, &mut MemorySource(v), part),
+        Voxels::File(layout) => {
+            let mut file = FileSource::open(layout.clone())?;
+            if p.level == 0 {
+                return bands_from(p, sampler, &mut file, part);
+            }
+            let averaging = averaging_for(&p.shading, p.shader().tf, p.absorption);
+            let (fine, level, axis) = (p.fine_dims, p.level, p.frame.sheet_axis);
+            with_level(&mut file, fine, level, axis, &*averaging, &mut |c| {
+                bands_from(p, sampler, c, part)
+            })
+        }
+        Voxels::Stdin { .. } => Err(CliError::input("a pipe is read once")),
+    };
+    if per >= rows.len() {
+        // One part: on this thread (a streamed file's buffers then go back to the allocator
+        // the frame's own render uses; a thread's arena kept 16 MiB more at the peak).
+        return part_of(rows);
+    }
     let parts: Vec<Result<Vec<Vec<[f32; 4]>>, CliError>> = std::thread::scope(|scope| {
         let handles: Vec<_> = rows
             .chunks(per)
-            .map(|part| {
-                crate::threads::spawn(scope, move || {
-                    if volume.is_coloured() {
-                        bands_from(p, sampler, &mut ColouredMemorySource(volume), part)
-                    } else {
-                        bands_from(p, sampler, &mut MemorySource(volume), part)
-                    }
-                })
-            })
+            .map(|part| crate::threads::spawn(scope, move || part_of(part)))
             .collect();
         handles
             .into_iter()
@@ -208,15 +218,16 @@ fn split_rows<S: Splatter + Sync + ?Sized>(
 
 /// One renderer per output row of `rows` (a band of k frame rows), all fed from one pass over
 /// `source`'s sheets: each band's k×-wide pixels.
-fn bands_from<S, T>(
+fn bands_from<S, T, Src>(
     p: &Prepared,
     sampler: &S,
-    source: &mut impl SheetSource<Sample = T, Error = CliError>,
+    source: &mut Src,
     rows: &[usize],
 ) -> Result<Vec<Vec<[f32; 4]>>, CliError>
 where
     S: Splatter + ?Sized,
     T: Sample + Default,
+    Src: SheetSource<Sample = T, Error = CliError> + ?Sized,
 {
     let (f, k) = (&p.frame, p.supersample);
     let n = f.size[0] * k;
@@ -249,7 +260,7 @@ where
     }
     let mut storage = try_filled(3 * f.sheet_shape().0, T::default(), "three sheets")?;
     let mut ring = SheetRing::new(&mut storage, f, p.order)?;
-    render_all_from(&mut renderers, &mut ring, source)?;
+    render_all_from(&mut renderers, &mut ring, &mut &mut *source)?;
     for r in renderers {
         r.finish();
     }
@@ -321,7 +332,9 @@ pub const AUTO_MIN_DB: f64 = 40.0;
 /// `--lod auto` for `p0` (prepared at level 0, `args` otherwise as given): the deepest level the
 /// geometric rule allows ([`crate::pipeline::stages::lod::auto_level`]) whose pilot bound stays at or above
 /// [`AUTO_MIN_DB`] against level 0, the levels tried from 1 down and the first to fail ending the
-/// search; level 0 when none passes, for a stream, or in perspective. The geometric rule alone
+/// search; level 0 when none passes or in perspective. A file streamed (too large to hold,
+/// `pipeline::stages::hold`) is measured as it streams, read once per level tried and once for
+/// level 0, so that it keeps the level its loaded file keeps; a pipe, read once, keeps the rule's. The geometric rule alone
 /// was fitted on grey ramps and kept the CT head's level 1 at 64² at 30.9 dB under a transfer
 /// function with sharp opacity steps (`ct-bone-skin`); the pilot sees what the data and the
 /// transfer function do to a level.
@@ -334,7 +347,7 @@ pub fn validated_auto(p0: Prepared, args: &Inputs, plan: &Plan) -> Result<Prepar
         &p0.kernel,
         p0.options,
     )?;
-    if deepest == 0 || p0.volume().is_none() {
+    if deepest == 0 || matches!(p0.voxels, Voxels::Stdin { .. }) {
         return Ok(p0);
     }
     let levels: Vec<u32> = (1..=deepest).collect();

@@ -126,7 +126,8 @@ use std::time::Instant;
 ///
 /// [`list_budget`]: crate::pipeline::stages::visible::list_budget
 fn field_bytes(volume: &crate::io::volume::Volume) -> (usize, usize) {
-    let field = volume.len().saturating_mul(16);
+    use crate::pipeline::stages::visible::PILOT_FIELD_BYTES_PER_VOXEL;
+    let field = volume.len().saturating_mul(PILOT_FIELD_BYTES_PER_VOXEL);
     (field, crate::pipeline::stages::visible::list_budget(volume))
 }
 

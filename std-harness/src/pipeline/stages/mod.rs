@@ -1,7 +1,8 @@
-//! Load → prepare → classify → bands: the stages every render goes through (loading, the window, the frame and its levels, supersampling and subsampling, the visible lists, spare voxels, bands of rows, and what refinement carried).
+//! (Hold →) load → prepare → classify → bands: the stages every render goes through (loading, the window, the frame and its levels, supersampling and subsampling, the visible lists, spare voxels, bands of rows, and what refinement carried).
 
 pub mod bands;
 pub mod blocks;
+pub mod hold;
 pub mod load;
 pub mod lod;
 pub mod prepare;

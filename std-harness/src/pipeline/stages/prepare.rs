@@ -110,20 +110,25 @@ impl Prepared {
         Ok(())
     }
 
-    /// This volume (prepared in memory at level 0) at level `level` ≥ 1 for `args`' view: that
-    /// level's frame, supersampling, kernel and shading, its volume coarsened from `from` (a
-    /// shallower level of this volume, prepared by this function) when given, else from this one.
-    /// Nothing is loaded again.
+    /// This volume (prepared at level 0, in memory or streamed from a file) at level `level` ≥ 1
+    /// for `args`' view: that level's frame, supersampling, kernel and shading; a volume in memory
+    /// coarsened from `from` (a shallower level of this volume, prepared by this function) when
+    /// given, else from this one; a file coarsened as it streams, when rendered. Nothing is
+    /// loaded again.
     pub fn at_level(
         &self,
         args: &Inputs,
         level: u32,
         from: Option<&Prepared>,
     ) -> Result<Prepared, CliError> {
-        let Voxels::Memory(fine) = &self.voxels else {
-            return Err(CliError::input(
-                "a level of a streamed volume is built as it streams, not from a prepared one",
-            ));
+        let fine = match &self.voxels {
+            Voxels::Memory(fine) => Some(fine),
+            Voxels::File(_) => None,
+            Voxels::Stdin { .. } => {
+                return Err(CliError::input(
+                    "a level of a pipe is built as it streams, not from a prepared one",
+                ))
+            }
         };
         if self.level != 0 || level == 0 {
             return Err(CliError::input(format!(
@@ -139,16 +144,28 @@ impl Prepared {
         let min_spacing = frame.spacing.iter().copied().fold(f32::INFINITY, f32::min);
         let shading = parse_shading(&args.shading, min_spacing)?;
         let averaging = super::lod::averaging_for(&shading, self.shader().tf, self.absorption);
-        let volume = match from {
-            Some(Prepared {
-                voxels: Voxels::Memory(v),
-                level: l @ 1..,
-                ..
-            }) if *l < level => super::lod::coarsen_volume(v, level - l, &*averaging)?,
-            _ => super::lod::coarsen_volume(fine, level, &*averaging)?,
+        let voxels = match (fine, from) {
+            (None, _) => self.voxels.clone(),
+            (
+                Some(_),
+                Some(Prepared {
+                    voxels: Voxels::Memory(v),
+                    level: l @ 1..,
+                    ..
+                }),
+            ) if *l < level => Voxels::Memory(Arc::new(super::lod::coarsen_volume(
+                v,
+                level - l,
+                &*averaging,
+            )?)),
+            (Some(fine), _) => Voxels::Memory(Arc::new(super::lod::coarsen_volume(
+                fine,
+                level,
+                &*averaging,
+            )?)),
         };
         Ok(Prepared {
-            voxels: Voxels::Memory(Arc::new(volume)),
+            voxels,
             name: self.name.clone(),
             kernel,
             grid: self.grid,

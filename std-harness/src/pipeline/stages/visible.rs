@@ -129,10 +129,26 @@ impl VisibleLists {
 /// Most bytes the visible lists of `volume` may hold: four per byte of the volume, at least
 /// 256 MiB and at most 1 GiB (see the module docs).
 pub fn list_budget(volume: &Volume) -> usize {
-    volume
-        .bytes()
+    list_budget_of(volume.bytes())
+}
+
+/// [`list_budget`] of a volume whose samples take `bytes`.
+pub fn list_budget_of(bytes: usize) -> usize {
+    bytes
         .saturating_mul(4)
         .clamp(MIN_LIST_BUDGET, MAX_LIST_BUDGET)
+}
+
+/// Bytes a voxel the default plan's pilot reference field may hold (`reference::sparse`'s
+/// bound).
+pub const PILOT_FIELD_BYTES_PER_VOXEL: usize = 16;
+
+/// Whether the default plan's pilot measures a volume of `voxels` samples of `sample_bytes`
+/// each: its reference field ([`PILOT_FIELD_BYTES_PER_VOXEL`] a voxel) fits [`list_budget`]
+/// (at most 16 Mi voxels for samples of 1 or 2 bytes, 64 Mi for 4 or 8).
+pub fn pilot_fits(voxels: usize, sample_bytes: usize) -> bool {
+    voxels.saturating_mul(PILOT_FIELD_BYTES_PER_VOXEL)
+        <= list_budget_of(voxels.saturating_mul(sample_bytes))
 }
 
 /// The lists' budget is never below this (256 MiB): a small volume keeps its lists.
