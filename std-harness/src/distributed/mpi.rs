@@ -142,10 +142,14 @@ pub fn job(
             "the ranks were given volumes of different kinds (a raw file one reads in part, \
              another loads whole): give every rank the same volume",
         );
-        return Err(match whole.then(|| Job::new(inputs, plan)) {
-            Some(Err(e)) => e,
-            _ => mismatch,
-        });
+        // Agreed, so that the failing rank has printed its reason before any rank leaves (else
+        // mpirun's teardown could end it first: CI saw only the mismatch once).
+        let mine = match whole.then(|| Job::new(inputs, plan)) {
+            Some(Err(e)) => Err(e),
+            _ => Ok(()),
+        };
+        agree(comm, "opening the volume", mine)?;
+        return Err(mismatch);
     }
     if !whole {
         return agree(comm, "opening the volume", Job::new(inputs, plan));

@@ -32,10 +32,20 @@ pub fn prepare<R: Request + ?Sized>(request: &R) -> Result<Prepared, CliError> {
             };
         }
     }
-    // A pipe is read once: it keeps the spacing rule's level (a file stream is measured as it
-    // streams).
-    if args.lod != Lod::Auto || args.quality || args.stream.as_deref().is_some_and(is_stdin) {
-        return prepare_as_asked(&args);
+    // A pipe is read once: it keeps the spacing rule's level, said so (a file stream is
+    // measured as it streams).
+    let piped = args.stream.as_deref().is_some_and(is_stdin);
+    if args.lod != Lod::Auto || args.quality || piped {
+        let p = prepare_as_asked(&args)?;
+        if piped && args.lod == Lod::Auto && p.level > 0 {
+            crate::say!(
+                "{}: --lod auto renders level {} by the spacing rule alone, not measured against \
+                 level 0 (a pipe too large to hold is read once); give --lod 0 for full resolution",
+                p.name,
+                p.level
+            );
+        }
+        return Ok(p);
     }
     let at_full = Inputs {
         lod: Lod::Level(0),

@@ -78,10 +78,15 @@ fn fits(dims: [usize; 3], sample_bytes: usize) -> bool {
 }
 
 fn in_memory(volume: Volume, name: String) -> InMemory {
+    let bytes = volume.bytes();
+    let size = if bytes < 1 << 20 {
+        format!("{:.1} KiB", bytes as f64 / 1024.0)
+    } else {
+        format!("{:.1} MiB", bytes as f64 / f64::from(1u32 << 20))
+    };
     crate::say!(
-        "{name}: held in memory ({:.1} MiB, as the file would be loaded) so that the default \
-         plan's pilot measures it; give --lod N with --slicing object to stream it",
-        volume.bytes() as f64 / f64::from(1u32 << 20)
+        "{name}: held in memory ({size}, as the file would be loaded) so that the default \
+         plan's pilot measures it; give --lod N with --slicing object to stream it"
     );
     InMemory {
         volume: Arc::new(volume),
