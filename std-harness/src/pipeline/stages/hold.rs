@@ -20,10 +20,11 @@
 //!
 //! # What it costs
 //! The samples, as loading the file costs (`voxels × bytes a sample`), instead of three sheets.
-//! Flags that leave nothing to choose keep a stream a stream: `--slicing object` (or `image`
-//! for a file) with `--lod N`, `--classification post`, `--refine`, `--method reference`, a
-//! perspective view, `--accum fixed` with `--lod N`. A held pipe no longer needs `--window` (its
-//! range is read as a file's) or a view near the z axis.
+//! Flags that leave nothing to choose keep a stream a stream: a fixed end (`--slicing object`,
+//! `--accum fixed` or `--method reference`) with a fixed `--lod N` (0 included), `--refine`, or
+//! a perspective view (post-classification and explicit slabs refuse a stream in the plan's
+//! flag rules, before anything is held). A held pipe no longer needs `--window` (its range is
+//! read as a file's) or a view near the z axis.
 
 use crate::args::Lod;
 use crate::io::formats::raw::RawOptions;
@@ -33,7 +34,7 @@ use crate::plan::{Inputs, Plan};
 use crate::CliError;
 use std::sync::Arc;
 
-/// Whether `inputs` with `plan` (the plan the flags give the volume loaded whole) leave a choice
+/// Whether `inputs` with `plan` (the request's plan: a stream's is its file's) leave a choice
 /// that a pilot measures on the volume: the default plan's slicing, `--quality`, or `--lod auto`
 /// (a perspective view and `--refine` keep level 0 without a pilot).
 pub fn wants_volume(inputs: &Inputs, plan: &Plan) -> bool {
@@ -42,8 +43,8 @@ pub fn wants_volume(inputs: &Inputs, plan: &Plan) -> bool {
 }
 
 /// `inputs`' stream (`--stream FILE|-`) read whole, where [`wants_volume`] and the pilot would
-/// measure it (called by [`crate::pipeline::entry::prepare`], before anything else is loaded) ([`crate::pipeline::stages::visible::pilot_fits`]); `None` where it stays a stream
-/// (or there is none). A file is loaded as `footprint render FILE` loads it (same refusals of
+/// measure it ([`crate::pipeline::stages::visible::pilot_fits`]); `None` where it stays a stream
+/// (or there is none). Called by [`crate::pipeline::entry::prepare`] before anything is loaded. A file is loaded as `footprint render FILE` loads it (same refusals of
 /// what cannot stream first); a pipe (standard input, or [`Inputs::stdin`]) is read to its
 /// `--dims`' last byte and decoded as the raw file would be. The name is the stream's.
 pub fn held(inputs: &Inputs, plan: &Plan) -> Result<Option<InMemory>, CliError> {
