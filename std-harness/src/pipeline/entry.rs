@@ -20,9 +20,11 @@ use crate::CliError;
 /// that it is prepared, planned and rendered as the file it is would be.
 pub fn prepare<R: Request + ?Sized>(request: &R) -> Result<Prepared, CliError> {
     let mut args = request.inputs();
-    // (A plan the flags refuse is refused by the command, with the stream's reasons.)
-    if let (Some(_), Ok(plan)) = (&args.stream, request.plan()) {
-        if let Some(memory) = held(&args, &plan)? {
+    // Resolved once, for the hold and the level pilot; a plan the flags refuse is refused only
+    // where one of them needs it (the command refuses it too, with the stream's reasons).
+    let plan = request.plan();
+    if let (Some(_), Ok(plan)) = (&args.stream, &plan) {
+        if let Some(memory) = held(&args, plan)? {
             args = Inputs {
                 memory: Some(memory),
                 stream: None,
@@ -51,5 +53,5 @@ pub fn prepare<R: Request + ?Sized>(request: &R) -> Result<Prepared, CliError> {
         lod: Lod::Level(0),
         ..args.clone()
     };
-    validated_auto(prepare_as_asked(&at_full)?, &args, &request.plan()?)
+    validated_auto(prepare_as_asked(&at_full)?, &args, &plan?)
 }

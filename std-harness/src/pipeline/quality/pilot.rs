@@ -126,9 +126,7 @@ use std::time::Instant;
 ///
 /// [`list_budget`]: crate::pipeline::stages::visible::list_budget
 fn field_bytes(volume: &crate::io::volume::Volume) -> (usize, usize) {
-    use crate::pipeline::stages::visible::PILOT_FIELD_BYTES_PER_VOXEL;
-    let field = volume.len().saturating_mul(PILOT_FIELD_BYTES_PER_VOXEL);
-    (field, crate::pipeline::stages::visible::list_budget(volume))
+    crate::pipeline::stages::visible::pilot_field(volume.len(), volume.bytes())
 }
 
 /// The second object-slicing candidate aims the table model this much above the target, dB.

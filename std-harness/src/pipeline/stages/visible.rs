@@ -143,12 +143,21 @@ pub fn list_budget_of(bytes: usize) -> usize {
 /// bound).
 pub const PILOT_FIELD_BYTES_PER_VOXEL: usize = 16;
 
+/// The bytes the default plan's pilot reference field holds for a volume of `voxels` samples
+/// taking `bytes` ([`PILOT_FIELD_BYTES_PER_VOXEL`] a voxel), and the budget it must fit
+/// ([`list_budget_of`]): the pilot measures only where the first is at most the second.
+pub fn pilot_field(voxels: usize, bytes: usize) -> (usize, usize) {
+    (
+        voxels.saturating_mul(PILOT_FIELD_BYTES_PER_VOXEL),
+        list_budget_of(bytes),
+    )
+}
+
 /// Whether the default plan's pilot measures a volume of `voxels` samples of `sample_bytes`
-/// each: its reference field ([`PILOT_FIELD_BYTES_PER_VOXEL`] a voxel) fits [`list_budget`]
-/// (at most 16 Mi voxels for samples of 1 or 2 bytes, 64 Mi for 4 or 8).
+/// each ([`pilot_field`]: at most 16 Mi voxels for samples of 1 or 2 bytes, 64 Mi for 4 or 8).
 pub fn pilot_fits(voxels: usize, sample_bytes: usize) -> bool {
-    voxels.saturating_mul(PILOT_FIELD_BYTES_PER_VOXEL)
-        <= list_budget_of(voxels.saturating_mul(sample_bytes))
+    let (field, budget) = pilot_field(voxels, voxels.saturating_mul(sample_bytes));
+    field <= budget
 }
 
 /// The lists' budget is never below this (256 MiB): a small volume keeps its lists.
