@@ -8,6 +8,7 @@ pub mod image;
 pub mod json;
 pub mod outputs;
 pub mod progress;
+pub mod ranges;
 pub mod stream;
 pub mod table;
 pub mod temporaries;
