@@ -268,7 +268,7 @@ fn frames(c: &mut Criterion) {
             args.extend_from_slice(cfg);
             let r = footprint_harness::args::parse_args(&args).unwrap();
             let p = footprint_harness::pipeline::prepare(&r).unwrap();
-            let plan = footprint_harness::plan::plan(&r).unwrap();
+            let plan = footprint_harness::args::plan(&r).unwrap();
             let label = format!(
                 "{name}/n={}/{}/{}/{}/{}",
                 cfg[1],

@@ -3,11 +3,11 @@
 //! integral has a closed form along every ray.
 
 use footprint_harness::args::parse_args;
+use footprint_harness::args::plan;
 use footprint_harness::pipeline::ends::continuous::{
     render_continuous_as, render_continuous_model,
 };
 use footprint_harness::pipeline::prepare;
-use footprint_harness::plan::plan;
 use footprint_harness::reference::continuous::{
     Absorption, Model, Reconstruction, CONVERGED_DB, DEFAULT_CAP,
 };

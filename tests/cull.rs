@@ -4,9 +4,9 @@
 //! cannot do is refused with a typed error.
 
 use footprint_harness::args::parse_args;
+use footprint_harness::args::plan;
 use footprint_harness::pipeline::stages::visible::FrameCache;
 use footprint_harness::pipeline::{prepare, render_frame, CoreFrame};
-use footprint_harness::plan::plan;
 use footprint_suite::{run_cli, tmpdir};
 
 const HEADSQ: &str = concat!(

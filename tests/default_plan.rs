@@ -4,11 +4,12 @@
 //! the plan's frame bit for bit, and the flags that leave nothing to choose checked to skip it.
 
 use footprint::stencil::PhaseLookup;
+use footprint_harness::args::plan;
 use footprint_harness::args::{parse_args, Supersample};
 use footprint_harness::metrics::compare;
 use footprint_harness::pipeline::stages::visible::FrameCache;
 use footprint_harness::pipeline::{prepare, render_continuous_ref, render_frame, Prepared};
-use footprint_harness::plan::{plan, End, DEFAULT_TARGET_DB};
+use footprint_harness::plan::{End, DEFAULT_TARGET_DB};
 use footprint_harness::reference::continuous::Reconstruction;
 use footprint_suite::{apply_quality, json_number, path_str as s, run_cli as run, tmpdir};
 

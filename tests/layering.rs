@@ -1,5 +1,5 @@
-//! The harness's layers, checked from its source: data flows one way (cli → commands → charts →
-//! pipeline → args/metrics → scene/tf → io/reference/dispatch → core), no command imports another,
+//! The harness's layers, checked from its source: data flows one way (cli → commands →
+//! charts/distributed → args → pipeline → plan → metrics → scene/tf → io/reference/dispatch → core), no command imports another,
 //! nothing imports `cli`, and files stay small enough to read (issue 16's "must show" 1 and 2).
 //!
 //! A module's dependencies are the `crate::…` and `super::…` paths in its code (`use` lines and
@@ -63,15 +63,18 @@ fn node(path: &[String], files: &BTreeSet<Vec<String>>) -> Option<String> {
 
 fn rank(node: &str) -> u32 {
     match node.split('/').next().unwrap_or(node) {
-        "cli" => 8,
-        "commands" => 7,
-        "charts" => 6,
+        "cli" => 9,
+        "commands" => 8,
+        "charts" => 7,
         // Scale-out: bricks rendered by the pipeline and composited; commands call it.
-        "distributed" => 6,
+        "distributed" => 7,
+        // The command line's flags (clap types) and their resolution into inputs and a plan,
+        // once (issue 76): above the pipeline, which reads only the typed values.
+        "args" => 6,
         "pipeline" => 5,
-        // The render plan: resolved from the arguments, read by the pipeline.
+        // The render plan and inputs: typed values, read by the pipeline.
         "plan" => 4,
-        "args" | "metrics" => 3,
+        "metrics" => 3,
         "scene" | "tf" => 2,
         "io" | "reference" => 1,
         // Threads that may fail to start, the one table-size dispatch, and a render's
@@ -210,7 +213,7 @@ fn data_flows_one_way() {
     }
     assert!(
         wrong.is_empty(),
-        "imports against the layers (cli → commands → charts → pipeline → args/metrics → scene/tf → io/…):\n{}",
+        "imports against the layers (cli → commands → charts → args → pipeline → plan → metrics → scene/tf → io/…):\n{}",
         wrong.join("\n")
     );
     assert!(
@@ -322,6 +325,44 @@ fn the_pipeline_never_reads_the_command_line_struct() {
     assert!(!names_render_args(&code_of(
         "// RenderArgs\nfn f(a: &MyRenderArgs) {}"
     )));
+}
+
+/// No clap type below the command line (issue 76): no file of `pipeline/` or `plan/` imports
+/// `crate::args` (in code; comments may name it), so the pipeline reads only the typed inputs
+/// and plan that `args::resolve` makes once.
+#[test]
+fn the_pipeline_and_the_plan_import_no_command_line_module() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("std-harness/src");
+    let mut files = vec![src.join("plan.rs")];
+    rs_files(&src.join("pipeline"), &mut files);
+    rs_files(&src.join("plan"), &mut files);
+    assert!(
+        files.len() > 20,
+        "the pipeline's and plan's files: {files:?}"
+    );
+    let importing: Vec<String> = files
+        .iter()
+        .filter(|f| imports_args(&code_of(&std::fs::read_to_string(f).unwrap())))
+        .map(|f| f.display().to_string())
+        .collect();
+    assert!(
+        importing.is_empty(),
+        "crate::args imported in {importing:?}"
+    );
+    // The checker sees an import or an inline path in code, and only there.
+    assert!(imports_args(&code_of("use crate::args::Lod;")));
+    assert!(imports_args(&code_of("fn f() { crate::args::plan(a) }")));
+    assert!(imports_args(&code_of("use crate::{args::Lod, io};")));
+    assert!(!imports_args(&code_of(
+        "// crate::args::Lod\nuse crate::argsx::A;"
+    )));
+}
+
+/// Whether `code` names the `args` module from the crate root.
+fn imports_args(code: &str) -> bool {
+    paths_after(code, "crate::")
+        .iter()
+        .any(|p| p.first().is_some_and(|m| m == "args"))
 }
 
 /// Whether `code` has the identifier `RenderArgs` (not as part of a longer one).

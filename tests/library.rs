@@ -231,7 +231,7 @@ fn view_is_vtks_camera() {
         let args =
             footprint_harness::args::parse_args(&["--view", name, "--size", "64x48"]).unwrap();
         let via_cli = footprint_harness::pipeline::stages::prepare::view_for(
-            &(&args).into(),
+            &footprint_harness::args::inputs(&args).unwrap(),
             [10, 20, 5],
             &grid,
         )
@@ -264,10 +264,13 @@ fn view_is_vtks_camera() {
         "--view", "30,20,10", "--zoom", "1.5", "--size", "64x48",
     ])
     .unwrap();
-    let via_cli =
-        footprint_harness::pipeline::stages::prepare::view_for(&(&args).into(), [10, 20, 5], &grid)
-            .unwrap()
-            .to_screen();
+    let via_cli = footprint_harness::pipeline::stages::prepare::view_for(
+        &footprint_harness::args::inputs(&args).unwrap(),
+        [10, 20, 5],
+        &grid,
+    )
+    .unwrap()
+    .to_screen();
     let direct = View::from_vtk_camera([30.0, 20.0, 10.0], 1.5, [10, 20, 5], &grid, [64, 48])
         .unwrap()
         .to_screen();

@@ -3,9 +3,9 @@
 //! close to full resolution; levels are refused where they are not placed (perspective).
 
 use footprint_harness::args::parse_args;
+use footprint_harness::args::plan;
 use footprint_harness::metrics::compare;
 use footprint_harness::pipeline::{prepare, render_core};
-use footprint_harness::plan::plan;
 use footprint_suite::{rgb_psnr, tmpdir};
 
 const HEADSQ: &str = concat!(

@@ -5,8 +5,8 @@
 //! bright: the test shows that too, so it can fail.
 
 use footprint_harness::args::parse_args;
+use footprint_harness::args::plan;
 use footprint_harness::pipeline::{prepare, render_core};
-use footprint_harness::plan::plan;
 use std::path::PathBuf;
 
 /// A 128³ u8 volume with detail finer than the small render's pixels: three thin concentric

@@ -8,7 +8,7 @@
 use footprint::frame::FrameSetup;
 use footprint::geometry::FootprintOptions;
 use footprint::{Grid, Kernel, View};
-use footprint_harness::plan::plan;
+use footprint_harness::args::plan;
 use footprint_harness::reference::perspective::PerspectiveVoxel;
 use footprint_suite::tmpdir;
 use std::io::Write;

@@ -12,9 +12,9 @@ use footprint::render::{
 };
 use footprint::Kernel;
 use footprint_harness::args::parse_args;
+use footprint_harness::args::plan;
 use footprint_harness::pipeline::stages::visible::FrameCache;
 use footprint_harness::pipeline::{prepare, render_frame};
-use footprint_harness::plan::plan;
 use glam::{DVec3, Mat3, Vec3};
 use std::cell::Cell;
 

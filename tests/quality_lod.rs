@@ -4,10 +4,10 @@
 //! against the f64 reference at level 0; streamed volumes stay at level 0.
 
 use footprint_harness::args::parse_args;
+use footprint_harness::args::plan;
 use footprint_harness::metrics::compare;
 use footprint_harness::pipeline::quality::level_pilot::{pilot_rows, render_rows, PILOT_ROWS};
 use footprint_harness::pipeline::{prepare, render_core, render_ref};
-use footprint_harness::plan::plan;
 use footprint_suite::{apply_quality, tmpdir};
 
 const HEADSQ: &str = concat!(

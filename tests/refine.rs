@@ -5,10 +5,10 @@
 //! 15 part 3).
 
 use footprint_harness::args::parse_args;
+use footprint_harness::args::plan;
 use footprint_harness::metrics::compare;
 use footprint_harness::pipeline::stages::visible::FrameCache;
 use footprint_harness::pipeline::{prepare, render_frame, CoreFrame};
-use footprint_harness::plan::plan;
 use footprint_suite::rgb_psnr;
 
 fn frame(args: &[&str]) -> CoreFrame {
@@ -196,7 +196,7 @@ fn quality_chooses_refinement_against_the_field() {
     assert_eq!(pilot.field_size, Some(128));
     let chosen = plan_with(&args, &c.config);
     let f = render_frame(&p, &chosen, &mut FrameCache::default()).unwrap();
-    let inputs = footprint_harness::plan::Inputs::from(&args);
+    let inputs = footprint_harness::args::inputs(&args).unwrap();
     let (truth, _) =
         render_continuous_ref(&prepare_field(&inputs).unwrap(), Reconstruction::Kernel).unwrap();
     let got = compare(&f.image, &truth.image).1.psnr_db;
@@ -229,13 +229,13 @@ fn quality_chooses_refinement_against_the_field() {
         "/tests/data/heart_32x32x12_float32_le.nhdr"
     );
     let args = parse_args(&[file, "--size", "32x32"]).unwrap();
-    let e = prepare_field(&(&args).into())
+    let e = prepare_field(&footprint_harness::args::inputs(&args).unwrap())
         .err()
         .expect("refused")
         .to_string();
     assert!(e.contains("nothing finer"), "{e}");
     let args = parse_args(&["--scene-size", "16", "--field-size", "16"]).unwrap();
-    let e = prepare_field(&(&args).into())
+    let e = prepare_field(&footprint_harness::args::inputs(&args).unwrap())
         .err()
         .expect("refused")
         .to_string();

@@ -183,9 +183,13 @@ fn paper_map_near_45_degrees_is_measured() {
     let mut args = splat_args();
     args.rotate_z = 45.0;
     args.footprint.method = MethodArg::Paper;
-    let img = splat_image(&args).unwrap().0;
+    let img = splat_image(&footprint_harness::args::single(&args).unwrap())
+        .unwrap()
+        .0;
     args.footprint.method = MethodArg::Reference;
-    let r = splat_image(&args).unwrap().0;
+    let r = splat_image(&footprint_harness::args::single(&args).unwrap())
+        .unwrap()
+        .0;
     assert_le(
         max_rel_diff(&img, &r),
         0.01,

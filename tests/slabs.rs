@@ -310,10 +310,10 @@ fn what_slabs_cannot_do_is_refused() {
 // ---- The harness's `--slicing image` ----
 
 use footprint_harness::args::parse_args;
+use footprint_harness::args::plan;
 use footprint_harness::metrics::compare;
 use footprint_harness::pipeline::stages::visible::FrameCache;
 use footprint_harness::pipeline::{prepare, render_continuous_ref, render_frame};
-use footprint_harness::plan::plan;
 use footprint_harness::reference::continuous::Reconstruction;
 
 const HEADSQ: &str = concat!(

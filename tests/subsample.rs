@@ -4,9 +4,9 @@
 //! `auto`, and refuses what it cannot honour with a typed error.
 
 use footprint_harness::args::parse_args;
+use footprint_harness::args::plan;
 use footprint_harness::pipeline::stages::visible::FrameCache;
 use footprint_harness::pipeline::{prepare, render_frame, stages::subsample, CoreFrame};
-use footprint_harness::plan::plan;
 use footprint_suite::{rgb_psnr, tmpdir};
 
 /// The built-in scene with `extra` flags.

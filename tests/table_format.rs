@@ -128,19 +128,25 @@ fn tables_command_output_loads_in_splat() {
     assert_eq!(code, 0);
     let mut a = splat_args();
     a.rotate_z = 30.0;
-    let built = footprint_harness::pipeline::ends::single::splat_image(&a)
+    let built = footprint_harness::args::single(&a)
+        .and_then(|s| footprint_harness::pipeline::ends::single::splat_image(&s))
         .unwrap()
         .0;
     a.footprint.table_file = Some(file.clone());
-    let loaded = footprint_harness::pipeline::ends::single::splat_image(&a)
+    let loaded = footprint_harness::args::single(&a)
+        .and_then(|s| footprint_harness::pipeline::ends::single::splat_image(&s))
         .unwrap()
         .0;
     assert_eq!(max_rel_diff(&loaded, &built), 0.0);
     a.footprint.kernel = "cone".into();
-    assert!(footprint_harness::pipeline::ends::single::splat_image(&a).is_err());
+    assert!(footprint_harness::args::single(&a)
+        .and_then(|s| footprint_harness::pipeline::ends::single::splat_image(&s))
+        .is_err());
     a.footprint.kernel = "gaussian".into();
     a.footprint.table = 33;
-    let err = footprint_harness::pipeline::ends::single::splat_image(&a).unwrap_err();
+    let err = footprint_harness::args::single(&a)
+        .and_then(|s| footprint_harness::pipeline::ends::single::splat_image(&s))
+        .unwrap_err();
     assert!(
         err.message.contains("65x65") && err.message.contains("33x33"),
         "{err}"

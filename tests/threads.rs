@@ -3,9 +3,9 @@
 //! full scan of every voxel, and `bench` writes the keys the issue names.
 
 use footprint_harness::args::parse_args;
+use footprint_harness::args::plan;
 use footprint_harness::pipeline::stages::visible::FrameCache;
 use footprint_harness::pipeline::{prepare, render_frame};
-use footprint_harness::plan::plan;
 use footprint_suite::tmpdir;
 
 /// The core's image of the built-in scene with `extra` flags on `threads` threads, as bits, and

@@ -270,8 +270,8 @@ fn frame(args: &RenderArgs) -> Result<Frame, CliError> {
         args.out.as_deref(),
         args.json.as_deref(),
     )?;
-    let asked = footprint_harness::plan::plan(args)?;
-    let inputs = footprint_harness::plan::Inputs::from(args);
+    let asked = footprint_harness::args::plan(args)?;
+    let inputs = footprint_harness::args::inputs(args)?;
     let (image, summary, _) = single(args, &inputs, &asked)?;
     if args.out.is_some() || args.json.is_some() {
         write_files(args, args.out.as_deref(), &image, summary)?;
@@ -434,10 +434,8 @@ fn load<'py>(py: Python<'py>, path: &str, flags: Vec<String>) -> PyResult<Loaded
     let mut all = vec![path.to_string()];
     all.extend(flags);
     let args = parse(&all)?;
-    let raw = footprint_harness::pipeline::stages::load::raw_options(
-        &footprint_harness::plan::Inputs::from(&args),
-    )
-    .map_err(py_err)?;
+    let inputs = footprint_harness::args::inputs(&args).map_err(py_err)?;
+    let raw = footprint_harness::pipeline::stages::load::raw_options(&inputs).map_err(py_err)?;
     let volume = py
         .detach(|| {
             footprint_harness::io::formats::load_array(

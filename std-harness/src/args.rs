@@ -13,9 +13,12 @@ use std::path::PathBuf;
 mod model;
 mod parse;
 mod phase;
+pub mod resolve;
+pub use crate::io::image::Background;
 pub use model::*;
 pub use parse::*;
 pub use phase::*;
+pub use resolve::{inputs, plan, single, turned};
 
 /// Table lookup, as on the command line.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, ValueEnum)]
@@ -116,17 +119,6 @@ impl SlicingArg {
             SlicingArg::Auto => "auto",
         }
     }
-}
-
-/// What the volume is composited over (`--background`).
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub enum Background {
-    /// Black, opaque: the PNG is RGB, the premultiplied colour as it is (the default).
-    Black,
-    /// Nothing: the PNG is RGBA with straight alpha, the render's coverage.
-    Transparent,
-    /// A PNG of the output size, composited behind the volume (its alpha respected).
-    Image(PathBuf),
 }
 
 fn parse_background(s: &str) -> Result<Background, String> {
@@ -489,16 +481,6 @@ impl GammaArg {
         match self {
             GammaArg::Linear => crate::io::image::Gamma::Linear,
             GammaArg::Srgb => crate::io::image::Gamma::Srgb,
-        }
-    }
-}
-
-impl Background {
-    /// The image file, if it names one.
-    pub fn file(&self) -> Option<&std::path::Path> {
-        match self {
-            Background::Image(p) => Some(p),
-            _ => None,
         }
     }
 }

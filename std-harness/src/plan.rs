@@ -1,42 +1,106 @@
-//! The render plan (issue 41): what draws a frame, resolved once from the command line.
-//!
-//! [`plan`] turns `render`'s flags into a typed [`Plan`] and holds every compatibility rule that
-//! the flags alone decide, before anything is loaded: between end points, precision and model,
-//! with a streamed volume, and between the resolution decorators ([`check_levels`], which the
-//! pipeline also applies to [`Inputs`] built in code). The rules that need the volume or the
-//! frame (a subsampling factor too large for the footprints, a supersampling the minimum radius
-//! asks for, a view a pipe cannot feed) stay where those are known. The pipeline renders `(&Prepared, &Plan)` ([`crate::pipeline::render_frame`]); `verify`,
-//! `bench`, `chart` and `--quality` build or derive plans ([`Plan::with_precision`],
-//! [`crate::pipeline::quality::config::Config::plan`]) instead of rewriting flags, so `verify` renders the
-//! plan `render` would, defaults included.
+//! The render plan (issue 41): what draws a frame ([`Plan`]) and what is rendered ([`Inputs`]),
+//! as typed values. The command line is resolved into them once (`crate::args::resolve`, with
+//! every rule the flags alone decide); programs build them themselves ([`Request`] for
+//! `(Inputs, Plan)`). Nothing here names a flag's clap type. The rules that need the volume or
+//! the frame (a subsampling factor too large for the footprints, a supersampling the minimum
+//! radius asks for, a view a pipe cannot feed) stay where those are known; the rules between the
+//! resolution decorators that the inputs decide are [`check_levels`], applied to every
+//! [`Inputs`]. The pipeline renders `(&Prepared, &Plan)` ([`crate::pipeline::render_frame`]);
+//! `verify`, `bench`, `chart` and `--quality` build or derive plans ([`Plan::with_precision`],
+//! [`crate::pipeline::quality::config::Config::plan`]) instead of rewriting flags, so `verify`
+//! renders the plan `render` would, defaults included.
 //!
 //! ```text
 //! Plan { end, table, phases, threads, subsample }
 //! end:        Sheets(Float | Fixed)   the paper's sheets (object slicing)
 //!             Slabs { thickness }     image-aligned slabs (float)
+//!             Post { thickness, .. }  post-classified image-aligned slabs (float)
 //!             Refined { threshold }   sheets on a refined grid (float, robust, orthographic)
 //!             Reference               the f64 sheet reference
 //! subsample:  a decorator of Sheets and Slabs: render at 1/s of the size and resample
 //! ```
 //!
-//! Levels of detail and supersampling are the other decorators; they are decided with the frame
-//! and never act on one frame together (`pipeline::stages::prepare::setup_frame`).
+//! Levels of detail and supersampling are the other decorators ([`resolution`]); they are
+//! decided with the frame and never act on one frame together
+//! (`pipeline::stages::prepare::setup_frame`).
 
-use crate::args::{
-    AccumArg, Background, ClassificationArg, FootprintArgs, GammaArg, Lod, LookupArg, MethodArg,
-    OrderArg, QualityReferenceArg, RenderArgs, SlicingArg, Supersample,
-};
+use crate::io::image::{Background, Gamma};
 use crate::CliError;
+use footprint::frame::Order;
+use footprint::geometry::FootprintOptions;
 use footprint::render::Absorption;
-use footprint::Lookup;
+use footprint::{Kernel, Lookup};
 use std::path::PathBuf;
 
-mod auto;
 mod phase;
-mod post;
-pub use auto::DEFAULT_TARGET_DB;
-use phase::phase_lookup_rules;
-use post::{no_post_flags, post_plan};
+pub mod resolution;
+pub use phase::phase_lookup_name;
+pub use resolution::{Lod, Supersample};
+
+/// The PSNR, dB, against the continuous model (`--absorption`'s, opacity by default) that the
+/// default plan's frame is measured to reach on its pilot before object slicing is kept.
+pub const DEFAULT_TARGET_DB: f64 = 44.0;
+
+/// How a footprint is evaluated (`--method`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Method {
+    /// View table built through the Cholesky (or sheet-parallelogram) map: no singular angle.
+    Robust,
+    /// View table built through the paper's θ/Sx/Sy decomposition with its rotation cheat.
+    Paper,
+    /// No view table: each pixel is mapped straight into the generic table.
+    Direct,
+    /// f64, no tables: the exact line integral (the float reference).
+    Reference,
+}
+
+impl Method {
+    /// The name the command line and the JSON use.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Robust => "robust",
+            Method::Paper => "paper",
+            Method::Direct => "direct",
+            Method::Reference => "reference",
+        }
+    }
+}
+
+/// What `--quality DB` aims at (`--quality-reference`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum QualityReference {
+    /// The f64 renderer with the same sheets: the table configuration's error, predicted from
+    /// one footprint.
+    Sheets,
+    /// The continuous volume-rendering integral, measured on a pilot of sampled rays.
+    Continuous,
+    /// The built-in scene only: the continuous integral of its analytic field sampled finer.
+    Field,
+}
+
+impl QualityReference {
+    /// The name `--quality-reference` and the JSON use.
+    pub fn name(self) -> &'static str {
+        match self {
+            QualityReference::Sheets => "sheets",
+            QualityReference::Continuous => "continuous",
+            QualityReference::Field => "field",
+        }
+    }
+}
+
+/// The kernel and how its footprints are shaped: what `--kernel`, `--method paper`'s
+/// `--paper-cheat`, `--min-radius` and `--table-file` resolve to.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct KernelModel {
+    /// The reconstruction kernel at full resolution.
+    pub kernel: Kernel,
+    /// The ellipse-to-circle map and the smallest footprint semi-axis, pixels.
+    pub options: FootprintOptions,
+    /// The generic table is loaded from a file made for [`KernelModel::kernel`]
+    /// (`--table-file`): coarser levels keep that kernel instead of narrowing it.
+    pub table_from_file: bool,
+}
 
 /// How the float or fixed sheets accumulate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -150,7 +214,7 @@ pub struct Quality {
     /// The target PSNR, dB.
     pub target_db: f64,
     /// What it is measured against.
-    pub reference: QualityReferenceArg,
+    pub reference: QualityReference,
 }
 
 impl Plan {
@@ -189,150 +253,6 @@ impl Plan {
     }
 }
 
-/// `args`' plan, with every rule the flags alone decide (see the module docs).
-pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
-    let fa = &args.footprint;
-    let precision = match args.accum {
-        AccumArg::Float => Precision::Float,
-        AccumArg::Fixed => Precision::Fixed,
-    };
-    if args.classification == ClassificationArg::Post {
-        return post_plan(args, precision);
-    }
-    no_post_flags(args)?;
-    let slicing = match args.slicing {
-        Some(SlicingArg::Image) => SlicingArg::Image,
-        _ => SlicingArg::Object,
-    };
-    let end = match (fa.method, args.refine, slicing) {
-        (MethodArg::Reference, _, _) => End::Reference,
-        (_, Some(threshold), _) => End::Refined {
-            threshold,
-            sheets: args.refine_sheets,
-        },
-        (_, None, SlicingArg::Image) => End::Slabs {
-            thickness: args.slab,
-        },
-        (_, None, _) => End::Sheets(precision),
-    };
-    let refuse = |flag: &str, why: &str| Err(CliError::input(format!("{flag}: {why}")));
-    match end {
-        End::Refined { .. } if precision == Precision::Fixed => {
-            return refuse("--refine", "float accumulation only (drop --accum fixed)")
-        }
-        End::Refined { .. } if slicing == SlicingArg::Image => {
-            return refuse("--refine", "the paper's sheets only (drop --slicing image)")
-        }
-        End::Refined { .. } if args.perspective.is_some() => {
-            return refuse("--refine", "orthographic views only (drop --perspective)")
-        }
-        End::Refined { .. } if fa.method != MethodArg::Robust => {
-            return refuse(
-                "--refine",
-                "the rate tables are view tables built by the robust method (drop --method)",
-            )
-        }
-        End::Slabs { .. } if precision == Precision::Fixed => {
-            return refuse(
-                "--slicing image",
-                "there is no fixed-point slab path (each slab is composited with an exponential \
-                 per pixel): use --accum float or --slicing object",
-            )
-        }
-        _ => {}
-    }
-    flag_rules(&end, args)?;
-    check_levels(&Inputs::from(args))?;
-    let extinction = Absorption::from(args.absorption) == Absorption::Extinction;
-    if extinction && matches!(end, End::Sheets(_) | End::Refined { .. }) {
-        // (Perspective sheets place each voxel's optical depth along its own ray: `PerVoxel`.)
-        if precision == Precision::Fixed {
-            return refuse(
-                "--absorption extinction",
-                "--accum fixed composites the opacity model only: use --accum float (or \
-                 --absorption opacity)",
-            );
-        }
-    }
-    subsample_rules(args)?;
-    let auto_slicing = auto::slicing_target(&end, args);
-    Ok(Plan {
-        end,
-        table: Table {
-            size: fa.table,
-            lookup: Lookup::from(fa.lookup),
-            footprints: match fa.method {
-                MethodArg::Direct => Footprints::Direct,
-                _ => Footprints::ViewTable,
-            },
-            file: fa.table_file.clone(),
-        },
-        phases: args.phases,
-        phase_lookup: args.phase_lookup.fixed(),
-        threads: args.thread_count(),
-        subsample: args.subsample.unwrap_or(Supersample::Fixed(1)),
-        cull: args.cull.0,
-        quality: args.quality.map(|target_db| Quality {
-            target_db,
-            reference: args.quality_reference,
-        }),
-        auto_slicing,
-        auto_subsample: args.subsample.is_none() && auto_slicing.is_some(),
-    })
-}
-
-/// The rules `--subsample` adds: not with `--quality` (which chooses at the output size), an
-/// explicit factor not with `--refine`, a perspective view, supersampling or a coarser level.
-fn subsample_rules(args: &RenderArgs) -> Result<(), CliError> {
-    let refuse = |flag: &str, why: &str| Err(CliError::input(format!("{flag}: {why}")));
-    let factor = match args.subsample {
-        None | Some(Supersample::Fixed(1)) => None,
-        Some(Supersample::Fixed(s)) => Some(s.to_string()),
-        Some(Supersample::Auto) => Some("auto".to_string()),
-    };
-    let Some(s) = factor else {
-        return Ok(());
-    };
-    if args.quality.is_some() {
-        return refuse(
-            &format!("--subsample {s}"),
-            "--quality chooses the method from measured errors at the output size; drop one",
-        );
-    }
-    if args.refine.is_some() && s != "auto" {
-        return refuse(
-            &format!("--subsample {s}"),
-            "--refine adds samples for magnified volumes; subsampling removes pixels: drop one",
-        );
-    }
-    // An explicit factor where the flags already rule subsampling out (`auto` then means
-    // 1; the frame decides the rest: `pipeline::stages::subsample::factor`).
-    let blocked = if s == "auto" {
-        None
-    } else if args.perspective.is_some() {
-        Some(SUBSAMPLE_NOT_PERSPECTIVE)
-    } else if matches!(args.supersample, Supersample::Fixed(2..)) {
-        Some("the frame is supersampled (--supersample): give one of them")
-    } else if matches!(args.lod, Lod::Level(1..)) {
-        Some(SUBSAMPLE_NOT_AT_A_LEVEL)
-    } else {
-        None
-    };
-    if let Some(why) = blocked {
-        return refuse(&format!("--subsample {s}"), why);
-    }
-    Ok(())
-}
-
-impl From<Lookup> for LookupArg {
-    fn from(l: Lookup) -> Self {
-        match l {
-            Lookup::Nearest => LookupArg::Nearest,
-            Lookup::Bilinear => LookupArg::Bilinear,
-        }
-    }
-}
-
 /// Why `--subsample` is refused with a perspective view: here from the flags, and in
 /// `pipeline::stages::subsample::factor` for a frame built in code.
 pub const SUBSAMPLE_NOT_PERSPECTIVE: &str =
@@ -342,60 +262,6 @@ pub const SUBSAMPLE_NOT_PERSPECTIVE: &str =
 /// choice in `pipeline::stages::subsample::factor`).
 pub const SUBSAMPLE_NOT_AT_A_LEVEL: &str =
     "the volume renders at a coarser level of detail (--lod); give --lod 0 or auto";
-
-/// The rules a streamed volume and `--cull` add to `end`.
-fn flag_rules(end: &End, args: &RenderArgs) -> Result<(), CliError> {
-    phase_lookup_rules(end, args)?;
-    if args.stream.is_some() {
-        streamed_rules(end, args)?;
-    }
-    match args.cull.0 {
-        Some(eps) => cull_rules(eps, end, args),
-        None => Ok(()),
-    }
-}
-
-/// `flag` refused for reason `why`, if there is one.
-fn refused_if(flag: &str, why: Option<&str>) -> Result<(), CliError> {
-    match why {
-        Some(why) => Err(CliError::input(format!("{flag}: {why}"))),
-        None => Ok(()),
-    }
-}
-
-/// The rules `--cull EPS` adds: sheets or pre-classified slabs, front to back, orthographic, and
-/// not with `--quality` (which chooses the method itself).
-fn cull_rules(eps: f32, end: &End, args: &RenderArgs) -> Result<(), CliError> {
-    let why = if !matches!(end, End::Sheets(_) | End::Slabs { .. }) {
-        Some("the paper's sheets and pre-classified slabs only: drop --classification post, --refine or --method reference")
-    } else if args.perspective.is_some() {
-        Some("orthographic views only (a perspective view's footprints vary per voxel)")
-    } else if args.order == Some(OrderArg::BackToFront) {
-        Some("culling needs front-to-back compositing: drop --order back-to-front")
-    } else if args.quality.is_some() {
-        Some("--quality chooses the method from measured errors: drop one")
-    } else {
-        None
-    };
-    refused_if(&format!("--cull {eps}"), why)
-}
-
-/// The rules a streamed volume (`--stream`: read once, a few sheets at a time) adds to `end`.
-fn streamed_rules(end: &End, args: &RenderArgs) -> Result<(), CliError> {
-    let refuse = |flag: &str, why: &str| Err(CliError::input(format!("{flag}: {why}")));
-    match end {
-        End::Refined { .. } => refuse("--refine", "the volume must be in memory (drop --stream)"),
-        End::Slabs { .. } => refuse(
-            "--slicing image",
-            "a slab of an oblique view crosses every sheet, so it cannot be fed from a few \
-             streamed sheets: drop --stream (the volume is loaded) or use --slicing object",
-        ),
-        _ => match (args.quality, args.lod) {
-            (Some(_), Lod::Level(n @ 1..)) => Err(quality_level_of_stream(n)),
-            _ => Ok(()),
-        },
-    }
-}
 
 /// `--quality` with `--lod N` (N ≥ 1) of a streamed volume: refused.
 pub fn quality_level_of_stream(n: u32) -> CliError {
@@ -409,8 +275,8 @@ pub fn quality_level_of_stream(n: u32) -> CliError {
 /// The rules between the resolution decorators that the inputs decide before any frame: an
 /// explicit level of detail (`--lod N`, N ≥ 1) is refused with a perspective view, with
 /// `--refine` (which refines full resolution) and with `--supersample K` (K ≥ 2: both would act
-/// on one frame). [`plan`] applies them to the flags; the pipeline's `setup_frame` to every
-/// [`Inputs`], including those built in code.
+/// on one frame). The command line's resolution applies them to the flags; the pipeline's
+/// `setup_frame` to every [`Inputs`], including those built in code.
 pub fn check_levels(inputs: &Inputs) -> Result<(), CliError> {
     let Lod::Level(n @ 1..) = inputs.lod else {
         return Ok(());
@@ -478,14 +344,15 @@ pub struct Inputs {
     pub shading: String,
     /// Picture: background, gamma, PNG depth.
     pub background: Background,
-    pub gamma: GammaArg,
+    pub gamma: Gamma,
     pub depth: u8,
-    /// Kernel and footprint options (`--kernel`, `--min-radius`, `--method paper`'s mapping).
-    pub footprint: FootprintArgs,
+    /// The kernel and its footprints' shape (`--kernel`, `--min-radius`, `--method paper`'s
+    /// mapping, `--table-file`).
+    pub kernel: KernelModel,
     /// The continuous model both slicings composite.
     pub absorption: Absorption,
     /// Compositing order; `None`: the default for the source.
-    pub order: Option<OrderArg>,
+    pub order: Option<Order>,
     /// Decorators decided with the frame: supersampling and level of detail.
     pub supersample: Supersample,
     pub lod: Lod,
@@ -495,91 +362,20 @@ pub struct Inputs {
     pub quality: bool,
 }
 
-impl From<&RenderArgs> for Inputs {
-    fn from(a: &RenderArgs) -> Self {
-        Inputs {
-            memory: a.memory.clone(),
-            stdin: a.stdin.clone(),
-            volume: a.volume.clone(),
-            stream: a.stream.clone(),
-            dims: a.dims,
-            sample_type: a.sample_type.clone(),
-            endian: a.endian.clone(),
-            spacing: a.spacing,
-            array: a.array.clone(),
-            scene_size: a.scene_size,
-            field_size: a.field_size,
-            size: a.size,
-            view: a.view,
-            zoom: a.zoom,
-            view_matrix: a.view_matrix,
-            perspective: a.perspective,
-            eye_distance: a.eye_distance,
-            tf: a.tf.clone(),
-            window: a.window,
-            shading: a.shading.clone(),
-            background: a.background.clone(),
-            gamma: a.gamma,
-            depth: a.depth,
-            footprint: a.footprint.clone(),
-            absorption: a.absorption.into(),
-            // Post-classification composites front to back unless told: opaque pixels then take
-            // nothing more (exact), where back to front must classify every slab.
-            // Culling needs what is in front first.
-            order: match (a.classification, a.order) {
-                (ClassificationArg::Post, None) => Some(crate::args::OrderArg::FrontToBack),
-                (_, None) if a.cull.0.is_some() => Some(crate::args::OrderArg::FrontToBack),
-                (_, order) => order,
-            },
-            supersample: a.supersample,
-            // Post-classification reconstructs the values at full resolution (a coarser level
-            // carries pre-classified colours): `auto` means level 0 there.
-            lod: match (a.classification, a.lod) {
-                (ClassificationArg::Post, Lod::Auto) => Lod::Level(0),
-                (_, lod) => lod,
-            },
-            refine: a.refine.is_some(),
-            quality: a.quality.is_some(),
-        }
-    }
-}
-
-/// `base` turned `degrees` of azimuth further about the volume's vertical axis: `--view`'s
-/// azimuth plus `degrees`, or a `--view-matrix` V as V · Ry(degrees) (the same turn). What
-/// `render --orbit` and `bench --orbit` step by.
-pub fn turned(base: &RenderArgs, degrees: f32) -> RenderArgs {
-    let mut a = base.clone();
-    a.view[0] += degrees;
-    if let Some(m) = a.view_matrix {
-        let v = glam::Mat3::from_cols_array(&m).transpose()
-            * glam::Mat3::from_rotation_y(degrees.to_radians());
-        a.view_matrix = Some(v.transpose().to_cols_array());
-    }
-    a
-}
-
 /// What a render was asked for: its [`Inputs`] and its [`Plan`]. The command line's
-/// [`RenderArgs`] is one (and `(Inputs, Plan)`, for a program that builds them itself): the
-/// pipeline's entry ([`crate::pipeline::prepare()`]) takes any, so it never names the command line.
+/// `RenderArgs` is one (resolved in `crate::args::resolve`), and `(Inputs, Plan)`, for a
+/// program that builds them itself: the pipeline's entry ([`crate::pipeline::prepare()`]) takes
+/// any, so it never names the command line.
 pub trait Request {
-    /// What to load and how to see it.
-    fn inputs(&self) -> Inputs;
+    /// What to load and how to see it (the kernel's and the mapping's rules checked).
+    fn inputs(&self) -> Result<Inputs, CliError>;
     /// What draws the frame (its rules checked).
     fn plan(&self) -> Result<Plan, CliError>;
 }
 
-impl Request for RenderArgs {
-    fn inputs(&self) -> Inputs {
-        Inputs::from(self)
-    }
-    fn plan(&self) -> Result<Plan, CliError> {
-        plan(self)
-    }
-}
-
 impl Request for (Inputs, Plan) {
-    fn inputs(&self) -> Inputs {
-        self.0.clone()
+    fn inputs(&self) -> Result<Inputs, CliError> {
+        Ok(self.0.clone())
     }
     fn plan(&self) -> Result<Plan, CliError> {
         Ok(self.1.clone())

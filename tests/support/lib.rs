@@ -133,10 +133,13 @@ pub fn splat_args() -> SplatArgs {
 
 /// Renders `args` with its method and with `--method reference`; returns (core, reference).
 pub fn with_reference(args: &SplatArgs) -> (GreyImage, GreyImage) {
-    let core = splat_image(args).expect("core splat").0;
+    let core = splat_image(&footprint_harness::args::single(args).expect("resolved"))
+        .expect("core splat")
+        .0;
     let mut r = args.clone();
     r.footprint.method = MethodArg::Reference;
-    (core, splat_image(&r).expect("reference splat").0)
+    let reference = footprint_harness::args::single(&r).expect("resolved");
+    (core, splat_image(&reference).expect("reference splat").0)
 }
 
 /// max |a − b| / max(b): the footprint difference relative to the reference's peak.
@@ -267,8 +270,8 @@ pub fn apply_quality(
     ),
     footprint_harness::CliError,
 > {
-    let plan = footprint_harness::plan::plan(args)?;
-    let inputs = footprint_harness::plan::Inputs::from(args);
+    let plan = footprint_harness::args::plan(args)?;
+    let inputs = footprint_harness::args::inputs(args)?;
     footprint_harness::pipeline::quality::choose::apply_quality(p, &inputs, &plan)
 }
 
@@ -280,10 +283,14 @@ pub fn choose_continuous(
     target_db: f64,
     reference: footprint_harness::args::QualityReferenceArg,
 ) -> Result<footprint_harness::pipeline::quality::model::Choice, footprint_harness::CliError> {
-    let plan = footprint_harness::plan::plan(args)?;
-    let inputs = footprint_harness::plan::Inputs::from(args);
+    let plan = footprint_harness::args::plan(args)?;
+    let inputs = footprint_harness::args::inputs(args)?;
     footprint_harness::pipeline::quality::pilot::choose_continuous(
-        p, &inputs, &plan, target_db, reference,
+        p,
+        &inputs,
+        &plan,
+        target_db,
+        reference.into(),
     )
 }
 
@@ -293,5 +300,5 @@ pub fn plan_with(
     args: &footprint_harness::args::RenderArgs,
     c: &footprint_harness::pipeline::quality::config::Config,
 ) -> footprint_harness::plan::Plan {
-    c.plan(&footprint_harness::plan::plan(args).unwrap())
+    c.plan(&footprint_harness::args::plan(args).unwrap())
 }

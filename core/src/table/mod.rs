@@ -27,7 +27,7 @@ pub(crate) use view::for_each_view_node;
 pub use view::{box_fill, ViewLayout, ViewTable, MIN_BOX_FILL};
 
 /// How a table is read between its nodes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Lookup {
     /// The value of the nearest node.
     Nearest,

@@ -1,5 +1,7 @@
 //! Value parsers for the shared flags: lists, views, sizes, levels of detail, supersampling.
 
+pub use crate::plan::{Lod, Supersample};
+
 /// Parses `a,b,c,…` into exactly `n` finite numbers (f32: one past its range is refused).
 pub fn parse_list<const N: usize>(s: &str) -> Result<[f32; N], String> {
     let wide = parse_list_f64::<N>(s)?;
@@ -109,24 +111,6 @@ pub fn parse_min_radius(s: &str) -> Result<f32, String> {
         return Err(format!("{v} px is outside [{least}, ∞) px"));
     }
     Ok(v)
-}
-
-/// `--supersample`: `auto`, or a fixed factor.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Supersample {
-    /// k from the footprint's natural size (1 when no widening is needed).
-    Auto,
-    /// This factor (1 = off).
-    Fixed(usize),
-}
-
-/// `--lod`: `auto`, or a fixed level of detail.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Lod {
-    /// The level from the projected voxel size (`pipeline::stages::lod::auto_level`).
-    Auto,
-    /// This level (0 = full resolution).
-    Level(u32),
 }
 
 /// Parses `auto` or a level 0 … `footprint::lod::MAX_LEVEL`.

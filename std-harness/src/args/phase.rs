@@ -26,10 +26,4 @@ impl PhaseLookupArg {
     }
 }
 
-/// The name the flag and the JSON use.
-pub fn phase_lookup_name(l: PhaseLookup) -> &'static str {
-    match l {
-        PhaseLookup::Blend => "blend",
-        PhaseLookup::Nearest => "nearest",
-    }
-}
+pub use crate::plan::phase_lookup_name;

@@ -63,12 +63,12 @@ pub fn sweep(base: &RenderArgs, runs: usize) -> Result<(Vec<LevelRow>, u32), Cli
     let mut caches: Vec<FrameCache> = levels.iter().map(|_| FrameCache::default()).collect();
     let mut images = Vec::new();
     for ((a, p), cache) in levels.iter().zip(&mut caches) {
-        images.push(render_frame(p, &crate::plan::plan(a)?, cache)?.image);
+        images.push(render_frame(p, &crate::args::plan(a)?, cache)?.image);
     }
     let mut times = vec![Vec::new(); levels.len()];
     for _ in 0..runs.max(1) {
         for (((a, p), cache), t) in levels.iter().zip(&mut caches).zip(&mut times) {
-            t.push(render_frame(p, &crate::plan::plan(a)?, cache)?.seconds);
+            t.push(render_frame(p, &crate::args::plan(a)?, cache)?.seconds);
         }
     }
     let full: Vec<[f64; 4]> = images[0].iter().map(|c| c.map(f64::from)).collect();

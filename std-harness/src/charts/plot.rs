@@ -5,11 +5,12 @@
 use super::popping::Popping;
 use super::stability::Curve;
 use super::sweep::Measured;
-use crate::args::{AccumArg, LookupArg, MethodArg};
 use crate::io;
 use crate::io::outputs::Batch;
 use crate::pipeline::quality::config::{accum_name, lookup_name, method_name, Config};
+use crate::plan::{Method, Precision};
 use crate::CliError;
+use footprint::Lookup;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -47,10 +48,10 @@ fn series_colour(c: &Config) -> RGBColor {
         return COLOURS[4];
     }
     let i = match (c.method, c.accum) {
-        (MethodArg::Direct, AccumArg::Float) => 1,
-        (MethodArg::Direct, AccumArg::Fixed) => 3,
-        (_, AccumArg::Float) => 0,
-        (_, AccumArg::Fixed) => 2,
+        (Method::Direct, Precision::Float) => 1,
+        (Method::Direct, Precision::Fixed) => 3,
+        (_, Precision::Float) => 0,
+        (_, Precision::Fixed) => 2,
     };
     COLOURS[i]
 }
@@ -121,7 +122,7 @@ where
             Some(t) => format!("slab {t}"),
             None => format!("{}", r.config.table),
         };
-        let style = if r.config.lookup == LookupArg::Bilinear {
+        let style = if r.config.lookup == Lookup::Bilinear {
             col.filled()
         } else {
             col.stroke_width(2)

@@ -59,14 +59,14 @@ pub fn popping(
         let az = f64::from(tenth) / 10.0;
         args.view = [az as f32, base.view[1], base.view[2]];
         args.view_matrix = None;
-        p.reframe(&crate::plan::Inputs::from(&args))?;
+        p.reframe(&crate::args::inputs(&args)?)?;
         let (truth, _) = render_continuous_ref(&p, Reconstruction::Kernel)?;
         for (k, slicing) in [SlicingArg::Object, SlicingArg::Image]
             .into_iter()
             .enumerate()
         {
             args.slicing = Some(slicing);
-            let plan = crate::plan::plan(&args)?.with_precision(crate::plan::Precision::Float);
+            let plan = crate::args::plan(&args)?.with_precision(crate::plan::Precision::Float);
             let f = render_frame(&p, &plan, &mut caches[k])?;
             out.truth_db[k].push(compare(&f.image, &truth.image).1.psnr_db);
             let img64 = f.image.iter().map(|c| c.map(f64::from)).collect();

@@ -55,7 +55,7 @@ pub fn sweep(base: &RenderArgs, runs: usize) -> Result<Vec<PostRow>, CliError> {
         .collect();
     let plans = configs
         .iter()
-        .map(|(a, _, _)| crate::plan::plan(a))
+        .map(|(a, _, _)| crate::args::plan(a))
         .collect::<Result<Vec<_>, _>>()?;
     let mut rows = Vec::new();
     let mut times = vec![Vec::new(); configs.len()];

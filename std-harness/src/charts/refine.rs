@@ -51,7 +51,7 @@ pub fn sweep(base: &RenderArgs, reference: usize, runs: usize) -> Result<Vec<Ref
     fine.refine_sheets = false;
     let pf = prepare(&fine)?;
     let truth: Vec<[f64; 4]> =
-        render_frame(&pf, &crate::plan::plan(&fine)?, &mut FrameCache::default())?
+        render_frame(&pf, &crate::args::plan(&fine)?, &mut FrameCache::default())?
             .image
             .iter()
             .map(|c| c.map(f64::from))
@@ -78,7 +78,7 @@ pub fn sweep(base: &RenderArgs, reference: usize, runs: usize) -> Result<Vec<Ref
     let mut times = vec![Vec::new(); configs.len()];
     for run in 0..=runs.max(1) {
         for (((a, t, sheets), p), times) in configs.iter().zip(&prepared).zip(&mut times) {
-            let f = render_frame(p, &crate::plan::plan(a)?, &mut FrameCache::default())?;
+            let f = render_frame(p, &crate::args::plan(a)?, &mut FrameCache::default())?;
             if run == 0 {
                 // The first pass gives the image (and warms caches); the rest are timed.
                 rows.push(RefineRow {

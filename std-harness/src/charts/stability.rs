@@ -13,10 +13,10 @@ pub struct Curve {
 }
 
 fn splat_error(args: &SplatArgs) -> Option<f64> {
-    let core = splat_image(args).ok()?.0;
+    let core = splat_image(&crate::args::single(args).ok()?).ok()?.0;
     let mut r = args.clone();
     r.footprint.method = MethodArg::Reference;
-    let reference = splat_image(&r).ok()?.0;
+    let reference = splat_image(&crate::args::single(&r).ok()?).ok()?.0;
     let e = max_rel_diff(&core, &reference).ok()?;
     e.is_finite().then_some(e)
 }

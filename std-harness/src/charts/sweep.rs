@@ -66,7 +66,7 @@ pub fn sweep(
         truth.change_db
     );
     // One untimed render first, so the first configuration is not timed with cold caches.
-    let base_plan = crate::plan::plan(base)?;
+    let base_plan = crate::args::plan(base)?;
     if let Some(c) = configs.first() {
         render_core(&p, &c.plan(&base_plan))?;
     }

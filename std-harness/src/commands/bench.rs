@@ -13,13 +13,13 @@
 //! `culled_voxels_per_frame`, and the render summary's fields (`plan`: what drew the frames).
 
 use crate::args::RenderArgs;
+use crate::args::{plan, turned};
 use crate::io::{self, json::Json};
 use crate::pipeline::quality::choose::{apply_quality, chosen_frame};
 use crate::pipeline::quality::model::quality_json;
 use crate::pipeline::stages::bands::Phases;
 use crate::pipeline::stages::visible::FrameCache;
 use crate::pipeline::{describe, prepare};
-use crate::plan::{plan, turned, Inputs};
 use crate::CliError;
 use clap::Args;
 use std::time::Instant;
@@ -99,7 +99,7 @@ fn check(args: &BenchArgs) -> Result<(), CliError> {
 pub fn run(args: &BenchArgs) -> Result<(), CliError> {
     check(args)?;
     let base = &args.render;
-    let inputs = Inputs::from(base);
+    let inputs = crate::args::inputs(base)?;
     let prepared = prepare(base)?;
     // The default plan's pilot (or --quality's) is part of a fresh volume's cost.
     let choosing = Instant::now();
@@ -116,7 +116,7 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
     for k in 0..args.frames {
         // The same plan every frame; only the view turns.
         if k > 0 {
-            p.reframe(&Inputs::from(&turned(base, args.orbit * k as f32)))?;
+            p.reframe(&crate::args::inputs(&turned(base, args.orbit * k as f32))?)?;
         }
         let (f, piloted) = chosen_frame(&p, &plan, &mut choice, &mut cache)?;
         pilot_frame |= piloted;

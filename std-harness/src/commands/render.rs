@@ -1,6 +1,7 @@
 //! `footprint render`: a volume (or the built-in scene) rendered by the core, sheet by sheet, to a
 //! PNG (see [`crate::pipeline::prepare`](mod@crate::pipeline::stages::prepare) for the view conventions).
 
+use crate::args::{plan, turned};
 use crate::args::{MethodArg, RenderArgs};
 use crate::charts::colorbar;
 use crate::io::image::{check_style, encode_apng, encode_rgb_for, RGB_EXTENSIONS};
@@ -9,7 +10,7 @@ use crate::pipeline::quality::choose::{apply_quality, chosen_frame};
 use crate::pipeline::quality::model::quality_json;
 use crate::pipeline::stages::visible::FrameCache;
 use crate::pipeline::{describe, prepare, render_frame, render_ref, Prepared};
-use crate::plan::{plan, turned, End, Inputs, Plan};
+use crate::plan::{End, Inputs, Plan};
 use crate::CliError;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -64,7 +65,7 @@ pub fn run(command: &RenderCommandArgs) -> Result<(), CliError> {
     }
     // Every rule the flags decide, before anything is loaded.
     let asked = plan(args)?;
-    let inputs = Inputs::from(args);
+    let inputs = crate::args::inputs(args)?;
     if let Some(split) = crate::distributed::render_split(&inputs, &asked, command.bricks)? {
         if command.orbit.is_some() || command.colorbar {
             return Err(CliError::input(
@@ -262,7 +263,7 @@ fn orbit(
     let image = encode_apng(args.size, args.png_style(), n, delay, |k| {
         let a = turned(args, 360.0 * k as f32 / n as f32);
         if k > 0 {
-            p.reframe(&Inputs::from(&a))?;
+            p.reframe(&crate::args::inputs(&a)?)?;
         }
         let mut f = render_frame(&p, plan, &mut cache)?;
         crate::say!("{}: frame {}/{n} in {:.3} s", p.name, k + 1, f.seconds);
@@ -272,7 +273,7 @@ fn orbit(
         Ok(f.image)
     })?;
     let secs = start.elapsed().as_secs_f64();
-    let summary = describe(&p, &Inputs::from(args), plan)
+    let summary = describe(&p, &crate::args::inputs(args)?, plan)
         .num("frames", n as f64)
         .num("frame_delay_ms", f64::from(delay))
         .num("seconds", secs)

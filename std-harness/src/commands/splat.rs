@@ -13,7 +13,7 @@ pub fn run(args: &SplatArgs) -> Result<(), CliError> {
         path: &args.out,
         extensions: &crate::io::image::GREY_EXTENSIONS,
     }])?;
-    let (img, r) = splat_image(args)?;
+    let (img, r) = splat_image(&crate::args::single(args)?)?;
     save_grey(&img, &args.out)?;
     let fa = &args.footprint;
     crate::say!(

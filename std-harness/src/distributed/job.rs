@@ -237,12 +237,9 @@ impl Job {
 
     /// The sheet axis of the frame the inputs ask for (what the default split cuts across).
     fn sheet_axis(&self) -> Result<usize, CliError> {
-        let kernel = self.inputs.footprint.kernel()?;
+        let kernel = self.inputs.kernel.kernel;
         let g2s = self.grid_to_screen()?;
-        let options = footprint::geometry::FootprintOptions {
-            mapping: self.inputs.footprint.mapping()?,
-            min_radius_px: self.inputs.footprint.min_radius,
-        };
+        let options = self.inputs.kernel.options;
         let f = footprint::geometry::Footprint::new(&kernel, &g2s, options)
             .map_err(|e| CliError::input(format!("{}: {e}", self.name)))?;
         Ok(f.sheet_axis)

@@ -79,7 +79,7 @@ pub fn agree_frame(
     let i = &job.inputs;
     let description = format!(
         "size {:?} view {:?} zoom {:?} matrix {:?} perspective {:?} eye {:?} tf {:?} window {:?} \
-         shading {:?} background {:?} gamma {:?} depth {} footprint {:?} absorption {:?} \
+         shading {:?} background {:?} gamma {:?} depth {} kernel {:?} absorption {:?} \
          order {:?} supersample {:?} lod {:?} refine {} quality {} plan {:?} grid {} bricks {:?}",
         i.size,
         i.view,
@@ -93,7 +93,7 @@ pub fn agree_frame(
         i.background,
         i.gamma,
         i.depth,
-        i.footprint,
+        i.kernel,
         i.absorption,
         i.order,
         i.supersample,
@@ -282,8 +282,8 @@ pub fn render_in_situ(
     stored: IndexBox,
     owned: IndexBox,
 ) -> Result<Option<Composited>, CliError> {
-    let mut inputs = crate::plan::Inputs::from(args);
-    let plan = crate::plan::plan(args)?;
+    let mut inputs = crate::args::inputs(args)?;
+    let plan = crate::args::plan(args)?;
     let held = [0, 1, 2].map(|c| stored.hi[c].saturating_sub(stored.lo[c]));
     if held.iter().product::<usize>() != samples_len(&samples)
         || !(0..3).all(|c| stored.lo[c] <= owned.lo[c] && owned.hi[c] <= stored.hi[c])

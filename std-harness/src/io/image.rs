@@ -159,6 +159,27 @@ pub fn save_grey(img: &GreyImage, path: &Path) -> Result<(), CliError> {
     super::write_atomic(path, &bytes)
 }
 
+/// What the volume is composited over (`--background`).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Background {
+    /// Black, opaque: the PNG is RGB, the premultiplied colour as it is (the default).
+    Black,
+    /// Nothing: the PNG is RGBA with straight alpha, the render's coverage.
+    Transparent,
+    /// A PNG of the output size, composited behind the volume (its alpha respected).
+    Image(std::path::PathBuf),
+}
+
+impl Background {
+    /// The image file, if it names one.
+    pub fn file(&self) -> Option<&Path> {
+        match self {
+            Background::Image(p) => Some(p),
+            _ => None,
+        }
+    }
+}
+
 /// How colour values become PNG samples: the transfer curve applied to the colour channels (alpha
 /// is always linear, as PNG defines it).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

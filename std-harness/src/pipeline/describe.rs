@@ -11,7 +11,10 @@ pub fn describe(p: &Prepared, args: &Inputs, plan: &Plan) -> Json {
     let method = match (plan.end, plan.table.footprints) {
         (End::Reference, _) => "reference".to_string(),
         (_, Footprints::Direct) => "direct".to_string(),
-        _ => format!("{:?}", args.footprint.method).to_lowercase(),
+        _ => match args.kernel.options.mapping {
+            footprint::geometry::Mapping::Paper { .. } => "paper".to_string(),
+            _ => "robust".to_string(),
+        },
     };
     Json::object()
         .str("volume", &p.name)
@@ -80,9 +83,9 @@ pub fn describe(p: &Prepared, args: &Inputs, plan: &Plan) -> Json {
         .str(
             "background",
             &match &args.background {
-                crate::args::Background::Black => "black".to_string(),
-                crate::args::Background::Transparent => "transparent".to_string(),
-                crate::args::Background::Image(path) => path.display().to_string(),
+                crate::io::image::Background::Black => "black".to_string(),
+                crate::io::image::Background::Transparent => "transparent".to_string(),
+                crate::io::image::Background::Image(path) => path.display().to_string(),
             },
         )
         .str("gamma", &format!("{:?}", args.gamma).to_lowercase())
@@ -120,6 +123,6 @@ pub fn plan_json(p: &Prepared, plan: &Plan) -> Json {
         .str("order", &format!("{:?}", p.order).to_lowercase())
         .str(
             "phase_lookup",
-            crate::args::phase_lookup_name(plan.phase_lookup.unwrap_or_default()),
+            crate::plan::phase_lookup_name(plan.phase_lookup.unwrap_or_default()),
         )
 }

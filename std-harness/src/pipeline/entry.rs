@@ -6,8 +6,8 @@
 use super::quality::level_pilot::validated_auto;
 use super::stages::hold::held;
 use super::stages::prepare::{prepare_as_asked, Prepared};
-use crate::args::Lod;
 use crate::io::stream::is_stdin;
+use crate::plan::Lod;
 use crate::plan::{Inputs, Request};
 use crate::CliError;
 
@@ -19,7 +19,7 @@ use crate::CliError;
 /// A stream that a pilot needs is first read whole where it fits ([`super::stages::hold`]), so
 /// that it is prepared, planned and rendered as the file it is would be.
 pub fn prepare<R: Request + ?Sized>(request: &R) -> Result<Prepared, CliError> {
-    let mut args = request.inputs();
+    let mut args = request.inputs()?;
     // Resolved once, for the hold and the level pilot; a plan the flags refuse is refused only
     // where one of them needs it (the command refuses it too, with the stream's reasons).
     let plan = request.plan();

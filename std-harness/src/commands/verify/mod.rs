@@ -6,6 +6,7 @@
 
 mod report;
 
+use crate::args::plan;
 use crate::args::{Lod, MethodArg, ReconstructionArg, ReferenceArg, RenderArgs};
 use crate::io::image::{check_style, RGB_EXTENSIONS};
 use crate::io::outputs::{self, Planned};
@@ -15,7 +16,7 @@ use crate::pipeline::quality::choose::{apply_quality, chosen_frame};
 use crate::pipeline::quality::{field::prepare_field, model::Choice};
 use crate::pipeline::stages::visible::FrameCache;
 use crate::pipeline::{prepare, render_core, render_ref, Prepared};
-use crate::plan::{plan, End, Inputs, Plan, Precision};
+use crate::plan::{End, Inputs, Plan, Precision};
 use crate::reference::continuous::{Continuous, Model};
 use crate::CliError;
 use clap::Args;
@@ -163,7 +164,7 @@ struct Measured {
 /// continuous integral when asked, full resolution for a coarser level, and the float path for
 /// the fixed one.
 fn measure(args: &VerifyArgs, r: &RenderArgs) -> Result<Measured, CliError> {
-    let inputs = Inputs::from(r);
+    let inputs = crate::args::inputs(r)?;
     let (p, plan, mut choice) = apply_quality(prepare(r)?, &inputs, &plan(r)?)?;
     // The default plan's pilot rendered the chosen frame whole already.
     let frame = chosen_frame(&p, &plan, &mut choice, &mut FrameCache::default())?.0;

@@ -23,11 +23,11 @@
 //! A streamed volume is refused (an oblique slab crosses every sheet), as are fixed-point
 //! accumulation and colour-carrying levels of detail (their colours are pre-classified).
 
-use crate::args::Supersample;
 use crate::pipeline::stages::bands::{equal_bands_for, on_bands, Bands};
 use crate::pipeline::stages::bands::{CoreFrame, Phases};
 use crate::pipeline::stages::prepare::Prepared;
 use crate::pipeline::stages::visible::{FrameCache, PostSamples};
+use crate::plan::Supersample;
 use crate::CliError;
 use footprint::composite::RowSpan;
 use footprint::frame::Order;

@@ -6,14 +6,15 @@
 //! voxel sits at the screen origin (W/2, H/2) unless --center moves it. Weights are px⁻² and
 //! integrate to one over the screen plane.
 
-use crate::args::{MethodArg, SplatArgs};
 use crate::io::image::GreyImage;
+use crate::plan::{KernelModel, Method};
 use crate::reference::ReferenceFootprint;
 use crate::CliError;
 use footprint::geometry::{Footprint, FootprintOptions, Mapping};
 use footprint::splat::{splat, Direct, ImageMut, Sampler};
 use footprint::{Grid, Lookup, View, ViewTable};
 use glam::Mat3;
+use std::path::PathBuf;
 use std::time::Instant;
 
 /// What one single-sample render did.
@@ -37,6 +38,28 @@ pub struct SplatReport {
     pub seconds: f64,
 }
 
+/// One voxel's render, resolved (what `footprint splat`'s flags ask for).
+#[derive(Clone, Debug)]
+pub struct Single {
+    /// The kernel and its footprint's shape.
+    pub kernel: KernelModel,
+    /// How the footprint is evaluated.
+    pub method: Method,
+    /// Generic and view table side N, and their lookup.
+    pub table: usize,
+    pub lookup: Lookup,
+    /// A generic table loaded from this file instead of built.
+    pub table_file: Option<PathBuf>,
+    /// G: world = G·(i, j, k) (`--spacing` as its diagonal, or `--grid-matrix`).
+    pub grid: Grid,
+    /// V: screen = V·world (`Rz·Ry·Rx·--view-matrix`, [`compose_view`]).
+    pub view: View,
+    /// Image size, pixels (width, height).
+    pub size: (usize, usize),
+    /// Where the voxel lands, pixels; `None`: the image's centre.
+    pub center: Option<[f32; 2]>,
+}
+
 /// `Rz(z)·Ry(y)·Rx(x)·V`, angles in degrees.
 pub fn compose_view(view_rows: Option<[f32; 9]>, rx: f32, ry: f32, rz: f32) -> Mat3 {
     let v = view_rows.map_or(Mat3::IDENTITY, |m| Mat3::from_cols_array(&m).transpose());
@@ -47,29 +70,16 @@ pub fn compose_view(view_rows: Option<[f32; 9]>, rx: f32, ry: f32, rz: f32) -> M
 }
 
 /// Renders the single sample described by `args` (no file is written).
-pub fn splat_image(args: &SplatArgs) -> Result<(GreyImage, SplatReport), CliError> {
-    let fa = &args.footprint;
-    let kernel = fa.kernel()?;
-    let grid = match args.grid_matrix {
-        Some(m) => Grid::from_matrix(Mat3::from_cols_array(&m).transpose()),
-        None => Grid::from_spacing(args.spacing),
-    }
-    .map_err(|e| CliError::input(format!("grid: {e}")))?;
-    let view = View::new(compose_view(
-        args.view_matrix,
-        args.rotate_x,
-        args.rotate_y,
-        args.rotate_z,
-    ))
-    .map_err(|e| CliError::input(format!("view: {e}")))?;
-    let g2s = view.grid_to_screen(&grid);
+pub fn splat_image(args: &Single) -> Result<(GreyImage, SplatReport), CliError> {
+    let kernel = args.kernel.kernel;
+    let min_radius = args.kernel.options.min_radius_px;
+    let g2s = args.view.grid_to_screen(&args.grid);
     let (w, h) = args.size;
     let center = args.center.unwrap_or([w as f32 / 2.0, h as f32 / 2.0]);
-    let lookup = Lookup::from(fa.lookup);
+    let lookup = args.lookup;
     let start = Instant::now();
-    if fa.method == MethodArg::Reference {
-        let reference =
-            ReferenceFootprint::new(&kernel, &g2s.as_dmat3(), f64::from(fa.min_radius))?;
+    if args.method == Method::Reference {
+        let reference = ReferenceFootprint::new(&kernel, &g2s.as_dmat3(), f64::from(min_radius))?;
         let mut out = vec![0.0f64; w * h];
         reference.splat([f64::from(center[0]), f64::from(center[1])], w, h, &mut out);
         let seconds = start.elapsed().as_secs_f64();
@@ -83,7 +93,7 @@ pub fn splat_image(args: &SplatArgs) -> Result<(GreyImage, SplatReport), CliErro
             &g2s,
             FootprintOptions {
                 mapping: Mapping::Robust,
-                min_radius_px: fa.min_radius,
+                min_radius_px: min_radius,
             },
         )?;
         let report = SplatReport {
@@ -101,19 +111,11 @@ pub fn splat_image(args: &SplatArgs) -> Result<(GreyImage, SplatReport), CliErro
         };
         return Ok((img, report));
     }
-    let mapping = fa.mapping()?;
-    let fp = Footprint::new(
-        &kernel,
-        &g2s,
-        FootprintOptions {
-            mapping,
-            min_radius_px: fa.min_radius,
-        },
-    )?;
+    let fp = Footprint::new(&kernel, &g2s, args.kernel.options)?;
     let mut pixels = vec![0.0f32; w * h];
     /// One splat of `fp` at `center` into `pixels` (w × h) through tables of side N.
     struct One<'a> {
-        fa: &'a crate::args::FootprintArgs,
+        args: &'a Single,
         kernel: footprint::Kernel,
         fp: Footprint,
         lookup: footprint::Lookup,
@@ -125,10 +127,11 @@ pub fn splat_image(args: &SplatArgs) -> Result<(GreyImage, SplatReport), CliErro
         type Output = ();
         fn run<const N: usize>(self) -> Result<(), CliError> {
             let (fp, lookup) = (self.fp, self.lookup);
-            let generic = self.fa.generic_table::<N>(&self.kernel)?;
+            let generic =
+                crate::io::table::generic_for::<N>(self.args.table_file.as_deref(), &self.kernel)?;
             let mut image = ImageMut::new(self.pixels, self.size.0, self.size.1, self.size.0)?;
-            let sampler: Box<dyn Sampler + '_> = match self.fa.method {
-                MethodArg::Direct => Box::new(Direct {
+            let sampler: Box<dyn Sampler + '_> = match self.args.method {
+                Method::Direct => Box::new(Direct {
                     footprint: fp,
                     table: &*generic,
                     lookup,
@@ -140,7 +143,7 @@ pub fn splat_image(args: &SplatArgs) -> Result<(GreyImage, SplatReport), CliErro
         }
     }
     let one = One {
-        fa,
+        args,
         kernel,
         fp,
         lookup,
@@ -148,7 +151,7 @@ pub fn splat_image(args: &SplatArgs) -> Result<(GreyImage, SplatReport), CliErro
         pixels: &mut pixels,
         size: (w, h),
     };
-    crate::dispatch::with_size(fa.table, one)?;
+    crate::dispatch::with_size(args.table, one)?;
     let seconds = start.elapsed().as_secs_f64();
     let img = GreyImage {
         width: w,
@@ -160,7 +163,7 @@ pub fn splat_image(args: &SplatArgs) -> Result<(GreyImage, SplatReport), CliErro
         sheet_axis: fp.sheet_axis,
         clamped: fp.clamped,
         cheated: fp.cheated,
-        layout: (fa.method != MethodArg::Direct).then(|| footprint::ViewLayout::for_footprint(&fp)),
+        layout: (args.method != Method::Direct).then(|| footprint::ViewLayout::for_footprint(&fp)),
         sum: img.data.iter().map(|&v| f64::from(v)).sum(),
         peak: img.peak(),
         seconds,

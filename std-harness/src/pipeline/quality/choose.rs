@@ -26,11 +26,11 @@
 use super::config::Config;
 use super::level_pilot::{candidate_levels, measure};
 use super::model::{self as quality, choose, footprint_error, predict_db, Choice};
-use crate::args::{Lod, MethodArg, QualityReferenceArg};
 use crate::pipeline::ends::run::{render_frame, CoreFrame};
 use crate::pipeline::stages::prepare::Prepared;
 use crate::pipeline::stages::visible::FrameCache;
 use crate::plan::{End, Inputs, Plan};
+use crate::plan::{Lod, Method, QualityReference};
 use crate::CliError;
 
 /// The frame of `plan` for `p`: the one the default plan's pilot rendered and kept in `choice`
@@ -73,15 +73,15 @@ pub fn apply_quality(
     };
     let q = quality.target_db;
     let (p, choice) = match quality.reference {
-        QualityReferenceArg::Sheets if matches!(plan.end, End::Slabs { .. }) => {
+        QualityReference::Sheets if matches!(plan.end, End::Slabs { .. }) => {
             return Err(CliError::input(
                 "--quality aims at the sheet reference by default and chooses among the table \
                  configurations of object slicing; image slicing has no table to choose: give \
                  --slab, or --quality-reference continuous to choose the slab",
             ));
         }
-        QualityReferenceArg::Sheets => choose_sheets(p, args, plan, q)?,
-        r @ (QualityReferenceArg::Continuous | QualityReferenceArg::Field) => {
+        QualityReference::Sheets => choose_sheets(p, args, plan, q)?,
+        r @ (QualityReference::Continuous | QualityReference::Field) => {
             if let Lod::Level(n @ 1..) = args.lod {
                 return Err(CliError::input(format!(
                     "--quality-reference {} measures against the integral at full resolution \
@@ -148,7 +148,7 @@ fn choose_sheets(
     }
     // What the pilot renders with: the plan's table (the default; --quality overrides it).
     let c0 = Config {
-        method: MethodArg::Robust,
+        method: Method::Robust,
         ..Config::of_plan(plan)
     };
     let allowed = rmse(target);

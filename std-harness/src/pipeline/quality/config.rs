@@ -2,8 +2,9 @@
 //! thickness, and whether the grid is refined (`--refine 0`): what `footprint chart` sweeps and
 //! `--quality` chooses among, with the names the benches use.
 
-use crate::args::{AccumArg, LookupArg, MethodArg, Supersample};
 use crate::plan::{End, Footprints, Plan, Precision};
+use crate::plan::{Method, Supersample};
+use footprint::Lookup;
 
 /// Slab thicknesses the chart sweeps with `--slicing image`, voxel spacings.
 pub const SLABS: [f32; 4] = [0.25, 0.5, 1.0, 2.0];
@@ -15,9 +16,9 @@ pub const SIZES: [usize; 7] = [5, 11, 21, 33, 65, 101, 129];
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Config {
     pub table: usize,
-    pub lookup: LookupArg,
-    pub method: MethodArg,
-    pub accum: AccumArg,
+    pub lookup: Lookup,
+    pub method: Method,
+    pub accum: Precision,
     /// `Some(q)`: image-aligned slicing with slabs q/4 voxel spacings thick (the table fields
     /// then do not apply); `None`: the paper's object-aligned sheets.
     pub slab_quarters: Option<u16>,
@@ -41,7 +42,7 @@ impl Config {
     pub fn for_frame(frame: &footprint::frame::FrameSetup) -> Vec<Config> {
         let mut v = Self::all();
         if frame.camera().is_some() {
-            v.retain(|c| c.method == MethodArg::Direct && c.accum == AccumArg::Float);
+            v.retain(|c| c.method == Method::Direct && c.accum == Precision::Float);
         }
         v
     }
@@ -50,9 +51,9 @@ impl Config {
     pub fn all() -> Vec<Config> {
         let mut v = Vec::new();
         for table in SIZES {
-            for lookup in [LookupArg::Nearest, LookupArg::Bilinear] {
-                for method in [MethodArg::Robust, MethodArg::Direct] {
-                    for accum in [AccumArg::Float, AccumArg::Fixed] {
+            for lookup in [Lookup::Nearest, Lookup::Bilinear] {
+                for method in [Method::Robust, Method::Direct] {
+                    for accum in [Precision::Float, Precision::Fixed] {
                         v.push(Config {
                             table,
                             lookup,
@@ -79,9 +80,9 @@ impl Config {
             .filter(|&&t| footprint::render::SlabSetup::new(frame, kernel, t).is_ok())
             .map(|&t| Config {
                 table: 0,
-                lookup: LookupArg::Bilinear,
-                method: MethodArg::Direct,
-                accum: AccumArg::Float,
+                lookup: Lookup::Bilinear,
+                method: Method::Direct,
+                accum: Precision::Float,
                 slab_quarters: Some((t * 4.0) as u16),
                 refine: false,
                 nearest_phase: false,
@@ -127,8 +128,8 @@ impl Config {
     /// robust method's view table, as refinement needs, with the same table size and lookup.
     pub fn refined(&self) -> Config {
         Config {
-            method: MethodArg::Robust,
-            accum: AccumArg::Float,
+            method: Method::Robust,
+            accum: Precision::Float,
             slab_quarters: None,
             refine: true,
             nearest_phase: false,
@@ -143,12 +144,12 @@ impl Config {
     pub fn of_plan(plan: &Plan) -> Config {
         Config {
             table: plan.table.size,
-            lookup: plan.table.lookup.into(),
+            lookup: plan.table.lookup,
             method: match plan.table.footprints {
-                Footprints::Direct => MethodArg::Direct,
-                Footprints::ViewTable => MethodArg::Robust,
+                Footprints::Direct => Method::Direct,
+                Footprints::ViewTable => Method::Robust,
             },
-            accum: AccumArg::Float,
+            accum: Precision::Float,
             slab_quarters: None,
             refine: false,
             nearest_phase: plan.phase_lookup == Some(footprint::stencil::PhaseLookup::Nearest),
@@ -180,15 +181,12 @@ impl Config {
         let mut p = base.clone();
         p.table.size = self.table;
         p.table.file = None;
-        p.table.lookup = footprint::Lookup::from(self.lookup);
+        p.table.lookup = self.lookup;
         p.table.footprints = match self.method {
-            MethodArg::Direct => Footprints::Direct,
+            Method::Direct => Footprints::Direct,
             _ => Footprints::ViewTable,
         };
-        let precision = match self.accum {
-            AccumArg::Float => Precision::Float,
-            AccumArg::Fixed => Precision::Fixed,
-        };
+        let precision = self.accum;
         if self.nearest_phase {
             p.phase_lookup = Some(footprint::stencil::PhaseLookup::Nearest);
         }
@@ -211,26 +209,26 @@ impl Config {
     }
 }
 
-pub fn lookup_name(l: LookupArg) -> &'static str {
+pub fn lookup_name(l: Lookup) -> &'static str {
     match l {
-        LookupArg::Nearest => "nearest",
-        LookupArg::Bilinear => "bilinear",
+        Lookup::Nearest => "nearest",
+        Lookup::Bilinear => "bilinear",
     }
 }
 
 /// `view` for the two-stage (view-table) methods, as in the bench names.
-pub fn method_name(m: MethodArg) -> &'static str {
+pub fn method_name(m: Method) -> &'static str {
     match m {
-        MethodArg::Robust => "view",
-        MethodArg::Paper => "paper",
-        MethodArg::Direct => "direct",
-        MethodArg::Reference => "reference",
+        Method::Robust => "view",
+        Method::Paper => "paper",
+        Method::Direct => "direct",
+        Method::Reference => "reference",
     }
 }
 
-pub fn accum_name(a: AccumArg) -> &'static str {
+pub fn accum_name(a: Precision) -> &'static str {
     match a {
-        AccumArg::Float => "float",
-        AccumArg::Fixed => "fixed",
+        Precision::Float => "float",
+        Precision::Fixed => "fixed",
     }
 }

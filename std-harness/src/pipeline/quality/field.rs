@@ -17,9 +17,9 @@
 //! The same box and the same view give the same world-to-screen map, so the finer sampling's
 //! image lines up pixel for pixel with the coarse one (the refinement chart relies on the same).
 
-use crate::args::Lod;
 use crate::pipeline::stages::prepare::Prepared;
 use crate::plan::Inputs;
+use crate::plan::Lod;
 use crate::CliError;
 
 /// The finer sampling of `args`' built-in scene, prepared to render (full resolution, object

@@ -28,14 +28,15 @@
 use super::config::Config;
 use super::level_pilot::LevelPilot;
 pub use super::sampling::Estimate;
-use crate::args::{AccumArg, LookupArg, MethodArg, QualityReferenceArg};
 use crate::io::json::Json;
 use crate::pipeline::stages::bands::CoreFrame;
 use crate::pipeline::stages::prepare::Prepared;
+use crate::plan::{Method, Precision, QualityReference};
 use crate::reference::ReferenceFootprint;
 use crate::CliError;
 use footprint::splat::{splat, Direct, ImageMut, Sampler};
-use footprint::{Footprint, Lookup, ViewTable};
+use footprint::Lookup;
+use footprint::{Footprint, ViewTable};
 
 /// K, dB: the calibration constant of `PSNR ≈ K − 20·log₁₀(e)` (see the module docs).
 pub const K_DB: f64 = CALIBRATED_K_DB - MARGIN_DB;
@@ -64,35 +65,15 @@ pub const MARGIN_DB: f64 = 1.0;
 /// `--quality`'s validation is re-run with nearest first: the 45 `verify --quality` runs CI
 /// makes (every shared volume, three views, 30/40/50 dB) all met their targets with it, but its
 /// choices and their documentation would change.
-pub const RELATIVE_COST: [(LookupArg, MethodArg, AccumArg, f64); 8] = [
-    (
-        LookupArg::Bilinear,
-        MethodArg::Robust,
-        AccumArg::Float,
-        1.22,
-    ),
-    (LookupArg::Nearest, MethodArg::Robust, AccumArg::Float, 1.22),
-    (LookupArg::Nearest, MethodArg::Robust, AccumArg::Fixed, 2.21),
-    (
-        LookupArg::Bilinear,
-        MethodArg::Robust,
-        AccumArg::Fixed,
-        2.26,
-    ),
-    (LookupArg::Nearest, MethodArg::Direct, AccumArg::Float, 4.28),
-    (LookupArg::Nearest, MethodArg::Direct, AccumArg::Fixed, 5.32),
-    (
-        LookupArg::Bilinear,
-        MethodArg::Direct,
-        AccumArg::Float,
-        5.39,
-    ),
-    (
-        LookupArg::Bilinear,
-        MethodArg::Direct,
-        AccumArg::Fixed,
-        6.73,
-    ),
+pub const RELATIVE_COST: [(Lookup, Method, Precision, f64); 8] = [
+    (Lookup::Bilinear, Method::Robust, Precision::Float, 1.22),
+    (Lookup::Nearest, Method::Robust, Precision::Float, 1.22),
+    (Lookup::Nearest, Method::Robust, Precision::Fixed, 2.21),
+    (Lookup::Bilinear, Method::Robust, Precision::Fixed, 2.26),
+    (Lookup::Nearest, Method::Direct, Precision::Float, 4.28),
+    (Lookup::Nearest, Method::Direct, Precision::Fixed, 5.32),
+    (Lookup::Bilinear, Method::Direct, Precision::Float, 5.39),
+    (Lookup::Bilinear, Method::Direct, Precision::Fixed, 6.73),
 ];
 
 /// What `--quality` chose, and why.
@@ -104,7 +85,7 @@ pub struct Choice {
     /// (continuous, [`super::pilot`]).
     pub predicted_db: f64,
     /// What the target is measured against.
-    pub reference: QualityReferenceArg,
+    pub reference: QualityReference,
     /// Its footprint error at this view (sheets only).
     pub footprint_error: Option<f64>,
     /// Cheaper candidates and their predictions, cheapest first.
@@ -216,10 +197,8 @@ impl Choice {
 }
 
 /// The name the command line and the JSON use for `r`.
-pub fn reference_name(r: QualityReferenceArg) -> String {
-    use clap::ValueEnum;
-    r.to_possible_value()
-        .map_or_else(String::new, |v| v.get_name().to_string())
+pub fn reference_name(r: QualityReference) -> String {
+    r.name().to_string()
 }
 
 /// PSNR predicted from a footprint error `e`.
@@ -242,7 +221,7 @@ fn cost(c: &Config) -> f64 {
 /// lookup before nearest, then a smaller table first (it builds faster and fits cache better).
 pub fn candidates(frame: &footprint::frame::FrameSetup) -> Vec<Config> {
     let mut v = Config::for_frame(frame);
-    let nearest = |c: &Config| c.lookup == LookupArg::Nearest;
+    let nearest = |c: &Config| c.lookup == Lookup::Nearest;
     v.sort_by(|a, b| {
         cost(a)
             .total_cmp(&cost(b))
@@ -323,10 +302,10 @@ fn one_footprint_error(
                 reference,
                 side,
             } = self;
-            let lookup = Lookup::from(c.lookup);
+            let lookup = c.lookup;
             let mut worst = 0.0f64;
             let generic = Box::new(footprint::GenericTable::<N>::build(p.kernel));
-            let sampler: Box<dyn Sampler> = if c.method == MethodArg::Direct {
+            let sampler: Box<dyn Sampler> = if c.method == Method::Direct {
                 Box::new(Direct {
                     footprint: fp,
                     table: &*generic,
@@ -412,7 +391,7 @@ pub fn pick(p: &Prepared, target_db: f64) -> Result<(Choice, bool), CliError> {
                 target_db,
                 config: c,
                 predicted_db: db,
-                reference: QualityReferenceArg::Sheets,
+                reference: QualityReference::Sheets,
                 footprint_error: Some(e),
                 rejected,
                 pilot: None,
@@ -433,7 +412,7 @@ pub fn pick(p: &Prepared, target_db: f64) -> Result<(Choice, bool), CliError> {
         target_db,
         config,
         predicted_db: db,
-        reference: QualityReferenceArg::Sheets,
+        reference: QualityReference::Sheets,
         footprint_error: Some(e),
         rejected: Vec::new(),
         pilot: None,

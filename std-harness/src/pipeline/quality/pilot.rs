@@ -109,13 +109,13 @@ use super::pixel_sample::{decide, stages, StageEnd, Verdict};
 pub use super::pixel_sample::{
     estimate, sample_pixels, MIN_FIRST_STAGE, PILOT_RAYS, STAGE_MARGINS_DB, Z,
 };
-use crate::args::QualityReferenceArg;
 use crate::pipeline::ends::continuous::{continuous_at, PilotReference};
 use crate::pipeline::ends::run::render_frame;
 use crate::pipeline::stages::bands::CoreFrame;
 use crate::pipeline::stages::prepare::Prepared;
 use crate::pipeline::stages::visible::FrameCache;
 use crate::plan::Inputs;
+use crate::plan::QualityReference;
 use crate::plan::{End, Plan};
 use crate::CliError;
 use std::time::Instant;
@@ -138,7 +138,7 @@ fn candidates(
     p: &Prepared,
     base: &Plan,
     target_db: f64,
-    reference: QualityReferenceArg,
+    reference: QualityReference,
 ) -> Result<Vec<Config>, CliError> {
     let mut v: Vec<Config> = Vec::new();
     if !matches!(base.end, End::Slabs { .. }) {
@@ -149,7 +149,7 @@ fn candidates(
             }
         }
     }
-    if let (Some(last), QualityReferenceArg::Field) = (v.last().copied(), reference) {
+    if let (Some(last), QualityReference::Field) = (v.last().copied(), reference) {
         if crate::pipeline::ends::refine::worth_trying(p, &last.refined().plan(base)) {
             v.push(last.refined());
         }
@@ -177,11 +177,11 @@ pub fn choose_continuous(
     args: &Inputs,
     base: &Plan,
     target_db: f64,
-    reference: QualityReferenceArg,
+    reference: QualityReference,
 ) -> Result<Choice, CliError> {
     quality::check_target(target_db)?;
     let fine = match reference {
-        QualityReferenceArg::Field => Some(super::field::prepare_field(args)?),
+        QualityReference::Field => Some(super::field::prepare_field(args)?),
         _ => None,
     };
     let candidates = candidates(p, base, target_db, reference)?
@@ -196,7 +196,7 @@ pub fn choose_continuous(
         base.threads,
     )?;
     drop(fine);
-    if reference == QualityReferenceArg::Field {
+    if reference == QualityReference::Field {
         run.field_size = Some(args.field_size);
     }
     let mut choice = run.measure(candidates, false)?.1;
@@ -259,13 +259,7 @@ pub fn choose_slicing(
             .collect();
         candidates.splice(0..0, small);
     }
-    let mut run = Run::new(
-        p,
-        p,
-        target_db,
-        QualityReferenceArg::Continuous,
-        base.threads,
-    )?;
+    let mut run = Run::new(p, p, target_db, QualityReference::Continuous, base.threads)?;
     Ok(Some(run.measure(candidates, true)?))
 }
 
@@ -290,7 +284,7 @@ fn subsampling_differs(p: &Prepared, base: &Plan) -> Result<bool, CliError> {
         return Ok(false);
     }
     let mut auto = base.clone();
-    auto.subsample = crate::args::Supersample::Auto;
+    auto.subsample = crate::plan::Supersample::Auto;
     Ok(p.subsample_factor(&auto)? > 1)
 }
 
@@ -299,7 +293,7 @@ fn subsampling_differs(p: &Prepared, base: &Plan) -> Result<bool, CliError> {
 struct Run<'a> {
     p: &'a Prepared,
     target_db: f64,
-    reference: QualityReferenceArg,
+    reference: QualityReference,
     /// The side N of the finer field's sampling (`field` only).
     field_size: Option<usize>,
     /// The sampled pixels, stage by stage ([`stages`]).
@@ -327,7 +321,7 @@ impl<'a> Run<'a> {
         p: &'a Prepared,
         against: &Prepared,
         target_db: f64,
-        reference: QualityReferenceArg,
+        reference: QualityReference,
         threads: usize,
     ) -> Result<Self, CliError> {
         let (w, h) = p.out_size();

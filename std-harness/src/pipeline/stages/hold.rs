@@ -26,10 +26,10 @@
 //! flag rules, before anything is held). A held pipe no longer needs `--window` (its range is
 //! read as a file's) or a view near the z axis.
 
-use crate::args::Lod;
 use crate::io::formats::raw::RawOptions;
 use crate::io::stream::{is_stdin, InMemory};
 use crate::io::volume::{byte_len, check_spacing, decode, Volume};
+use crate::plan::Lod;
 use crate::plan::{Inputs, Plan};
 use crate::CliError;
 use std::sync::Arc;

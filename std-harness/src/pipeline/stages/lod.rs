@@ -22,10 +22,10 @@
 //! these two volumes and checked on every volume in `../shared/data` at 64², 128² and 512²
 //! (docs/modes.md, "Levels of detail").
 
-use crate::args::Lod;
 use crate::io::stream::{ColouredMemorySource, MemorySource};
 use crate::io::try_filled;
 use crate::io::volume::{Samples, Volume};
+use crate::plan::Lod;
 use crate::CliError;
 use footprint::frame::FrameSetup;
 use footprint::lod::{

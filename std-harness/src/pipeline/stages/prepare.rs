@@ -11,8 +11,8 @@ use super::load::{load_background, load_voxels, Loaded, Voxels};
 use super::supersample;
 pub use super::window::outside_data_warnings;
 use super::window::values_shading;
-use crate::args::Lod;
 use crate::io::volume::Volume;
+use crate::plan::Lod;
 use crate::plan::Plan;
 use crate::plan::{check_levels, Inputs};
 use crate::{tf, CliError};
@@ -221,7 +221,7 @@ impl Prepared {
         low.background = None;
         low.background_out = None;
         let mut at_low = plan.clone();
-        at_low.subsample = crate::args::Supersample::Fixed(1);
+        at_low.subsample = crate::plan::Supersample::Fixed(1);
         Ok((low, at_low))
     }
 
@@ -286,7 +286,7 @@ pub fn view_for(args: &Inputs, dims: [usize; 3], grid: &Grid) -> Result<View, Cl
 /// The kernel level `level` is reconstructed with: a narrower one for a coarser level (the core's
 /// `lod::level_kernel`), unless `--table-file` fixes the table (and so the kernel) as given.
 fn kernel_at(args: &Inputs, kernel: &Kernel, level: u32) -> Kernel {
-    if args.footprint.table_file.is_some() {
+    if args.kernel.table_from_file {
         *kernel
     } else {
         level_kernel(kernel, level)
@@ -316,7 +316,7 @@ pub fn setup_frame(
     }
     let fine = FrameSetup::new(dims, grid, &view, kernel, options, size)?;
     let fixed_k = match args.supersample {
-        crate::args::Supersample::Fixed(k @ 2..) => Some(k),
+        crate::plan::Supersample::Fixed(k @ 2..) => Some(k),
         _ => None,
     };
     let level = match (args.refine, fixed_k) {
@@ -421,7 +421,7 @@ fn perspective_frame(
 /// Loads and sets up everything `args` describes, with `--lod` taken as it is (`auto`: the
 /// geometric rule of [`super::lod`]); [`crate::pipeline::entry::prepare`] validates that rule's level.
 pub fn prepare_as_asked(args: &Inputs) -> Result<Prepared, CliError> {
-    let kernel = args.footprint.kernel()?;
+    let kernel = args.kernel.kernel;
     let Loaded {
         voxels,
         name,
@@ -431,11 +431,7 @@ pub fn prepare_as_asked(args: &Inputs) -> Result<Prepared, CliError> {
         sample,
     } = load_voxels(args)?;
     let grid = Grid::from_matrix(grid).map_err(|e| CliError::input(format!("{name}: {e}")))?;
-    let mapping = args.footprint.mapping()?;
-    let options = FootprintOptions {
-        mapping,
-        min_radius_px: args.footprint.min_radius,
-    };
+    let options = args.kernel.options;
     // With --quality the volume is prepared at full resolution: the choice measures the levels
     // against it and builds the one it picks (`crate::pipeline::quality::choose`).
     let at_full;
@@ -493,7 +489,7 @@ pub fn prepare_as_asked(args: &Inputs) -> Result<Prepared, CliError> {
     let background_out: Option<Arc<[[f32; 4]]>> = args
         .background
         .file()
-        .map(|p| load_background(p, args.size, args.gamma.curve()))
+        .map(|p| load_background(p, args.size, args.gamma))
         .transpose()?
         .map(Into::into);
     let background = at_frame(background_out.as_ref(), args.size, supersample);
@@ -552,7 +548,7 @@ fn compositing_order(
                 )));
             }
             let needed = frame.order_for_ascending();
-            if let Some(asked) = args.order.map(Order::from) {
+            if let Some(asked) = args.order {
                 if asked != needed {
                     return Err(CliError::input(format!(
                         "from a pipe this view composites {needed:?} (file order runs {} the viewer); drop --order",
@@ -562,7 +558,7 @@ fn compositing_order(
             }
             needed
         }
-        _ => args.order.map_or(Order::BackToFront, Order::from),
+        _ => args.order.unwrap_or(Order::BackToFront),
     })
 }
 

@@ -12,7 +12,7 @@
 //! 62–71 dB. `--supersample auto` (the default) does that only when footprints would be widened;
 //! a render that needs no widening is unchanged, bit for bit.
 
-use crate::args::Supersample;
+use crate::plan::Supersample;
 use footprint::frame::FrameSetup;
 use footprint::geometry::FootprintOptions;
 

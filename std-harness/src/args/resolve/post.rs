@@ -1,8 +1,9 @@
 //! The plan's rules for `--classification post` (issue 47): what post-classified slabs need, and
 //! post's own flags refused without it.
 
-use super::{plan, End, Plan, Precision};
+use super::plan;
 use crate::args::{ClassificationArg, Lod, MethodArg, RenderArgs, SlicingArg, Supersample};
+use crate::plan::{End, Plan, Precision};
 use crate::CliError;
 use footprint::render::Absorption;
 

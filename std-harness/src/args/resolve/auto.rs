@@ -10,14 +10,10 @@
 //! rest (a kernel with no slabs, a coarser level of detail, a stream too large to hold whole,
 //! `pipeline::stages::hold`): the pilot is skipped there. Where
 //! the pilot runs and `--subsample` is unset, it tries each candidate subsampled first
-//! ([`super::Plan::auto_subsample`]).
+//! (`crate::plan::Plan::auto_subsample`).
 
-use super::{End, Precision};
 use crate::args::{RenderArgs, SlicingArg};
-
-/// The PSNR, dB, against the continuous model (`--absorption`'s, opacity by default) that the
-/// default plan's frame is measured to reach on its pilot before object slicing is kept.
-pub const DEFAULT_TARGET_DB: f64 = 44.0;
+use crate::plan::{End, Precision, DEFAULT_TARGET_DB};
 
 /// [`DEFAULT_TARGET_DB`] where `args` leave the slicing to the pilot and `end` (what the flags
 /// alone resolved) is float sheets; `None` otherwise.
