@@ -4,7 +4,7 @@
 //! split is checked where it must be exact, where it is bounded, and what it refuses.
 
 use footprint_harness::args::parse_args;
-use footprint_harness::args::{inputs, plan};
+use footprint_harness::args::{plan, scene};
 use footprint_harness::distributed::{render_in_turn, BrickLayout, Job};
 use footprint_harness::pipeline::stages::visible::FrameCache;
 use footprint_harness::pipeline::{prepare, render_frame};
@@ -20,7 +20,7 @@ fn one_process(flags: &[&str]) -> Vec<[f32; 4]> {
 
 fn split(flags: &[&str], layout: impl Fn(&Job) -> BrickLayout) -> Vec<[f32; 4]> {
     let args = parse_args(flags).unwrap();
-    let job = Job::new(&inputs(&args).unwrap(), &plan(&args).unwrap()).unwrap();
+    let job = Job::new(&scene(&args).unwrap(), &plan(&args).unwrap()).unwrap();
     render_in_turn(&job, &layout(&job)).unwrap().image
 }
 
@@ -79,7 +79,7 @@ fn cuts_along_the_sheets_stay_bounded_and_the_order_matters() {
     assert!(db >= 50.0, "2x2x1 bricks: {db:.1} dB");
     // Back to front instead of front to back: the order is what makes it right.
     let args = parse_args(&flags).unwrap();
-    let job = Job::new(&inputs(&args).unwrap(), &plan(&args).unwrap()).unwrap();
+    let job = Job::new(&scene(&args).unwrap(), &plan(&args).unwrap()).unwrap();
     let layout = grid(&job);
     let c = render_in_turn(&job, &layout).unwrap();
     let mut frames = Vec::new();
@@ -130,15 +130,13 @@ fn bricks_refuse_what_they_cannot_split() {
     ] {
         let args = parse_args(&flags).unwrap();
         let err = match plan(&args) {
-            Ok(p) => Job::new(&inputs(&args).unwrap(), &p)
-                .err()
-                .expect("refused"),
+            Ok(p) => Job::new(&scene(&args).unwrap(), &p).err().expect("refused"),
             Err(e) => e,
         };
         assert!(err.to_string().contains(says), "{flags:?}: {err}");
     }
     let args = parse_args(&["--scene-size", "8"]).unwrap();
-    let job = Job::new(&inputs(&args).unwrap(), &plan(&args).unwrap()).unwrap();
+    let job = Job::new(&scene(&args).unwrap(), &plan(&args).unwrap()).unwrap();
     assert!(
         job.layout(4, Some([2, 2, 2])).is_err(),
         "8 bricks for 4 ranks"

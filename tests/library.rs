@@ -231,7 +231,7 @@ fn view_is_vtks_camera() {
         let args =
             footprint_harness::args::parse_args(&["--view", name, "--size", "64x48"]).unwrap();
         let via_cli = footprint_harness::pipeline::stages::prepare::view_for(
-            &footprint_harness::args::inputs(&args).unwrap(),
+            &footprint_harness::args::scene(&args).unwrap(),
             [10, 20, 5],
             &grid,
         )
@@ -265,7 +265,7 @@ fn view_is_vtks_camera() {
     ])
     .unwrap();
     let via_cli = footprint_harness::pipeline::stages::prepare::view_for(
-        &footprint_harness::args::inputs(&args).unwrap(),
+        &footprint_harness::args::scene(&args).unwrap(),
         [10, 20, 5],
         &grid,
     )

@@ -192,7 +192,8 @@ fn refusal(flags: &[&str]) -> String {
     let mut a = flags.to_vec();
     a.extend_from_slice(&["--size", "32x32", "--quality", "40"]);
     let args = parse_args(&a).unwrap();
-    match apply_quality(prepare(&args).unwrap(), &args) {
+    // Refused by the plan's rules before anything is prepared, or by the choice.
+    match prepare(&args).and_then(|p| apply_quality(p, &args)) {
         Ok(_) => panic!("{flags:?}: accepted"),
         Err(e) => e.to_string(),
     }

@@ -196,9 +196,12 @@ fn quality_chooses_refinement_against_the_field() {
     assert_eq!(pilot.field_size, Some(128));
     let chosen = plan_with(&args, &c.config);
     let f = render_frame(&p, &chosen, &mut FrameCache::default()).unwrap();
-    let inputs = footprint_harness::args::inputs(&args).unwrap();
-    let (truth, _) =
-        render_continuous_ref(&prepare_field(&inputs).unwrap(), Reconstruction::Kernel).unwrap();
+    let inputs = footprint_harness::args::scene(&args).unwrap();
+    let (truth, _) = render_continuous_ref(
+        &prepare_field(&inputs, &chosen).unwrap(),
+        Reconstruction::Kernel,
+    )
+    .unwrap();
     let got = compare(&f.image, &truth.image).1.psnr_db;
     assert!(got >= target, "refined: {got:.2} dB against the field");
     // Unzoomed at 256², steps of 9.9 px: refinement cannot split an interval, so it is not tried.
@@ -229,15 +232,21 @@ fn quality_chooses_refinement_against_the_field() {
         "/tests/data/heart_32x32x12_float32_le.nhdr"
     );
     let args = parse_args(&[file, "--size", "32x32"]).unwrap();
-    let e = prepare_field(&footprint_harness::args::inputs(&args).unwrap())
-        .err()
-        .expect("refused")
-        .to_string();
+    let e = prepare_field(
+        &footprint_harness::args::scene(&args).unwrap(),
+        &plan(&args).unwrap(),
+    )
+    .err()
+    .expect("refused")
+    .to_string();
     assert!(e.contains("nothing finer"), "{e}");
     let args = parse_args(&["--scene-size", "16", "--field-size", "16"]).unwrap();
-    let e = prepare_field(&footprint_harness::args::inputs(&args).unwrap())
-        .err()
-        .expect("refused")
-        .to_string();
+    let e = prepare_field(
+        &footprint_harness::args::scene(&args).unwrap(),
+        &plan(&args).unwrap(),
+    )
+    .err()
+    .expect("refused")
+    .to_string();
     assert!(e.contains("must be finer"), "{e}");
 }

@@ -84,7 +84,7 @@ fn library(flags: &[&str], size: &str, memory: Option<InMemory>, pipe: Option<Pi
     args.memory = memory;
     args.stdin = pipe;
     let asked = footprint_harness::args::plan(&args).unwrap();
-    let inputs = footprint_harness::args::inputs(&args).unwrap();
+    let inputs = footprint_harness::args::scene(&args).unwrap();
     let (image, _, _) =
         footprint_harness::commands::render::single(&args, &inputs, &asked).unwrap();
     image.into_iter().flatten().collect()
@@ -136,7 +136,7 @@ fn a_stream_with_nothing_to_choose_stays_a_stream() {
     assert!(stream == file);
     assert!(!json.contains("\"quality\""), "{json}");
     let args = parse_args(&[&["--stream", NHDR][..], &flags].concat()).unwrap();
-    let inputs = footprint_harness::args::inputs(&args).unwrap();
+    let inputs = footprint_harness::args::scene(&args).unwrap();
     let plan = footprint_harness::args::plan(&args).unwrap();
     assert!(
         footprint_harness::pipeline::stages::hold::held(&inputs, &plan)

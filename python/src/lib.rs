@@ -271,7 +271,7 @@ fn frame(args: &RenderArgs) -> Result<Frame, CliError> {
         args.json.as_deref(),
     )?;
     let asked = footprint_harness::args::plan(args)?;
-    let inputs = footprint_harness::args::inputs(args)?;
+    let inputs = footprint_harness::args::scene(args)?;
     let (image, summary, _) = single(args, &inputs, &asked)?;
     if args.out.is_some() || args.json.is_some() {
         write_files(args, args.out.as_deref(), &image, summary)?;
@@ -434,7 +434,7 @@ fn load<'py>(py: Python<'py>, path: &str, flags: Vec<String>) -> PyResult<Loaded
     let mut all = vec![path.to_string()];
     all.extend(flags);
     let args = parse(&all)?;
-    let inputs = footprint_harness::args::inputs(&args).map_err(py_err)?;
+    let inputs = footprint_harness::args::scene(&args).map_err(py_err)?;
     let raw = footprint_harness::pipeline::stages::load::raw_options(&inputs).map_err(py_err)?;
     let volume = py
         .detach(|| {

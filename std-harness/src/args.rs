@@ -18,7 +18,7 @@ pub use crate::io::image::Background;
 pub use model::*;
 pub use parse::*;
 pub use phase::*;
-pub use resolve::{inputs, plan, single, turned};
+pub use resolve::{plan, scene, single, turned};
 
 /// Table lookup, as on the command line.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, ValueEnum)]
@@ -313,7 +313,7 @@ pub struct RenderArgs {
     pub array: Option<String>,
     /// The built-in scene only: its analytic field sampled N×N×N over the same box (64 by
     /// default; 16 and 128 are what the refinement chart compares).
-    #[arg(help_heading = "Input", long, value_name = "N", default_value_t = crate::scene::SIDE, value_parser = parse_scene_size)]
+    #[arg(help_heading = "Input", long, value_name = "N", default_value_t = crate::builtin::SIDE, value_parser = parse_scene_size)]
     pub scene_size: usize,
     /// The built-in scene only: the finer sampling, N×N×N over the same box, whose continuous
     /// integral `--quality-reference field` and `verify --reference field` measure against (it

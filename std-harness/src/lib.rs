@@ -90,6 +90,7 @@ macro_rules! warn {
 }
 
 pub mod args;
+pub mod builtin;
 pub mod cancel;
 pub mod charts;
 pub mod cli;

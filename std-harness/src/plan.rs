@@ -1,11 +1,11 @@
-//! The render plan (issue 41): what draws a frame ([`Plan`]) and what is rendered ([`Inputs`]),
+//! The render plan (issue 41): what draws a frame ([`Plan`]) and what is rendered ([`Scene`]),
 //! as typed values. The command line is resolved into them once (`crate::args::resolve`, with
 //! every rule the flags alone decide); programs build them themselves ([`Request`] for
-//! `(Inputs, Plan)`). Nothing here names a flag's clap type. The rules that need the volume or
+//! `(Scene, Plan)`). Nothing here names a flag's clap type. The rules that need the volume or
 //! the frame (a subsampling factor too large for the footprints, a supersampling the minimum
 //! radius asks for, a view a pipe cannot feed) stay where those are known; the rules between the
 //! resolution decorators that the inputs decide are [`check_levels`], applied to every
-//! [`Inputs`]. The pipeline renders `(&Prepared, &Plan)` ([`crate::pipeline::render_frame`]);
+//! [`Scene`]. The pipeline renders `(&Prepared, &Plan)` ([`crate::pipeline::render_frame`]);
 //! `verify`, `bench`, `chart` and `--quality` build or derive plans ([`Plan::with_precision`],
 //! [`crate::pipeline::quality::config::Config::plan`]) instead of rewriting flags, so `verify`
 //! renders the plan `render` would, defaults included.
@@ -24,18 +24,16 @@
 //! decided with the frame and never act on one frame together
 //! (`pipeline::stages::prepare::setup_frame`).
 
-use crate::io::image::{Background, Gamma};
+use crate::scene::Scene;
 use crate::CliError;
 use footprint::frame::Order;
-use footprint::geometry::FootprintOptions;
-use footprint::render::Absorption;
-use footprint::{Kernel, Lookup};
+use footprint::Lookup;
 use std::path::PathBuf;
 
 mod phase;
 pub mod resolution;
 pub use phase::phase_lookup_name;
-pub use resolution::{Lod, Supersample};
+pub use resolution::{Lod, Resolution, Supersample};
 
 /// The PSNR, dB, against the continuous model (`--absorption`'s, opacity by default) that the
 /// default plan's frame is measured to reach on its pilot before object slicing is kept.
@@ -87,19 +85,6 @@ impl QualityReference {
             QualityReference::Field => "field",
         }
     }
-}
-
-/// The kernel and how its footprints are shaped: what `--kernel`, `--method paper`'s
-/// `--paper-cheat`, `--min-radius` and `--table-file` resolve to.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct KernelModel {
-    /// The reconstruction kernel at full resolution.
-    pub kernel: Kernel,
-    /// The ellipse-to-circle map and the smallest footprint semi-axis, pixels.
-    pub options: FootprintOptions,
-    /// The generic table is loaded from a file made for [`KernelModel::kernel`]
-    /// (`--table-file`): coarser levels keep that kernel instead of narrowing it.
-    pub table_from_file: bool,
 }
 
 /// How the float or fixed sheets accumulate.
@@ -202,6 +187,14 @@ pub struct Plan {
     /// ([`DEFAULT_TARGET_DB`]); the pipeline measures it on a pilot and returns the plan it chose,
     /// with this `None` (`pipeline::quality::choose::apply_quality`). `None`: `end` as it is.
     pub auto_slicing: Option<f64>,
+    /// The level of detail (`--lod`): `Auto` is the spacing rule's level, validated on the level
+    /// pilot where the volume can be read again (`pipeline::entry::prepare`).
+    pub lod: Lod,
+    /// Supersampling (`--supersample`): `Auto` where footprints would be widened to the
+    /// minimum radius; never with a coarser level on one frame ([`check_levels`]).
+    pub supersample: Supersample,
+    /// The compositing order; `None`: the source's (back to front; a pipe's file order).
+    pub order: Option<Order>,
     /// `--subsample` left unset where the default plan's pilot runs (`auto_slicing`): the pilot
     /// tries each candidate subsampled (`Supersample::Auto`) before it is tried at full size, and
     /// keeps the first that reaches the target (`pipeline::quality::pilot::choose_slicing`).
@@ -244,6 +237,21 @@ impl Plan {
         }
     }
 
+    /// The resolution chain a frame's set-up reads.
+    pub fn resolution(&self) -> Resolution {
+        Resolution {
+            lod: self.lod,
+            supersample: self.supersample,
+            refine: self.refines(),
+            quality: self.quality.is_some(),
+        }
+    }
+
+    /// Whether the end refines the grid (`--refine`).
+    pub fn refines(&self) -> bool {
+        matches!(self.end, End::Refined { .. })
+    }
+
     /// The name `--slicing` and the JSON use: `image` for slabs, `object` otherwise.
     pub fn slicing(&self) -> &'static str {
         match self.end {
@@ -272,25 +280,25 @@ pub fn quality_level_of_stream(n: u32) -> CliError {
     ))
 }
 
-/// The rules between the resolution decorators that the inputs decide before any frame: an
-/// explicit level of detail (`--lod N`, N ≥ 1) is refused with a perspective view, with
+/// The rules between the resolution decorators that the scene and plan decide before any
+/// frame: an explicit level of detail (`--lod N`, N ≥ 1) is refused with a perspective view, with
 /// `--refine` (which refines full resolution) and with `--supersample K` (K ≥ 2: both would act
 /// on one frame). The command line's resolution applies them to the flags; the pipeline's
-/// `setup_frame` to every [`Inputs`], including those built in code.
-pub fn check_levels(inputs: &Inputs) -> Result<(), CliError> {
-    let Lod::Level(n @ 1..) = inputs.lod else {
+/// `setup_frame` to every scene and plan, including those built in code.
+pub fn check_levels(scene: &Scene, res: &Resolution) -> Result<(), CliError> {
+    let Lod::Level(n @ 1..) = res.lod else {
         return Ok(());
     };
-    if inputs.perspective.is_some() {
+    if scene.perspective.is_some() {
         return Err(no_level_in_perspective(n));
     }
-    if inputs.refine {
+    if res.refine {
         return Err(CliError::input(format!(
             "--refine adds samples to full resolution; --lod {n} removes them: give --lod 0 or \
              auto"
         )));
     }
-    if let Supersample::Fixed(k @ 2..) = inputs.supersample {
+    if let Supersample::Fixed(k @ 2..) = res.supersample {
         return Err(CliError::input(format!(
             "--lod {n} and --supersample {k} would both act on one frame (a coarser level seen \
              at k x the size): give one of them (--lod 0, or --supersample 1 or auto)"
@@ -307,74 +315,19 @@ pub fn no_level_in_perspective(n: u32) -> CliError {
     ))
 }
 
-/// What a render loads and how it sees it, resolved from the command line: the volume and its
-/// layout, classification, camera, picture, kernel and the resolution decorators decided with
-/// the frame (levels, supersampling). The pipeline prepares from these ([`crate::pipeline::prepare()`])
-/// and never reads the command-line struct; what draws the frame is the [`Plan`].
-#[derive(Clone, Debug)]
-pub struct Inputs {
-    /// A volume already in memory (set by a program, such as the Python package).
-    pub memory: Option<crate::io::stream::InMemory>,
-    /// What `--stream -` reads instead of standard input.
-    pub stdin: Option<crate::io::stream::Pipe>,
-    /// The volume file; `None`: the built-in scene.
-    pub volume: Option<PathBuf>,
-    /// `--stream FILE|-`.
-    pub stream: Option<PathBuf>,
-    /// Raw layout: `--dims`, `--type`, `--endian`, `--spacing`; `--array`.
-    pub dims: Option<[usize; 3]>,
-    pub sample_type: Option<String>,
-    pub endian: String,
-    pub spacing: [f32; 3],
-    pub array: Option<String>,
-    /// The built-in scene's grid, and its finer field's (`--reference field`).
-    pub scene_size: usize,
-    pub field_size: usize,
-    /// Output size, pixels (width, height).
-    pub size: (usize, usize),
-    /// Camera: VTK's azimuth, elevation, roll (degrees), zoom, an explicit matrix, perspective.
-    pub view: [f32; 3],
-    pub zoom: f32,
-    pub view_matrix: Option<[f32; 9]>,
-    pub perspective: Option<f32>,
-    pub eye_distance: Option<f32>,
-    /// Classification: `--tf`, `--window`, `--shading`.
-    pub tf: Option<String>,
-    pub window: Option<[f64; 2]>,
-    pub shading: String,
-    /// Picture: background, gamma, PNG depth.
-    pub background: Background,
-    pub gamma: Gamma,
-    pub depth: u8,
-    /// The kernel and its footprints' shape (`--kernel`, `--min-radius`, `--method paper`'s
-    /// mapping, `--table-file`).
-    pub kernel: KernelModel,
-    /// The continuous model both slicings composite.
-    pub absorption: Absorption,
-    /// Compositing order; `None`: the default for the source.
-    pub order: Option<Order>,
-    /// Decorators decided with the frame: supersampling and level of detail.
-    pub supersample: Supersample,
-    pub lod: Lod,
-    /// Whether the frame must stay at full resolution: `--refine` (it refines level 0) or
-    /// `--quality` (it measures the levels itself).
-    pub refine: bool,
-    pub quality: bool,
-}
-
-/// What a render was asked for: its [`Inputs`] and its [`Plan`]. The command line's
-/// `RenderArgs` is one (resolved in `crate::args::resolve`), and `(Inputs, Plan)`, for a
+/// What a render was asked for: its [`Scene`] and its [`Plan`]. The command line's
+/// `RenderArgs` is one (resolved in `crate::args::resolve`), and `(Scene, Plan)`, for a
 /// program that builds them itself: the pipeline's entry ([`crate::pipeline::prepare()`]) takes
 /// any, so it never names the command line.
 pub trait Request {
     /// What to load and how to see it (the kernel's and the mapping's rules checked).
-    fn inputs(&self) -> Result<Inputs, CliError>;
+    fn scene(&self) -> Result<Scene, CliError>;
     /// What draws the frame (its rules checked).
     fn plan(&self) -> Result<Plan, CliError>;
 }
 
-impl Request for (Inputs, Plan) {
-    fn inputs(&self) -> Result<Inputs, CliError> {
+impl Request for (Scene, Plan) {
+    fn scene(&self) -> Result<Scene, CliError> {
         Ok(self.0.clone())
     }
     fn plan(&self) -> Result<Plan, CliError> {

@@ -1,62 +1,72 @@
-//! The built-in default scene: an electron-density-like field, after the paper's Image 8 (the
-//! p-orbitals of copper chloride): |ψ|² of a hydrogen-like 3d_xy orbital (four lobes) plus a
-//! weaker 2p_z pair, tilted 30° about x and 20° about y so the default front view shows all of
-//! them, on a 64³ grid of spacing 1, normalised to a peak of 1. [`volume`] samples the same field
-//! on an n³ grid over the same box (spacing 63/(n − 1)), with the same normalisation, so grids of
-//! any side render to the same image up to their sampling.
+//! What is rendered ([`Scene`]): the volume's source and layout, the camera, classification and
+//! shading, the picture's style, the kernel and the continuous model. One of the two typed values
+//! a request is resolved into once (issue 76; the command line's resolution is
+//! `crate::args::resolve`); the other, what draws it and at which resolution, is
+//! `crate::plan::Plan`. Programs build a scene themselves. Nothing here is a flag's clap type.
 
-use crate::io::volume::{Samples, Volume};
-use crate::CliError;
+use crate::io::image::{Background, Gamma};
+use footprint::geometry::FootprintOptions;
+use footprint::render::Absorption;
+use footprint::Kernel;
+use std::path::PathBuf;
 
-/// Side of the default volume, voxels.
-pub const SIDE: usize = 64;
-
-/// Builds the default volume (f32 densities in [0, 1]).
-pub fn default_volume() -> Volume {
-    volume(SIDE).expect("the 64³ scene (1 MiB) fits in memory")
+/// The kernel and how its footprints are shaped: what `--kernel`, `--method paper`'s
+/// `--paper-cheat`, `--min-radius` and `--table-file` resolve to.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct KernelModel {
+    /// The reconstruction kernel at full resolution.
+    pub kernel: Kernel,
+    /// The ellipse-to-circle map and the smallest footprint semi-axis, pixels.
+    pub options: FootprintOptions,
+    /// The generic table is loaded from a file made for [`KernelModel::kernel`]
+    /// (`--table-file`): coarser levels keep that kernel instead of narrowing it.
+    pub table_from_file: bool,
 }
 
-/// The field sampled on an `n`³ grid (n ≥ 2) over the default volume's box, divided by the
-/// default grid's peak (so another grid's peak may differ slightly from 1). An `n`³ grid takes
-/// 4n³ bytes: memory refusing them is an error (`--scene-size 512` needs 512 MiB), not an abort.
-pub fn volume(n: usize) -> Result<Volume, CliError> {
-    let (data, spacing) = sample(n)?;
-    let peak = if n == SIDE {
-        data.iter().copied().fold(0.0f32, f32::max)
-    } else {
-        sample(SIDE)?.0.into_iter().fold(0.0f32, f32::max)
-    };
-    let data: Vec<f32> = data.into_iter().map(|v| v / peak).collect();
-    Ok(Volume::new([n; 3], [spacing; 3], Samples::F32(data.into())))
-}
-
-/// The unnormalised field on an `n`³ grid, and the grid's spacing (world units).
-fn sample(n: usize) -> Result<(Vec<f32>, f32), CliError> {
-    let c = (n as f32 - 1.0) / 2.0;
-    // Grid spans ±18 Bohr radii.
-    let s = 18.0 / c;
-    let (ca, sa) = (30f32.to_radians().cos(), 30f32.to_radians().sin());
-    let (cb, sb) = (20f32.to_radians().cos(), 20f32.to_radians().sin());
-    let len = n
-        .checked_pow(3)
-        .ok_or_else(|| CliError::input(format!("--scene-size {n}: n³ samples overflow")))?;
-    let mut data =
-        crate::io::try_vec(len, &format!("the built-in scene at {n}³")).map_err(CliError::input)?;
-    for k in 0..n {
-        for j in 0..n {
-            for i in 0..n {
-                let (x0, y0, z0) = ((i as f32 - c) * s, (j as f32 - c) * s, (k as f32 - c) * s);
-                // Orbital frame: tilt about x, then about y.
-                let (y1, z1) = (ca * y0 - sa * z0, sa * y0 + ca * z0);
-                let (x, z) = (cb * x0 + sb * z1, -sb * x0 + cb * z1);
-                let y = y1;
-                let r = (x * x + y * y + z * z).sqrt();
-                // 3d_xy: ψ ∝ x y e^(−r/3), peak density at r = 6. 2p_z: ψ ∝ z e^(−r/2), peak at r = 2.
-                let d = (x * y).powi(2) * (-2.0 * r / 3.0).exp();
-                let p = z * z * (-r).exp();
-                data.push(d / 6.8 + 0.45 * p / 0.54);
-            }
-        }
-    }
-    Ok((data, (SIDE as f32 - 1.0) / (n as f32 - 1.0)))
+/// What a render loads and how it sees it: the volume and its layout, classification, camera,
+/// picture, kernel and continuous model. The pipeline prepares from a scene and a plan
+/// (`crate::pipeline::prepare()`) and never reads the command-line struct.
+///
+/// Units and conventions: world = G·(i, j, k) with the volume's centre at the origin (G from
+/// the file's spacing or directions, or [`Scene::spacing`] for raw files); `view` is VTK's
+/// azimuth, elevation and roll, degrees; `size` is pixels, (width, height).
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// A volume already in memory (set by a program, such as the Python package).
+    pub memory: Option<crate::io::stream::InMemory>,
+    /// What `--stream -` reads instead of standard input.
+    pub stdin: Option<crate::io::stream::Pipe>,
+    /// The volume file; `None`: the built-in scene.
+    pub volume: Option<PathBuf>,
+    /// `--stream FILE|-`.
+    pub stream: Option<PathBuf>,
+    /// Raw layout: `--dims`, `--type`, `--endian`, `--spacing`; `--array`.
+    pub dims: Option<[usize; 3]>,
+    pub sample_type: Option<String>,
+    pub endian: String,
+    pub spacing: [f32; 3],
+    pub array: Option<String>,
+    /// The built-in scene's grid, and its finer field's (`--reference field`).
+    pub scene_size: usize,
+    pub field_size: usize,
+    /// Output size, pixels (width, height).
+    pub size: (usize, usize),
+    /// Camera: VTK's azimuth, elevation, roll (degrees), zoom, an explicit matrix, perspective.
+    pub view: [f32; 3],
+    pub zoom: f32,
+    pub view_matrix: Option<[f32; 9]>,
+    pub perspective: Option<f32>,
+    pub eye_distance: Option<f32>,
+    /// Classification: `--tf`, `--window`, `--shading`.
+    pub tf: Option<String>,
+    pub window: Option<[f64; 2]>,
+    pub shading: String,
+    /// Picture: background, gamma, PNG depth.
+    pub background: Background,
+    pub gamma: Gamma,
+    pub depth: u8,
+    /// The kernel and its footprints' shape.
+    pub kernel: KernelModel,
+    /// The continuous model every end composites.
+    pub absorption: Absorption,
 }

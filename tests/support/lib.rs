@@ -271,7 +271,7 @@ pub fn apply_quality(
     footprint_harness::CliError,
 > {
     let plan = footprint_harness::args::plan(args)?;
-    let inputs = footprint_harness::args::inputs(args)?;
+    let inputs = footprint_harness::args::scene(args)?;
     footprint_harness::pipeline::quality::choose::apply_quality(p, &inputs, &plan)
 }
 
@@ -284,7 +284,7 @@ pub fn choose_continuous(
     reference: footprint_harness::args::QualityReferenceArg,
 ) -> Result<footprint_harness::pipeline::quality::model::Choice, footprint_harness::CliError> {
     let plan = footprint_harness::args::plan(args)?;
-    let inputs = footprint_harness::args::inputs(args)?;
+    let inputs = footprint_harness::args::scene(args)?;
     footprint_harness::pipeline::quality::pilot::choose_continuous(
         p,
         &inputs,

@@ -1,5 +1,5 @@
 //! The command line resolved once (issue 76): `render`'s flags ([`RenderArgs`]) into the
-//! pipeline's two typed values, what is rendered ([`Inputs`]) and what draws it ([`Plan`]), with
+//! pipeline's two typed values, what is rendered ([`Scene`]) and what draws it ([`Plan`]), with
 //! every compatibility rule that the flags alone decide, before anything is loaded: between end
 //! points, precision and model ([`plan`]), with a streamed volume, `--cull`, `--subsample` and
 //! `--phase-lookup`, and post-classification's (`post.rs`). Nothing below this layer names a
@@ -11,10 +11,10 @@ use super::{
 };
 use crate::pipeline::ends::single::{compose_view, Single};
 use crate::plan::{
-    check_levels, quality_level_of_stream, End, Footprints, Inputs, KernelModel, Method, Plan,
-    Precision, Quality, QualityReference, Request, Table, SUBSAMPLE_NOT_AT_A_LEVEL,
-    SUBSAMPLE_NOT_PERSPECTIVE,
+    check_levels, quality_level_of_stream, End, Footprints, Method, Plan, Precision, Quality,
+    QualityReference, Request, Table, SUBSAMPLE_NOT_AT_A_LEVEL, SUBSAMPLE_NOT_PERSPECTIVE,
 };
+use crate::scene::{KernelModel, Scene};
 use crate::CliError;
 use footprint::frame::Order;
 use footprint::geometry::FootprintOptions;
@@ -77,7 +77,6 @@ pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
         _ => {}
     }
     flag_rules(&end, args)?;
-    check_levels(&inputs(args)?)?;
     let extinction = Absorption::from(args.absorption) == Absorption::Extinction;
     if extinction && matches!(end, End::Sheets(_) | End::Refined { .. }) {
         // (Perspective sheets place each voxel's optical depth along its own ray: `PerVoxel`.)
@@ -91,7 +90,7 @@ pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
     }
     subsample_rules(args)?;
     let auto_slicing = auto::slicing_target(&end, args);
-    Ok(Plan {
+    let plan = Plan {
         end,
         table: Table {
             size: fa.table,
@@ -113,7 +112,16 @@ pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
         }),
         auto_slicing,
         auto_subsample: args.subsample.is_none() && auto_slicing.is_some(),
-    })
+        lod: args.lod,
+        supersample: args.supersample,
+        // Culling needs what is in front first.
+        order: match args.order {
+            None if args.cull.0.is_some() => Some(Order::FrontToBack),
+            order => order.map(Order::from),
+        },
+    };
+    check_levels(&scene(args)?, &plan.resolution())?;
+    Ok(plan)
 }
 
 /// The rules `--subsample` adds: not with `--quality` (which chooses at the output size), an
@@ -222,10 +230,10 @@ fn streamed_rules(end: &End, args: &RenderArgs) -> Result<(), CliError> {
     }
 }
 
-/// `a`'s inputs: what the render loads and how it sees it, the kernel parsed and the mapping's
+/// `a`'s scene: what the render loads and how it sees it, the kernel parsed and the mapping's
 /// rules checked (`--kernel`, `--paper-cheat`).
-pub fn inputs(a: &RenderArgs) -> Result<Inputs, CliError> {
-    Ok(Inputs {
+pub fn scene(a: &RenderArgs) -> Result<Scene, CliError> {
+    Ok(Scene {
         memory: a.memory.clone(),
         stdin: a.stdin.clone(),
         volume: a.volume.clone(),
@@ -251,23 +259,6 @@ pub fn inputs(a: &RenderArgs) -> Result<Inputs, CliError> {
         depth: a.depth,
         kernel: kernel_model(&a.footprint)?,
         absorption: a.absorption.into(),
-        // Post-classification composites front to back unless told: opaque pixels then take
-        // nothing more (exact), where back to front must classify every slab.
-        // Culling needs what is in front first.
-        order: match (a.classification, a.order) {
-            (ClassificationArg::Post, None) => Some(Order::FrontToBack),
-            (_, None) if a.cull.0.is_some() => Some(Order::FrontToBack),
-            (_, order) => order.map(Order::from),
-        },
-        supersample: a.supersample,
-        // Post-classification reconstructs the values at full resolution (a coarser level
-        // carries pre-classified colours): `auto` means level 0 there.
-        lod: match (a.classification, a.lod) {
-            (ClassificationArg::Post, Lod::Auto) => Lod::Level(0),
-            (_, lod) => lod,
-        },
-        refine: a.refine.is_some(),
-        quality: a.quality.is_some(),
     })
 }
 
@@ -358,8 +349,8 @@ pub fn turned(base: &RenderArgs, degrees: f32) -> RenderArgs {
 }
 
 impl Request for RenderArgs {
-    fn inputs(&self) -> Result<Inputs, CliError> {
-        inputs(self)
+    fn scene(&self) -> Result<Scene, CliError> {
+        scene(self)
     }
     fn plan(&self) -> Result<Plan, CliError> {
         plan(self)

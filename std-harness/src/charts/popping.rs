@@ -59,7 +59,7 @@ pub fn popping(
         let az = f64::from(tenth) / 10.0;
         args.view = [az as f32, base.view[1], base.view[2]];
         args.view_matrix = None;
-        p.reframe(&crate::args::inputs(&args)?)?;
+        p.reframe(&crate::args::scene(&args)?)?;
         let (truth, _) = render_continuous_ref(&p, Reconstruction::Kernel)?;
         for (k, slicing) in [SlicingArg::Object, SlicingArg::Image]
             .into_iter()

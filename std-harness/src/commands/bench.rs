@@ -99,7 +99,7 @@ fn check(args: &BenchArgs) -> Result<(), CliError> {
 pub fn run(args: &BenchArgs) -> Result<(), CliError> {
     check(args)?;
     let base = &args.render;
-    let inputs = crate::args::inputs(base)?;
+    let inputs = crate::args::scene(base)?;
     let prepared = prepare(base)?;
     // The default plan's pilot (or --quality's) is part of a fresh volume's cost.
     let choosing = Instant::now();
@@ -116,7 +116,7 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
     for k in 0..args.frames {
         // The same plan every frame; only the view turns.
         if k > 0 {
-            p.reframe(&crate::args::inputs(&turned(base, args.orbit * k as f32))?)?;
+            p.reframe(&crate::args::scene(&turned(base, args.orbit * k as f32))?)?;
         }
         let (f, piloted) = chosen_frame(&p, &plan, &mut choice, &mut cache)?;
         pilot_frame |= piloted;

@@ -33,7 +33,7 @@ pub fn run(args: &InfoArgs) -> Result<(), CliError> {
             extensions: &[],
         }])?;
     }
-    let raw = raw_options(&crate::args::inputs(r)?)?;
+    let raw = raw_options(&crate::args::scene(r)?)?;
     let v = crate::io::formats::load_array(path, raw.as_ref(), r.array.as_deref())?;
     let report = Report::of(&v, path.display().to_string(), r.window);
     report.print(&v);

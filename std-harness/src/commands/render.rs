@@ -10,7 +10,8 @@ use crate::pipeline::quality::choose::{apply_quality, chosen_frame};
 use crate::pipeline::quality::model::quality_json;
 use crate::pipeline::stages::visible::FrameCache;
 use crate::pipeline::{describe, prepare, render_frame, render_ref, Prepared};
-use crate::plan::{End, Inputs, Plan};
+use crate::plan::{End, Plan};
+use crate::scene::Scene;
 use crate::CliError;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -65,7 +66,7 @@ pub fn run(command: &RenderCommandArgs) -> Result<(), CliError> {
     }
     // Every rule the flags decide, before anything is loaded.
     let asked = plan(args)?;
-    let inputs = crate::args::inputs(args)?;
+    let inputs = crate::args::scene(args)?;
     if let Some(split) = crate::distributed::render_split(&inputs, &asked, command.bricks)? {
         if command.orbit.is_some() || command.colorbar {
             return Err(CliError::input(
@@ -94,7 +95,7 @@ pub fn run(command: &RenderCommandArgs) -> Result<(), CliError> {
 /// package's `render` calls too.
 pub fn single(
     args: &RenderArgs,
-    inputs: &Inputs,
+    inputs: &Scene,
     asked: &Plan,
 ) -> Result<(Vec<[f32; 4]>, crate::io::json::Json, Prepared), CliError> {
     let (p, plan, mut choice) = apply_quality(prepare(args)?, inputs, asked)?;
@@ -263,7 +264,7 @@ fn orbit(
     let image = encode_apng(args.size, args.png_style(), n, delay, |k| {
         let a = turned(args, 360.0 * k as f32 / n as f32);
         if k > 0 {
-            p.reframe(&crate::args::inputs(&a)?)?;
+            p.reframe(&crate::args::scene(&a)?)?;
         }
         let mut f = render_frame(&p, plan, &mut cache)?;
         crate::say!("{}: frame {}/{n} in {:.3} s", p.name, k + 1, f.seconds);
@@ -273,7 +274,7 @@ fn orbit(
         Ok(f.image)
     })?;
     let secs = start.elapsed().as_secs_f64();
-    let summary = describe(&p, &crate::args::inputs(args)?, plan)
+    let summary = describe(&p, &crate::args::scene(args)?, plan)
         .num("frames", n as f64)
         .num("frame_delay_ms", f64::from(delay))
         .num("seconds", secs)

@@ -10,8 +10,9 @@ use crate::io::volume::Volume;
 use crate::pipeline::stages::load::Voxels;
 use crate::pipeline::stages::visible::FrameCache;
 use crate::pipeline::{prepare, render_frame};
-use crate::plan::{End, Inputs, Plan};
-use crate::{scene, CliError};
+use crate::plan::{End, Plan};
+use crate::scene::Scene;
+use crate::{builtin, CliError};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -93,7 +94,7 @@ impl Header {
 /// One render split into bricks: what every brick shares.
 pub struct Job {
     /// The inputs each brick renders with (its volume and the window set per brick).
-    pub inputs: Inputs,
+    pub inputs: Scene,
     pub plan: Plan,
     /// The volume's name in messages and the JSON.
     pub name: String,
@@ -108,13 +109,13 @@ pub struct Job {
 impl Job {
     /// The job for `inputs` and `plan`, refused with a reason where bricks cannot honour them.
     /// Opens the source: a seekable file's header only; anything else is loaded whole.
-    pub fn new(inputs: &Inputs, plan: &Plan) -> Result<Job, CliError> {
+    pub fn new(inputs: &Scene, plan: &Plan) -> Result<Job, CliError> {
         Job::open(inputs, plan, None)
     }
 
     /// Whether `inputs`' volume is loaded whole ([`Source::Whole`] from a file or the built-in
     /// scene, not a program's volume in memory): the same answer on every rank.
-    pub fn loads_whole(inputs: &Inputs) -> Result<bool, CliError> {
+    pub fn loads_whole(inputs: &Scene) -> Result<bool, CliError> {
         let raw = crate::pipeline::stages::load::raw_options(inputs)?;
         Ok(match (&inputs.memory, &inputs.volume) {
             (Some(_), _) => false,
@@ -130,19 +131,20 @@ impl Job {
     /// [`Job::new`] on a rank that does not load a whole volume: `header` is what the loading
     /// rank says of it ([`Source::Elsewhere`]); a seekable file or a volume in memory is opened
     /// as by [`Job::new`].
-    pub fn remote(inputs: &Inputs, plan: &Plan, header: Header) -> Result<Job, CliError> {
+    pub fn remote(inputs: &Scene, plan: &Plan, header: Header) -> Result<Job, CliError> {
         Job::open(inputs, plan, Some(header))
     }
 
-    fn open(inputs: &Inputs, plan: &Plan, remote: Option<Header>) -> Result<Job, CliError> {
+    fn open(inputs: &Scene, plan: &Plan, remote: Option<Header>) -> Result<Job, CliError> {
         refuse(inputs, plan)?;
         let mut inputs = inputs.clone();
         let builtin = inputs.volume.is_none() && inputs.memory.is_none();
         // Bricks reach the pipeline as volumes in memory: the one-process choice, made here.
         inputs.tf = Some(crate::pipeline::stages::prepare::tf_name(&inputs));
-        if inputs.lod == Lod::Auto {
+        let mut plan = plan.clone();
+        if plan.lod == Lod::Auto {
             // A level of detail is built from the whole volume; bricks render level 0.
-            inputs.lod = Lod::Level(0);
+            plan.lod = Lod::Level(0);
         }
         let raw = crate::pipeline::stages::load::raw_options(&inputs)?;
         let (name, source) = match (&inputs.memory, &inputs.volume) {
@@ -177,7 +179,7 @@ impl Job {
                 match remote {
                     Some(h) => Source::Elsewhere(h),
                     None => Source::Whole {
-                        volume: Arc::new(scene::volume(inputs.scene_size)?),
+                        volume: Arc::new(builtin::volume(inputs.scene_size)?),
                         bytes: 0,
                     },
                 },
@@ -194,7 +196,7 @@ impl Job {
         inputs.sample_type = None;
         Ok(Job {
             inputs,
-            plan: plan.clone(),
+            plan,
             name,
             dims,
             source,
@@ -489,12 +491,12 @@ impl BrickFrame {
 }
 
 /// The flags bricks cannot honour, refused with the reason (the same on every rank).
-pub fn check(inputs: &Inputs, plan: &Plan) -> Result<(), CliError> {
+pub fn check(inputs: &Scene, plan: &Plan) -> Result<(), CliError> {
     refuse(inputs, plan)
 }
 
 /// The flags bricks cannot honour, refused with the reason.
-fn refuse(inputs: &Inputs, plan: &Plan) -> Result<(), CliError> {
+fn refuse(inputs: &Scene, plan: &Plan) -> Result<(), CliError> {
     let no = |what: &str, why: &str| {
         Err(CliError::input(format!(
             "{what} does not render in bricks: {why}"
@@ -531,13 +533,13 @@ fn refuse(inputs: &Inputs, plan: &Plan) -> Result<(), CliError> {
             "the bricks' visibility order is the orthographic one",
         );
     }
-    if matches!(inputs.lod, Lod::Level(1..)) {
+    if matches!(plan.lod, Lod::Level(1..)) {
         return no(
             "--lod N",
             "a level averages voxel blocks across brick borders",
         );
     }
-    if inputs.quality || plan.quality.is_some() {
+    if plan.quality.is_some() {
         return no("--quality", "its pilots would choose per brick; choose the plan with one process and pass its flags");
     }
     Ok(())

@@ -28,7 +28,8 @@ pub mod mpi;
 pub use job::{BrickFrame, Header, Job, Resample, Source, WindowPart};
 pub use layout::BrickLayout;
 
-use crate::plan::{Inputs, Plan};
+use crate::plan::Plan;
+use crate::scene::Scene;
 use crate::CliError;
 use std::time::Instant;
 
@@ -184,7 +185,7 @@ pub fn json(
 /// background under it) and the JSON summary.
 #[allow(clippy::type_complexity)]
 pub fn render_split(
-    inputs: &Inputs,
+    inputs: &Scene,
     plan: &Plan,
     bricks: Option<[usize; 3]>,
 ) -> Result<Option<Option<(Vec<[f32; 4]>, crate::io::json::Json)>>, CliError> {

@@ -80,7 +80,7 @@ pub fn agree_frame(
     let description = format!(
         "size {:?} view {:?} zoom {:?} matrix {:?} perspective {:?} eye {:?} tf {:?} window {:?} \
          shading {:?} background {:?} gamma {:?} depth {} kernel {:?} absorption {:?} \
-         order {:?} supersample {:?} lod {:?} refine {} quality {} plan {:?} grid {} bricks {:?}",
+         plan {:?} grid {} bricks {:?}",
         i.size,
         i.view,
         i.zoom,
@@ -95,11 +95,6 @@ pub fn agree_frame(
         i.depth,
         i.kernel,
         i.absorption,
-        i.order,
-        i.supersample,
-        i.lod,
-        i.refine,
-        i.quality,
         job.plan,
         job.grid_description(),
         layout.boxes,
@@ -126,7 +121,7 @@ pub fn agree_frame(
 /// the next collective, so a rank that cannot read its volume ends every rank's job with exit 2.
 pub fn job(
     comm: &SimpleCommunicator,
-    inputs: &crate::plan::Inputs,
+    inputs: &crate::scene::Scene,
     plan: &crate::plan::Plan,
 ) -> Result<Job, CliError> {
     let whole = agree(comm, "opening the volume", Job::loads_whole(inputs))?;
@@ -282,7 +277,7 @@ pub fn render_in_situ(
     stored: IndexBox,
     owned: IndexBox,
 ) -> Result<Option<Composited>, CliError> {
-    let mut inputs = crate::args::inputs(args)?;
+    let mut inputs = crate::args::scene(args)?;
     let plan = crate::args::plan(args)?;
     let held = [0, 1, 2].map(|c| stored.hi[c].saturating_sub(stored.lo[c]));
     if held.iter().product::<usize>() != samples_len(&samples)

@@ -16,7 +16,7 @@
 //! back, so it is written after every regular output is written to its temporary and before any
 //! is renamed into place: a device that fails (`/dev/full`, a closed pipe) leaves no output.
 //!
-//! **Inputs.** No output may name a file the command reads (`--json VOLUME`, an NRRD's detached
+//! **Scene.** No output may name a file the command reads (`--json VOLUME`, an NRRD's detached
 //! data file, a `--tf` file; through symbolic or hard links alike): [`check`] refuses the inputs
 //! its command names, and [`write_all`] every file read since (`crate::io::is_input`).
 //!

@@ -3,10 +3,11 @@
 
 use super::stages::prepare::Prepared;
 use crate::io::json::Json;
-use crate::plan::{End, Footprints, Inputs, Plan, Precision};
+use crate::plan::{End, Footprints, Plan, Precision};
+use crate::scene::Scene;
 
 /// The JSON fields every render and verify summary share.
-pub fn describe(p: &Prepared, args: &Inputs, plan: &Plan) -> Json {
+pub fn describe(p: &Prepared, args: &Scene, plan: &Plan) -> Json {
     let f = &p.frame;
     let method = match (plan.end, plan.table.footprints) {
         (End::Reference, _) => "reference".to_string(),

@@ -7,11 +7,11 @@ use super::quality::level_pilot::validated_auto;
 use super::stages::hold::held;
 use super::stages::prepare::{prepare_as_asked, Prepared};
 use crate::io::stream::is_stdin;
-use crate::plan::Lod;
-use crate::plan::{Inputs, Request};
+use crate::plan::{Lod, Plan, Request};
+use crate::scene::Scene;
 use crate::CliError;
 
-/// Loads and sets up everything `request` describes (its [`Inputs`]). `--lod auto` keeps a
+/// Loads and sets up everything `request` describes (its [`Scene`]). `--lod auto` keeps a
 /// coarser level only where a pilot, rendered with the request's plan, measures it close to
 /// level 0: on a volume in memory, or on a file streamed (read once per level tried); a pipe
 /// keeps the geometric rule alone (it cannot be read twice).
@@ -19,13 +19,12 @@ use crate::CliError;
 /// A stream that a pilot needs is first read whole where it fits ([`super::stages::hold`]), so
 /// that it is prepared, planned and rendered as the file it is would be.
 pub fn prepare<R: Request + ?Sized>(request: &R) -> Result<Prepared, CliError> {
-    let mut args = request.inputs()?;
-    // Resolved once, for the hold and the level pilot; a plan the flags refuse is refused only
-    // where one of them needs it (the command refuses it too, with the stream's reasons).
-    let plan = request.plan();
-    if let (Some(_), Ok(plan)) = (&args.stream, &plan) {
-        if let Some(memory) = held(&args, plan)? {
-            args = Inputs {
+    let mut args = request.scene()?;
+    // Resolved once, for the hold, the frame's resolution and the level pilot.
+    let plan = request.plan()?;
+    if args.stream.is_some() {
+        if let Some(memory) = held(&args, &plan)? {
+            args = Scene {
                 memory: Some(memory),
                 stream: None,
                 dims: None,
@@ -37,9 +36,9 @@ pub fn prepare<R: Request + ?Sized>(request: &R) -> Result<Prepared, CliError> {
     // A pipe is read once: it keeps the spacing rule's level, said so (a file stream is
     // measured as it streams).
     let piped = args.stream.as_deref().is_some_and(is_stdin);
-    if args.lod != Lod::Auto || args.quality || piped {
-        let p = prepare_as_asked(&args)?;
-        if piped && args.lod == Lod::Auto && p.level > 0 {
+    if plan.lod != Lod::Auto || plan.quality.is_some() || piped {
+        let p = prepare_as_asked(&args, &plan)?;
+        if piped && plan.lod == Lod::Auto && p.level > 0 {
             crate::say!(
                 "{}: --lod auto renders level {} by the spacing rule alone, not measured against \
                  level 0 (a pipe too large to hold is read once); give --lod 0 for full resolution",
@@ -49,9 +48,9 @@ pub fn prepare<R: Request + ?Sized>(request: &R) -> Result<Prepared, CliError> {
         }
         return Ok(p);
     }
-    let at_full = Inputs {
+    let at_full = Plan {
         lod: Lod::Level(0),
-        ..args.clone()
+        ..plan.clone()
     };
-    validated_auto(prepare_as_asked(&at_full)?, &args, &plan?)
+    validated_auto(prepare_as_asked(&args, &at_full)?, &args, &plan)
 }

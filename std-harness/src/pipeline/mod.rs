@@ -2,7 +2,7 @@
 //! it, and its folders are its stages:
 //!
 //! ```text
-//! Inputs ─▶ entry::prepare ─▶ stages (load, window, prepare, lod, super/subsample, visible,
+//! Scene ─▶ entry::prepare ─▶ stages (load, window, prepare, lod, super/subsample, visible,
 //!                                      spares, supply, bands)          ─▶ Prepared
 //! (&Prepared, &Plan) ─▶ ends (run: the core's sheets; slabs; refine; the f64 and continuous
 //!                             references; single)                    ─▶ image
@@ -29,7 +29,7 @@
 //!   [`describe`](mod@describe): the JSON fields every summary shares.
 //!
 //! A frame renders `(&Prepared, &Plan)` ([`render_frame`], [`crate::plan`]); preparing reads
-//! [`crate::plan::Inputs`]. No file here names the command-line struct (`tests/layering.rs`); it
+//! [`crate::scene::Scene`]. No file here names the command-line struct (`tests/layering.rs`); it
 //! calls down into [`crate::io`], [`crate::reference`] and the core, and imports no command;
 //! stages import no end, and ends no quality module.
 

@@ -19,3 +19,28 @@ pub enum Lod {
     /// This level (0 = full resolution).
     Level(u32),
 }
+
+/// The resolution chain as a frame's set-up reads it: the level asked for, supersampling, and
+/// whether the frame must stay at full resolution because the end refines it or `--quality`
+/// measures the levels itself (`crate::plan::Plan::resolution`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Resolution {
+    /// The level of detail asked for.
+    pub lod: Lod,
+    /// Supersampling asked for.
+    pub supersample: Supersample,
+    /// The end refines the grid (`--refine`): level 0 always.
+    pub refine: bool,
+    /// `--quality` chooses the level: the volume is prepared at level 0.
+    pub quality: bool,
+}
+
+impl Resolution {
+    /// The same chain at level `n`.
+    pub fn at_level(self, n: u32) -> Resolution {
+        Resolution {
+            lod: Lod::Level(n),
+            ..self
+        }
+    }
+}

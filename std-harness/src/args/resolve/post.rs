@@ -5,6 +5,7 @@ use super::plan;
 use crate::args::{ClassificationArg, Lod, MethodArg, RenderArgs, SlicingArg, Supersample};
 use crate::plan::{End, Plan, Precision};
 use crate::CliError;
+use footprint::frame::Order;
 use footprint::render::Absorption;
 
 /// `--slab-post` and `--value-subsample` without `--classification post`: refused, not ignored.
@@ -101,5 +102,13 @@ pub(super) fn post_plan(args: &RenderArgs, precision: Precision) -> Result<Plan,
             .unwrap_or_else(|| crate::args::default_post_slab(&args.shading)),
         values: args.value_subsample,
     };
+    // Post-classification composites front to back unless told: opaque pixels then take
+    // nothing more (exact), where back to front must classify every slab.
+    plan.order = Some(args.order.map_or(Order::FrontToBack, Order::from));
+    // It reconstructs the values at full resolution (a coarser level carries pre-classified
+    // colours): `auto` means level 0 there.
+    if plan.lod == Lod::Auto {
+        plan.lod = Lod::Level(0);
+    }
     Ok(plan)
 }

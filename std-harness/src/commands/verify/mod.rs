@@ -16,8 +16,9 @@ use crate::pipeline::quality::choose::{apply_quality, chosen_frame};
 use crate::pipeline::quality::{field::prepare_field, model::Choice};
 use crate::pipeline::stages::visible::FrameCache;
 use crate::pipeline::{prepare, render_core, render_ref, Prepared};
-use crate::plan::{End, Inputs, Plan, Precision};
+use crate::plan::{End, Plan, Precision};
 use crate::reference::continuous::{Continuous, Model};
+use crate::scene::Scene;
 use crate::CliError;
 use clap::Args;
 use footprint::render::RenderStats;
@@ -143,7 +144,7 @@ struct AgainstContinuous {
 /// What `verify` measured: the core's render and every figure it is compared by.
 struct Measured {
     p: Prepared,
-    inputs: Inputs,
+    inputs: Scene,
     plan: Plan,
     choice: Option<Choice>,
     core: Vec<[f32; 4]>,
@@ -164,7 +165,7 @@ struct Measured {
 /// continuous integral when asked, full resolution for a coarser level, and the float path for
 /// the fixed one.
 fn measure(args: &VerifyArgs, r: &RenderArgs) -> Result<Measured, CliError> {
-    let inputs = crate::args::inputs(r)?;
+    let inputs = crate::args::scene(r)?;
     let (p, plan, mut choice) = apply_quality(prepare(r)?, &inputs, &plan(r)?)?;
     // The default plan's pilot rendered the chosen frame whole already.
     let frame = chosen_frame(&p, &plan, &mut choice, &mut FrameCache::default())?.0;
@@ -176,7 +177,7 @@ fn measure(args: &VerifyArgs, r: &RenderArgs) -> Result<Measured, CliError> {
         reference => {
             // `field`: the same integral, over the finer sampling of the built-in scene.
             let fine = match reference {
-                ReferenceArg::Field => Some(prepare_field(&inputs)?),
+                ReferenceArg::Field => Some(prepare_field(&inputs, &plan)?),
                 _ => None,
             };
             let over = fine.as_ref().unwrap_or(&p);
@@ -198,12 +199,12 @@ fn measure(args: &VerifyArgs, r: &RenderArgs) -> Result<Measured, CliError> {
     // A coarser level is also measured against full resolution: its own error counts there.
     let full_resolution = match (args.reference, p.level) {
         (ReferenceArg::Sheets, 1..) => {
-            let at_full = Inputs {
+            let at_full = Plan {
                 lod: Lod::Level(0),
-                quality: false,
-                ..inputs.clone()
+                quality: None,
+                ..plan.clone()
             };
-            let level0 = prepare(&(at_full, plan.clone()))?;
+            let level0 = prepare(&(inputs.clone(), at_full))?;
             let (full, _) = render_ref(&level0)?;
             Some(compare(&core, &full).1)
         }

@@ -7,8 +7,9 @@
 //! integrate to one over the screen plane.
 
 use crate::io::image::GreyImage;
-use crate::plan::{KernelModel, Method};
+use crate::plan::Method;
 use crate::reference::ReferenceFootprint;
+use crate::scene::KernelModel;
 use crate::CliError;
 use footprint::geometry::{Footprint, FootprintOptions, Mapping};
 use footprint::splat::{splat, Direct, ImageMut, Sampler};

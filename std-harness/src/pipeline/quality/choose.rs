@@ -29,8 +29,9 @@ use super::model::{self as quality, choose, footprint_error, predict_db, Choice}
 use crate::pipeline::ends::run::{render_frame, CoreFrame};
 use crate::pipeline::stages::prepare::Prepared;
 use crate::pipeline::stages::visible::FrameCache;
-use crate::plan::{End, Inputs, Plan};
+use crate::plan::{End, Plan};
 use crate::plan::{Lod, Method, QualityReference};
+use crate::scene::Scene;
 use crate::CliError;
 
 /// The frame of `plan` for `p`: the one the default plan's pilot rendered and kept in `choice`
@@ -54,7 +55,7 @@ pub fn chosen_frame(
 /// level 0) and the choice.
 pub fn apply_quality(
     p: Prepared,
-    args: &Inputs,
+    args: &Scene,
     plan: &Plan,
 ) -> Result<(Prepared, Plan, Option<Choice>), CliError> {
     let Some(quality) = plan.quality else {
@@ -82,7 +83,7 @@ pub fn apply_quality(
         }
         QualityReference::Sheets => choose_sheets(p, args, plan, q)?,
         r @ (QualityReference::Continuous | QualityReference::Field) => {
-            if let Lod::Level(n @ 1..) = args.lod {
+            if let Lod::Level(n @ 1..) = plan.lod {
                 return Err(CliError::input(format!(
                     "--quality-reference {} measures against the integral at full resolution \
                      and chooses among full-resolution renders: drop --lod {n}",
@@ -122,12 +123,12 @@ fn table_rmse(p: &Prepared, c: &Config) -> Result<f64, CliError> {
 /// The level and the table against the sheet reference at full resolution (see the module docs).
 fn choose_sheets(
     p0: Prepared,
-    args: &Inputs,
+    args: &Scene,
     plan: &Plan,
     target: f64,
 ) -> Result<(Prepared, Choice), CliError> {
     quality::check_target(target)?;
-    let explicit = match args.lod {
+    let explicit = match plan.lod {
         Lod::Level(n) => Some(n),
         Lod::Auto => None,
     };

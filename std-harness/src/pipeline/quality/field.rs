@@ -18,13 +18,13 @@
 //! image lines up pixel for pixel with the coarse one (the refinement chart relies on the same).
 
 use crate::pipeline::stages::prepare::Prepared;
-use crate::plan::Inputs;
-use crate::plan::Lod;
+use crate::plan::{Lod, Plan};
+use crate::scene::Scene;
 use crate::CliError;
 
-/// The finer sampling of `args`' built-in scene, prepared to render (full resolution, object
-/// slicing, unrefined, no `--quality`).
-pub fn prepare_field(args: &Inputs) -> Result<Prepared, CliError> {
+/// The finer sampling of `args`' built-in scene, prepared to render with `plan`'s order at full
+/// resolution (no `--quality`).
+pub fn prepare_field(args: &Scene, plan: &Plan) -> Result<Prepared, CliError> {
     if args.volume.is_some() || args.stream.is_some() {
         return Err(CliError::input(
             "the field reference is the built-in scene's analytic field sampled --field-size N³; \
@@ -39,11 +39,14 @@ pub fn prepare_field(args: &Inputs) -> Result<Prepared, CliError> {
         )));
     }
     // At level 0 with no --quality there is no level to validate: prepared as asked.
-    crate::pipeline::stages::prepare::prepare_as_asked(&Inputs {
-        scene_size: args.field_size,
-        refine: false,
-        quality: false,
+    let at_full = Plan {
         lod: Lod::Level(0),
+        quality: None,
+        ..plan.clone()
+    };
+    let field = Scene {
+        scene_size: args.field_size,
         ..args.clone()
-    })
+    };
+    crate::pipeline::stages::prepare::prepare_as_asked(&field, &at_full)
 }

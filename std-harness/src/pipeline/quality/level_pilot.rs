@@ -32,8 +32,8 @@ use crate::pipeline::stages::load::Voxels;
 use crate::pipeline::stages::lod::{averaging_for, with_level};
 use crate::pipeline::stages::prepare::Prepared;
 use crate::pipeline::stages::supersample::downsample;
-use crate::plan::Inputs;
 use crate::plan::Plan;
+use crate::scene::Scene;
 use crate::CliError;
 use footprint::composite::RowSpan;
 use footprint::render::{FloatPath, RenderBuffers, SheetRenderer, SheetRing};
@@ -292,7 +292,7 @@ pub fn candidate_levels(p: &Prepared, explicit: Option<u32>) -> Vec<u32> {
 /// first level `accept` refuses. Returns the pilot and the prepared levels accepted, in order.
 pub fn measure(
     p0: &Prepared,
-    args: &Inputs,
+    args: &Scene,
     plan: &Plan,
     levels: &[u32],
     mut accept: impl FnMut(u32, &Prepared, &Estimate) -> Result<bool, CliError>,
@@ -338,10 +338,11 @@ pub const AUTO_MIN_DB: f64 = 40.0;
 /// was fitted on grey ramps and kept the CT head's level 1 at 64² at 30.9 dB under a transfer
 /// function with sharp opacity steps (`ct-bone-skin`); the pilot sees what the data and the
 /// transfer function do to a level.
-pub fn validated_auto(p0: Prepared, args: &Inputs, plan: &Plan) -> Result<Prepared, CliError> {
+pub fn validated_auto(p0: Prepared, args: &Scene, plan: &Plan) -> Result<Prepared, CliError> {
     // The level the geometric rule picks for `args` (`--lod auto`), as prepare would have.
     let (_, _, deepest) = crate::pipeline::stages::prepare::setup_frame(
         args,
+        plan.resolution(),
         p0.fine_dims,
         &p0.grid,
         &p0.kernel,

@@ -114,9 +114,9 @@ use crate::pipeline::ends::run::render_frame;
 use crate::pipeline::stages::bands::CoreFrame;
 use crate::pipeline::stages::prepare::Prepared;
 use crate::pipeline::stages::visible::FrameCache;
-use crate::plan::Inputs;
 use crate::plan::QualityReference;
 use crate::plan::{End, Plan};
+use crate::scene::Scene;
 use crate::CliError;
 use std::time::Instant;
 
@@ -174,14 +174,14 @@ fn candidates(
 /// [`super::field`]).
 pub fn choose_continuous(
     p: &Prepared,
-    args: &Inputs,
+    args: &Scene,
     base: &Plan,
     target_db: f64,
     reference: QualityReference,
 ) -> Result<Choice, CliError> {
     quality::check_target(target_db)?;
     let fine = match reference {
-        QualityReference::Field => Some(super::field::prepare_field(args)?),
+        QualityReference::Field => Some(super::field::prepare_field(args, base)?),
         _ => None,
     };
     let candidates = candidates(p, base, target_db, reference)?

@@ -30,24 +30,25 @@ use crate::io::formats::raw::RawOptions;
 use crate::io::stream::{is_stdin, InMemory};
 use crate::io::volume::{byte_len, check_spacing, decode, Volume};
 use crate::plan::Lod;
-use crate::plan::{Inputs, Plan};
+use crate::plan::Plan;
+use crate::scene::Scene;
 use crate::CliError;
 use std::sync::Arc;
 
 /// Whether `inputs` with `plan` (the request's plan: a stream's is its file's) leave a choice
 /// that a pilot measures on the volume: the default plan's slicing, `--quality`, or `--lod auto`
 /// (a perspective view and `--refine` keep level 0 without a pilot).
-pub fn wants_volume(inputs: &Inputs, plan: &Plan) -> bool {
-    let level_pilot = inputs.lod == Lod::Auto && inputs.perspective.is_none() && !inputs.refine;
+pub fn wants_volume(inputs: &Scene, plan: &Plan) -> bool {
+    let level_pilot = plan.lod == Lod::Auto && inputs.perspective.is_none() && !plan.refines();
     plan.auto_slicing.is_some() || plan.quality.is_some() || level_pilot
 }
 
 /// `inputs`' stream (`--stream FILE|-`) read whole, where [`wants_volume`] and the pilot would
 /// measure it ([`crate::pipeline::stages::visible::pilot_fits`]); `None` where it stays a stream
 /// (or there is none). Called by [`crate::pipeline::entry::prepare`] before anything is loaded. A file is loaded as `footprint render FILE` loads it (same refusals of
-/// what cannot stream first); a pipe (standard input, or [`Inputs::stdin`]) is read to its
+/// what cannot stream first); a pipe (standard input, or [`Scene::stdin`]) is read to its
 /// `--dims`' last byte and decoded as the raw file would be. The name is the stream's.
-pub fn held(inputs: &Inputs, plan: &Plan) -> Result<Option<InMemory>, CliError> {
+pub fn held(inputs: &Scene, plan: &Plan) -> Result<Option<InMemory>, CliError> {
     let Some(stream) = &inputs.stream else {
         return Ok(None);
     };
@@ -96,7 +97,7 @@ fn in_memory(volume: Volume, name: String) -> InMemory {
 }
 
 /// The pipe's `o.dims` samples, read to the last byte and decoded as `raw::load` decodes a file.
-fn read_pipe(inputs: &Inputs, o: &RawOptions) -> Result<Volume, CliError> {
+fn read_pipe(inputs: &Scene, o: &RawOptions) -> Result<Volume, CliError> {
     let name = "standard input";
     let need = byte_len(o.dims, o.ty).map_err(|e| CliError::input(format!("{name}: {e}")))?;
     check_spacing(o.spacing).map_err(|e| CliError::input(format!("{name}: {e}")))?;

@@ -5,8 +5,8 @@ use crate::io::formats::{self, raw::RawOptions};
 use crate::io::stream::{file_summary, is_stdin, Layout, Pipe};
 use crate::io::volume::ValueMap;
 use crate::io::volume::{SampleType, Volume};
-use crate::plan::Inputs;
-use crate::{io, scene, CliError};
+use crate::scene::Scene;
+use crate::{builtin, io, CliError};
 use glam::{Mat3, Vec3};
 use std::sync::Arc;
 
@@ -23,7 +23,7 @@ pub enum Voxels {
         dims: [usize; 3],
         ty: SampleType,
         big_endian: bool,
-        /// What to read instead of standard input (`Inputs::stdin`).
+        /// What to read instead of standard input (`Scene::stdin`).
         pipe: Option<Pipe>,
         /// How wide samples become values: from the window a pipe must be given
         /// ([`stream_values`]).
@@ -53,7 +53,7 @@ pub fn stream_values(ty: SampleType, window: Option<[f64; 2]>) -> ValueMap {
 }
 
 /// The raw-file options from `--dims`, `--type`, `--endian`, `--spacing`, if `--dims` was given.
-pub fn raw_options(args: &Inputs) -> Result<Option<RawOptions>, CliError> {
+pub fn raw_options(args: &Scene) -> Result<Option<RawOptions>, CliError> {
     let given = args.dims.is_some() || args.sample_type.is_some();
     let file = args.volume.as_ref().or(args.stream.as_ref());
     if let Some(format) = file.and_then(|f| crate::io::formats::header_format(f)) {
@@ -111,9 +111,9 @@ pub(crate) struct Loaded {
     pub(crate) sample: Option<Vec<f32>>,
 }
 
-pub(crate) fn load_voxels(args: &Inputs) -> Result<Loaded, CliError> {
+pub(crate) fn load_voxels(args: &Scene) -> Result<Loaded, CliError> {
     let raw = raw_options(args)?;
-    if args.scene_size != scene::SIDE && (args.volume.is_some() || args.stream.is_some()) {
+    if args.scene_size != builtin::SIDE && (args.volume.is_some() || args.stream.is_some()) {
         return Err(CliError::input(
             "--scene-size samples the built-in scene: give no volume with it",
         ));
@@ -144,7 +144,10 @@ pub(crate) fn load_voxels(args: &Inputs) -> Result<Loaded, CliError> {
                 formats::load_array(path, raw.as_ref(), args.array.as_deref())?,
                 path.display().to_string(),
             ),
-            None => (scene::volume(args.scene_size)?, scene_name(args.scene_size)),
+            None => (
+                builtin::volume(args.scene_size)?,
+                scene_name(args.scene_size),
+            ),
         };
         let (dims, grid, range) = (volume.dims, volume.grid_to_world(), Some(volume.range()));
         let sample =
@@ -164,7 +167,7 @@ pub(crate) fn load_voxels(args: &Inputs) -> Result<Loaded, CliError> {
 /// The built-in scene's name in messages and the JSON's `volume`, sampled on an `n`³ grid.
 pub(crate) fn scene_name(n: usize) -> String {
     match n {
-        scene::SIDE => "built-in electron-density scene".to_string(),
+        builtin::SIDE => "built-in electron-density scene".to_string(),
         n => format!("built-in electron-density scene, {n}^3"),
     }
 }
@@ -173,7 +176,7 @@ pub(crate) fn scene_name(n: usize) -> String {
 /// NRRD or MetaImage with raw data), checked against the file, and, without `--window`, the
 /// range and sample the default window needs (one pass over the file).
 fn load_stream(
-    args: &Inputs,
+    args: &Scene,
     stream: &std::path::Path,
     raw: Option<RawOptions>,
 ) -> Result<Loaded, CliError> {

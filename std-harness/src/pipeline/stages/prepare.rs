@@ -12,9 +12,8 @@ use super::supersample;
 pub use super::window::outside_data_warnings;
 use super::window::values_shading;
 use crate::io::volume::Volume;
-use crate::plan::Lod;
-use crate::plan::Plan;
-use crate::plan::{check_levels, Inputs};
+use crate::plan::{check_levels, Plan, Resolution, Supersample};
+use crate::scene::Scene;
 use crate::{tf, CliError};
 use footprint::frame::{FrameSetup, Order};
 use footprint::geometry::FootprintOptions;
@@ -76,6 +75,9 @@ pub struct Prepared {
     pub options: FootprintOptions,
     /// The frame is set up at `supersample` × the output size (see [`super::supersample`]).
     pub supersample: usize,
+    /// The resolution chain the render was prepared with (its level aside): what
+    /// [`Prepared::reframe`] and [`Prepared::at_level`] set a frame up with again.
+    pub resolution: Resolution,
     /// The continuous model both slicings composite (`--absorption`).
     pub absorption: footprint::render::Absorption,
     /// The view at the output size (`--view`, `--zoom`, `--view-matrix`): what a subsampled
@@ -93,18 +95,17 @@ impl Prepared {
     /// The same volume, transfer function and shading seen with `args`' view (`--view`, `--zoom`,
     /// `--view-matrix`, `--size`): only the frame is set up again, nothing is loaded. The
     /// compositing order and the level of detail stay as prepared.
-    pub fn reframe(&mut self, args: &Inputs) -> Result<(), CliError> {
-        let mut args = args.clone();
-        args.lod = Lod::Level(self.level);
+    pub fn reframe(&mut self, args: &Scene) -> Result<(), CliError> {
         let (frame, k, _) = setup_frame(
-            &args,
+            args,
+            self.resolution.at_level(self.level),
             self.fine_dims,
             &self.grid,
             &self.kernel,
             self.options,
         )?;
         self.frame = frame;
-        self.view = view_for(&args, self.fine_dims, &self.grid)?;
+        self.view = view_for(args, self.fine_dims, &self.grid)?;
         self.supersample = k;
         self.background = at_frame(self.background_out.as_ref(), args.size, k);
         Ok(())
@@ -117,7 +118,7 @@ impl Prepared {
     /// loaded again.
     pub fn at_level(
         &self,
-        args: &Inputs,
+        args: &Scene,
         level: u32,
         from: Option<&Prepared>,
     ) -> Result<Prepared, CliError> {
@@ -136,11 +137,15 @@ impl Prepared {
                 self.level
             )));
         }
-        let mut a = args.clone();
-        a.lod = Lod::Level(level);
-        let (frame, supersample, _) =
-            setup_frame(&a, self.fine_dims, &self.grid, &self.kernel, self.options)?;
-        let kernel = kernel_at(&a, &self.kernel, level);
+        let (frame, supersample, _) = setup_frame(
+            args,
+            self.resolution.at_level(level),
+            self.fine_dims,
+            &self.grid,
+            &self.kernel,
+            self.options,
+        )?;
+        let kernel = kernel_at(args, &self.kernel, level);
         let min_spacing = frame.spacing.iter().copied().fold(f32::INFINITY, f32::min);
         let shading = parse_shading(&args.shading, min_spacing)?;
         let averaging = super::lod::averaging_for(&shading, self.shader().tf, self.absorption);
@@ -181,6 +186,7 @@ impl Prepared {
             order: self.order,
             options: self.options,
             supersample,
+            resolution: self.resolution,
             absorption: self.absorption,
             view: self.view,
         })
@@ -256,7 +262,7 @@ impl Prepared {
 
 /// The view for `--view`/`--zoom` (VTK's camera fitted to a volume of `dims` on `grid`, the
 /// core's [`View::from_vtk_camera`]) or `--view-matrix` (exactly as given).
-pub fn view_for(args: &Inputs, dims: [usize; 3], grid: &Grid) -> Result<View, CliError> {
+pub fn view_for(args: &Scene, dims: [usize; 3], grid: &Grid) -> Result<View, CliError> {
     let view = match args.view_matrix {
         Some(m) => View::from_rows(m).map_err(|e| CliError::input(format!("--view-matrix: {e}"))),
         None => {
@@ -285,7 +291,7 @@ pub fn view_for(args: &Inputs, dims: [usize; 3], grid: &Grid) -> Result<View, Cl
 
 /// The kernel level `level` is reconstructed with: a narrower one for a coarser level (the core's
 /// `lod::level_kernel`), unless `--table-file` fixes the table (and so the kernel) as given.
-fn kernel_at(args: &Inputs, kernel: &Kernel, level: u32) -> Kernel {
+fn kernel_at(args: &Scene, kernel: &Kernel, level: u32) -> Kernel {
     if args.kernel.table_from_file {
         *kernel
     } else {
@@ -301,29 +307,39 @@ fn kernel_at(args: &Inputs, kernel: &Kernel, level: u32) -> Kernel {
 /// of detail `--lod` picks ([`super::lod`]), placed exactly where level 0 would be seen, and the
 /// level is returned third.
 pub fn setup_frame(
-    args: &Inputs,
+    args: &Scene,
+    res: Resolution,
     dims: [usize; 3],
     grid: &Grid,
     kernel: &Kernel,
     options: FootprintOptions,
 ) -> Result<(FrameSetup, usize, u32), CliError> {
-    check_levels(args)?;
+    check_levels(args, &res)?;
     let view = view_for(args, dims, grid)?;
     let size = [args.size.0, args.size.1];
     if let Some(fovy) = args.perspective {
-        let (frame, k) = perspective_frame(args, fovy, &view, dims, grid, kernel, options)?;
+        let (frame, k) = perspective_frame(
+            args,
+            res.supersample,
+            fovy,
+            &view,
+            dims,
+            grid,
+            kernel,
+            options,
+        )?;
         return Ok((frame, k, 0));
     }
     let fine = FrameSetup::new(dims, grid, &view, kernel, options, size)?;
-    let fixed_k = match args.supersample {
+    let fixed_k = match res.supersample {
         crate::plan::Supersample::Fixed(k @ 2..) => Some(k),
         _ => None,
     };
-    let level = match (args.refine, fixed_k) {
+    let level = match (res.refine, fixed_k) {
         // Refinement is for magnified volumes: it always starts from full resolution; so does
         // a frame supersampled on request.
         (true, _) | (false, Some(_)) => 0,
-        (false, None) => super::lod::choose_level(args.lod, &fine, kernel),
+        (false, None) => super::lod::choose_level(res.lod, &fine, kernel),
     };
     let coarse_kernel = kernel_at(args, kernel, level);
     let at_level = |fine: &FrameSetup, view: &View| {
@@ -334,7 +350,7 @@ pub fn setup_frame(
     // Levels and supersampling never act on one frame: a coarser level is rendered at the
     // output size (its own error is what `--lod auto` validates, `crate::pipeline::quality::level_pilot`).
     let k = match level {
-        0 => supersample::factor(args.supersample, &frame, options),
+        0 => supersample::factor(res.supersample, &frame, options),
         _ => 1,
     };
     if k == 1 {
@@ -350,8 +366,10 @@ pub fn setup_frame(
 /// at `--eye-distance` or R / sin(FOVY/2) from the centre, focal length (H/2)/tan(FOVY/2) ×
 /// `--zoom` pixels. Supersampling (`auto`) is decided by the farthest voxels, whose footprints
 /// are the smallest.
+#[allow(clippy::too_many_arguments)]
 fn perspective_frame(
-    args: &Inputs,
+    args: &Scene,
+    supersample: Supersample,
     fovy: f32,
     view: &View,
     dims: [usize; 3],
@@ -401,7 +419,7 @@ fn perspective_frame(
         .fold(0.0f32, f32::max);
     let shrink = cam.focal_px / far;
     let far_frame = FrameSetup::new(dims, grid, &scaled(shrink)?, kernel, options, size)?;
-    let k = supersample::factor(args.supersample, &far_frame, options);
+    let k = supersample::factor(supersample, &far_frame, options);
     if k == 1 {
         return Ok((frame, 1));
     }
@@ -420,7 +438,8 @@ fn perspective_frame(
 
 /// Loads and sets up everything `args` describes, with `--lod` taken as it is (`auto`: the
 /// geometric rule of [`super::lod`]); [`crate::pipeline::entry::prepare`] validates that rule's level.
-pub fn prepare_as_asked(args: &Inputs) -> Result<Prepared, CliError> {
+pub fn prepare_as_asked(args: &Scene, plan: &Plan) -> Result<Prepared, CliError> {
+    let resolution = plan.resolution();
     let kernel = args.kernel.kernel;
     let Loaded {
         voxels,
@@ -434,20 +453,15 @@ pub fn prepare_as_asked(args: &Inputs) -> Result<Prepared, CliError> {
     let options = args.kernel.options;
     // With --quality the volume is prepared at full resolution: the choice measures the levels
     // against it and builds the one it picks (`crate::pipeline::quality::choose`).
-    let at_full;
-    let framing = if args.quality {
-        at_full = Inputs {
-            lod: Lod::Level(0),
-            ..args.clone()
-        };
-        &at_full
+    let framing = if resolution.quality {
+        resolution.at_level(0)
     } else {
-        args
+        resolution
     };
-    let (frame, supersample, level) = setup_frame(framing, dims, &grid, &kernel, options)?;
+    let (frame, supersample, level) = setup_frame(args, framing, dims, &grid, &kernel, options)?;
     let kernel = kernel_at(args, &kernel, level);
 
-    let order = compositing_order(args, &voxels, &frame)?;
+    let order = compositing_order(plan.order, &voxels, &frame)?;
     let tf_name = tf_name(args);
     let lut = tf::lut(&tf::load(&tf_name)?);
     let values = voxels.values();
@@ -510,6 +524,7 @@ pub fn prepare_as_asked(args: &Inputs) -> Result<Prepared, CliError> {
         order,
         options,
         supersample,
+        resolution,
         absorption: args.absorption,
         view: view_for(args, dims, &grid)?,
     })
@@ -518,7 +533,7 @@ pub fn prepare_as_asked(args: &Inputs) -> Result<Prepared, CliError> {
 /// The transfer function `args` render with: `--tf`, else `density` for the built-in scene and
 /// `ct-bone-skin` for a user's volume (transparent below the default window's first 18 %: see
 /// `super::window`).
-pub fn tf_name(args: &Inputs) -> String {
+pub fn tf_name(args: &Scene) -> String {
     args.tf.clone().unwrap_or_else(|| {
         if args.volume.is_none() && args.stream.is_none() && args.memory.is_none() {
             "density"
@@ -533,7 +548,7 @@ pub fn tf_name(args: &Inputs) -> String {
 /// file order gives (refused for a view whose sheets do not run along z, or an `--order` against
 /// it).
 fn compositing_order(
-    args: &Inputs,
+    asked: Option<Order>,
     voxels: &Voxels,
     frame: &FrameSetup,
 ) -> Result<Order, CliError> {
@@ -548,7 +563,7 @@ fn compositing_order(
                 )));
             }
             let needed = frame.order_for_ascending();
-            if let Some(asked) = args.order {
+            if let Some(asked) = asked {
                 if asked != needed {
                     return Err(CliError::input(format!(
                         "from a pipe this view composites {needed:?} (file order runs {} the viewer); drop --order",
@@ -558,7 +573,7 @@ fn compositing_order(
             }
             needed
         }
-        _ => args.order.unwrap_or(Order::BackToFront),
+        _ => asked.unwrap_or(Order::BackToFront),
     })
 }
 
