@@ -11,6 +11,7 @@ mod cull;
 mod default_plan;
 mod degenerate;
 mod display;
+mod door;
 mod ellipse_geometry;
 mod fixed_point;
 mod flat_field;

@@ -15,14 +15,11 @@
 use crate::args::RenderArgs;
 use crate::args::{plan, turned};
 use crate::io::{self, json::Json};
-use crate::pipeline::quality::choose::{apply_quality, chosen_frame};
 use crate::pipeline::quality::model::quality_json;
 use crate::pipeline::stages::bands::Phases;
-use crate::pipeline::stages::visible::FrameCache;
-use crate::pipeline::{describe, prepare};
+use crate::pipeline::{describe, Renderer};
 use crate::CliError;
 use clap::Args;
-use std::time::Instant;
 
 #[derive(Args, Debug, Clone)]
 pub struct BenchArgs {
@@ -100,14 +97,12 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
     check(args)?;
     let base = &args.render;
     let inputs = crate::args::scene(base)?;
-    let prepared = prepare(base)?;
+    let asked = plan(base)?;
     // The default plan's pilot (or --quality's) is part of a fresh volume's cost.
-    let choosing = Instant::now();
-    let (mut p, plan, mut choice) = apply_quality(prepared, &inputs, &plan(base)?)?;
-    let plan_ms = choosing.elapsed().as_secs_f64() * 1e3;
+    let mut r = Renderer::open(&inputs, &asked)?;
+    let plan_ms = r.choosing_seconds() * 1e3;
     // Frame 1 as the default plan's pilot rendered it, if it did (its time is in plan_ms).
     let mut pilot_frame = false;
-    let mut cache = FrameCache::default();
     let mut times = Vec::with_capacity(args.frames);
     let mut phases = Vec::with_capacity(args.frames);
     let mut first_image = None;
@@ -116,9 +111,9 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
     for k in 0..args.frames {
         // The same plan every frame; only the view turns.
         if k > 0 {
-            p.reframe(&crate::args::scene(&turned(base, args.orbit * k as f32))?)?;
+            r.reframe(&crate::args::scene(&turned(base, args.orbit * k as f32))?)?;
         }
-        let (f, piloted) = chosen_frame(&p, &plan, &mut choice, &mut cache)?;
+        let (f, piloted) = r.frame()?;
         pilot_frame |= piloted;
         crate::say!(
             "frame {:>3}: {:8.2} ms (classify {:.2}, tables {:.2}, splat {:.2}, composite {:.2}, resample {:.2}); sheets along {}",
@@ -129,7 +124,7 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
             f.phases.splat * 1e3,
             f.phases.composite * 1e3,
             f.phases.resample * 1e3,
-            ["i", "j", "k"][p.frame.sheet_axis]
+            ["i", "j", "k"][r.prepared().frame.sheet_axis]
         );
         times.push(f.seconds * 1e3);
         phases.push(f.phases);
@@ -138,9 +133,10 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
         if k == 0 {
             first_image = Some(f.image);
         } else {
-            cache.recycle(f.image);
+            r.recycle(f.image);
         }
     }
+    let (p, plan, choice) = r.into_parts();
     let later = &times[1..];
     let first = if pilot_frame {
         plan_ms

@@ -6,10 +6,8 @@ use crate::args::{MethodArg, RenderArgs};
 use crate::charts::colorbar;
 use crate::io::image::{check_style, encode_apng, encode_rgb_for, RGB_EXTENSIONS};
 use crate::io::outputs::{self, Planned};
-use crate::pipeline::quality::choose::{apply_quality, chosen_frame};
 use crate::pipeline::quality::model::quality_json;
-use crate::pipeline::stages::visible::FrameCache;
-use crate::pipeline::{describe, prepare, render_frame, render_ref, Prepared};
+use crate::pipeline::{describe, Prepared, Renderer};
 use crate::plan::{End, Plan};
 use crate::scene::Scene;
 use crate::CliError;
@@ -79,8 +77,8 @@ pub fn run(command: &RenderCommandArgs) -> Result<(), CliError> {
         return write(args, &out, &rgb, summary);
     }
     if let Some(n) = command.orbit {
-        let (p, plan, _) = apply_quality(prepare(args)?, &inputs, &asked)?;
-        return orbit(p, args, &plan, &out, usize::from(n), command.colorbar);
+        let renderer = Renderer::open(&inputs, &asked)?;
+        return orbit(renderer, args, &out, usize::from(n), command.colorbar);
     }
     let (mut rgb, summary, p) = single(args, &inputs, &asked)?;
     if command.colorbar {
@@ -98,15 +96,15 @@ pub fn single(
     inputs: &Scene,
     asked: &Plan,
 ) -> Result<(Vec<[f32; 4]>, crate::io::json::Json, Prepared), CliError> {
-    let (p, plan, mut choice) = apply_quality(prepare(args)?, inputs, asked)?;
+    let (frame, renderer) = crate::pipeline::render(inputs, asked)?;
+    let (p, plan, choice) = renderer.into_parts();
     let (rgb, summary) = if plan.end == End::Reference {
-        let (img, secs) = render_ref(&p)?;
-        let rgb: Vec<[f32; 4]> = img.iter().map(|c| c.map(|x| x as f32)).collect();
-        crate::say!("{}: f64 reference render in {:.3} s", p.name, secs);
-        (rgb, describe(&p, inputs, &plan).num("seconds", secs))
+        crate::say!("{}: f64 reference render in {:.3} s", p.name, frame.seconds);
+        (
+            frame.image,
+            describe(&p, inputs, &plan).num("seconds", frame.seconds),
+        )
     } else {
-        // The default plan's pilot rendered the chosen frame whole already.
-        let frame = chosen_frame(&p, &plan, &mut choice, &mut FrameCache::default())?.0;
         let (img, stats, secs) = (frame.image, frame.stats, frame.seconds);
         if let Some(r) = &frame.refine {
             crate::say!(
@@ -251,22 +249,21 @@ fn check_orbit(args: &RenderArgs, out: &Path) -> Result<(), CliError> {
 /// `--orbit N`: N frames a 360/N-degree turn apart, reusing the loaded volume, its level and its
 /// visible-voxel lists, encoded into one animated PNG as they come.
 fn orbit(
-    mut p: Prepared,
+    mut r: Renderer,
     args: &RenderArgs,
-    plan: &Plan,
     out: &Path,
     n: usize,
     bar: bool,
 ) -> Result<(), CliError> {
     let start = Instant::now();
-    let mut cache = FrameCache::default();
     let delay = (4000 / n).clamp(20, 1000) as u16;
     let image = encode_apng(args.size, args.png_style(), n, delay, |k| {
         let a = turned(args, 360.0 * k as f32 / n as f32);
         if k > 0 {
-            p.reframe(&crate::args::scene(&a)?)?;
+            r.reframe(&crate::args::scene(&a)?)?;
         }
-        let mut f = render_frame(&p, plan, &mut cache)?;
+        let mut f = r.frame()?.0;
+        let p = r.prepared();
         crate::say!("{}: frame {}/{n} in {:.3} s", p.name, k + 1, f.seconds);
         if bar {
             colorbar::draw(&mut f.image, args.size, &p.lut, p.data_window())?;
@@ -274,7 +271,8 @@ fn orbit(
         Ok(f.image)
     })?;
     let secs = start.elapsed().as_secs_f64();
-    let summary = describe(&p, &crate::args::scene(args)?, plan)
+    let (p, plan) = (r.prepared(), r.plan());
+    let summary = describe(p, &crate::args::scene(args)?, plan)
         .num("frames", n as f64)
         .num("frame_delay_ms", f64::from(delay))
         .num("seconds", secs)

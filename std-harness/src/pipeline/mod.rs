@@ -2,13 +2,16 @@
 //! it, and its folders are its stages:
 //!
 //! ```text
-//! Scene ─▶ entry::prepare ─▶ stages (load, window, prepare, lod, super/subsample, visible,
-//!                                      spares, supply, bands)          ─▶ Prepared
-//! (&Prepared, &Plan) ─▶ ends (run: the core's sheets; slabs; refine; the f64 and continuous
-//!                             references; single)                    ─▶ image
-//! quality (--quality, chart): derives plans and measures them with the ends
+//! door: Renderer::open(&Scene, &Plan), frame(); render(&Scene, &Plan) ─▶ frame
+//! (&Scene, &Plan) ─▶ entry::prepare ─▶ stages (load, window, prepare, lod, super/subsample,
+//!                                      visible, spares, supply, bands) ─▶ Prepared
+//! (&Prepared, &Plan) ─▶ ends (run: subsampling, then the core's sheets or the f64 reference;
+//!                             slabs; post; refine; the continuous integral; single) ─▶ image
+//! quality (--quality, the default plan's pilot, chart): derives plans, measures them with the ends
 //! ```
 //!
+//! - [`door`]: the one door every picture goes through ([`Renderer`], [`render`]): prepare,
+//!   resolve the plan's automatic choices, render frames.
 //! - [`stages`]: from the inputs to a [`Prepared`] render, and what a frame is split into:
 //!   [`stages::load`] (where the voxels come from), [`stages::hold`] (a stream the default
 //!   plan's pilot needs, read whole by [`entry::prepare`] first: the file's plan and picture),
@@ -29,17 +32,19 @@
 //!   [`describe`](mod@describe): the JSON fields every summary shares.
 //!
 //! A frame renders `(&Prepared, &Plan)` ([`render_frame`], [`crate::plan`]); preparing reads
-//! [`crate::scene::Scene`]. No file here names the command-line struct (`tests/layering.rs`); it
+//! [`crate::scene::Scene`] and the plan's resolution chain. No file here names the command-line struct (`tests/layering.rs`); it
 //! calls down into [`crate::io`], [`crate::reference`] and the core, and imports no command;
 //! stages import no end, and ends no quality module.
 
 pub mod describe;
+pub mod door;
 pub mod ends;
 pub mod entry;
 pub mod quality;
 pub mod stages;
 
 pub use describe::describe;
+pub use door::{render, Renderer};
 pub use ends::continuous::render_continuous_ref;
 pub use ends::run::{render_core, render_frame, render_ref, CoreFrame};
 pub use entry::prepare;

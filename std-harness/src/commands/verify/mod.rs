@@ -12,10 +12,8 @@ use crate::io::image::{check_style, RGB_EXTENSIONS};
 use crate::io::outputs::{self, Planned};
 use crate::metrics::{compare, ErrorStats};
 use crate::pipeline::ends::continuous::{continuous_models, ModelFigures};
-use crate::pipeline::quality::choose::{apply_quality, chosen_frame};
 use crate::pipeline::quality::{field::prepare_field, model::Choice};
-use crate::pipeline::stages::visible::FrameCache;
-use crate::pipeline::{prepare, render_core, render_ref, Prepared};
+use crate::pipeline::{prepare, render, render_core, render_ref, Prepared};
 use crate::plan::{End, Plan, Precision};
 use crate::reference::continuous::{Continuous, Model};
 use crate::scene::Scene;
@@ -166,9 +164,8 @@ struct Measured {
 /// the fixed one.
 fn measure(args: &VerifyArgs, r: &RenderArgs) -> Result<Measured, CliError> {
     let inputs = crate::args::scene(r)?;
-    let (p, plan, mut choice) = apply_quality(prepare(r)?, &inputs, &plan(r)?)?;
-    // The default plan's pilot rendered the chosen frame whole already.
-    let frame = chosen_frame(&p, &plan, &mut choice, &mut FrameCache::default())?.0;
+    let (frame, renderer) = render(&inputs, &plan(r)?)?;
+    let (p, plan, choice) = renderer.into_parts();
     let (core, stats, core_s) = (frame.image, frame.stats, frame.seconds);
     let (reference, ref_s) = render_ref(&p)?;
     let (per, overall) = compare(&core, &reference);

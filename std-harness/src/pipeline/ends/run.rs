@@ -77,10 +77,23 @@ pub fn render_frame(
             super::post::render_post(p, thickness, values, plan.threads, cache)
         }
         End::Sheets(precision) => render_sheets(p, plan, precision, cache),
-        End::Reference => Err(CliError::input(
-            "the f64 reference is not a core render: use render_ref (--method reference)",
-        )),
+        End::Reference => reference_frame(p),
     }
+}
+
+/// The f64 sheet reference as an end like the others: [`render_ref`]'s image rounded to f32
+/// (premultiplied RGBA at the output size), on one thread, with no core counts.
+fn reference_frame(p: &Prepared) -> Result<CoreFrame, CliError> {
+    let (img, seconds) = render_ref(p)?;
+    Ok(CoreFrame {
+        image: img.iter().map(|c| c.map(|x| x as f32)).collect(),
+        stats: Default::default(),
+        seconds,
+        phases: Phases::default(),
+        threads: 1,
+        visible: None,
+        refine: None,
+    })
 }
 
 /// The paper's sheets of `p` through `plan`'s tables in `precision`.
