@@ -329,11 +329,11 @@ pub struct RenderArgs {
     #[arg(help_heading = "Input", long, value_parser = parse_dims, allow_hyphen_values = true)]
     pub dims: Option<[usize; 3]>,
     /// Raw volumes: sample type (u8, i8, u16, i16, u32, i32, f32, f64).
-    #[arg(help_heading = "Input", long = "type")]
-    pub sample_type: Option<String>,
+    #[arg(help_heading = "Input", long = "type", value_parser = parse_sample_type)]
+    pub sample_type: Option<crate::io::volume::SampleType>,
     /// Raw volumes: byte order.
-    #[arg(help_heading = "Input", long, default_value = "little")]
-    pub endian: String,
+    #[arg(help_heading = "Input", long, value_enum, default_value_t = EndianArg::Little)]
+    pub endian: EndianArg,
     /// Raw volumes: spacing X,Y,Z in world units.
     #[arg(help_heading = "Input", long, default_value = "1,1,1", value_parser = parse_spacing, allow_hyphen_values = true)]
     pub spacing: [f32; 3],

@@ -42,8 +42,8 @@ pub struct Scene {
     pub stream: Option<PathBuf>,
     /// Raw layout: `--dims`, `--type`, `--endian`, `--spacing`; `--array`.
     pub dims: Option<[usize; 3]>,
-    pub sample_type: Option<String>,
-    pub endian: String,
+    pub sample_type: Option<crate::io::volume::SampleType>,
+    pub big_endian: bool,
     pub spacing: [f32; 3],
     pub array: Option<String>,
     /// The built-in scene's grid, and its finer field's (`--reference field`).

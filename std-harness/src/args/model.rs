@@ -64,3 +64,12 @@ impl From<AbsorptionArg> for footprint::render::Absorption {
         }
     }
 }
+
+/// `--endian`: the byte order of a raw volume's samples.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum EndianArg {
+    /// Least significant byte first (x86, ARM).
+    Little,
+    /// Most significant byte first (network order; many older CT files).
+    Big,
+}

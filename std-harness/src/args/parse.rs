@@ -103,6 +103,13 @@ pub fn parse_fov(s: &str) -> Result<f32, String> {
     Ok(v)
 }
 
+/// Parses `--type`: a sample type name (u8, i8, u16, i16, u32, i32, f32, f64, or NRRD's
+/// spellings).
+pub fn parse_sample_type(s: &str) -> Result<crate::io::volume::SampleType, String> {
+    crate::io::volume::SampleType::parse(s)
+        .ok_or_else(|| format!("'{s}' is not a sample type (u8, i8, u16, i16, u32, i32, f32, f64)"))
+}
+
 /// Parses `--min-radius`: a finite number of pixels, at least the geometry's smallest.
 pub fn parse_min_radius(s: &str) -> Result<f32, String> {
     let [v] = parse_list::<1>(s)?;

@@ -73,23 +73,10 @@ pub fn raw_options(args: &Scene) -> Result<Option<RawOptions>, CliError> {
         }
         return Ok(None);
     };
-    let ty = args.sample_type.as_deref().ok_or_else(|| {
+    let ty = args.sample_type.ok_or_else(|| {
         CliError::input("headerless raw files need --type as well as --dims (e.g. --type u8)")
     })?;
-    let ty = SampleType::parse(ty).ok_or_else(|| {
-        CliError::input(format!(
-            "--type '{ty}' is not a sample type (u8, i8, u16, i16, u32, i32, f32, f64)"
-        ))
-    })?;
-    let big_endian = match args.endian.as_str() {
-        "little" => false,
-        "big" => true,
-        e => {
-            return Err(CliError::input(format!(
-                "--endian '{e}': expected little or big"
-            )))
-        }
-    };
+    let big_endian = args.big_endian;
     Ok(Some(RawOptions {
         dims,
         ty,
