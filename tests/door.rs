@@ -5,6 +5,7 @@
 use footprint_harness::args::{parse_args, plan, scene};
 use footprint_harness::pipeline::{prepare, render, render_ref, Renderer};
 use footprint_harness::plan::{End, Lod, Plan};
+use footprint_harness::scene::Scene;
 
 #[test]
 fn the_reference_is_an_ordinary_end() {
@@ -64,4 +65,51 @@ fn reframing_the_renderer_equals_opening_it_at_the_new_view() {
     let (a, _) = r.frame().unwrap();
     let (b, _) = render(&scene(&turned).unwrap(), &plan(&turned).unwrap()).unwrap();
     assert_eq!(a.image, b.image);
+}
+
+#[test]
+fn the_typed_defaults_are_the_command_lines() {
+    let args = parse_args(&[]).unwrap();
+    assert_eq!(Plan::default(), plan(&args).unwrap());
+    // Scene holds shared handles (a program's volume, a pipe): compared as written out.
+    let (typed, resolved) = (Scene::default(), scene(&args).unwrap());
+    assert_eq!(format!("{typed:?}"), format!("{resolved:?}"));
+}
+
+#[test]
+fn a_program_renders_a_typed_scene_and_plan_without_flags() {
+    // What a library user writes: no flag string anywhere.
+    let scene = Scene {
+        size: (48, 48),
+        view: [30.0, 20.0, 0.0],
+        ..Scene::default()
+    };
+    let slabs = Plan {
+        end: End::Slabs { thickness: 1.0 },
+        auto_slicing: None,
+        auto_subsample: false,
+        threads: 1,
+        ..Plan::default()
+    };
+    let (frame, r) = render(&scene, &slabs).unwrap();
+    assert_eq!(r.plan().end, End::Slabs { thickness: 1.0 });
+    assert_eq!(frame.image.len(), 48 * 48);
+    // The same request as flags gives the same bits.
+    let args = parse_args(&[
+        "--size",
+        "48x48",
+        "--view",
+        "30,20,0",
+        "--slicing",
+        "image",
+        "--threads",
+        "1",
+    ])
+    .unwrap();
+    let (flags, _) = render(
+        &footprint_harness::args::scene(&args).unwrap(),
+        &plan(&args).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(frame.image, flags.image);
 }

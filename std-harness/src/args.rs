@@ -151,7 +151,7 @@ fn parse_depth(s: &str) -> Result<u8, String> {
 #[derive(clap::Args, Debug, Clone)]
 pub struct FootprintArgs {
     /// Kernel spec, e.g. gaussian:spread=1.6,sigmas=2.5 (also cone, sinc, bilinear).
-    #[arg(long, default_value = "gaussian:spread=1.6,sigmas=2.5")]
+    #[arg(long, default_value = crate::scene::DEFAULT_KERNEL)]
     pub kernel: String,
     /// Generic and view table size N (N×N). The default, 129, is on the Pareto frontier of
     /// `footprint chart` for both charted scenes (docs/accuracy.md, "Speed against accuracy").
@@ -513,11 +513,7 @@ impl RenderArgs {
 
     /// `--threads`, with 0 resolved to the number of cores, and at most [`MAX_THREADS`].
     pub fn thread_count(&self) -> usize {
-        match self.threads {
-            0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
-            n => n,
-        }
-        .min(MAX_THREADS)
+        crate::threads::count(self.threads)
     }
 }
 
@@ -528,10 +524,7 @@ fn parse_threads(s: &str) -> Result<usize, String> {
         .map_err(|_| format!("'{s}' is not a whole number of threads >= 0 (0 = every core)"))
 }
 
-/// The most threads a render starts (`--threads` above it renders on this many): every image is
-/// the same bits for any count, a thread more than the cores never helps, and each costs a
-/// stack, so `--threads 2000` must not exhaust the address space before the first voxel.
-pub const MAX_THREADS: usize = 256;
+pub use crate::threads::MAX_THREADS;
 
 /// `render`'s flags from a list of arguments (as on the command line after `render`), for
 /// programs that drive the harness (benches, charts).

@@ -201,6 +201,35 @@ pub struct Plan {
     pub auto_subsample: bool,
 }
 
+impl Default for Plan {
+    /// The plan `footprint render` resolves with no flags: float sheets through a 129² view
+    /// table (bilinear, robust), the default phases, the default plan's pilot choosing the slicing
+    /// ([`DEFAULT_TARGET_DB`]) and trying subsampling, `--lod auto`, `--supersample auto`, no
+    /// culling, every core (`tests/door.rs` checks it against the command line's).
+    fn default() -> Plan {
+        Plan {
+            end: End::Sheets(Precision::Float),
+            table: Table {
+                size: 129,
+                lookup: Lookup::Bilinear,
+                footprints: Footprints::ViewTable,
+                file: None,
+            },
+            phases: footprint::stencil::DEFAULT_PHASES,
+            phase_lookup: None,
+            threads: crate::threads::count(0),
+            subsample: Supersample::Fixed(1),
+            cull: None,
+            quality: None,
+            auto_slicing: Some(DEFAULT_TARGET_DB),
+            auto_subsample: true,
+            lod: Lod::Auto,
+            supersample: Supersample::Auto,
+            order: None,
+        }
+    }
+}
+
 /// `--quality DB --quality-reference R`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Quality {

@@ -70,3 +70,50 @@ pub struct Scene {
     /// The continuous model every end composites.
     pub absorption: Absorption,
 }
+
+impl Default for Scene {
+    /// The scene `footprint render` resolves with no flags: the built-in volume (64³), 512 × 512
+    /// pixels seen from the front (VTK's azimuth, elevation and roll 0), zoom 1, orthographic,
+    /// its default transfer function and window, emission shading, black background, linear
+    /// 8-bit PNG, the paper's Gaussian (spread 1.6, 2.5 σ) with the robust map and the default
+    /// minimum radius, the opacity model (`tests/door.rs` checks it against the command line's).
+    fn default() -> Scene {
+        Scene {
+            memory: None,
+            stdin: None,
+            volume: None,
+            stream: None,
+            dims: None,
+            sample_type: None,
+            big_endian: false,
+            spacing: [1.0; 3],
+            array: None,
+            scene_size: crate::builtin::SIDE,
+            field_size: 128,
+            size: (512, 512),
+            view: [0.0; 3],
+            zoom: 1.0,
+            view_matrix: None,
+            perspective: None,
+            eye_distance: None,
+            tf: None,
+            window: None,
+            shading: "emission".to_string(),
+            background: Background::Black,
+            gamma: Gamma::Linear,
+            depth: 8,
+            kernel: KernelModel {
+                kernel: Kernel::parse(DEFAULT_KERNEL).expect("the default kernel parses"),
+                options: FootprintOptions {
+                    mapping: footprint::geometry::Mapping::Robust,
+                    min_radius_px: footprint::geometry::DEFAULT_MIN_RADIUS_PX,
+                },
+                table_from_file: false,
+            },
+            absorption: Absorption::Opacity,
+        }
+    }
+}
+
+/// The default kernel spec (`--kernel`'s default): the paper's Gaussian.
+pub const DEFAULT_KERNEL: &str = "gaussian:spread=1.6,sigmas=2.5";

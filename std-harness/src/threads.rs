@@ -59,6 +59,20 @@ where
     }
 }
 
+/// The most threads a render starts (`--threads` above it renders on this many): every image is
+/// the same bits for any count, a thread more than the cores never helps, and each costs a
+/// stack, so `--threads 2000` must not exhaust the address space before the first voxel.
+pub const MAX_THREADS: usize = 256;
+
+/// `n` threads, with 0 meaning every core, and at most [`MAX_THREADS`].
+pub fn count(n: usize) -> usize {
+    match n {
+        0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
+        n => n,
+    }
+    .min(MAX_THREADS)
+}
+
 #[cfg(test)]
 mod tests {
     /// Work runs once, on a thread or inline, and its result comes back in order.
