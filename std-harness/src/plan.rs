@@ -1,11 +1,12 @@
-//! The render plan (issue 41): what draws a frame ([`Plan`]) and what is rendered ([`Scene`]),
-//! as typed values. The command line is resolved into them once (`crate::args::resolve`, with
-//! every rule the flags alone decide); programs build them themselves ([`Request`] for
+//! The render plan (issues 41, 76): what draws a frame and at which resolution ([`Plan`]), as a
+//! typed value beside what is rendered ([`Scene`]). The command line is resolved into both once
+//! (`crate::args::resolve`, with every rule the flags alone decide); programs build them
+//! themselves ([`Plan::default`] is the command line's default; [`Request`] for
 //! `(Scene, Plan)`). Nothing here names a flag's clap type. The rules that need the volume or
 //! the frame (a subsampling factor too large for the footprints, a supersampling the minimum
 //! radius asks for, a view a pipe cannot feed) stay where those are known; the rules between the
-//! resolution decorators that the inputs decide are [`check_levels`], applied to every
-//! [`Scene`]. The pipeline renders `(&Prepared, &Plan)` ([`crate::pipeline::render_frame`]);
+//! resolution decorators that the scene and plan decide are [`check_levels`], applied to every
+//! frame's set-up. The pipeline's door is `crate::pipeline::render`; it renders `(&Prepared, &Plan)` ([`crate::pipeline::render_frame`]);
 //! `verify`, `bench`, `chart` and `--quality` build or derive plans ([`Plan::with_precision`],
 //! [`crate::pipeline::quality::config::Config::plan`]) instead of rewriting flags, so `verify`
 //! renders the plan `render` would, defaults included.
