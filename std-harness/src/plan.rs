@@ -196,6 +196,10 @@ pub struct Plan {
     pub supersample: Supersample,
     /// The compositing order; `None`: the source's (back to front; a pipe's file order).
     pub order: Option<Order>,
+    /// The sort-last split (`render --bricks X,Y,Z`): X·Y·Z bricks rendered on their own and
+    /// composited front to back (`crate::distributed::render_split`); `None`: one frame, or
+    /// under `mpirun -np N` a balanced split into N.
+    pub bricks: Option<[usize; 3]>,
     /// `--subsample` left unset where the default plan's pilot runs (`auto_slicing`): the pilot
     /// tries each candidate subsampled (`Supersample::Auto`) before it is tried at full size, and
     /// keeps the first that reaches the target (`pipeline::quality::pilot::choose_slicing`).
@@ -227,6 +231,7 @@ impl Default for Plan {
             lod: Lod::Auto,
             supersample: Supersample::Auto,
             order: None,
+            bricks: None,
         }
     }
 }

@@ -119,6 +119,8 @@ pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
             None if args.cull.0.is_some() => Some(Order::FrontToBack),
             order => order.map(Order::from),
         },
+        // A command flag of `render` (`RenderCommandArgs::bricks`), set there.
+        bricks: None,
     };
     check_levels(&scene(args)?, &plan.resolution())?;
     Ok(plan)

@@ -63,9 +63,12 @@ pub fn run(command: &RenderCommandArgs) -> Result<(), CliError> {
         check_orbit(args, &out)?;
     }
     // Every rule the flags decide, before anything is loaded.
-    let asked = plan(args)?;
+    let asked = Plan {
+        bricks: command.bricks,
+        ..plan(args)?
+    };
     let inputs = crate::args::scene(args)?;
-    if let Some(split) = crate::distributed::render_split(&inputs, &asked, command.bricks)? {
+    if let Some(split) = crate::distributed::render_split(&inputs, &asked)? {
         if command.orbit.is_some() || command.colorbar {
             return Err(CliError::input(
                 "--orbit and --colorbar render one process's frame: drop --bricks (or mpirun)",

@@ -187,7 +187,6 @@ pub fn json(
 pub fn render_split(
     inputs: &Scene,
     plan: &Plan,
-    bricks: Option<[usize; 3]>,
 ) -> Result<Option<Option<(Vec<[f32; 4]>, crate::io::json::Json)>>, CliError> {
     let start = Instant::now();
     #[cfg(feature = "mpi")]
@@ -204,7 +203,7 @@ pub fn render_split(
                 let layout = self::mpi::agree(
                     &world,
                     "splitting the volume",
-                    job.layout(world.size() as usize, bricks),
+                    job.layout(world.size() as usize, plan.bricks),
                 )?;
                 self::mpi::agree_frame(&world, &job, &layout)?;
                 return Ok(match self::mpi::render(&world, &job, &layout)? {
@@ -214,7 +213,7 @@ pub fn render_split(
             }
         }
     }
-    let Some(counts) = bricks else {
+    let Some(counts) = plan.bricks else {
         return Ok(None);
     };
     let n = counts.iter().fold(1usize, |a, &c| a.saturating_mul(c));
