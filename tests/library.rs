@@ -228,15 +228,7 @@ fn view_is_vtks_camera() {
         ("+z", [0.0, 0.0, 1.0], [0.0, 1.0, 0.0]),
         ("-z", [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]),
     ] {
-        let args =
-            footprint_harness::args::parse_args(&["--view", name, "--size", "64x48"]).unwrap();
-        let via_cli = footprint_harness::pipeline::stages::prepare::view_for(
-            &footprint_harness::args::scene(&args).unwrap(),
-            [10, 20, 5],
-            &grid,
-        )
-        .unwrap()
-        .to_screen();
+        let via_cli = cli_view(&["--view", name, "--size", "64x48"], &grid);
         let want = View::looking(
             footprint::glam::Vec3::from_array(dop),
             footprint::glam::Vec3::from_array(up),
@@ -260,17 +252,10 @@ fn view_is_vtks_camera() {
         assert!((-inv.y_axis.normalize()).abs_diff_eq(footprint::glam::Vec3::from_array(up), 1e-5));
     }
     // The CLI's angles build the core's view.
-    let args = footprint_harness::args::parse_args(&[
-        "--view", "30,20,10", "--zoom", "1.5", "--size", "64x48",
-    ])
-    .unwrap();
-    let via_cli = footprint_harness::pipeline::stages::prepare::view_for(
-        &footprint_harness::args::scene(&args).unwrap(),
-        [10, 20, 5],
+    let via_cli = cli_view(
+        &["--view", "30,20,10", "--zoom", "1.5", "--size", "64x48"],
         &grid,
-    )
-    .unwrap()
-    .to_screen();
+    );
     let direct = View::from_vtk_camera([30.0, 20.0, 10.0], 1.5, [10, 20, 5], &grid, [64, 48])
         .unwrap()
         .to_screen();
@@ -279,6 +264,15 @@ fn view_is_vtks_camera() {
     assert!(View::from_vtk_camera([f32::NAN, 0.0, 0.0], 1.0, [2; 3], &grid, [8, 8]).is_err());
     assert!(View::from_vtk_camera([0.0; 3], 1.0, [0, 2, 2], &grid, [8, 8]).is_err());
     assert!(footprint_harness::args::parse_args(&["--view", "+w"]).is_err());
+}
+
+/// The screen map the command line's `flags` give a 10×20×5 volume on `grid`.
+fn cli_view(flags: &[&str], grid: &Grid) -> footprint::glam::Mat3 {
+    let args = footprint_harness::args::parse_args(flags).unwrap();
+    let scene = footprint_harness::args::scene(&args).unwrap();
+    footprint_harness::pipeline::stages::prepare::view_for(&scene, [10, 20, 5], grid)
+        .unwrap()
+        .to_screen()
 }
 
 #[test]

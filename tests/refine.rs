@@ -231,22 +231,16 @@ fn quality_chooses_refinement_against_the_field() {
         env!("CARGO_MANIFEST_DIR"),
         "/tests/data/heart_32x32x12_float32_le.nhdr"
     );
-    let args = parse_args(&[file, "--size", "32x32"]).unwrap();
-    let e = prepare_field(
-        &footprint_harness::args::scene(&args).unwrap(),
-        &plan(&args).unwrap(),
-    )
-    .err()
-    .expect("refused")
-    .to_string();
+    let refused = |flags: &[&str]| {
+        let args = parse_args(flags).unwrap();
+        let scene = footprint_harness::args::scene(&args).unwrap();
+        prepare_field(&scene, &plan(&args).unwrap())
+            .err()
+            .expect("refused")
+            .to_string()
+    };
+    let e = refused(&[file, "--size", "32x32"]);
     assert!(e.contains("nothing finer"), "{e}");
-    let args = parse_args(&["--scene-size", "16", "--field-size", "16"]).unwrap();
-    let e = prepare_field(
-        &footprint_harness::args::scene(&args).unwrap(),
-        &plan(&args).unwrap(),
-    )
-    .err()
-    .expect("refused")
-    .to_string();
+    let e = refused(&["--scene-size", "16", "--field-size", "16"]);
     assert!(e.contains("must be finer"), "{e}");
 }

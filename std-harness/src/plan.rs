@@ -272,6 +272,17 @@ impl Plan {
         }
     }
 
+    /// The same plan at full resolution with nothing left to choose about the level: level 0,
+    /// no `--quality` (what `--lod auto`'s pilot, the field reference and `verify`'s
+    /// full-resolution figure compare against).
+    pub fn at_level_0(&self) -> Plan {
+        Plan {
+            lod: Lod::Level(0),
+            quality: None,
+            ..self.clone()
+        }
+    }
+
     /// The resolution chain a frame's set-up reads.
     pub fn resolution(&self) -> Resolution {
         Resolution {

@@ -12,8 +12,7 @@
 //! voxels skipped by occlusion culling, `--cull`; per band, as `render` counts them) and
 //! `culled_voxels_per_frame`, and the render summary's fields (`plan`: what drew the frames).
 
-use crate::args::RenderArgs;
-use crate::args::{plan, turned};
+use crate::args::{plan, turned, RenderArgs};
 use crate::io::{self, json::Json};
 use crate::pipeline::quality::model::quality_json;
 use crate::pipeline::stages::bands::Phases;

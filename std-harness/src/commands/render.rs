@@ -1,8 +1,7 @@
 //! `footprint render`: a volume (or the built-in scene) rendered by the core, sheet by sheet, to a
 //! PNG (see [`crate::pipeline::prepare`](mod@crate::pipeline::stages::prepare) for the view conventions).
 
-use crate::args::{plan, turned};
-use crate::args::{MethodArg, RenderArgs};
+use crate::args::{plan, turned, MethodArg, RenderArgs};
 use crate::charts::colorbar;
 use crate::io::image::{check_style, encode_apng, encode_rgb_for, RGB_EXTENSIONS};
 use crate::io::outputs::{self, Planned};
@@ -81,7 +80,14 @@ pub fn run(command: &RenderCommandArgs) -> Result<(), CliError> {
     }
     if let Some(n) = command.orbit {
         let renderer = Renderer::open(&inputs, &asked)?;
-        return orbit(renderer, args, &out, usize::from(n), command.colorbar);
+        return orbit(
+            renderer,
+            args,
+            &inputs,
+            &out,
+            usize::from(n),
+            command.colorbar,
+        );
     }
     let (mut rgb, summary, p) = single(args, &inputs, &asked)?;
     if command.colorbar {
@@ -254,6 +260,7 @@ fn check_orbit(args: &RenderArgs, out: &Path) -> Result<(), CliError> {
 fn orbit(
     mut r: Renderer,
     args: &RenderArgs,
+    inputs: &Scene,
     out: &Path,
     n: usize,
     bar: bool,
@@ -275,7 +282,7 @@ fn orbit(
     })?;
     let secs = start.elapsed().as_secs_f64();
     let (p, plan) = (r.prepared(), r.plan());
-    let summary = describe(p, &crate::args::scene(args)?, plan)
+    let summary = describe(p, inputs, plan)
         .num("frames", n as f64)
         .num("frame_delay_ms", f64::from(delay))
         .num("seconds", secs)

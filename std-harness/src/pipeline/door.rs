@@ -15,7 +15,7 @@
 //! level of detail in the frame [`Prepared`] holds. The f64 reference is an end like the others.
 
 use super::ends::run::CoreFrame;
-use super::entry::prepare;
+use super::entry::prepare_scene;
 use super::quality::choose::{apply_quality, chosen_frame};
 use super::quality::model::Choice;
 use super::stages::prepare::Prepared;
@@ -39,7 +39,7 @@ impl Renderer {
     /// Prepares `scene` and resolves `plan`: every automatic choice made (the level, the
     /// default plan's slicing, `--quality`'s table), so [`Renderer::plan`] has none left.
     pub fn open(scene: &Scene, plan: &Plan) -> Result<Renderer, CliError> {
-        let prepared = prepare(&(scene.clone(), plan.clone()))?;
+        let prepared = prepare_scene(scene.clone(), plan)?;
         let start = Instant::now();
         let (prepared, plan, choice) = apply_quality(prepared, scene, plan)?;
         Ok(Renderer {

@@ -19,11 +19,14 @@ use crate::CliError;
 /// A stream that a pilot needs is first read whole where it fits ([`super::stages::hold`]), so
 /// that it is prepared, planned and rendered as the file it is would be.
 pub fn prepare<R: Request + ?Sized>(request: &R) -> Result<Prepared, CliError> {
-    let mut args = request.scene()?;
     // Resolved once, for the hold, the frame's resolution and the level pilot.
-    let plan = request.plan()?;
+    prepare_scene(request.scene()?, &request.plan()?)
+}
+
+/// [`prepare`] of a scene and a plan already resolved (what the door opens with).
+pub fn prepare_scene(mut args: Scene, plan: &Plan) -> Result<Prepared, CliError> {
     if args.stream.is_some() {
-        if let Some(memory) = held(&args, &plan)? {
+        if let Some(memory) = held(&args, plan)? {
             args = Scene {
                 memory: Some(memory),
                 stream: None,
@@ -37,7 +40,7 @@ pub fn prepare<R: Request + ?Sized>(request: &R) -> Result<Prepared, CliError> {
     // measured as it streams).
     let piped = args.stream.as_deref().is_some_and(is_stdin);
     if plan.lod != Lod::Auto || plan.quality.is_some() || piped {
-        let p = prepare_as_asked(&args, &plan)?;
+        let p = prepare_as_asked(&args, plan)?;
         if piped && plan.lod == Lod::Auto && p.level > 0 {
             crate::say!(
                 "{}: --lod auto renders level {} by the spacing rule alone, not measured against \
@@ -48,9 +51,5 @@ pub fn prepare<R: Request + ?Sized>(request: &R) -> Result<Prepared, CliError> {
         }
         return Ok(p);
     }
-    let at_full = Plan {
-        lod: Lod::Level(0),
-        ..plan.clone()
-    };
-    validated_auto(prepare_as_asked(&args, &at_full)?, &args, &plan)
+    validated_auto(prepare_as_asked(&args, &plan.at_level_0())?, &args, plan)
 }

@@ -6,14 +6,14 @@
 
 mod report;
 
-use crate::args::plan;
-use crate::args::{Lod, MethodArg, ReconstructionArg, ReferenceArg, RenderArgs};
+use crate::args::{plan, Lod, MethodArg, ReconstructionArg, ReferenceArg, RenderArgs};
 use crate::io::image::{check_style, RGB_EXTENSIONS};
 use crate::io::outputs::{self, Planned};
 use crate::metrics::{compare, ErrorStats};
 use crate::pipeline::ends::continuous::{continuous_models, ModelFigures};
+use crate::pipeline::entry::prepare_scene;
 use crate::pipeline::quality::{field::prepare_field, model::Choice};
-use crate::pipeline::{prepare, render, render_core, render_ref, Prepared};
+use crate::pipeline::{render, render_core, render_ref, Prepared};
 use crate::plan::{End, Plan, Precision};
 use crate::reference::continuous::{Continuous, Model};
 use crate::scene::Scene;
@@ -196,12 +196,7 @@ fn measure(args: &VerifyArgs, r: &RenderArgs) -> Result<Measured, CliError> {
     // A coarser level is also measured against full resolution: its own error counts there.
     let full_resolution = match (args.reference, p.level) {
         (ReferenceArg::Sheets, 1..) => {
-            let at_full = Plan {
-                lod: Lod::Level(0),
-                quality: None,
-                ..plan.clone()
-            };
-            let level0 = prepare(&(inputs.clone(), at_full))?;
+            let level0 = prepare_scene(inputs.clone(), &plan.at_level_0())?;
             let (full, _) = render_ref(&level0)?;
             Some(compare(&core, &full).1)
         }

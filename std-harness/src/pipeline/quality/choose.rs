@@ -29,8 +29,7 @@ use super::model::{self as quality, choose, footprint_error, predict_db, Choice}
 use crate::pipeline::ends::run::{render_frame, CoreFrame};
 use crate::pipeline::stages::prepare::Prepared;
 use crate::pipeline::stages::visible::FrameCache;
-use crate::plan::{End, Plan};
-use crate::plan::{Lod, Method, QualityReference};
+use crate::plan::{End, Lod, Method, Plan, QualityReference};
 use crate::scene::Scene;
 use crate::CliError;
 

@@ -2,8 +2,7 @@
 //! thickness, and whether the grid is refined (`--refine 0`): what `footprint chart` sweeps and
 //! `--quality` chooses among, with the names the benches use.
 
-use crate::plan::{End, Footprints, Plan, Precision};
-use crate::plan::{Method, Supersample};
+use crate::plan::{End, Footprints, Method, Plan, Precision, Supersample};
 use footprint::Lookup;
 
 /// Slab thicknesses the chart sweeps with `--slicing image`, voxel spacings.

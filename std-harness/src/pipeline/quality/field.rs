@@ -18,7 +18,7 @@
 //! image lines up pixel for pixel with the coarse one (the refinement chart relies on the same).
 
 use crate::pipeline::stages::prepare::Prepared;
-use crate::plan::{Lod, Plan};
+use crate::plan::Plan;
 use crate::scene::Scene;
 use crate::CliError;
 
@@ -39,14 +39,9 @@ pub fn prepare_field(args: &Scene, plan: &Plan) -> Result<Prepared, CliError> {
         )));
     }
     // At level 0 with no --quality there is no level to validate: prepared as asked.
-    let at_full = Plan {
-        lod: Lod::Level(0),
-        quality: None,
-        ..plan.clone()
-    };
     let field = Scene {
         scene_size: args.field_size,
         ..args.clone()
     };
-    crate::pipeline::stages::prepare::prepare_as_asked(&field, &at_full)
+    crate::pipeline::stages::prepare::prepare_as_asked(&field, &plan.at_level_0())
 }

@@ -29,8 +29,7 @@
 use crate::io::formats::raw::RawOptions;
 use crate::io::stream::{is_stdin, InMemory};
 use crate::io::volume::{byte_len, check_spacing, decode, Volume};
-use crate::plan::Lod;
-use crate::plan::Plan;
+use crate::plan::{Lod, Plan};
 use crate::scene::Scene;
 use crate::CliError;
 use std::sync::Arc;

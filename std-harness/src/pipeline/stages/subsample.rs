@@ -27,8 +27,7 @@
 //! edges: channels are clamped at 0 and opacity at 1. A background image is composited under the
 //! resampled frame at the output size (C + (1 − A)·background, what the core's sheet loop does).
 
-use crate::plan::Supersample;
-use crate::plan::{End, Plan};
+use crate::plan::{End, Plan, Supersample};
 use crate::CliError;
 use footprint::frame::FrameSetup;
 use footprint::geometry::FootprintOptions;
