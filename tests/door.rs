@@ -15,8 +15,16 @@ fn the_reference_is_an_ordinary_end() {
     let (frame, r) = render(&s, &p).unwrap();
     let (direct, _) = render_ref(r.prepared()).unwrap();
     assert_eq!(frame.image.len(), 48 * 40);
-    let want: Vec<[f32; 4]> = direct.iter().map(|c| c.map(|x| x as f32)).collect();
-    assert_eq!(frame.image, want);
+    // The scene's voxels project closer than the smallest footprint at this size, so the frame
+    // is supersampled: the end draws the f64 reference at k× the size, rounded to f32, and the
+    // decorator averages it; `render_ref` averages in f64 and rounds once. They differ by the
+    // f32 rounding alone.
+    assert!(r.prepared().supersample > 1, "the decorator is exercised");
+    for (a, b) in frame.image.iter().zip(&direct) {
+        for (x, y) in a.iter().zip(b) {
+            assert!((f64::from(*x) - y).abs() <= 1e-6, "{x} against {y}");
+        }
+    }
     assert!(
         frame.image.iter().any(|c| c[3] > 0.01),
         "the scene is visible"
@@ -112,4 +120,69 @@ fn a_program_renders_a_typed_scene_and_plan_without_flags() {
     )
     .unwrap();
     assert_eq!(frame.image, flags.image);
+}
+
+/// Supersampling is one decorator around whatever end draws the frame: for every end, a frame
+/// at w × h supersampled 2× is the mean of the 2 × 2 blocks of the same end's frame at 2w × 2h
+/// with no supersampling (the view scales with the size, so the wide frames are the same).
+#[test]
+fn supersampling_wraps_every_end_alike() {
+    use footprint_harness::pipeline::stages::supersample::to_output;
+    let ends: [&[&str]; 6] = [
+        &["--slicing", "object"],
+        &["--slicing", "object", "--accum", "fixed"],
+        &["--slicing", "image", "--slab", "1"],
+        &["--classification", "post"],
+        &["--refine", "0.05"],
+        &["--method", "reference"],
+    ];
+    for end in ends {
+        let draw = |size: &str, k: &str| {
+            let mut flags = vec!["--size", size, "--view", "30,20,0", "--lod", "0"];
+            flags.extend_from_slice(&["--supersample", k]);
+            flags.extend_from_slice(end);
+            let args = parse_args(&flags).unwrap();
+            let (frame, r) = render(&scene(&args).unwrap(), &plan(&args).unwrap()).unwrap();
+            (frame.image, r.prepared().supersample)
+        };
+        let (small, k) = draw("24x20", "2");
+        assert_eq!(k, 2, "{end:?}: supersampled");
+        let (wide, k) = draw("48x40", "1");
+        assert_eq!(k, 1, "{end:?}: not supersampled");
+        let averaged = to_output(wide, (24, 20), 2);
+        let worst = small
+            .iter()
+            .zip(&averaged)
+            .flat_map(|(a, b)| a.iter().zip(b).map(|(x, y)| (x - y).abs()))
+            .fold(0.0f32, f32::max);
+        assert!(small == averaged, "{end:?}: differs by up to {worst}");
+        assert!(small.iter().any(|c| c[3] > 0.01), "{end:?}: visible");
+    }
+}
+
+/// Turning a typed scene (what `--orbit` steps by) adds to the azimuth, or turns a view matrix
+/// about the volume's vertical axis; a full turn in steps comes back to the start.
+#[test]
+fn a_turned_scene_adds_azimuth_or_turns_the_matrix() {
+    let s = scene(&parse_args(&["--view", "30,20,5"]).unwrap()).unwrap();
+    let t = s.turned(45.0);
+    assert_eq!(t.view, [75.0, 20.0, 5.0]);
+    assert_eq!((t.size, t.zoom, t.view_matrix), (s.size, s.zoom, None));
+    let m = ["--view-matrix", "0.8,0,0.6,0,1,0,-0.6,0,0.8"];
+    let s = scene(&parse_args(&m).unwrap()).unwrap();
+    let quarter = s.turned(90.0).view_matrix.unwrap();
+    assert!(
+        quarter
+            .iter()
+            .zip(s.view_matrix.unwrap())
+            .any(|(a, b)| (a - b).abs() > 0.5),
+        "a quarter turn moves the matrix"
+    );
+    let mut back = s.clone();
+    for _ in 0..4 {
+        back = back.turned(90.0);
+    }
+    for (a, b) in back.view_matrix.unwrap().iter().zip(s.view_matrix.unwrap()) {
+        assert!((a - b).abs() < 1e-5, "{a} against {b}");
+    }
 }

@@ -18,7 +18,7 @@ pub use crate::io::image::Background;
 pub use model::*;
 pub use parse::*;
 pub use phase::*;
-pub use resolve::{plan, scene, single, turned};
+pub use resolve::{plan, scene, single};
 
 /// Table lookup, as on the command line.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, ValueEnum)]

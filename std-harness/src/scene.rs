@@ -71,6 +71,22 @@ pub struct Scene {
     pub absorption: Absorption,
 }
 
+impl Scene {
+    /// This scene turned `degrees` of azimuth further about the volume's vertical axis: the
+    /// view's azimuth plus `degrees`, or a view matrix V as V · Ry(degrees) (the same turn); the
+    /// rest unchanged. What `render --orbit` and `bench --orbit` step by.
+    pub fn turned(&self, degrees: f32) -> Scene {
+        let mut s = self.clone();
+        s.view[0] += degrees;
+        if let Some(m) = s.view_matrix {
+            let v = glam::Mat3::from_cols_array(&m).transpose()
+                * glam::Mat3::from_rotation_y(degrees.to_radians());
+            s.view_matrix = Some(v.transpose().to_cols_array());
+        }
+        s
+    }
+}
+
 impl Default for Scene {
     /// The scene `footprint render` resolves with no flags: the built-in volume (64³), 512 × 512
     /// pixels seen from the front (VTK's azimuth, elevation and roll 0), zoom 1, orthographic,

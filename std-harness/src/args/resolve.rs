@@ -336,20 +336,6 @@ pub fn single(args: &SplatArgs) -> Result<Single, CliError> {
     })
 }
 
-/// `base` turned `degrees` of azimuth further about the volume's vertical axis: `--view`'s
-/// azimuth plus `degrees`, or a `--view-matrix` V as V · Ry(degrees) (the same turn). What
-/// `render --orbit` and `bench --orbit` step by.
-pub fn turned(base: &RenderArgs, degrees: f32) -> RenderArgs {
-    let mut a = base.clone();
-    a.view[0] += degrees;
-    if let Some(m) = a.view_matrix {
-        let v = glam::Mat3::from_cols_array(&m).transpose()
-            * glam::Mat3::from_rotation_y(degrees.to_radians());
-        a.view_matrix = Some(v.transpose().to_cols_array());
-    }
-    a
-}
-
 impl Request for RenderArgs {
     fn scene(&self) -> Result<Scene, CliError> {
         scene(self)

@@ -9,8 +9,7 @@ use super::plot::{plot_err, time_chart, time_spread, write_svg_png};
 use crate::args::{Lod, RenderArgs};
 use crate::io::outputs::Batch;
 use crate::metrics::compare;
-use crate::pipeline::stages::visible::FrameCache;
-use crate::pipeline::{prepare, render_frame, Prepared};
+use crate::pipeline::Renderer;
 use crate::CliError;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -40,14 +39,14 @@ pub fn sweep(base: &RenderArgs, runs: usize) -> Result<(Vec<LevelRow>, u32), Cli
         a.quality = None;
         a
     };
-    let auto = prepare(&with(Lod::Auto))?;
-    let deepest = crate::pipeline::stages::lod::deepest_level(auto.fine_dims).min(MAX_CHARTED);
-    let auto = auto.level;
-    let mut levels: Vec<(RenderArgs, Prepared)> = Vec::new();
+    let auto = super::open(&with(Lod::Auto))?;
+    let deepest =
+        crate::pipeline::stages::lod::deepest_level(auto.prepared().fine_dims).min(MAX_CHARTED);
+    let auto = auto.prepared().level;
+    let mut levels: Vec<Renderer> = Vec::new();
     for level in 0..=deepest {
-        let a = with(Lod::Level(level));
-        let p = match prepare(&a) {
-            Ok(p) => p,
+        let r = match super::open(&with(Lod::Level(level))) {
+            Ok(r) => r,
             // A frame levels are not placed for (perspective): the sweep ends where they stop.
             Err(e) if level > 0 => {
                 crate::say!(
@@ -58,17 +57,16 @@ pub fn sweep(base: &RenderArgs, runs: usize) -> Result<(Vec<LevelRow>, u32), Cli
             }
             Err(e) => return Err(e),
         };
-        levels.push((a, p));
+        levels.push(r);
     }
-    let mut caches: Vec<FrameCache> = levels.iter().map(|_| FrameCache::default()).collect();
     let mut images = Vec::new();
-    for ((a, p), cache) in levels.iter().zip(&mut caches) {
-        images.push(render_frame(p, &crate::args::plan(a)?, cache)?.image);
+    for r in &mut levels {
+        images.push(r.frame()?.0.image);
     }
     let mut times = vec![Vec::new(); levels.len()];
     for _ in 0..runs.max(1) {
-        for (((a, p), cache), t) in levels.iter().zip(&mut caches).zip(&mut times) {
-            t.push(render_frame(p, &crate::args::plan(a)?, cache)?.seconds);
+        for (r, t) in levels.iter_mut().zip(&mut times) {
+            t.push(r.frame()?.0.seconds);
         }
     }
     let full: Vec<[f64; 4]> = images[0].iter().map(|c| c.map(f64::from)).collect();
@@ -76,7 +74,8 @@ pub fn sweep(base: &RenderArgs, runs: usize) -> Result<(Vec<LevelRow>, u32), Cli
         .iter()
         .zip(&images)
         .zip(&mut times)
-        .map(|(((_, p), img), t)| {
+        .map(|((r, img), t)| {
+            let p = r.prepared();
             t.sort_by(f64::total_cmp);
             LevelRow {
                 level: p.level,

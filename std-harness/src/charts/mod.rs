@@ -37,6 +37,10 @@
 //! built-in scene at `--scene-size`, unrefined and at each `--refine` threshold, its frame time
 //! and its PSNR against the same field sampled at `--refine-reference`.
 
+use crate::args::RenderArgs;
+use crate::pipeline::Renderer;
+use crate::CliError;
+
 pub mod colorbar;
 pub mod lod;
 pub mod plot;
@@ -45,3 +49,9 @@ pub mod post;
 pub mod refine;
 pub mod stability;
 pub mod sweep;
+
+/// The door a chart opens on `a`'s scene: prepared for `a`'s plan, nothing more resolved (the
+/// chart derives the plans it sweeps: [`Renderer::frame_of`]).
+pub fn open(a: &RenderArgs) -> Result<Renderer, CliError> {
+    Renderer::prepare(&crate::args::scene(a)?, &crate::args::plan(a)?)
+}

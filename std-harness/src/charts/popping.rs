@@ -8,8 +8,7 @@
 
 use crate::args::{RenderArgs, SlicingArg};
 use crate::metrics::compare;
-use crate::pipeline::stages::visible::FrameCache;
-use crate::pipeline::{prepare, render_continuous_ref, render_frame};
+use crate::pipeline::render_continuous_ref;
 use crate::reference::continuous::Reconstruction;
 use crate::CliError;
 
@@ -38,8 +37,7 @@ pub fn popping(
     mut progress: impl FnMut(usize, usize),
 ) -> Result<Popping, CliError> {
     let mut args = base.clone();
-    let mut p = prepare(&args)?;
-    let mut caches = [FrameCache::default(), FrameCache::default()];
+    let mut r = super::open(&args)?;
     // The previous frame of each curve, and each new frame's change against it.
     let mut previous: [Option<Vec<[f64; 4]>>; 3] = Default::default();
     let mut out = Popping {
@@ -59,15 +57,15 @@ pub fn popping(
         let az = f64::from(tenth) / 10.0;
         args.view = [az as f32, base.view[1], base.view[2]];
         args.view_matrix = None;
-        p.reframe(&crate::args::scene(&args)?)?;
-        let (truth, _) = render_continuous_ref(&p, Reconstruction::Kernel)?;
+        r.reframe(&crate::args::scene(&args)?)?;
+        let (truth, _) = render_continuous_ref(r.prepared(), Reconstruction::Kernel)?;
         for (k, slicing) in [SlicingArg::Object, SlicingArg::Image]
             .into_iter()
             .enumerate()
         {
             args.slicing = Some(slicing);
             let plan = crate::args::plan(&args)?.with_precision(crate::plan::Precision::Float);
-            let f = render_frame(&p, &plan, &mut caches[k])?;
+            let f = r.frame_of(&plan)?;
             out.truth_db[k].push(compare(&f.image, &truth.image).1.psnr_db);
             let img64 = f.image.iter().map(|c| c.map(f64::from)).collect();
             advance(&mut out, k, &f.image, img64);

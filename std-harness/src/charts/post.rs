@@ -13,8 +13,6 @@ use crate::args::{ClassificationArg, RenderArgs, Supersample};
 use crate::io::outputs::Batch;
 use crate::metrics::compare;
 use crate::pipeline::ends::continuous::render_continuous_as;
-use crate::pipeline::stages::visible::FrameCache;
-use crate::pipeline::{prepare, render_frame};
 use crate::reference::continuous::{Model, Reconstruction, DEFAULT_CAP};
 use crate::CliError;
 use plotters::coord::Shift;
@@ -41,8 +39,13 @@ pub struct PostRow {
 pub fn sweep(base: &RenderArgs, runs: usize) -> Result<Vec<PostRow>, CliError> {
     let mut base = base.clone();
     base.classification = ClassificationArg::Post;
-    let p = prepare(&base)?;
-    let (truth, _) = render_continuous_as(&p, Reconstruction::Kernel, Model::Post, DEFAULT_CAP)?;
+    let mut r = super::open(&base)?;
+    let (truth, _) = render_continuous_as(
+        r.prepared(),
+        Reconstruction::Kernel,
+        Model::Post,
+        DEFAULT_CAP,
+    )?;
     let configs: Vec<(RenderArgs, f32, usize)> = SLABS
         .iter()
         .flat_map(|&slab| SCALES.iter().map(move |&s| (slab, s)))
@@ -59,11 +62,10 @@ pub fn sweep(base: &RenderArgs, runs: usize) -> Result<Vec<PostRow>, CliError> {
         .collect::<Result<Vec<_>, _>>()?;
     let mut rows = Vec::new();
     let mut times = vec![Vec::new(); configs.len()];
-    // One cache: every configuration splats the same voxels, found once.
-    let mut cache = FrameCache::default();
+    // One renderer, one cache: every configuration splats the same voxels, found once.
     for run in 0..=runs.max(1) {
         for (((_, slab, scale), plan), times) in configs.iter().zip(&plans).zip(&mut times) {
-            let f = render_frame(&p, plan, &mut cache)?;
+            let f = r.frame_of(plan)?;
             if run == 0 {
                 rows.push(PostRow {
                     slab: *slab,

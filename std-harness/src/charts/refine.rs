@@ -12,8 +12,7 @@ use super::plot::{
 use crate::args::RenderArgs;
 use crate::io::outputs::Batch;
 use crate::metrics::compare;
-use crate::pipeline::stages::visible::FrameCache;
-use crate::pipeline::{prepare, render_frame, Prepared};
+use crate::pipeline::Renderer;
 use crate::CliError;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -49,14 +48,13 @@ pub fn sweep(base: &RenderArgs, reference: usize, runs: usize) -> Result<Vec<Ref
     fine.scene_size = reference;
     fine.refine = None;
     fine.refine_sheets = false;
-    let pf = prepare(&fine)?;
-    let truth: Vec<[f64; 4]> =
-        render_frame(&pf, &crate::args::plan(&fine)?, &mut FrameCache::default())?
-            .image
-            .iter()
-            .map(|c| c.map(f64::from))
-            .collect();
-    drop(pf);
+    let truth: Vec<[f64; 4]> = super::open(&fine)?
+        .frame()?
+        .0
+        .image
+        .iter()
+        .map(|c| c.map(f64::from))
+        .collect();
     let mut configs: Vec<(RenderArgs, Option<f32>, bool)> = Vec::new();
     let mut with = |t: Option<f32>, sheets: bool| {
         let mut a = base.clone();
@@ -70,15 +68,15 @@ pub fn sweep(base: &RenderArgs, reference: usize, runs: usize) -> Result<Vec<Ref
         with(Some(t), false);
     }
     with(Some(0.0), true);
-    let prepared: Vec<Prepared> = configs
+    let opened: Vec<Renderer> = configs
         .iter()
-        .map(|(a, _, _)| prepare(a))
+        .map(|(a, _, _)| super::open(a))
         .collect::<Result<_, _>>()?;
     let mut rows = Vec::new();
     let mut times = vec![Vec::new(); configs.len()];
     for run in 0..=runs.max(1) {
-        for (((a, t, sheets), p), times) in configs.iter().zip(&prepared).zip(&mut times) {
-            let f = render_frame(p, &crate::args::plan(a)?, &mut FrameCache::default())?;
+        for (((_, t, sheets), r), times) in configs.iter().zip(&opened).zip(&mut times) {
+            let (p, f) = (r.prepared(), r.fresh_frame_of(r.plan())?);
             if run == 0 {
                 // The first pass gives the image (and warms caches); the rest are timed.
                 rows.push(RefineRow {

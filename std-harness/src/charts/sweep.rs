@@ -4,7 +4,7 @@ use crate::args::RenderArgs;
 use crate::metrics::compare;
 use crate::pipeline::quality::config::{accum_name, lookup_name, method_name, Config};
 use crate::pipeline::quality::model as quality;
-use crate::pipeline::{prepare, render_continuous_ref, render_core, render_ref};
+use crate::pipeline::{render_continuous_ref, render_ref};
 use crate::reference::continuous::Reconstruction;
 use crate::CliError;
 
@@ -44,8 +44,9 @@ pub fn sweep(
     configs: &[Config],
     runs: usize,
 ) -> Result<Vec<Measured>, CliError> {
-    let p = prepare(base)?;
-    let (reference, ref_s) = render_ref(&p)?;
+    let r = super::open(base)?;
+    let p = r.prepared();
+    let (reference, ref_s) = render_ref(p)?;
     crate::say!(
         "{}: {}x{}, reference {:.2} s; {} configurations x {runs} runs",
         p.name,
@@ -58,7 +59,7 @@ pub fn sweep(
         footprint::Kernel::Gaussian { .. } => Reconstruction::Kernel,
         _ => Reconstruction::Trilinear,
     };
-    let (truth, truth_s) = render_continuous_ref(&p, rec)?;
+    let (truth, truth_s) = render_continuous_ref(p, rec)?;
     crate::say!(
         "continuous reference ({} reconstruction): {truth_s:.2} s, step {:.4} world units, last change {:.1} dB",
         rec.name(),
@@ -68,7 +69,7 @@ pub fn sweep(
     // One untimed render first, so the first configuration is not timed with cold caches.
     let base_plan = crate::args::plan(base)?;
     if let Some(c) = configs.first() {
-        render_core(&p, &c.plan(&base_plan))?;
+        r.fresh_frame_of(&c.plan(&base_plan))?;
     }
     let mut out = Vec::new();
     let bar = crate::io::progress::Progress::new("chart", configs.len(), "configurations");
@@ -77,15 +78,15 @@ pub fn sweep(
         let mut times = Vec::with_capacity(runs);
         let mut image = Vec::new();
         for _ in 0..runs.max(1) {
-            let (img, _, secs) = render_core(&p, &plan)?;
-            times.push(secs);
-            image = img;
+            let f = r.fresh_frame_of(&plan)?;
+            times.push(f.seconds);
+            image = f.image;
         }
         times.sort_by(f64::total_cmp);
         let (_, overall) = compare(&image, &reference);
         let footprint_error = match c.slab() {
             Some(_) => f64::NAN,
-            None => quality::footprint_error(&p, c)?,
+            None => quality::footprint_error(p, c)?,
         };
         let (_, against_truth) = compare(&image, &truth.image);
         let m = Measured {

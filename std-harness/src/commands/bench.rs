@@ -12,7 +12,7 @@
 //! voxels skipped by occlusion culling, `--cull`; per band, as `render` counts them) and
 //! `culled_voxels_per_frame`, and the render summary's fields (`plan`: what drew the frames).
 
-use crate::args::{plan, turned, RenderArgs};
+use crate::args::{plan, RenderArgs};
 use crate::io::{self, json::Json};
 use crate::pipeline::quality::model::quality_json;
 use crate::pipeline::stages::bands::Phases;
@@ -110,7 +110,7 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
     for k in 0..args.frames {
         // The same plan every frame; only the view turns.
         if k > 0 {
-            r.reframe(&crate::args::scene(&turned(base, args.orbit * k as f32))?)?;
+            r.reframe(&inputs.turned(args.orbit * k as f32))?;
         }
         let (f, piloted) = r.frame()?;
         pilot_frame |= piloted;

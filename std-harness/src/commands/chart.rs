@@ -4,7 +4,6 @@
 use crate::args::{ClassificationArg, Lod, RenderArgs};
 use crate::charts::{lod, plot, popping, post, refine, stability, sweep};
 use crate::io::outputs::Batch;
-use crate::pipeline::prepare;
 use crate::pipeline::quality::config::Config;
 use crate::pipeline::quality::model as quality;
 use crate::CliError;
@@ -49,10 +48,11 @@ pub struct ChartArgs {
 
 pub fn run(args: &ChartArgs) -> Result<(), CliError> {
     if args.model_only {
-        let p = prepare(&args.render)?;
+        let r = crate::charts::open(&args.render)?;
+        let p = r.prepared();
         crate::say!("config,footprint_error");
         for c in Config::for_frame(&p.frame) {
-            crate::say!("{},{:.4e}", c.label(), quality::footprint_error(&p, &c)?);
+            crate::say!("{},{:.4e}", c.label(), quality::footprint_error(p, &c)?);
         }
         return Ok(());
     }
@@ -171,10 +171,11 @@ fn tradeoff_chart(
     name: &str,
     runs: usize,
 ) -> Result<(), CliError> {
-    let prepared = prepare(base)?;
+    let opened = crate::charts::open(base)?;
+    let prepared = opened.prepared();
     let mut configs = Config::for_frame(&prepared.frame);
     configs.extend(Config::slabs(&prepared.frame, &prepared.kernel));
-    drop(prepared);
+    drop(opened);
     let rows = sweep::sweep(base, &configs, runs)?;
     out.add("tradeoff.csv", sweep::csv(&rows));
     let title = format!(

@@ -1,7 +1,7 @@
 //! `footprint render`: a volume (or the built-in scene) rendered by the core, sheet by sheet, to a
 //! PNG (see [`crate::pipeline::prepare`](mod@crate::pipeline::stages::prepare) for the view conventions).
 
-use crate::args::{plan, turned, MethodArg, RenderArgs};
+use crate::args::{plan, MethodArg, RenderArgs};
 use crate::charts::colorbar;
 use crate::io::image::{check_style, encode_apng, encode_rgb_for, RGB_EXTENSIONS};
 use crate::io::outputs::{self, Planned};
@@ -268,9 +268,8 @@ fn orbit(
     let start = Instant::now();
     let delay = (4000 / n).clamp(20, 1000) as u16;
     let image = encode_apng(args.size, args.png_style(), n, delay, |k| {
-        let a = turned(args, 360.0 * k as f32 / n as f32);
         if k > 0 {
-            r.reframe(&crate::args::scene(&a)?)?;
+            r.reframe(&inputs.turned(360.0 * k as f32 / n as f32))?;
         }
         let mut f = r.frame()?.0;
         let p = r.prepared();

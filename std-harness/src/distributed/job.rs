@@ -7,9 +7,11 @@ use crate::io::brick::{BrickPlace, IndexBox};
 use crate::io::cut::{crop, read_box};
 use crate::io::stream::{InMemory, Layout};
 use crate::io::volume::Volume;
+use crate::pipeline::ends::run::end_frame;
+use crate::pipeline::stages::decorators::{self, Resample};
 use crate::pipeline::stages::load::Voxels;
 use crate::pipeline::stages::visible::FrameCache;
-use crate::pipeline::{prepare, render_frame};
+use crate::pipeline::Renderer;
 use crate::plan::{End, Plan};
 use crate::scene::Scene;
 use crate::{builtin, CliError};
@@ -396,50 +398,30 @@ impl Job {
             volume: Arc::new(brick),
             name: self.name.clone(),
         });
-        let mut p = prepare(&(inputs, self.plan.clone()))?;
+        // The door, opened as given: a brick's plan is the job's, every choice already made.
+        let (mut p, _, _) = Renderer::prepare(&inputs, &self.plan)?.into_parts();
         let background = p.background_out.take();
         p.background = None;
         let out = p.out_size();
-        let s = p.subsample_factor(&self.plan)?;
-        let mut plan = self.plan.clone();
-        plan.subsample = crate::args::Supersample::Fixed(1);
-        let (p, resample) = if s > 1 {
-            let (low, _) = p.subsampled(&self.plan, s)?;
-            let low_size = low.out_size();
-            (low, Resample::Magnify { s, low: low_size })
-        } else if p.supersample > 1 {
-            let k = p.supersample;
-            p.supersample = 1;
-            (p, Resample::Average { k })
-        } else {
-            (p, Resample::None)
-        };
-        let mut cache = match plan.end {
+        // The door's own decorator, taken off here and put back once the bricks' images are
+        // composited (`BrickFrame::finish`): compositing is not linear, so it must come first.
+        let d = decorators::peel(&p, &self.plan)?;
+        let mut cache = match d.plan.end {
             End::Sheets(_) => FrameCache::with_list_budget(0),
             _ => FrameCache::default(),
         };
-        let frame = render_frame(&p, &plan, &mut cache)?;
+        let frame = end_frame(&d.prepared, &d.plan, &mut cache)?;
+        let (resample, threads) = (d.resample, d.plan.threads);
         Ok(BrickFrame {
             image: frame.image,
             size: out,
             resample,
-            threads: plan.threads,
+            threads,
             voxels: frame.stats.voxels,
             seconds: start.elapsed().as_secs_f64(),
             background,
         })
     }
-}
-
-/// How a composited image reaches the output size.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Resample {
-    /// Rendered at the output size.
-    None,
-    /// Rendered at k× the output size: the mean of each k×k block.
-    Average { k: usize },
-    /// Rendered at `low`, 1/s of the output size: magnified (`pipeline::stages::subsample`).
-    Magnify { s: usize, low: (usize, usize) },
 }
 
 /// What a brick contributes to the default window ([`Job::window`]).
@@ -474,19 +456,8 @@ impl BrickFrame {
     /// The composited `image` (at this frame's internal size) at the output size, with the
     /// background under it.
     pub fn finish(&self, image: Vec<[f32; 4]>) -> Result<Vec<[f32; 4]>, CliError> {
-        use crate::pipeline::stages::{subsample, supersample};
-        let mut image = match self.resample {
-            Resample::None => image,
-            Resample::Average { k } => supersample::to_output(image, self.size, k),
-            Resample::Magnify { s, low } => {
-                let threads = subsample::resample_threads(self.threads, self.size);
-                subsample::magnify(&image, low, self.size, s, threads)?
-            }
-        };
-        if let Some(bg) = &self.background {
-            subsample::under_background(&mut image, bg);
-        }
-        Ok(image)
+        self.resample
+            .finish(image, self.size, self.threads, self.background.as_deref())
     }
 }
 

@@ -25,7 +25,8 @@ pub mod layout;
 #[cfg(feature = "mpi")]
 pub mod mpi;
 
-pub use job::{BrickFrame, Header, Job, Resample, Source, WindowPart};
+pub use crate::pipeline::stages::decorators::Resample;
+pub use job::{BrickFrame, Header, Job, Source, WindowPart};
 pub use layout::BrickLayout;
 
 use crate::plan::Plan;

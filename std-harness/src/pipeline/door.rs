@@ -1,20 +1,25 @@
 //! The pipeline's one door (issue 76): a [`Scene`] and a [`Plan`] in, frames out. Every command
-//! that draws a picture (render, verify, bench, Python's `render`) opens a [`Renderer`]; charts
-//! sweep derived plans over what it prepared.
+//! that draws a picture (render, verify, bench, chart, Python's `render` and `render_stream`)
+//! opens a [`Renderer`]; a chart opens one as given ([`Renderer::prepare`]) and sweeps the plans
+//! it derives over what it prepared ([`Renderer::frame_of`]). A brick of a split frame
+//! (`crate::distributed`) takes the same resolution decorator off and puts it back after the
+//! bricks are composited.
 //!
 //! ```text
 //! (&Scene, &Plan) ─▶ entry::prepare: hold a stream the pilot needs, load, classify, set the
 //!                     frame up (level, supersampling), validate --lod auto     ─▶ Prepared
 //!                 ─▶ quality::choose::apply_quality: --quality, the default plan's pilot
 //!                                                      ─▶ the plan with every choice made
-//!                 ─▶ ends::run::render_frame: subsample ▸ supersample ▸ level ▸ end
-//!                    (sheets | slabs | post | refined | reference)             ─▶ CoreFrame
+//!                 ─▶ ends::run::render_frame: stages::decorators::peel (subsample or
+//!                    supersample) ▸ ends::run::end_frame (sheets | slabs | post | refined |
+//!                    reference) ▸ Resample::finish                            ─▶ CoreFrame
 //! ```
 //!
-//! The resolution decorators wrap any end: subsampling in `render_frame`, supersampling and the
-//! level of detail in the frame [`Prepared`] holds. The f64 reference is an end like the others.
+//! The resolution decorators wrap any end ([`super::stages::decorators`]); the level of detail
+//! wraps the source (the volume [`Prepared`] holds, coarsened in memory or as it streams). The f64
+//! reference is an end like the others.
 
-use super::ends::run::CoreFrame;
+use super::ends::run::{render_frame, CoreFrame};
 use super::entry::prepare_scene;
 use super::quality::choose::{apply_quality, chosen_frame};
 use super::quality::model::Choice;
@@ -49,6 +54,32 @@ impl Renderer {
             cache: FrameCache::default(),
             choosing: start.elapsed().as_secs_f64(),
         })
+    }
+
+    /// Prepares `scene` for `plan` and resolves nothing more: the plan stays as given (an
+    /// automatic choice left in it is not made; its frames draw the end it names). What a chart
+    /// opens, to sweep the plans it derives over one prepared volume ([`Renderer::frame_of`]).
+    pub fn prepare(scene: &Scene, plan: &Plan) -> Result<Renderer, CliError> {
+        Ok(Renderer {
+            prepared: prepare_scene(scene.clone(), plan)?,
+            plan: plan.clone(),
+            choice: None,
+            cache: FrameCache::default(),
+            choosing: 0.0,
+        })
+    }
+
+    /// A frame of `plan` over what was prepared, with this renderer's cache: `plan` derives from
+    /// the one it was opened with (another end, table, precision or thread count; the same
+    /// resolution chain and order, which the preparation fixed).
+    pub fn frame_of(&mut self, plan: &Plan) -> Result<CoreFrame, CliError> {
+        render_frame(&self.prepared, plan, &mut self.cache)
+    }
+
+    /// A frame of `plan` (as [`Renderer::frame_of`]) drawn as a fresh volume's first frame is:
+    /// with an empty cache, so its visible voxels are classified and its tables built in it.
+    pub fn fresh_frame_of(&self, plan: &Plan) -> Result<CoreFrame, CliError> {
+        render_frame(&self.prepared, plan, &mut FrameCache::default())
     }
 
     /// Seconds spent choosing the plan after preparing (the default plan's pilot, `--quality`):

@@ -5,8 +5,10 @@
 //! door: Renderer::open(&Scene, &Plan), frame(); render(&Scene, &Plan) ─▶ frame
 //! (&Scene, &Plan) ─▶ entry::prepare ─▶ stages (load, window, prepare, lod, super/subsample,
 //!                                      visible, spares, supply, bands) ─▶ Prepared
-//! (&Prepared, &Plan) ─▶ ends (run: subsampling, then the core's sheets or the f64 reference;
-//!                             slabs; post; refine; the continuous integral; single) ─▶ image
+//! (&Prepared, &Plan) ─▶ stages::decorators::peel (subsample or supersample off)
+//!                    ─▶ ends (run::end_frame: the core's sheets or the f64 reference; slabs; post;
+//!                             refine; the continuous integral; single)
+//!                    ─▶ Resample::finish (the decorator back on)                ─▶ image
 //! quality (--quality, the default plan's pilot, chart): derives plans, measures them with the ends
 //! ```
 //!
@@ -16,7 +18,8 @@
 //!   [`stages::load`] (where the voxels come from), [`stages::hold`] (a stream the default
 //!   plan's pilot needs, read whole by [`entry::prepare`] first: the file's plan and picture),
 //!   [`stages::window`], [`stages::prepare`],
-//!   [`stages::lod`] (levels of detail), [`stages::supersample`] and [`stages::subsample`],
+//!   [`stages::lod`] (levels of detail), [`stages::supersample`] and [`stages::subsample`]
+//!   (wrapped around any end by [`stages::decorators`]),
 //!   [`stages::visible`] (visible-voxel lists kept across frames), [`stages::spares`],
 //!   [`stages::supply`], [`stages::bands`] (bands of rows, byte-identical for any count),
 //!   [`stages::refinement`] (what a refined frame carries).

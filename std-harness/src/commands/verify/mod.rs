@@ -11,9 +11,8 @@ use crate::io::image::{check_style, RGB_EXTENSIONS};
 use crate::io::outputs::{self, Planned};
 use crate::metrics::{compare, ErrorStats};
 use crate::pipeline::ends::continuous::{continuous_models, ModelFigures};
-use crate::pipeline::entry::prepare_scene;
 use crate::pipeline::quality::{field::prepare_field, model::Choice};
-use crate::pipeline::{render, render_core, render_ref, Prepared};
+use crate::pipeline::{render, render_ref, Prepared, Renderer};
 use crate::plan::{End, Plan, Precision};
 use crate::reference::continuous::{Continuous, Model};
 use crate::scene::Scene;
@@ -165,8 +164,17 @@ struct Measured {
 fn measure(args: &VerifyArgs, r: &RenderArgs) -> Result<Measured, CliError> {
     let inputs = crate::args::scene(r)?;
     let (frame, renderer) = render(&inputs, &plan(r)?)?;
-    let (p, plan, choice) = renderer.into_parts();
     let (core, stats, core_s) = (frame.image, frame.stats, frame.seconds);
+    // The fixed path against the float path of the same table and method.
+    let fixed_vs_float = if renderer.plan().precision() == Precision::Fixed {
+        let float_plan = renderer.plan().with_precision(Precision::Float);
+        let float = renderer.fresh_frame_of(&float_plan)?.image;
+        let float: Vec<[f64; 4]> = float.iter().map(|c| c.map(f64::from)).collect();
+        Some(compare(&core, &float).1)
+    } else {
+        None
+    };
+    let (p, plan, choice) = renderer.into_parts();
     let (reference, ref_s) = render_ref(&p)?;
     let (per, overall) = compare(&core, &reference);
     let continuous = match args.reference {
@@ -196,18 +204,11 @@ fn measure(args: &VerifyArgs, r: &RenderArgs) -> Result<Measured, CliError> {
     // A coarser level is also measured against full resolution: its own error counts there.
     let full_resolution = match (args.reference, p.level) {
         (ReferenceArg::Sheets, 1..) => {
-            let level0 = prepare_scene(inputs.clone(), &plan.at_level_0())?;
-            let (full, _) = render_ref(&level0)?;
+            let level0 = Renderer::prepare(&inputs, &plan.at_level_0())?;
+            let (full, _) = render_ref(level0.prepared())?;
             Some(compare(&core, &full).1)
         }
         _ => None,
-    };
-    let fixed_vs_float = if plan.precision() == Precision::Fixed {
-        let (float, _, _) = render_core(&p, &plan.with_precision(Precision::Float))?;
-        let float: Vec<[f64; 4]> = float.iter().map(|c| c.map(f64::from)).collect();
-        Some(compare(&core, &float).1)
-    } else {
-        None
     };
     Ok(Measured {
         p,

@@ -24,7 +24,6 @@ use crate::io::volume::Volume;
 use crate::pipeline::stages::bands::{equal_bands, on_bands, CoreFrame, Phases};
 use crate::pipeline::stages::prepare::Prepared;
 pub use crate::pipeline::stages::refinement::Refinement;
-use crate::pipeline::stages::supersample::to_output;
 use crate::plan::{End, Plan};
 use crate::CliError;
 use footprint::composite::RowSpan;
@@ -263,7 +262,6 @@ fn refined_at<const N: usize>(
     };
     let table_secs = t0.elapsed().as_secs_f64();
     let (image, stats, phases) = refined_bands(p, plan.threads, &grid, &tables)?;
-    let image = to_output(image, p.out_size(), p.supersample);
     Ok(CoreFrame {
         image,
         stats,

@@ -8,11 +8,11 @@ use crate::io::stream::{ColouredMemorySource, FileSource, MemorySource, PipeSour
 use crate::io::try_filled;
 pub use crate::pipeline::stages::bands::CoreFrame;
 use crate::pipeline::stages::bands::{run_bands, Bands, Phases};
+use crate::pipeline::stages::decorators::{self, Resample};
 use crate::pipeline::stages::load::Voxels;
 use crate::pipeline::stages::lod::{with_level, DynSource};
 use crate::pipeline::stages::prepare::Prepared;
-use crate::pipeline::stages::subsample;
-use crate::pipeline::stages::supersample::{downsample, to_output};
+use crate::pipeline::stages::supersample::downsample;
 use crate::pipeline::stages::visible::FrameCache;
 use crate::plan::{End, Footprints, Plan, Precision as PlanPrecision};
 use crate::reference::render::{render_reference, ReferenceScene};
@@ -49,23 +49,33 @@ pub fn render_frame(
     plan: &Plan,
     cache: &mut FrameCache,
 ) -> Result<CoreFrame, CliError> {
-    let s = p.subsample_factor(plan)?;
-    if s > 1 {
-        // Rendered at 1/s of the size and resampled (`crate::pipeline::stages::subsample`); timed as one frame.
-        let start = Instant::now();
-        let (low, at_low) = p.subsampled(plan, s)?;
-        let mut f = render_frame(&low, &at_low, cache)?;
-        let resample = Instant::now();
-        let size = p.out_size();
-        let threads = subsample::resample_threads(plan.threads, size);
-        f.image = subsample::magnify(&f.image, low.out_size(), size, s, threads)?;
-        if let Some(bg) = &p.background {
-            subsample::under_background(&mut f.image, bg);
-        }
-        f.phases.resample = resample.elapsed().as_secs_f64();
-        f.seconds = start.elapsed().as_secs_f64();
+    // The resolution decorator (subsample or supersample) off, the end, the decorator's
+    // resampling; timed as one frame (`crate::pipeline::stages::decorators`).
+    let start = Instant::now();
+    let d = decorators::peel(p, plan)?;
+    let mut f = end_frame(&d.prepared, &d.plan, cache)?;
+    if d.resample == Resample::None {
         return Ok(f);
     }
+    let resample = Instant::now();
+    // A subsampled frame is drawn over nothing and its background goes under at the output
+    // size; a supersampled one's end composited it at k× the size.
+    let background = match d.resample {
+        Resample::Magnify { .. } => p.background.as_deref(),
+        _ => None,
+    };
+    f.image = d
+        .resample
+        .finish(f.image, p.out_size(), plan.threads, background)?;
+    f.phases.resample = resample.elapsed().as_secs_f64();
+    f.seconds = start.elapsed().as_secs_f64();
+    Ok(f)
+}
+
+/// The end `plan` names drawing `p`'s frame as it stands: at its internal size (k× the output
+/// size when supersampled), with no resolution decorator; what [`render_frame`] wraps and a
+/// brick of a split frame draws (`crate::distributed`).
+pub fn end_frame(p: &Prepared, plan: &Plan, cache: &mut FrameCache) -> Result<CoreFrame, CliError> {
     match plan.end {
         End::Refined { threshold, sheets } => {
             super::refine::render_refined(p, plan, threshold, sheets)
@@ -81,10 +91,10 @@ pub fn render_frame(
     }
 }
 
-/// The f64 sheet reference as an end like the others: [`render_ref`]'s image rounded to f32
-/// (premultiplied RGBA at the output size), on one thread, with no core counts.
+/// The f64 sheet reference as an end like the others: its image at the frame's internal size
+/// rounded to f32 (premultiplied RGBA), on one thread, with no core counts.
 fn reference_frame(p: &Prepared) -> Result<CoreFrame, CliError> {
-    let (img, seconds) = render_ref(p)?;
+    let (img, seconds) = render_ref_at_frame(p)?;
     Ok(CoreFrame {
         image: img.iter().map(|c| c.map(|x| x as f32)).collect(),
         stats: Default::default(),
@@ -195,8 +205,6 @@ fn sheets_at<const N: usize>(
             PlanPrecision::Fixed => fixed_sheets(p, plan, &generic, cache, start)?,
         };
         phases.tables = phases.tables.max(0.0);
-        // Supersampled: the mean of each k×k block (timed with the frame: it is part of it).
-        let image = to_output(image, p.out_size(), p.supersample);
         Ok(CoreFrame {
             image,
             stats,
@@ -524,8 +532,19 @@ impl<S: SheetSource<Error = CliError>, F: FnMut(usize, usize)> SheetSource for R
     }
 }
 
-/// The f64 reference render of `p` and its seconds (the volume must be in memory).
+/// The f64 reference render of `p` and its seconds (the volume must be in memory), at the
+/// output size: a supersampled frame's k×k blocks averaged in f64.
 pub fn render_ref(p: &Prepared) -> Result<(Vec<[f64; 4]>, f64), CliError> {
+    let (img, seconds) = render_ref_at_frame(p)?;
+    let img = match p.supersample {
+        1 => img,
+        k => downsample(&img, p.out_size(), k, |v| v),
+    };
+    Ok((img, seconds))
+}
+
+/// [`render_ref`] at the frame's internal size (k× the output size when supersampled).
+fn render_ref_at_frame(p: &Prepared) -> Result<(Vec<[f64; 4]>, f64), CliError> {
     let volume = p.volume().ok_or_else(|| {
         CliError::input("the f64 reference needs the volume in memory: drop --stream")
     })?;
@@ -545,9 +564,5 @@ pub fn render_ref(p: &Prepared) -> Result<(Vec<[f64; 4]>, f64), CliError> {
         |s, out| volume.coloured_sheet_into(axis, s, out),
         sheets("reference"),
     )?;
-    let img = match p.supersample {
-        1 => img,
-        k => downsample(&img, p.out_size(), k, |v| v),
-    };
     Ok((img, start.elapsed().as_secs_f64()))
 }

@@ -27,7 +27,6 @@
 use crate::pipeline::stages::bands::{Bands, CoreFrame, Phases};
 use crate::pipeline::stages::blocks::{block_rows, blocks, on_blocks, Members};
 use crate::pipeline::stages::prepare::Prepared;
-use crate::pipeline::stages::supersample::to_output;
 use crate::pipeline::stages::visible::FrameCache;
 use crate::CliError;
 use footprint::composite::RowSpan;
@@ -123,7 +122,6 @@ where
         tables,
         ..band_phases
     };
-    let image = to_output(image, p.out_size(), p.supersample);
     Ok(CoreFrame {
         image,
         stats,
