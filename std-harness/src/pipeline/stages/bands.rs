@@ -30,7 +30,9 @@ pub struct Phases {
     pub splat: f64,
     /// Compositing sheets into the image.
     pub composite: f64,
-    /// Resampling a subsampled frame to the output size (`--subsample`; zero without it).
+    /// Bringing the frame to the output size (`pipeline::stages::decorators`): magnifying a
+    /// subsampled frame (`--subsample`), averaging a supersampled one's k×k blocks; zero with
+    /// neither.
     pub resample: f64,
 }
 
