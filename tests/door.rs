@@ -186,3 +186,30 @@ fn a_turned_scene_adds_azimuth_or_turns_the_matrix() {
         assert!((a - b).abs() < 1e-5, "{a} against {b}");
     }
 }
+
+/// `--shading` is a typed part of the scene: parsed when the request is resolved (a bad one is
+/// refused before any volume is read, naming the flag), spelled back as given, and completed
+/// with the volume's spacing only when it is prepared.
+#[test]
+fn shading_is_resolved_with_the_scene() {
+    use footprint::shade::Shading;
+    use footprint_harness::scene::ShadingSpec;
+    let bad = parse_args(&["/no/such/volume.nrrd", "--shading", "glossy"]).unwrap();
+    let e = scene(&bad).unwrap_err().message;
+    assert!(e.contains("--shading 'glossy'"), "{e}");
+    for s in ["emission", "phong", "texture", "iso:0.5", "iso:-1200"] {
+        let spec = ShadingSpec::parse(s).unwrap();
+        assert_eq!(spec.to_string(), s);
+        let ok = parse_args(&["--shading", s]).unwrap();
+        assert_eq!(scene(&ok).unwrap().shading, spec);
+    }
+    for bad in ["iso:", "iso:nan", "iso:1e39", "Phong", ""] {
+        assert!(ShadingSpec::parse(bad).is_err(), "{bad}");
+    }
+    match ShadingSpec::parse("iso:7").unwrap().at_spacing(0.5) {
+        Shading::Iso {
+            value, thickness, ..
+        } => assert_eq!((value, thickness), (7.0, 0.75)),
+        other => panic!("{other:?}"),
+    }
+}

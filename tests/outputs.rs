@@ -2,7 +2,8 @@
 //! only in the format their extension names; messages that name the flag or the cause.
 
 use footprint_harness::io::outputs::{self, Planned};
-use footprint_harness::pipeline::stages::prepare::{outside_data_warnings, parse_shading};
+use footprint_harness::pipeline::stages::prepare::outside_data_warnings;
+use footprint_harness::scene::ShadingSpec;
 use std::path::Path;
 
 fn tmpdir(name: &str) -> footprint_suite::TestDir {
@@ -188,13 +189,17 @@ fn messages_name_the_flag_or_the_cause() {
 
 #[test]
 fn values_outside_the_data_are_warned_about() {
-    let iso = |v: f32| parse_shading(&format!("iso:{v}"), 1.0).unwrap();
+    let iso = |v: f32| {
+        ShadingSpec::parse(&format!("iso:{v}"))
+            .unwrap()
+            .at_spacing(1.0)
+    };
     let range = (0.0f32, 255.0f32);
     let w = outside_data_warnings(&iso(99999.0), None, range);
     assert_eq!(w.len(), 1);
     assert!(w[0].contains("99999") && w[0].contains("outside"), "{w:?}");
     assert!(outside_data_warnings(&iso(100.0), None, range).is_empty());
-    let emission = parse_shading("emission", 1.0).unwrap();
+    let emission = ShadingSpec::parse("emission").unwrap().at_spacing(1.0);
     assert_eq!(
         outside_data_warnings(&emission, Some([300.0, 400.0]), range).len(),
         1

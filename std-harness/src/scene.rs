@@ -5,10 +5,79 @@
 //! `crate::plan::Plan`. Programs build a scene themselves. Nothing here is a flag's clap type.
 
 use crate::io::image::{Background, Gamma};
+use crate::CliError;
 use footprint::geometry::FootprintOptions;
 use footprint::render::Absorption;
+use footprint::shade::{Phong, Shading};
 use footprint::Kernel;
 use std::path::PathBuf;
+
+/// How the samples are lit (`--shading`), as a request gives it, before the volume is known:
+/// what [`ShadingSpec::at_spacing`] completes into the core's [`Shading`] when the volume is
+/// prepared. Phong's light and material are [`Phong::default`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ShadingSpec {
+    /// The classified colour as it is (`emission`).
+    Emission,
+    /// Lit by the value's gradient (`phong`).
+    Phong,
+    /// Lit, with the gradient's magnitude scaling opacity (`texture`).
+    Texture,
+    /// An iso-surface at `value` (`iso:VALUE`), in the data's own units (f64, so a wide
+    /// sample's value is exact), opacity 0.9, 1.5 × the volume's smallest spacing thick.
+    Iso { value: f64 },
+}
+
+impl ShadingSpec {
+    /// Parses `--shading`: `emission`, `phong`, `texture` or `iso:VALUE` (VALUE finite).
+    pub fn parse(s: &str) -> Result<ShadingSpec, CliError> {
+        Ok(match s {
+            "emission" => ShadingSpec::Emission,
+            "phong" => ShadingSpec::Phong,
+            "texture" => ShadingSpec::Texture,
+            _ => match s.strip_prefix("iso:").map(|v| v.trim().parse::<f64>()) {
+                Some(Ok(value)) if value.is_finite() && (value as f32).is_finite() => {
+                    ShadingSpec::Iso { value }
+                }
+                _ => {
+                    return Err(CliError::input(format!(
+                        "--shading '{s}': expected emission, phong, iso:VALUE or texture"
+                    )))
+                }
+            },
+        })
+    }
+
+    /// The core's shading for a volume whose smallest spacing is `min_spacing` (world units:
+    /// an iso-surface is 1.5 × that thick); an iso value as f32, in the data's units (a wide
+    /// volume's renderer values are `crate::pipeline::stages::window::values_shading`'s).
+    pub fn at_spacing(self, min_spacing: f32) -> Shading {
+        let phong = Phong::default();
+        match self {
+            ShadingSpec::Emission => Shading::Emission,
+            ShadingSpec::Phong => Shading::Phong(phong),
+            ShadingSpec::Texture => Shading::Texture(phong),
+            ShadingSpec::Iso { value } => Shading::Iso {
+                value: value as f32,
+                opacity: 0.9,
+                thickness: 1.5 * min_spacing,
+                phong,
+            },
+        }
+    }
+}
+
+impl std::fmt::Display for ShadingSpec {
+    /// As `--shading` spells it (an iso value in Rust's shortest form: `iso:0.5`).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ShadingSpec::Emission => f.write_str("emission"),
+            ShadingSpec::Phong => f.write_str("phong"),
+            ShadingSpec::Texture => f.write_str("texture"),
+            ShadingSpec::Iso { value } => write!(f, "iso:{value}"),
+        }
+    }
+}
 
 /// The kernel and how its footprints are shaped: what `--kernel`, `--method paper`'s
 /// `--paper-cheat`, `--min-radius` and `--table-file` resolve to.
@@ -57,10 +126,11 @@ pub struct Scene {
     pub view_matrix: Option<[f32; 9]>,
     pub perspective: Option<f32>,
     pub eye_distance: Option<f32>,
-    /// Classification: `--tf`, `--window`, `--shading`.
+    /// Classification: `--tf` (a built-in name or a file, read when the volume is prepared;
+    /// `None`: the default for the source), `--window` (data units), `--shading`.
     pub tf: Option<String>,
     pub window: Option<[f64; 2]>,
-    pub shading: String,
+    pub shading: ShadingSpec,
     /// Picture: background, gamma, PNG depth.
     pub background: Background,
     pub gamma: Gamma,
@@ -114,7 +184,7 @@ impl Default for Scene {
             eye_distance: None,
             tf: None,
             window: None,
-            shading: "emission".to_string(),
+            shading: ShadingSpec::Emission,
             background: Background::Black,
             gamma: Gamma::Linear,
             depth: 8,

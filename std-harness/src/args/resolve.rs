@@ -14,7 +14,7 @@ use crate::plan::{
     check_levels, quality_level_of_stream, End, Footprints, Method, Plan, Precision, Quality,
     QualityReference, Request, Table, SUBSAMPLE_NOT_AT_A_LEVEL, SUBSAMPLE_NOT_PERSPECTIVE,
 };
-use crate::scene::{KernelModel, Scene};
+use crate::scene::{KernelModel, Scene, ShadingSpec};
 use crate::CliError;
 use footprint::frame::Order;
 use footprint::geometry::FootprintOptions;
@@ -255,7 +255,7 @@ pub fn scene(a: &RenderArgs) -> Result<Scene, CliError> {
         eye_distance: a.eye_distance,
         tf: a.tf.clone(),
         window: a.window,
-        shading: a.shading.clone(),
+        shading: ShadingSpec::parse(&a.shading)?,
         background: a.background.clone(),
         gamma: a.gamma.curve(),
         depth: a.depth,

@@ -35,7 +35,7 @@ pub fn describe(p: &Prepared, args: &Scene, plan: &Plan) -> Json {
             },
         )
         .bool("streamed", p.volume().is_none())
-        .str("shading", &args.shading)
+        .str("shading", &args.shading.to_string())
         .str("tf", &p.tf_name)
         .arr_f64("window", &p.data_window())
         .str("sheet_axis", ["i", "j", "k"][f.sheet_axis])

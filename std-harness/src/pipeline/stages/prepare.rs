@@ -18,32 +18,9 @@ use crate::{tf, CliError};
 use footprint::frame::{FrameSetup, Order};
 use footprint::geometry::FootprintOptions;
 use footprint::lod::{level_frame, level_kernel};
-use footprint::shade::{Phong, Shader, Shading, TransferFunction};
+use footprint::shade::{Shader, Shading, TransferFunction};
 use footprint::{Grid, Kernel, View};
 use std::sync::Arc;
-
-/// Parses `--shading`; iso-surfaces are `1.5 × min_spacing` thick (world units).
-pub fn parse_shading(s: &str, min_spacing: f32) -> Result<Shading, CliError> {
-    let phong = Phong::default();
-    Ok(match s {
-        "emission" => Shading::Emission,
-        "phong" => Shading::Phong(phong),
-        "texture" => Shading::Texture(phong),
-        _ => match s.strip_prefix("iso:").map(str::parse::<f32>) {
-            Some(Ok(value)) if value.is_finite() => Shading::Iso {
-                value,
-                opacity: 0.9,
-                thickness: 1.5 * min_spacing,
-                phong,
-            },
-            _ => {
-                return Err(CliError::input(format!(
-                    "--shading '{s}': expected emission, phong, iso:VALUE or texture"
-                )))
-            }
-        },
-    })
-}
 
 /// A render, set up and ready to run: the volume, the frame, the shading. A clone shares the
 /// volume in memory.
@@ -147,7 +124,7 @@ impl Prepared {
         )?;
         let kernel = kernel_at(args, &self.kernel, level);
         let min_spacing = frame.spacing.iter().copied().fold(f32::INFINITY, f32::min);
-        let shading = parse_shading(&args.shading, min_spacing)?;
+        let shading = args.shading.at_spacing(min_spacing);
         let averaging = super::lod::averaging_for(&shading, self.shader().tf, self.absorption);
         let voxels = match (fine, from) {
             (None, _) => self.voxels.clone(),
@@ -470,11 +447,9 @@ pub fn prepare_as_asked(args: &Scene, plan: &Plan) -> Result<Prepared, CliError>
         None => super::window::default_window(&name, range, &voxels, sample.as_deref())?,
     };
     let shading = values_shading(
-        parse_shading(
-            &args.shading,
-            frame.spacing.iter().copied().fold(f32::INFINITY, f32::min),
-        )?,
-        &args.shading,
+        args.shading
+            .at_spacing(frame.spacing.iter().copied().fold(f32::INFINITY, f32::min)),
+        args.shading,
         values,
     );
     if let Some((lo, hi)) = range {

@@ -15,6 +15,7 @@
 use super::load::Voxels;
 use crate::io::volume::SampleType;
 use crate::io::volume::ValueMap;
+use crate::scene::ShadingSpec;
 use crate::CliError;
 use footprint::shade::Shading;
 
@@ -153,9 +154,9 @@ pub fn auto_window(sorted: &[f32]) -> Option<[f32; 2]> {
     })
 }
 
-/// `shading` (parsed from `text`) with an iso value in the renderer's values: the data's, read
-/// again in f64 and mapped through `values` where wide samples are rebased.
-pub(crate) fn values_shading(shading: Shading, text: &str, values: ValueMap) -> Shading {
+/// `shading` (completed from `spec`) with an iso value in the renderer's values: the data's, as
+/// `spec` holds it in f64, mapped through `values` where wide samples are rebased.
+pub(crate) fn values_shading(shading: Shading, spec: ShadingSpec, values: ValueMap) -> Shading {
     match shading {
         Shading::Iso {
             value,
@@ -163,11 +164,10 @@ pub(crate) fn values_shading(shading: Shading, text: &str, values: ValueMap) -> 
             thickness,
             phong,
         } if !values.is_identity() => {
-            let exact = text
-                .trim()
-                .strip_prefix("iso:")
-                .and_then(|v| v.trim().parse::<f64>().ok())
-                .unwrap_or(f64::from(value));
+            let exact = match spec {
+                ShadingSpec::Iso { value } => value,
+                _ => f64::from(value),
+            };
             Shading::Iso {
                 value: values.from_data(exact),
                 opacity,
