@@ -39,10 +39,13 @@ pub fn sweep(base: &RenderArgs, runs: usize) -> Result<(Vec<LevelRow>, u32), Cli
         a.quality = None;
         a
     };
-    let auto = super::open(&with(Lod::Auto))?;
-    let deepest =
-        crate::pipeline::stages::lod::deepest_level(auto.prepared().fine_dims).min(MAX_CHARTED);
-    let auto = auto.prepared().level;
+    // `--lod auto`'s pick, its render dropped before the levels are prepared.
+    let (deepest, auto) = {
+        let r = super::open(&with(Lod::Auto))?;
+        let p = r.prepared();
+        let deepest = crate::pipeline::stages::lod::deepest_level(p.fine_dims);
+        (deepest.min(MAX_CHARTED), p.level)
+    };
     let mut levels: Vec<Renderer> = Vec::new();
     for level in 0..=deepest {
         let r = match super::open(&with(Lod::Level(level))) {

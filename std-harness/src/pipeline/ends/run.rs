@@ -58,15 +58,9 @@ pub fn render_frame(
         return Ok(f);
     }
     let resample = Instant::now();
-    // A subsampled frame is drawn over nothing and its background goes under at the output
-    // size; a supersampled one's end composited it at k× the size.
-    let background = match d.resample {
-        Resample::Magnify { .. } => p.background.as_deref(),
-        _ => None,
-    };
     f.image = d
         .resample
-        .finish(f.image, p.out_size(), plan.threads, background)?;
+        .finish(f.image, p.out_size(), plan.threads, d.under.as_deref())?;
     f.phases.resample = resample.elapsed().as_secs_f64();
     f.seconds = start.elapsed().as_secs_f64();
     Ok(f)

@@ -25,6 +25,7 @@ use super::{subsample, supersample};
 use crate::plan::Plan;
 use crate::CliError;
 use std::borrow::Cow;
+use std::sync::Arc;
 
 /// How an end's image, composited at the inner frame's size, reaches the output size.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -73,6 +74,10 @@ pub struct Decorated<'a> {
     pub plan: Cow<'a, Plan>,
     /// How the end's image reaches [`Prepared::out_size`] of the render peeled.
     pub resample: Resample,
+    /// The background [`Resample::finish`] puts under the image: a subsampled frame's (drawn
+    /// over nothing, it is composited at the output size); none otherwise (a supersampled
+    /// frame's end composites its own, repeated to k× the size).
+    pub under: Option<Arc<[[f32; 4]]>>,
 }
 
 /// `p` drawn by `plan` with its resolution decorator taken off (see the module's docs); refuses
@@ -86,6 +91,7 @@ pub fn peel<'a>(p: &'a Prepared, plan: &'a Plan) -> Result<Decorated<'a>, CliErr
             prepared: Cow::Owned(low),
             plan: Cow::Owned(at_low),
             resample: Resample::Magnify { s, low: low_size },
+            under: p.background.clone(),
         });
     }
     let resample = match p.supersample {
@@ -96,5 +102,6 @@ pub fn peel<'a>(p: &'a Prepared, plan: &'a Plan) -> Result<Decorated<'a>, CliErr
         prepared: Cow::Borrowed(p),
         plan: Cow::Borrowed(plan),
         resample,
+        under: None,
     })
 }
