@@ -20,6 +20,7 @@ mod formats;
 mod freestanding_scene;
 mod harness_render;
 mod kernels;
+mod keywords;
 mod layering;
 mod library;
 mod lod;

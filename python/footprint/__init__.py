@@ -1,9 +1,13 @@
 """Footprint from Python: Westover's footprint-evaluation splatting, numpy in, numpy out.
 
-Every function mirrors the ``footprint`` command line: its keyword arguments are the command's
-flags (``shading="phong"`` is ``--shading phong``, ``lod=0`` is ``--lod 0``, ``threads=4`` is
-``--threads 4``; underscores become hyphens, ``True`` gives a bare flag, tuples are joined with
-commas), and its errors carry the command's one-line messages.
+Every function mirrors the ``footprint`` command line: each keyword argument is one of the
+command's flags, named with underscores (``eye_distance`` is ``--eye-distance``), and its value
+is typed, not text: a number (``lod=0``, ``slab=1.5``, ``threads=4``), a string for a choice or
+a word (``shading="phong"``, ``slicing="image"``, ``lod="auto"``), a tuple for a list
+(``size=(256, 256)``, ``window=(0, 100)``), ``True`` for a switch (``refine_sheets=True``), a
+path for a file; ``None`` leaves the default. The request is built from those values and checked
+as the command line's is (the same checks, the same rules between flags, the same one-line
+messages); no flag string is written or parsed on the way.
 
 Conventions (as the command line's):
 
@@ -57,40 +61,15 @@ SAMPLE_TYPES = (
 )
 
 
-def _flag_value(value: Any) -> str:
-    if isinstance(value, (tuple, list)):
-        return ",".join(_flag_value(v) for v in value)
-    if isinstance(value, float):
-        return repr(value)
-    return str(value)
-
-
-def _flags(**flags: Any) -> list:
-    """The command line's flags for keyword arguments (None and False are left out)."""
-    out = []
-    for key, value in flags.items():
-        if value is None or value is False:
-            continue
-        flag = "--" + key.replace("_", "-")
-        if value is True:
-            out.append(flag)
-        else:
-            out.extend([flag, _flag_value(value)])
-    return out
-
-
-def _size(size: Sequence[int]) -> str:
-    w, h = size
-    return f"{int(w)}x{int(h)}"
-
-
-def _common(size, view, tf, window, flags):
-    return _flags(
-        size=_size(size),
-        view=tuple(view),
+def _common(size, view, tf, window, flags: dict) -> dict:
+    """The keywords of a request: the camera and picture arguments every function names, and the
+    rest as given (typed values; the extension checks them as the flags are checked)."""
+    return dict(
+        flags,
+        size=tuple(size),
+        view=view if isinstance(view, str) else tuple(view),
         tf=tf,
         window=tuple(window) if window is not None else None,
-        **flags,
     )
 
 
@@ -151,8 +130,8 @@ def render(
     Ctrl-C interrupts the render within a sheet or slab and raises ``KeyboardInterrupt``.
     """
     array, spacing = _volume_of(volume, spacing)
-    args = _common(size, view, tf, window, flags)
-    image = _footprint.render_array(array, tuple(float(s) for s in spacing), args)
+    keywords = _common(size, view, tf, window, flags)
+    image = _footprint.render_array(array, tuple(float(s) for s in spacing), keywords)
     return _image(image, dtype)
 
 
@@ -192,9 +171,9 @@ def render_stream(
             count += 1
             yield a
 
-    args = _common(size, view, tf, window, flags)
+    keywords = _common(size, view, tf, window, flags)
     image = _footprint.render_stream(
-        slices(), (nx, ny, nz), dtype.name, tuple(float(s) for s in spacing), args
+        slices(), (nx, ny, nz), dtype.name, tuple(float(s) for s in spacing), keywords
     )
     return _image(image, image_dtype)
 
@@ -204,24 +183,25 @@ def load(path: "os.PathLike[str] | str", **flags: Any) -> Tuple[np.ndarray, Tupl
     NIfTI; raw with ``dims=(x, y, z), type="u16"``). Returns (array, spacing, metadata): the
     array C-ordered (z, y, x) in the file's sample type, spacing (x, y, z), and a dict with
     ``dims``, ``type``, ``directions`` (each grid axis's world direction) and ``path``."""
-    return _footprint.load(os.fspath(path), _flags(**flags))
+    return _footprint.load(os.fspath(path), flags)
 
 
 def _command_json(command: str, volume: Any, spacing, size, view, tf, window, flags: dict) -> dict:
     """Runs ``footprint COMMAND`` on ``volume`` (an array, an ImageData, a file path, or None for
     the built-in scene) with ``--json`` to a temporary file, and returns that JSON as a dict."""
-    args = _common(size, view, tf, window, flags)
+    keywords = _common(size, view, tf, window, flags)
     with tempfile.TemporaryDirectory(prefix="footprint-") as d:
-        out = os.path.join(d, "out.json")
+        keywords["json"] = os.path.join(d, "out.json")
         if volume is None:
-            _footprint.run_command([command] + args + ["--json", out], None, None)
+            _footprint.run_measure(command, keywords)
         elif isinstance(volume, (str, os.PathLike)):
-            _footprint.run_command([command, os.fspath(volume)] + args + ["--json", out], None, None)
+            _footprint.run_measure(command, dict(keywords, volume=os.fspath(volume)))
         else:
             array, spacing = _volume_of(volume, spacing)
-            _footprint.run_command(
-                [command] + args + ["--json", out], array, tuple(float(s) for s in spacing)
+            _footprint.run_measure(
+                command, keywords, array, tuple(float(s) for s in spacing)
             )
+        out = keywords["json"]
         with open(out) as f:
             return json.load(f)
 
@@ -268,7 +248,7 @@ def save_table(
     """Writes the generic table as ``footprint tables`` does, for ``render(..., table=size,
     table_file=path)``."""
     _footprint.run_command(
-        ["tables", "--kernel", kernel, "--size", str(int(size)), "--out", os.fspath(path)], None, None
+        ["tables", "--kernel", kernel, "--size", str(int(size)), "--out", os.fspath(path)]
     )
 
 

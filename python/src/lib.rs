@@ -15,7 +15,10 @@
 // The one use of `unsafe`: reading a numpy array's buffer as a slice (see the module docs).
 #![deny(unsafe_op_in_unsafe_fn)]
 
-use footprint_harness::args::{parse_args, RenderArgs};
+mod keywords;
+use keywords::request;
+
+use footprint_harness::args::RenderArgs;
 use footprint_harness::io::stream::{InMemory, Pipe};
 use footprint_harness::io::volume::{check_spacing, Data, Samples, Volume};
 use footprint_harness::CliError;
@@ -177,11 +180,6 @@ fn spacing3(spacing: (f64, f64, f64)) -> [f32; 3] {
     [spacing.0 as f32, spacing.1 as f32, spacing.2 as f32]
 }
 
-fn parse(flags: &[String]) -> PyResult<RenderArgs> {
-    let refs: Vec<&str> = flags.iter().map(String::as_str).collect();
-    parse_args(&refs).map_err(py_err)
-}
-
 /// A rendered image: premultiplied RGBA, row-major, top row first, and its (width, height).
 type Frame = (Vec<[f32; 4]>, (usize, usize));
 
@@ -288,15 +286,16 @@ fn to_numpy<'py>(
     PyArray1::from_vec(py, flat).reshape([h, w, 4])
 }
 
-/// Renders `volume` (a 3-D numpy array) with `footprint render`'s `flags`, releasing the GIL.
+/// Renders `volume` (a 3-D numpy array) with `footprint render`'s flags as typed `keywords`,
+/// releasing the GIL.
 #[pyfunction]
 fn render_array<'py>(
     py: Python<'py>,
     volume: &Bound<'py, PyAny>,
     spacing: (f64, f64, f64),
-    flags: Vec<String>,
+    keywords: &Bound<'py, PyDict>,
 ) -> PyResult<Bound<'py, PyArray3<f32>>> {
-    let mut args = parse(&flags)?;
+    let mut args: RenderArgs = request(keywords)?;
     let (image, size) = with_volume(volume, spacing3(spacing), |v, _| {
         if args.window.is_none() {
             // A constant volume (np.zeros) has no range to map: it renders as the transfer
@@ -381,42 +380,53 @@ fn render_stream<'py>(
     dims: (usize, usize, usize),
     dtype: &str,
     spacing: (f64, f64, f64),
-    flags: Vec<String>,
+    keywords: &Bound<'py, PyDict>,
 ) -> PyResult<Bound<'py, PyArray3<f32>>> {
-    let ty = match dtype {
-        "uint8" => "u8",
-        "int8" => "i8",
-        "uint16" => "u16",
-        "int16" => "i16",
-        "uint32" => "u32",
-        "int32" => "i32",
-        "float32" => "f32",
-        "float64" => "f64",
+    use footprint_harness::args::EndianArg;
+    use footprint_harness::io::volume::SampleType;
+    let sample_type = match dtype {
+        "uint8" => SampleType::U8,
+        "int8" => SampleType::I8,
+        "uint16" => SampleType::U16,
+        "int16" => SampleType::I16,
+        "uint32" => SampleType::U32,
+        "int32" => SampleType::I32,
+        "float32" => SampleType::F32,
+        "float64" => SampleType::F64,
         o => {
             return Err(PyValueError::new_err(format!(
                 "dtype {o} is not a sample type"
             )))
         }
     };
-    let endian = if cfg!(target_endian = "big") {
-        "big"
+    for own in [
+        "volume",
+        "stream",
+        "dims",
+        "type",
+        "sample_type",
+        "endian",
+        "spacing",
+    ] {
+        if keywords.contains(own)? {
+            return Err(PyValueError::new_err(format!(
+                "{own}: render_stream sets it from its own arguments (dims, dtype, spacing)"
+            )));
+        }
+    }
+    let mut args: RenderArgs = request(keywords)?;
+    // What `--stream - --dims X,Y,Z --type T --endian E --spacing X,Y,Z` would set, typed: the
+    // slices arrive in this machine's byte order.
+    args.stream = Some("-".into());
+    args.dims = Some([dims.0, dims.1, dims.2]);
+    args.sample_type = Some(sample_type);
+    args.endian = if cfg!(target_endian = "big") {
+        EndianArg::Big
     } else {
-        "little"
+        EndianArg::Little
     };
-    let mut all = vec![
-        "--stream".to_string(),
-        "-".into(),
-        "--dims".into(),
-        format!("{},{},{}", dims.0, dims.1, dims.2),
-        "--type".into(),
-        ty.into(),
-        "--endian".into(),
-        endian.into(),
-        "--spacing".into(),
-        format!("{},{},{}", spacing.0, spacing.1, spacing.2),
-    ];
-    all.extend(flags);
-    let mut args = parse(&all)?;
+    args.spacing = footprint_harness::args::spacing(spacing3(spacing))
+        .map_err(|e| PyValueError::new_err(format!("spacing: {e}")))?;
     let raised = Raised::default();
     args.stdin = Some(Pipe::new(Slices {
         iter: PyIterator::from_object(sheets)?.unbind(),
@@ -430,10 +440,9 @@ fn render_stream<'py>(
 
 /// Loads a volume file: (array (z, y, x) of its sample type, spacing (x, y, z), metadata).
 #[pyfunction]
-fn load<'py>(py: Python<'py>, path: &str, flags: Vec<String>) -> PyResult<Loaded<'py>> {
-    let mut all = vec![path.to_string()];
-    all.extend(flags);
-    let args = parse(&all)?;
+fn load<'py>(py: Python<'py>, path: &str, keywords: &Bound<'py, PyDict>) -> PyResult<Loaded<'py>> {
+    let mut args: RenderArgs = request(keywords)?;
+    args.volume = Some(path.into());
     let inputs = footprint_harness::args::scene(&args).map_err(py_err)?;
     let raw = footprint_harness::pipeline::stages::load::raw_options(&inputs).map_err(py_err)?;
     let volume = py
@@ -476,22 +485,30 @@ fn load<'py>(py: Python<'py>, path: &str, flags: Vec<String>) -> PyResult<Loaded
     Ok((array, (sp[0], sp[1], sp[2]), meta))
 }
 
-/// Runs a `footprint` command line (without the program name); `volume`, if given, is the array
-/// `render`, `verify` or `bench` renders in place of VOLUME. Nothing is printed; the GIL is
-/// released.
+/// Runs `verify` or `bench` (`command`) built from typed `keywords` on `volume`: an array
+/// (rendered in place of VOLUME), or None (a file path or the built-in scene: the `volume`
+/// keyword). Nothing is printed (`json=` writes the summary); the GIL is released.
 #[pyfunction]
-#[pyo3(signature = (args, volume=None, spacing=None))]
-fn run_command(
+#[pyo3(signature = (command, keywords, volume=None, spacing=None))]
+fn run_measure(
     py: Python<'_>,
-    args: Vec<String>,
+    command: &str,
+    keywords: &Bound<'_, PyDict>,
     volume: Option<&Bound<'_, PyAny>>,
     spacing: Option<(f64, f64, f64)>,
 ) -> PyResult<()> {
-    let argv: Vec<String> = std::iter::once("footprint".to_string())
-        .chain(args)
-        .collect();
-    let run = |memory: Option<InMemory>| {
-        py.detach(|| footprint_harness::run_with(argv.clone(), memory))
+    use footprint_harness::cli::Command;
+    let command = match command {
+        "verify" => Command::Verify(request(keywords)?),
+        "bench" => Command::Bench(request(keywords)?),
+        o => {
+            return Err(PyValueError::new_err(format!(
+                "{o}: verify or bench is measured"
+            )))
+        }
+    };
+    let run = move |memory: Option<InMemory>| {
+        py.detach(|| footprint_harness::cli::run_command(command, memory))
             .map_err(py_err)
     };
     match volume {
@@ -503,6 +520,17 @@ fn run_command(
             }))
         }),
     }
+}
+
+/// Runs a `footprint` command line (without the program name): what the package uses for
+/// `tables`. Nothing is printed; the GIL is released.
+#[pyfunction]
+fn run_command(py: Python<'_>, args: Vec<String>) -> PyResult<()> {
+    let argv: Vec<String> = std::iter::once("footprint".to_string())
+        .chain(args)
+        .collect();
+    py.detach(|| footprint_harness::run_with(argv, None))
+        .map_err(py_err)
 }
 
 /// The generic table of `kernel` (a `--kernel` spec) at `size`² nodes, as an array.
@@ -552,6 +580,7 @@ fn _footprint(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(shares_memory, m)?)?;
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(run_command, m)?)?;
+    m.add_function(wrap_pyfunction!(run_measure, m)?)?;
     m.add_function(wrap_pyfunction!(generic_table, m)?)?;
     m.add_function(wrap_pyfunction!(to_rgba8, m)?)?;
     Ok(())

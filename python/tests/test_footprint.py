@@ -28,6 +28,21 @@ def cli():
     return path
 
 
+def cli_flags(keywords):
+    """The command line's flags for typed keywords, written out by hand (the package itself writes
+    no flags: it hands the values over typed)."""
+    out = []
+    for key, value in keywords.items():
+        flag = "--" + key.replace("_", "-")
+        if value is True:
+            out.append(flag)
+        elif isinstance(value, tuple):
+            out += [flag, ",".join(str(v) for v in value)]
+        else:
+            out += [flag, str(value)]
+    return out
+
+
 def blob(shape=(24, 20, 28), dtype=np.uint16):
     """A smooth asymmetric blob, C order (z, y, x)."""
     z, y, x = np.mgrid[0 : shape[0], 0 : shape[1], 0 : shape[2]].astype(np.float64)
@@ -76,7 +91,7 @@ def test_render_is_byte_identical_to_the_command_line(tmp_path, flags):
     assert py.shape == (64, 96, 4) and py.dtype == np.float32
     args = [cli(), "render", str(raw), "--dims", "28,20,24", "--type", "u16", "--spacing", "1,1.5,2"]
     args += ["--size", "96x64", "--window", "0,3500", "--out", str(tmp_path / "o.pfm")]
-    args += footprint._flags(**{k: v for k, v in flags.items()})
+    args += cli_flags(flags)
     if "view" not in flags:
         args += ["--view", "0,0,0"]
     subprocess.run(args, check=True, capture_output=True)
@@ -209,6 +224,32 @@ def test_bad_input_raises_the_right_exception(tmp_path):
         "except MemoryError as e:\n    print('MemoryError', e)\n"
     out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True)
     assert out.returncode == 0 and out.stdout.startswith("MemoryError"), (out.stdout, out.stderr)
+
+
+def test_keywords_are_typed_values_checked_as_flags_are():
+    v = blob()
+    base = dict(size=(32, 24), window=(0, 3500), view=(30, 20, 0))
+    want = footprint.render(v, lod=0, slicing="object", **base)
+    # numpy scalars and arrays are values of their kind, not text.
+    got = footprint.render(
+        v, lod=np.int64(0), slicing="object", **dict(base, size=np.array([32, 24]))
+    )
+    assert np.array_equal(want, got)
+    for keywords, needle in [
+        (dict(lod=2.5), "lod=2.5"),
+        (dict(lod="coarse"), "expected auto or a level"),
+        (dict(slab="2"), "expected a number"),
+        (dict(slicing="diagonal"), "expected one of object, image, auto"),
+        (dict(glossiness=1), "unknown keyword 'glossiness'"),
+        (dict(eye_distance=300), "needs --perspective"),
+        (dict(quality=40, table=65), "--table cannot be used with --quality"),
+        (dict(refine_sheets=True), "needs --refine"),
+        (dict(threads=object()), "not understood"),
+    ]:
+        with pytest.raises(ValueError, match=needle):
+            footprint.render(v, **dict(base, **keywords))
+    with pytest.raises(ValueError, match="render_stream sets it"):
+        footprint.render_stream(iter([]), (28, 20, 24), window=(0, 1), endian="big")
 
 
 def test_threads_release_the_gil():

@@ -10,11 +10,13 @@ use clap::{Args, ValueEnum};
 use footprint::frame::Order;
 use std::path::PathBuf;
 
+pub mod keywords;
 mod model;
 mod parse;
 mod phase;
 pub mod resolve;
 pub use crate::io::image::Background;
+pub use keywords::{Keywords, Value};
 pub use model::*;
 pub use parse::*;
 pub use phase::*;
@@ -268,7 +270,7 @@ pub struct RenderArgs {
     /// With --perspective: the eye's distance from the volume's centre, world units. Default
     /// VTK's ResetCamera: R / sin(FOVY/2), R half the diagonal of the voxel-centre box. An eye
     /// inside the volume (or within a kernel radius of it, or among its sheets) is refused.
-    #[arg(help_heading = "Camera", long, value_name = "D", value_parser = parse_positive, requires = "perspective")]
+    #[arg(help_heading = "Camera", long, value_name = "D", value_parser = parse_positive)]
     pub eye_distance: Option<f32>,
     /// Transfer function: a preset (grey, ct-bone-skin, density; ParaView's Grayscale, Cool to
     /// Warm, Viridis, X Ray), a ParaView preset file (`.json`, `FILE.json#NAME` for one of
@@ -424,11 +426,11 @@ pub struct RenderArgs {
     /// footprints for their local spacing (one-sided at region borders); steps stay ≥ 2 px apart
     /// on screen. Float, object slicing, orthographic, the volume in memory. See docs/modes.md,
     /// "Adaptive refinement".
-    #[arg(help_heading = "Resolution", long, value_name = "THRESHOLD", value_parser = parse_threshold, conflicts_with = "quality", allow_hyphen_values = true)]
+    #[arg(help_heading = "Resolution", long, value_name = "THRESHOLD", value_parser = parse_threshold, allow_hyphen_values = true)]
     pub refine: Option<f32>,
     /// With --refine: refine along the sheet axis too (more sheets; the paper's method in full).
     /// Off by default: on the refinement chart it bought 0.9 dB for 3.6x the time.
-    #[arg(help_heading = "Resolution", long, requires = "refine")]
+    #[arg(help_heading = "Resolution", long)]
     pub refine_sheets: bool,
     /// Threads (bands of image rows) for the core's render; 0 = every core. The image is
     /// byte-identical for any number. A streamed volume renders on one thread; more than 256

@@ -160,9 +160,14 @@ where
     I: IntoIterator<Item = T>,
     T: Into<OsString> + Clone,
 {
-    crate::io::forget_inputs();
     let cli = Cli::try_parse_from(args).map_err(|e| crate::CliError::input(clap_line(&e)))?;
-    let mut command = cli.command;
+    run_command(cli.command, memory)
+}
+
+/// Runs `command`, built by flags or by keywords (`crate::args::keywords`), on `memory` if given
+/// (a volume in memory, for `render`, `verify` and `bench` only).
+pub fn run_command(mut command: Command, memory: Option<InMemory>) -> Result<(), crate::CliError> {
+    crate::io::forget_inputs();
     if let Some(m) = memory {
         let render = match &mut command {
             Command::Render(a) => &mut a.render,

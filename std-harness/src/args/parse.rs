@@ -65,19 +65,27 @@ pub fn parse_finite_f64(s: &str) -> Result<f64, String> {
 
 /// [`parse_finite_f64`] for an f32 flag (also refusing a number past f32's range).
 pub fn parse_finite_f32(s: &str) -> Result<f32, String> {
-    let v = parse_finite_f64(s)?;
+    finite_f32(parse_finite_f64(s)?).map_err(|_| format!("'{s}' is out of range"))
+}
+
+/// `v` as an f32 if it is finite there (the typed check [`parse_finite_f32`] makes).
+pub fn finite_f32(v: f64) -> Result<f32, String> {
     let f = v as f32;
     if f.is_finite() {
         Ok(f)
     } else {
-        Err(format!("'{s}' is out of range"))
+        Err(format!("{v} is not a finite f32"))
     }
 }
 
 /// Parses `X,Y,Z` voxel spacing: three positive finite numbers (world units).
 pub fn parse_spacing(s: &str) -> Result<[f32; 3], String> {
-    let v = parse_list::<3>(s)?;
-    if let Some(bad) = v.iter().find(|x| !(**x > 0.0)) {
+    spacing(parse_list::<3>(s)?)
+}
+
+/// `v` if every spacing is positive and finite (the typed check [`parse_spacing`] makes).
+pub fn spacing(v: [f32; 3]) -> Result<[f32; 3], String> {
+    if let Some(bad) = v.iter().find(|x| !(**x > 0.0 && x.is_finite())) {
         return Err(format!(
             "spacing {bad} is not positive (expected X,Y,Z > 0)"
         ));
@@ -88,7 +96,12 @@ pub fn parse_spacing(s: &str) -> Result<[f32; 3], String> {
 /// Parses a positive finite number (a zoom factor).
 pub fn parse_positive(s: &str) -> Result<f32, String> {
     let [v] = parse_list::<1>(s)?;
-    if !(v > 0.0) {
+    positive(v)
+}
+
+/// `v` if it is positive and finite (the typed check [`parse_positive`] makes).
+pub fn positive(v: f32) -> Result<f32, String> {
+    if !(v > 0.0 && v.is_finite()) {
         return Err(format!("{v} is not a positive finite number"));
     }
     Ok(v)
@@ -97,6 +110,11 @@ pub fn parse_positive(s: &str) -> Result<f32, String> {
 /// Parses `--perspective`: a field of view in degrees, strictly between 0 and 180.
 pub fn parse_fov(s: &str) -> Result<f32, String> {
     let [v] = parse_list::<1>(s)?;
+    fov(v)
+}
+
+/// `v` if it is a field of view in (0, 180) degrees (the typed check [`parse_fov`] makes).
+pub fn fov(v: f32) -> Result<f32, String> {
     if !(v > 0.0 && v < 180.0) {
         return Err(format!("{v}: a field of view is degrees in (0, 180)"));
     }
@@ -113,8 +131,14 @@ pub fn parse_sample_type(s: &str) -> Result<crate::io::volume::SampleType, Strin
 /// Parses `--min-radius`: a finite number of pixels, at least the geometry's smallest.
 pub fn parse_min_radius(s: &str) -> Result<f32, String> {
     let [v] = parse_list::<1>(s)?;
+    min_radius(v)
+}
+
+/// `v` if it is a finite radius of at least the geometry's smallest, pixels (the typed check
+/// [`parse_min_radius`] makes).
+pub fn min_radius(v: f32) -> Result<f32, String> {
     let least = footprint::geometry::MIN_MIN_RADIUS_PX;
-    if !(v >= least) {
+    if !(v >= least && v.is_finite()) {
         return Err(format!("{v} px is outside [{least}, ∞) px"));
     }
     Ok(v)
@@ -125,12 +149,24 @@ pub fn parse_lod(s: &str) -> Result<Lod, String> {
     if s == "auto" {
         return Ok(Lod::Auto);
     }
-    match s.parse::<u32>() {
+    match s.parse::<u64>() {
+        Ok(n) => level(n).map_err(|_| lod_error(s)),
+        _ => Err(lod_error(s)),
+    }
+}
+
+fn lod_error(s: &str) -> String {
+    format!(
+        "'{s}': expected auto or a level 0..={} (0 = full resolution)",
+        footprint::lod::MAX_LEVEL
+    )
+}
+
+/// Level `n` if it is one (the typed check [`parse_lod`] makes of a number).
+pub fn level(n: u64) -> Result<Lod, String> {
+    match u32::try_from(n) {
         Ok(n) if n <= footprint::lod::MAX_LEVEL => Ok(Lod::Level(n)),
-        _ => Err(format!(
-            "'{s}': expected auto or a level 0..={} (0 = full resolution)",
-            footprint::lod::MAX_LEVEL
-        )),
+        _ => Err(lod_error(&n.to_string())),
     }
 }
 
@@ -139,9 +175,21 @@ pub fn parse_supersample(s: &str) -> Result<Supersample, String> {
     if s == "auto" {
         return Ok(Supersample::Auto);
     }
-    match s.parse::<usize>() {
-        Ok(k @ 1..=8) => Ok(Supersample::Fixed(k)),
-        _ => Err(format!("'{s}': expected auto or a whole number 1..=8")),
+    match s.parse::<u64>() {
+        Ok(k) => factor(k).map_err(|_| factor_error(s)),
+        _ => Err(factor_error(s)),
+    }
+}
+
+fn factor_error(s: &str) -> String {
+    format!("'{s}': expected auto or a whole number 1..=8")
+}
+
+/// Factor `k` if it is one, 1 … 8 (the typed check [`parse_supersample`] makes of a number).
+pub fn factor(k: u64) -> Result<Supersample, String> {
+    match k {
+        1..=8 => Ok(Supersample::Fixed(k as usize)),
+        _ => Err(factor_error(&k.to_string())),
     }
 }
 
@@ -150,31 +198,56 @@ pub fn parse_size(s: &str) -> Result<(usize, usize), String> {
     let (w, h) = s
         .split_once(['x', 'X'])
         .ok_or_else(|| format!("'{s}' is not WxH"))?;
-    let parse = |v: &str| -> Result<usize, String> {
-        let n: usize = v
-            .parse()
-            .map_err(|_| format!("'{v}' is not a whole number in 1..=16384"))?;
-        if !(1..=16384).contains(&n) {
-            return Err(format!("image side {n} is outside 1..=16384"));
-        }
-        Ok(n)
+    let parse = |v: &str| -> Result<u64, String> {
+        v.parse()
+            .map_err(|_| format!("'{v}' is not a whole number in 1..=16384"))
     };
-    Ok((parse(w)?, parse(h)?))
+    size([parse(w)?, parse(h)?])
+}
+
+/// `(w, h)` pixels if each side is in 1 … 16384 (the typed check [`parse_size`] makes).
+pub fn size([w, h]: [u64; 2]) -> Result<(usize, usize), String> {
+    let side = |n: u64| {
+        if (1..=16384).contains(&n) {
+            Ok(n as usize)
+        } else {
+            Err(format!("image side {n} is outside 1..=16384"))
+        }
+    };
+    Ok((side(w)?, side(h)?))
 }
 
 /// Parses `--refine`'s threshold: a finite number ≥ 0.
 pub fn parse_threshold(s: &str) -> Result<f32, String> {
     match s.trim().parse::<f32>() {
-        Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
+        Ok(v) => threshold(v).map_err(|_| format!("{s:?} is not a finite number ≥ 0")),
         _ => Err(format!("{s:?} is not a finite number ≥ 0")),
+    }
+}
+
+/// `v` if it is a finite threshold ≥ 0 (the typed check [`parse_threshold`] makes).
+pub fn threshold(v: f32) -> Result<f32, String> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(v)
+    } else {
+        Err(format!("{v} is not a finite number ≥ 0"))
     }
 }
 
 /// Parses `--scene-size`: 2 ≤ N ≤ 512.
 pub fn parse_scene_size(s: &str) -> Result<usize, String> {
-    match s.trim().parse::<usize>() {
-        Ok(n) if (2..=512).contains(&n) => Ok(n),
+    match s.trim().parse::<u64>() {
+        Ok(n) => grid_side(n).map_err(|_| format!("{s:?} is not a grid side in 2..=512")),
         _ => Err(format!("{s:?} is not a grid side in 2..=512")),
+    }
+}
+
+/// `n` if it is a grid side in 2 … 512 (the typed check [`parse_scene_size`] makes).
+pub fn grid_side(n: u64) -> Result<usize, String> {
+    if (2..=512).contains(&n) {
+        Ok(n as usize)
+    } else {
+        Err(format!("{n} is not a grid side in 2..=512"))
     }
 }
 
@@ -208,11 +281,16 @@ pub fn parse_cull(s: &str) -> Result<Cull, String> {
         .trim()
         .parse()
         .map_err(|_| format!("'{s}' is neither a number nor 'off'"))?;
+    cull(e)
+}
+
+/// Culling at `e` if it lies strictly between 0 and 1 (the typed check [`parse_cull`] makes).
+pub fn cull(e: f32) -> Result<Cull, String> {
     if e > 0.0 && e < 1.0 {
         Ok(Cull(Some(e)))
     } else {
         Err(format!(
-            "'{s}': EPS must lie strictly between 0 and 1 (or be 'off')"
+            "'{e}': EPS must lie strictly between 0 and 1 (or be 'off')"
         ))
     }
 }

@@ -29,6 +29,7 @@ use post::{no_post_flags, post_plan};
 
 /// `args`' plan, with every rule the flags alone decide (see the module docs).
 pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
+    request_rules(args)?;
     let fa = &args.footprint;
     let precision = Precision::from(args.accum);
     if args.classification == ClassificationArg::Post {
@@ -124,6 +125,47 @@ pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
     };
     check_levels(&scene(args)?, &plan.resolution())?;
     Ok(plan)
+}
+
+/// The rules between fields that hold for any request, whether flags or keywords built it: a flag
+/// that needs another (`--eye-distance` a perspective view, `--refine-sheets` `--refine`,
+/// `--quality-reference` a `--quality` target), and what `--quality` chooses itself (the table,
+/// lookup, method, accumulation and slab), which a request may not also set. On the command
+/// line clap refuses the last two when the flags are given at all (even at their defaults);
+/// here they are checked on the values, so a request built from keywords meets them too.
+fn request_rules(args: &RenderArgs) -> Result<(), CliError> {
+    let refuse = |why: &str| Err(CliError::input(why.to_string()));
+    if args.eye_distance.is_some() && args.perspective.is_none() {
+        return refuse("--eye-distance: needs --perspective (an orthographic eye is at infinity)");
+    }
+    if args.refine_sheets && args.refine.is_none() {
+        return refuse("--refine-sheets: needs --refine THRESHOLD");
+    }
+    if args.quality.is_none() {
+        return match args.quality_reference {
+            QualityReferenceArg::Sheets => Ok(()),
+            _ => refuse("--quality-reference: needs --quality DB"),
+        };
+    }
+    if args.refine.is_some() {
+        return refuse("--refine cannot be used with --quality (which chooses the method itself)");
+    }
+    let d: RenderArgs = super::keywords::defaults();
+    let (fa, da) = (&args.footprint, &d.footprint);
+    let set = [
+        ("--table", fa.table != da.table),
+        ("--lookup", fa.lookup != da.lookup),
+        ("--method", fa.method != da.method),
+        ("--accum", args.accum != d.accum),
+        ("--table-file", fa.table_file.is_some()),
+        ("--slab", args.slab != d.slab),
+    ];
+    match set.iter().find(|(_, set)| *set) {
+        Some((flag, _)) => refuse(&format!(
+            "{flag} cannot be used with --quality (which chooses it): drop one"
+        )),
+        None => Ok(()),
+    }
 }
 
 /// The rules `--subsample` adds: not with `--quality` (which chooses at the output size), an

@@ -12,6 +12,7 @@
 //! voxels skipped by occlusion culling, `--cull`; per band, as `render` counts them) and
 //! `culled_voxels_per_frame`, and the render summary's fields (`plan`: what drew the frames).
 
+use crate::args::keywords::{self, Keywords, Value};
 use crate::args::{plan, RenderArgs};
 use crate::io::{self, json::Json};
 use crate::pipeline::quality::model::quality_json;
@@ -31,6 +32,21 @@ pub struct BenchArgs {
     /// Azimuth added per frame, degrees.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = crate::args::parse_finite_f32)]
     pub orbit: f32,
+}
+
+/// `bench`'s own keywords (`frames`, `orbit`), then `render`'s.
+impl Keywords for BenchArgs {
+    fn set(&mut self, key: &str, v: &Value) -> Result<(), CliError> {
+        match key {
+            "frames" => self.frames = keywords::whole(key, v)? as usize,
+            "orbit" => {
+                self.orbit = crate::args::finite_f32(keywords::finite(key, v)?)
+                    .map_err(|e| keywords::refused(key, v, e))?
+            }
+            _ => self.render.set(key, v)?,
+        }
+        Ok(())
+    }
 }
 
 /// Most frames one bench renders: its per-frame times (about 50 bytes a frame) stay small, and

@@ -6,6 +6,7 @@
 
 mod report;
 
+use crate::args::keywords::{self, Keywords, Value};
 use crate::args::{plan, Lod, MethodArg, ReconstructionArg, ReferenceArg, RenderArgs};
 use crate::io::image::{check_style, RGB_EXTENSIONS};
 use crate::io::outputs::{self, Planned};
@@ -51,6 +52,21 @@ pub struct VerifyArgs {
     /// trilinearly (as VTK's ray casters do).
     #[arg(long, value_enum, default_value_t = ReconstructionArg::Kernel)]
     pub reconstruction: ReconstructionArg,
+}
+
+/// `verify`'s own keywords (`min_psnr`, `reference_out`, `reference`, `reconstruction`), then
+/// `render`'s.
+impl Keywords for VerifyArgs {
+    fn set(&mut self, key: &str, v: &Value) -> Result<(), CliError> {
+        match key {
+            "min_psnr" => self.min_psnr = Some(keywords::finite(key, v)?),
+            "reference_out" => self.reference_out = Some(keywords::text(key, v)?.into()),
+            "reference" => self.reference = keywords::choice(key, v)?,
+            "reconstruction" => self.reconstruction = keywords::choice(key, v)?,
+            _ => self.render.set(key, v)?,
+        }
+        Ok(())
+    }
 }
 
 pub fn run(args: &VerifyArgs) -> Result<(), CliError> {

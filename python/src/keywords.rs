@@ -1,0 +1,61 @@
+//! Python keyword arguments as a typed request (issue 76): each keyword's value is converted to
+//! the harness's [`Value`] by its Python type (never written as flag text), and the request is
+//! built and checked by `footprint_harness::args::keywords`, as the command line's flags are.
+
+use crate::py_err;
+use footprint_harness::args::keywords::{from_keywords, Keywords};
+use footprint_harness::args::Value;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::{PyBool, PyDict, PyString};
+
+/// A Python keyword's value, typed (`None`: the keyword is left at its default): `bool`, `int`
+/// (numpy's too), `float`, `str` or a path, or a sequence of them (tuple, list, 1-D array).
+fn value(key: &str, o: &Bound<'_, PyAny>) -> PyResult<Option<Value>> {
+    if o.is_none() {
+        return Ok(None);
+    }
+    Ok(Some(typed(key, o)?))
+}
+
+fn typed(key: &str, o: &Bound<'_, PyAny>) -> PyResult<Value> {
+    if let Ok(b) = o.cast::<PyBool>() {
+        return Ok(Value::Bool(b.is_true()));
+    }
+    if let Ok(i) = o.extract::<i64>() {
+        return Ok(Value::Int(i));
+    }
+    if let Ok(x) = o.extract::<f64>() {
+        return Ok(Value::Float(x));
+    }
+    if let Ok(t) = o.cast::<PyString>() {
+        return Ok(Value::Text(t.extract::<String>()?));
+    }
+    if o.hasattr("__fspath__")? {
+        let path = o.py().import("os")?.call_method1("fspath", (o,))?;
+        return Ok(Value::Text(path.extract::<String>()?));
+    }
+    if let Ok(items) = o.try_iter() {
+        let v = items
+            .map(|item| typed(key, &item?))
+            .collect::<PyResult<Vec<Value>>>()?;
+        return Ok(Value::List(v));
+    }
+    Err(PyValueError::new_err(format!(
+        "{key}: a value of type {} is not understood (numbers, strings, paths and tuples are)",
+        o.get_type()
+    )))
+}
+
+/// A request (`render`'s, `verify`'s or `bench`'s) built from Python keywords as typed values:
+/// the command line's defaults, each keyword set and checked as its flag would be.
+pub fn request<T: Keywords>(keywords: &Bound<'_, PyDict>) -> PyResult<T> {
+    let mut pairs = Vec::new();
+    for (k, v) in keywords.iter() {
+        let key: String = k.extract()?;
+        if let Some(v) = value(&key, &v)? {
+            pairs.push((key, v));
+        }
+    }
+    from_keywords(pairs.iter().map(|(k, v)| (k.as_str(), v))).map_err(py_err)
+}
