@@ -10,6 +10,7 @@ mod continuous;
 mod cull;
 mod default_plan;
 mod degenerate;
+mod depth;
 mod display;
 mod door;
 mod ellipse_geometry;

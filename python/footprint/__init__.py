@@ -39,6 +39,8 @@ from . import _footprint
 __all__ = [
     "render",
     "render_stream",
+    "depth_map",
+    "probe",
     "load",
     "verify",
     "bench",
@@ -133,6 +135,48 @@ def render(
     keywords = _common(size, view, tf, window, flags)
     image = _footprint.render_array(array, tuple(float(s) for s in spacing), keywords)
     return _image(image, dtype)
+
+
+def depth_map(
+    volume: Any,
+    spacing: Sequence[float] = (1, 1, 1),
+    size: Sequence[int] = (512, 512),
+    view: Sequence[float] = (0, 0, 0),
+    tf: Optional[str] = None,
+    window: Optional[Sequence[float]] = None,
+    **flags: Any,
+) -> np.ndarray:
+    """The depth map of the frame :func:`render` draws with the same arguments, as ``footprint
+    render --depth-map`` writes it: (height, width) float32, per pixel the screen z where the
+    accumulated opacity first reaches 0.5, in world units (0 on the plane through the volume's
+    centre, growing away from the viewer), NaN where it never does. Found in the frame's
+    continuous model (its f64 march, full resolution), not in the splatted sheets."""
+    array, spacing = _volume_of(volume, spacing)
+    keywords = _common(size, view, tf, window, flags)
+    return _footprint.depth_array(array, tuple(float(s) for s in spacing), keywords)
+
+
+def probe(
+    volume: Any,
+    at: Sequence[int],
+    spacing: Sequence[float] = (1, 1, 1),
+    size: Sequence[int] = (512, 512),
+    view: Sequence[float] = (0, 0, 0),
+    tf: Optional[str] = None,
+    window: Optional[Sequence[float]] = None,
+    **flags: Any,
+) -> dict:
+    """``footprint probe --at X,Y``: where the ray through pixel ``at`` = (x, y) ((0, 0) top
+    left) first reaches an accumulated opacity of 0.5. Returns ``{"depth", "world", "value"}``:
+    the depth as in :func:`depth_map`, the world point (x, y, z) with the volume's centre at the
+    origin, and the volume's value there (trilinear, data units); NaNs where it never does."""
+    array, spacing = _volume_of(volume, spacing)
+    keywords = _common(size, view, tf, window, flags)
+    x, y = (int(a) for a in at)
+    depth, world, value = _footprint.probe_pixel(
+        array, tuple(float(s) for s in spacing), (x, y), keywords
+    )
+    return {"depth": depth, "world": world, "value": value}
 
 
 def render_stream(

@@ -32,6 +32,25 @@ def render_stream(
     image_dtype: npt.DTypeLike = ...,
     **flags: Any,
 ) -> np.ndarray: ...
+def depth_map(
+    volume: Any,
+    spacing: Sequence[float] = ...,
+    size: Sequence[int] = ...,
+    view: Sequence[float] = ...,
+    tf: Optional[str] = ...,
+    window: Optional[Sequence[float]] = ...,
+    **flags: Any,
+) -> np.ndarray: ...
+def probe(
+    volume: Any,
+    at: Sequence[int],
+    spacing: Sequence[float] = ...,
+    size: Sequence[int] = ...,
+    view: Sequence[float] = ...,
+    tf: Optional[str] = ...,
+    window: Optional[Sequence[float]] = ...,
+    **flags: Any,
+) -> dict: ...
 def load(path: PathLike, **flags: Any) -> Tuple[np.ndarray, Tuple[float, float, float], dict]: ...
 def verify(
     volume: Any = ...,

@@ -15,6 +15,7 @@
 // The one use of `unsafe`: reading a numpy array's buffer as a slice (see the module docs).
 #![deny(unsafe_op_in_unsafe_fn)]
 
+mod depth;
 mod keywords;
 use keywords::request;
 
@@ -581,6 +582,8 @@ fn _footprint(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(run_command, m)?)?;
     m.add_function(wrap_pyfunction!(run_measure, m)?)?;
+    m.add_function(wrap_pyfunction!(depth::depth_array, m)?)?;
+    m.add_function(wrap_pyfunction!(depth::probe_pixel, m)?)?;
     m.add_function(wrap_pyfunction!(generic_table, m)?)?;
     m.add_function(wrap_pyfunction!(to_rgba8, m)?)?;
     Ok(())

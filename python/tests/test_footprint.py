@@ -252,6 +252,36 @@ def test_keywords_are_typed_values_checked_as_flags_are():
         footprint.render_stream(iter([]), (28, 20, 24), window=(0, 1), endian="big")
 
 
+def test_depth_map_and_probe(tmp_path):
+    """The depth of an opaque slab's near face (voxels z = 12 ... 19 of 32: the face 4 world
+    units in front of the centre, within a voxel), as the command line writes it."""
+    v = np.zeros((32, 32, 32), np.uint8)
+    v[12:20] = 255
+    tf = tmp_path / "step.tf"
+    tf.write_text("0 1 1 1 0\n0.4 1 1 1 0\n0.6 1 1 1 1\n1 1 1 1 1\n")
+    kw = dict(size=(48, 40), window=(0, 255), tf=str(tf))
+    d = footprint.depth_map(v, **kw)
+    assert d.shape == (40, 48) and d.dtype == np.float32
+    assert abs(d[20, 24] + 4) <= 1 and np.isnan(d[0, 0])
+    p = footprint.probe(v, at=(24, 20), **kw)
+    # The probe's march converges on its own ray, the map's on every ray: they agree within it.
+    assert p["depth"] == pytest.approx(float(d[20, 24]), abs=0.05)
+    assert p["value"] > 0 and abs(abs(p["world"][2]) - 4) <= 1
+    assert np.isnan(footprint.probe(v, at=(0, 0), **kw)["depth"])
+    raw = tmp_path / "v.raw"
+    v.tofile(raw)
+    npy = tmp_path / "d.npy"
+    subprocess.run(
+        [cli(), "render", str(raw), "--dims", "32,32,32", "--type", "u8", "--size", "48x40",
+         "--window", "0,255", "--tf", str(tf), "--out", str(tmp_path / "o.png"),
+         "--depth-map", str(npy)],
+        check=True, capture_output=True,
+    )
+    assert np.array_equal(np.load(npy), d, equal_nan=True)
+    with pytest.raises(ValueError, match="outside"):
+        footprint.probe(v, at=(48, 0), **kw)
+
+
 def test_threads_release_the_gil():
     # While one thread renders, the main thread keeps running Python: the longest stretch in
     # which it could not run is a small part of the render (with the GIL held it would be all of

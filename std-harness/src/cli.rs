@@ -46,6 +46,11 @@ pub enum Command {
     /// reusing cached state (first_ms, median_ms, phases_ms; --json).
     #[command(allow_negative_numbers = true)]
     Bench(commands::bench::BenchArgs),
+    /// Where the ray through one pixel (--at X,Y) first reaches an accumulated opacity of 0.5 in
+    /// the frame's continuous model: its depth (world units, 0 at the volume's centre, growing
+    /// away from the viewer), its world point and the volume's value there (--json).
+    #[command(allow_negative_numbers = true)]
+    Probe(commands::probe::ProbeArgs),
     /// Print a shell completion script: `footprint completions bash > ~/.local/share/bash-completion/completions/footprint`
     /// (zsh: into a folder on $fpath as `_footprint`; fish: ~/.config/fish/completions/footprint.fish).
     Completions {
@@ -126,6 +131,7 @@ fn dispatch(command: Command) -> Result<(), crate::CliError> {
         Command::Chart(a) => commands::chart::run(&a),
         Command::Bench(a) => commands::bench::run(&a),
         Command::Info(a) => commands::info::run(&a),
+        Command::Probe(a) => commands::probe::run(&a),
         Command::Completions { shell } => {
             let out = completion_script(&shell.to_string())?;
             use std::io::Write as _;
@@ -173,9 +179,10 @@ pub fn run_command(mut command: Command, memory: Option<InMemory>) -> Result<(),
             Command::Render(a) => &mut a.render,
             Command::Verify(a) => &mut a.render,
             Command::Bench(a) => &mut a.render,
+            Command::Probe(a) => &mut a.render,
             _ => {
                 return Err(crate::CliError::input(
-                    "only render, verify and bench take a volume in memory",
+                    "only render, verify, bench and probe take a volume in memory",
                 ))
             }
         };

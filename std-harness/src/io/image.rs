@@ -34,6 +34,24 @@ pub fn encode_pfm(img: &GreyImage) -> Vec<u8> {
     out
 }
 
+/// `data` as NumPy's `.npy` format, version 1.0: little-endian f32, C order, shape (rows, cols).
+pub fn encode_npy(data: &[f32], rows: usize, cols: usize) -> Vec<u8> {
+    let dict = format!("{{'descr': '<f4', 'fortran_order': False, 'shape': ({rows}, {cols}), }}");
+    // Magic (6), version (2), header length (2), then the dictionary padded with spaces and
+    // ended by a newline to a multiple of 64 bytes.
+    let unpadded = 10 + dict.len() + 1;
+    let header_len = dict.len() + 1 + (64 - unpadded % 64) % 64;
+    let mut out = b"\x93NUMPY\x01\x00".to_vec();
+    out.extend_from_slice(&(header_len as u16).to_le_bytes());
+    out.extend_from_slice(dict.as_bytes());
+    out.resize(10 + header_len - 1, b' ');
+    out.push(b'\n');
+    for v in data {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    out
+}
+
 /// Decodes a single-channel PFM (either endianness).
 pub fn decode_pfm(bytes: &[u8], name: &str) -> Result<GreyImage, CliError> {
     decode_pfm_as(bytes, name, false).map(|(img, _)| img)

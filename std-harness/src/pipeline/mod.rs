@@ -39,6 +39,7 @@
 //! calls down into [`crate::io`], [`crate::reference`] and the core, and imports no command;
 //! stages import no end, and ends no quality module.
 
+pub mod depth;
 pub mod describe;
 pub mod door;
 pub mod ends;

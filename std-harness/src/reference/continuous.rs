@@ -75,6 +75,11 @@ pub struct Continuous {
     pub change_db: f64,
     /// Whether that change reached [`CONVERGED_DB`].
     pub converged: bool,
+    /// Per ray, in `image`'s order: the grid point (i, j, k, in voxel steps) where the ray's
+    /// accumulated opacity first reaches one half in the final pass, found within its step as
+    /// the exact crossing of that step's exponential attenuation; NaN where it never does. (The
+    /// pilot's nested march leaves it NaN.)
+    pub crossings: Vec<[f64; 3]>,
 }
 
 /// Which rays to march: every pixel's, or those through the listed pixels.
@@ -103,13 +108,14 @@ impl Rays<'_> {
 /// Marches the rays of `rays` with step `h` (world units) and returns their values, in the
 /// order of `rays`; `nested`: also at step h/3, from the same samples (each step's midpoint is
 /// the middle one of its thirds'), returned second (empty otherwise).
+/// Returned third: each ray's [`Continuous::crossings`] at step `h` (NaN when `nested`).
 fn march(
     scene: &ContinuousScene<'_>,
     field: &Field,
     h: f64,
     rays: Rays<'_>,
     nested: bool,
-) -> (Vec<[f64; 4]>, Vec<[f64; 4]>) {
+) -> Marched {
     let f = scene.frame;
     let w = f.size[0];
     let g2s: DMat3 = f.grid_to_screen.as_dmat3();
@@ -123,11 +129,16 @@ fn march(
     let count = rays.count(f);
     let mut image = vec![[0.0f64; 4]; count];
     let mut thirds = vec![[0.0f64; 4]; if nested { count } else { 0 }];
+    let mut crossings = vec![[f64::NAN; 3]; count];
     let band = count.div_ceil(threads).max(1);
     let mut fine_chunks = thirds.chunks_mut(band);
+    let mut crossing_chunks = crossings.chunks_mut(band);
     std::thread::scope(|sc| {
         for (t, chunk) in image.chunks_mut(band).enumerate() {
             let fine_chunk = fine_chunks.next();
+            let crossing_chunk = crossing_chunks
+                .next()
+                .expect("as many chunks as the image's");
             crate::threads::spawn(sc, move || {
                 let mut taps = field.taps();
                 let mut fine_chunk = fine_chunk;
@@ -172,8 +183,9 @@ fn march(
                     }
                     let mut coarse = Ray::default();
                     let mut fine = Ray::default();
+                    let per_t = (grid * dg).length();
                     if t1 > t0 {
-                        let world = (t1 - t0) * (grid * dg).length();
+                        let world = (t1 - t0) * per_t;
                         let steps = ((world / h).ceil() as usize).max(1);
                         let step = (t1 - t0) / steps as f64;
                         let hw = world / steps as f64;
@@ -207,19 +219,31 @@ fn march(
                     *px = coarse.over(bg);
                     if let Some(f) = fine_chunk.as_deref_mut() {
                         f[i] = fine.over(bg);
+                    } else if coarse.half.is_finite() {
+                        let tc = t0 + coarse.half / per_t;
+                        crossing_chunk[i] = (g0 + dg * tc).to_array();
                     }
                 }
             });
         }
     });
-    (image, thirds)
+    (image, thirds, crossings)
 }
 
-/// One ray's emission and transmittance so far, front to back.
+/// What [`march`] returns: the image, the nested thirds' image (empty unless nested) and the
+/// crossings.
+type Marched = (Vec<[f64; 4]>, Vec<[f64; 4]>, Vec<[f64; 3]>);
+
+/// One ray's emission and transmittance so far, front to back, and how far it has gone.
 #[derive(Clone, Copy)]
 struct Ray {
     colour: [f64; 3],
     trans: f64,
+    /// World length marched so far.
+    walked: f64,
+    /// World length from the ray's entry at which its transmittance first fell to one half
+    /// (its accumulated opacity reached 0.5); NaN until it does.
+    half: f64,
 }
 
 impl Default for Ray {
@@ -227,6 +251,8 @@ impl Default for Ray {
         Ray {
             colour: [0.0; 3],
             trans: 1.0,
+            walked: 0.0,
+            half: f64::NAN,
         }
     }
 }
@@ -235,6 +261,8 @@ impl Ray {
     /// Composites one step of length `hw` (world units) whose field value is `v` (σ or α, then
     /// the colour terms) behind what the ray holds. Returns whether the ray is done (opaque).
     fn add(&mut self, v: [f64; 4], hw: f64, absorption: Absorption) -> bool {
+        let from = self.walked;
+        self.walked += hw;
         if v[0] <= 0.0 {
             return false;
         }
@@ -247,6 +275,16 @@ impl Ray {
         let share = self.trans * (1.0 - att) / v[0];
         for ch in 0..3 {
             self.colour[ch] += share * v[ch + 1];
+        }
+        if self.half.is_nan() && self.trans * att <= 0.5 {
+            // Within the step the transmittance is trans·att^(s/hw): it is one half at
+            // s = hw·ln(0.5/trans)/ln(att) (at the step's start for an opaque step, att = 0).
+            let s = if att > 0.0 {
+                hw * (0.5 / self.trans).ln() / att.ln()
+            } else {
+                0.0
+            };
+            self.half = from + s.clamp(0.0, hw);
         }
         self.trans *= att;
         if self.trans < 1e-12 {
@@ -387,31 +425,33 @@ fn converge_on(
         .copied()
         .fold(f32::INFINITY, f32::min);
     let mut h = 0.5 * f64::from(smallest);
-    let (mut image, mut passes, mut change, halvings) = if nested {
+    let (mut image, mut crossings, mut passes, mut change, halvings) = if nested {
         // The first two passes from one march: steps of 3/4 of the smallest spacing and their
         // thirds (1/4 of it, the second pass's step without nesting), 2 samples per 1/2
         // spacing instead of 3.
-        let (coarse, thirds) = march(scene, field, 3.0 * h / 2.0, rays, true);
+        let (coarse, thirds, _) = march(scene, field, 3.0 * h / 2.0, rays, true);
         progress(1, 3.0 * h / 2.0);
         h /= 2.0;
         progress(2, h);
         let change = change_db(&coarse, &thirds);
-        (thirds, 2, change, MAX_HALVINGS - 1)
+        let none = vec![[f64::NAN; 3]; thirds.len()];
+        (thirds, none, 2, change, MAX_HALVINGS - 1)
     } else {
-        let image = march(scene, field, h, rays, false).0;
+        let (image, _, crossings) = march(scene, field, h, rays, false);
         progress(1, h);
-        (image, 1, 0.0, MAX_HALVINGS)
+        (image, crossings, 1, 0.0, MAX_HALVINGS)
     };
     for _ in 0..halvings {
         if passes > 1 && change >= CONVERGED_DB {
             break;
         }
         h *= 0.5;
-        let finer = march(scene, field, h, rays, false).0;
+        let (finer, _, finer_crossings) = march(scene, field, h, rays, false);
         passes += 1;
         progress(passes, h);
         change = change_db(&image, &finer);
         image = finer;
+        crossings = finer_crossings;
         if change >= CONVERGED_DB {
             break;
         }
@@ -422,5 +462,6 @@ fn converge_on(
         passes,
         change_db: change,
         converged: change >= CONVERGED_DB,
+        crossings,
     })
 }

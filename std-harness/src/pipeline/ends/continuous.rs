@@ -220,3 +220,97 @@ pub fn continuous_at(
     let c = PilotReference::new(p, threads)?.at(pixels)?;
     Ok((c, start.elapsed().as_secs_f64()))
 }
+
+/// What lies where a ray's accumulated opacity first reaches one half (issue 77: `render
+/// --depth-map`, `footprint probe`), in the continuous model of the frame (its f64 march, not the
+/// splatted sheets: a sheet's opacity is known only on its plane, so a crossing found there
+/// would be quantised to the sheet spacing).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Probe {
+    /// The crossing's screen z in world units: its distance along the view direction from the
+    /// plane through the volume's centre, growing away from the viewer; NaN where the ray's
+    /// opacity never reaches 0.5.
+    pub depth: f64,
+    /// The crossing in world coordinates (the grid's axes times their spacing, world units),
+    /// the volume's centre at the origin (the convention of `--clip`); NaN where none.
+    pub world: [f64; 3],
+    /// The volume's value there, trilinearly interpolated from the samples, in the data's units;
+    /// NaN where none.
+    pub value: f64,
+}
+
+/// [`Probe`]s of `p`'s frame in `model` with kernel reconstruction: every pixel's, row-major
+/// (`pixels` None), or those listed ((x, y), each inside the frame), with their seconds. `p` must
+/// be a level-0 volume in memory rendered without supersampling (the rays are the pixels').
+pub fn probes(
+    p: &Prepared,
+    model: Model,
+    pixels: Option<&[[usize; 2]]>,
+) -> Result<(Vec<Probe>, f64), CliError> {
+    let start = Instant::now();
+    let (volume, scene) = continuous_scene(p, Reconstruction::Kernel, model, DEFAULT_CAP)?;
+    if p.supersample != 1 || volume.brick.is_some() {
+        return Err(CliError::input(
+            "depth: the frame must be rendered at its own size from the whole volume",
+        ));
+    }
+    let axis = p.frame.sheet_axis;
+    let mut bar = sheets("depth");
+    let sheet = |s, out: &mut [f32]| volume.sheet_into(axis, s, out);
+    let progress = |pass, _| bar(pass, MAX_HALVINGS + 1);
+    let c = match pixels {
+        None => render_continuous(&scene, sheet, progress)?,
+        Some(px) => {
+            crate::reference::continuous::render_continuous_at(&scene, sheet, progress, px)?
+        }
+    };
+    let f = &p.frame;
+    let grid = f.grid_inverse_transpose.as_dmat3().inverse().transpose();
+    let g2s = f.grid_to_screen.as_dmat3();
+    // The view direction in world units: the world vector screen z moves along.
+    let away = (grid * g2s.inverse() * glam::DVec3::Z).normalize();
+    let centre = glam::DVec3::from_array(f.dims.map(|n| (n as f64 - 1.0) / 2.0));
+    let probe = |g: &[f64; 3]| {
+        let world = grid * (glam::DVec3::from_array(*g) - centre);
+        Probe {
+            depth: world.dot(away),
+            world: world.to_array(),
+            value: trilinear(volume, *g),
+        }
+    };
+    Ok((
+        c.crossings.iter().map(probe).collect(),
+        start.elapsed().as_secs_f64(),
+    ))
+}
+
+/// `volume`'s value at grid point `g` (voxel steps), trilinearly interpolated between the eight
+/// samples around it (clamped to the grid), in the data's units; NaN for a NaN point.
+fn trilinear(volume: &crate::io::volume::Volume, g: [f64; 3]) -> f64 {
+    if g.iter().any(|x| x.is_nan()) {
+        return f64::NAN;
+    }
+    let d = volume.dims;
+    let mut lo = [0usize; 3];
+    let mut frac = [0.0f64; 3];
+    for a in 0..3 {
+        let x = g[a].clamp(0.0, (d[a] - 1) as f64);
+        lo[a] = (x.floor() as usize).min(d[a].saturating_sub(2));
+        frac[a] = x - lo[a] as f64;
+    }
+    let mut sum = 0.0;
+    for corner in 0..8 {
+        let mut w = 1.0;
+        let mut at = [0usize; 3];
+        for a in 0..3 {
+            let up = corner >> a & 1 == 1;
+            at[a] = (lo[a] + usize::from(up)).min(d[a] - 1);
+            w *= if up { frac[a] } else { 1.0 - frac[a] };
+        }
+        if w > 0.0 {
+            let n = at[0] + d[0] * (at[1] + d[1] * at[2]);
+            sum += w * volume.values.to_data(volume.value(n));
+        }
+    }
+    sum
+}

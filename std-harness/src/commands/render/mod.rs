@@ -1,17 +1,19 @@
 //! `footprint render`: a volume (or the built-in scene) rendered by the core, sheet by sheet, to a
 //! PNG (see [`crate::pipeline::prepare`](mod@crate::pipeline::stages::prepare) for the view conventions).
 
-use crate::args::{plan, MethodArg, RenderArgs};
+mod orbit;
+use crate::args::{plan, RenderArgs};
 use crate::charts::colorbar;
-use crate::io::image::{check_style, encode_apng, encode_rgb_for, RGB_EXTENSIONS};
+use crate::io::image::{check_style, encode_rgb_for, RGB_EXTENSIONS};
 use crate::io::outputs::{self, Planned};
+use crate::pipeline::depth::DEPTH_EXTENSIONS;
 use crate::pipeline::quality::model::quality_json;
 use crate::pipeline::{describe, Prepared, Renderer};
 use crate::plan::{End, Plan};
 use crate::scene::Scene;
 use crate::CliError;
+use orbit::{check_orbit, orbit};
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 /// `footprint render`: the render flags every rendering command shares, and what only a picture
 /// for people needs.
@@ -35,6 +37,13 @@ pub struct RenderCommandArgs {
     /// docs/scale-out.md.
     #[arg(help_heading = "Scale-out", long, value_name = "X,Y,Z", value_parser = crate::args::parse_bricks)]
     pub bricks: Option<[usize; 3]>,
+    /// Also write the depth map: per pixel, the screen z where the accumulated opacity first
+    /// reaches 0.5, in world units (0 on the plane through the volume's centre, growing away from
+    /// the viewer; NaN where it never does), from the frame's continuous model at full
+    /// resolution (`.pfm`, single channel, or `.npy`, float32 (height, width), top row first).
+    /// See `footprint probe` and docs/depth.md.
+    #[arg(help_heading = "Picture", long, value_name = "FILE")]
+    pub depth_map: Option<PathBuf>,
 }
 
 pub fn run(command: &RenderCommandArgs) -> Result<(), CliError> {
@@ -55,11 +64,23 @@ pub fn run(command: &RenderCommandArgs) -> Result<(), CliError> {
             extensions: &[],
         });
     }
+    if let Some(d) = &command.depth_map {
+        planned.push(Planned {
+            flag: "--depth-map",
+            path: d,
+            extensions: &DEPTH_EXTENSIONS,
+        });
+    }
     args.note_inputs();
     outputs::check(&planned)?;
     check_style(&out, args.png_style())?;
     if command.orbit.is_some() {
-        check_orbit(args, &out)?;
+        check_orbit(args, &out, command.depth_map.is_some())?;
+    }
+    if command.depth_map.is_some() && args.stream.is_some() {
+        return Err(CliError::input(
+            "--depth-map marches the volume in memory: drop --stream (the volume is loaded)",
+        ));
     }
     // Every rule the flags decide, before anything is loaded.
     let asked = Plan {
@@ -68,9 +89,10 @@ pub fn run(command: &RenderCommandArgs) -> Result<(), CliError> {
     };
     let inputs = crate::args::scene(args)?;
     if let Some(split) = crate::distributed::render_split(&inputs, &asked)? {
-        if command.orbit.is_some() || command.colorbar {
+        if command.orbit.is_some() || command.colorbar || command.depth_map.is_some() {
             return Err(CliError::input(
-                "--orbit and --colorbar render one process's frame: drop --bricks (or mpirun)",
+                "--orbit, --colorbar and --depth-map render one process's frame: drop --bricks \
+                 (or mpirun)",
             ));
         }
         let Some((rgb, summary)) = split else {
@@ -93,7 +115,15 @@ pub fn run(command: &RenderCommandArgs) -> Result<(), CliError> {
     if command.colorbar {
         colorbar::draw(&mut rgb, args.size, &p.lut, p.data_window())?;
     }
-    write(args, &out, &rgb, summary)
+    drop(p);
+    let depth = match &command.depth_map {
+        Some(d) => vec![(
+            d.as_path(),
+            crate::pipeline::depth::depth_map(&inputs, &asked, d)?,
+        )],
+        None => vec![],
+    };
+    write_files_with(args, Some(&out), &rgb, summary, &depth)
 }
 
 /// One frame of `args` (with `inputs` and the plan `asked` resolved from them) as `footprint
@@ -189,15 +219,13 @@ fn write(
     write_files(args, Some(out), rgb, summary)
 }
 
-/// Writes the image to `out` (if any) and the JSON summary to `--json` (if given), all or
-/// nothing: what `render` writes, for a program that renders with [`single`] (Python's
-/// `render(out=..., json=...)`). Check the paths with [`crate::io::outputs::check_image_and_json`]
-/// before rendering.
-pub fn write_files(
+/// [`write_files`] and more files with them (`--depth-map`), all or nothing.
+fn write_files_with(
     args: &RenderArgs,
     out: Option<&Path>,
     rgb: &[[f32; 4]],
     summary: crate::io::json::Json,
+    more: &[(&Path, Vec<u8>)],
 ) -> Result<(), CliError> {
     let image = match out {
         Some(o) => Some(encode_rgb_for(
@@ -214,84 +242,33 @@ pub fn write_files(
         None => summary,
     }
     .finish();
-    let mut files = Vec::new();
+    let mut files: Vec<(&Path, &[u8])> = Vec::new();
     if let (Some(o), Some(image)) = (out, &image) {
         files.push((o, image.as_slice()));
     }
     if let Some(j) = &args.json {
         files.push((j.as_path(), summary.as_bytes()));
     }
+    files.extend(more.iter().map(|(p, b)| (*p, b.as_slice())));
     outputs::write_all(&files)?;
-    if let Some(o) = out {
-        crate::say!("wrote {}", o.display());
-    }
-    Ok(())
-}
-
-/// What `--orbit` cannot do, refused before the volume is loaded: another output than a PNG, the
-/// f64 reference, a pipe (each frame reads the volume again).
-fn check_orbit(args: &RenderArgs, out: &Path) -> Result<(), CliError> {
-    if crate::io::outputs::extension(out).as_deref() != Some("png") {
-        return Err(CliError::input(format!(
-            "--orbit writes an animated PNG: {} is not a .png",
-            out.display()
-        )));
-    }
-    if args.footprint.method == MethodArg::Reference {
-        return Err(CliError::input(
-            "--orbit renders with the core: --method reference is one frame (render without --orbit)",
-        ));
-    }
-    if args
-        .stream
-        .as_deref()
-        .is_some_and(crate::io::stream::is_stdin)
+    for (path, _) in files
+        .iter()
+        .filter(|(p, _)| Some(*p) != args.json.as_deref())
     {
-        return Err(CliError::input(
-            "--orbit renders the volume once per frame, and standard input can be read once: \
-             give the volume as a file (VOLUME, or --stream FILE)",
-        ));
+        crate::say!("wrote {}", path.display());
     }
     Ok(())
 }
 
-/// `--orbit N`: N frames a 360/N-degree turn apart, reusing the loaded volume, its level and its
-/// visible-voxel lists, encoded into one animated PNG as they come.
-fn orbit(
-    mut r: Renderer,
+/// Writes the image to `out` (if any) and the JSON summary to `--json` (if given), all or
+/// nothing: what `render` writes, for a program that renders with [`single`] (Python's
+/// `render(out=..., json=...)`). Check the paths with [`crate::io::outputs::check_image_and_json`]
+/// before rendering.
+pub fn write_files(
     args: &RenderArgs,
-    inputs: &Scene,
-    out: &Path,
-    n: usize,
-    bar: bool,
+    out: Option<&Path>,
+    rgb: &[[f32; 4]],
+    summary: crate::io::json::Json,
 ) -> Result<(), CliError> {
-    let start = Instant::now();
-    let delay = (4000 / n).clamp(20, 1000) as u16;
-    let image = encode_apng(args.size, args.png_style(), n, delay, |k| {
-        if k > 0 {
-            r.reframe(&inputs.turned(360.0 * k as f32 / n as f32))?;
-        }
-        let mut f = r.frame()?.0;
-        let p = r.prepared();
-        crate::say!("{}: frame {}/{n} in {:.3} s", p.name, k + 1, f.seconds);
-        if bar {
-            colorbar::draw(&mut f.image, args.size, &p.lut, p.data_window())?;
-        }
-        Ok(f.image)
-    })?;
-    let secs = start.elapsed().as_secs_f64();
-    let (p, plan) = (r.prepared(), r.plan());
-    let summary = describe(p, inputs, plan)
-        .num("frames", n as f64)
-        .num("frame_delay_ms", f64::from(delay))
-        .num("seconds", secs)
-        .str("out", &out.display().to_string())
-        .finish();
-    let mut files = vec![(out, image.as_slice())];
-    if let Some(j) = &args.json {
-        files.push((j.as_path(), summary.as_bytes()));
-    }
-    outputs::write_all(&files)?;
-    crate::say!("wrote {} ({n} frames, {secs:.2} s)", out.display());
-    Ok(())
+    write_files_with(args, out, rgb, summary, &[])
 }
