@@ -16,7 +16,7 @@
 
 use crate::args::RenderArgs;
 use crate::io::json::Json;
-use crate::io::outputs::{self, Planned};
+use crate::io::outputs;
 use crate::pipeline::depth::{probes, Probe};
 use crate::CliError;
 use clap::Args;
@@ -45,14 +45,9 @@ fn parse_pixel(s: &str) -> Result<[usize; 2], String> {
 
 pub fn run(args: &ProbeArgs) -> Result<(), CliError> {
     let r = &args.render;
-    if let Some(j) = &r.json {
-        outputs::check(&[Planned {
-            flag: "--json",
-            path: j,
-            extensions: &[],
-        }])?;
-    }
+    // Inputs first, so that a --json naming one of them is refused before any work.
     r.note_inputs();
+    outputs::check_image_and_json(None, r.json.as_deref())?;
     let [x, y] = args.at;
     let (found, secs) = probe_frame(r, Some(&[args.at]))?;
     let p = found[0];
