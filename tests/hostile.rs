@@ -674,9 +674,12 @@ fn cases(dir: &Path) -> Vec<Case> {
     });
     c.extend(second_campaign(dir));
     c.extend(third::cases(dir));
+    c.extend(cut::cases(dir));
     c
 }
 
+#[path = "hostile/cut.rs"]
+mod cut;
 #[path = "hostile/third.rs"]
 mod third;
 

@@ -8,6 +8,7 @@ mod classify;
 mod compact;
 mod continuous;
 mod cull;
+mod cut;
 mod default_plan;
 mod degenerate;
 mod depth;

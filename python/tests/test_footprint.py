@@ -282,6 +282,24 @@ def test_depth_map_and_probe(tmp_path):
         footprint.probe(v, at=(48, 0), **kw)
 
 
+def test_crop_is_the_volume_with_the_rest_missing():
+    """``crop`` (nested pairs or the flag's text) renders the volume whose samples outside the box
+    are NaN, bit for bit; an empty range is refused."""
+    rng = np.random.default_rng(7)
+    v = rng.random((12, 32, 32), dtype=np.float32)
+    kw = dict(size=(48, 48), window=(0.2, 1.0), slicing="object", lod=0)
+    cropped = footprint.render(v, crop=((3, 20), (0, 31), (1, 10)), **kw)
+    masked = np.full_like(v, np.nan)
+    masked[1:11, 0:32, 3:21] = v[1:11, 0:32, 3:21]
+    assert np.array_equal(cropped, footprint.render(masked, **kw))
+    assert np.array_equal(cropped, footprint.render(v, crop="3:20,0:31,1:10", **kw))
+    assert not np.array_equal(cropped, footprint.render(v, **kw))
+    with pytest.raises(ValueError, match="empty"):
+        footprint.render(v, crop=((5, 4), (0, 31), (1, 10)), **kw)
+    with pytest.raises(ValueError, match="reaches past the volume"):
+        footprint.render(v, crop=((0, 32), (0, 31), (1, 10)), **kw)
+
+
 def test_threads_release_the_gil():
     # While one thread renders, the main thread keeps running Python: the longest stretch in
     # which it could not run is a small part of the render (with the GIL held it would be all of

@@ -283,6 +283,11 @@ pub struct RenderArgs {
     /// strided samples (`footprint info` prints it); the built-in scene: the data's range. Data units, f64.
     #[arg(help_heading = "Picture", long, value_parser = parse_list_f64::<2>, allow_hyphen_values = true)]
     pub window: Option<[f64; 2]>,
+    /// Render only the voxels of this box: inclusive voxel-index ranges along i, j, k (e.g.
+    /// 0:127,0:255,40:112). The rest are missing samples, in the picture and in the continuous
+    /// model; the voxels keep their places, the window and the transfer function. See docs/cut.md.
+    #[arg(help_heading = "Picture", long, value_name = "X0:X1,Y0:Y1,Z0:Z1", value_parser = parse_crop)]
+    pub crop: Option<crate::scene::Crop>,
     /// Shading: emission, phong, iso:VALUE (Levoy iso-surface at VALUE, data units), texture.
     #[arg(help_heading = "Picture", long, default_value = "emission")]
     pub shading: String,

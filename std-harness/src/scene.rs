@@ -139,6 +139,65 @@ pub struct Scene {
     pub kernel: KernelModel,
     /// The continuous model every end composites.
     pub absorption: Absorption,
+    /// `--crop`: only the voxels of this box are rendered (the rest are missing samples).
+    pub crop: Option<Crop>,
+}
+
+/// `--crop X0:X1,Y0:Y1,Z0:Z1`: a box of voxel indices, inclusive at both ends, along i, j, k.
+///
+/// The cropped volume is the volume whose samples outside the box are missing (NaN: weight zero,
+/// transparent), so the renderer splats only the box's voxels and the continuous model
+/// (`crate::reference::continuous`) integrates only their kernels; the voxels keep their places
+/// (the frame, the window and the default transfer function are the whole volume's). A kept
+/// voxel next to the cut takes its gradient from its kept neighbours (a missing neighbour stands
+/// in as the voxel's own value). Held in memory as a brick ([`crate::io::brick`]) of the box's
+/// samples alone.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Crop(pub [[usize; 2]; 3]);
+
+impl Crop {
+    /// The box of inclusive ranges `ranges` (i, j, k), each `[first, last]` with first ≤ last
+    /// (an empty range is refused: a crop keeping nothing is a mistake, not a picture).
+    pub fn new(ranges: [[usize; 2]; 3]) -> Result<Crop, String> {
+        for (c, [lo, hi]) in ranges.iter().enumerate() {
+            if lo > hi {
+                return Err(format!(
+                    "{} range {lo}:{hi} is empty (give FIRST:LAST with FIRST <= LAST)",
+                    ["X", "Y", "Z"][c]
+                ));
+            }
+        }
+        Ok(Crop(ranges))
+    }
+
+    /// The box as half-open indices, checked against a volume of `dims` voxels: every range
+    /// must lie inside the volume.
+    pub fn index_box(&self, dims: [usize; 3]) -> Result<crate::io::brick::IndexBox, CliError> {
+        for (c, [lo, hi]) in self.0.iter().enumerate() {
+            if *hi >= dims[c] {
+                return Err(CliError::input(format!(
+                    "--crop: {} range {lo}:{hi} reaches past the volume, whose {} voxels along {} \
+                     are indexed 0:{}",
+                    ["X", "Y", "Z"][c],
+                    dims[c],
+                    ["i", "j", "k"][c],
+                    dims[c].saturating_sub(1)
+                )));
+            }
+        }
+        Ok(crate::io::brick::IndexBox {
+            lo: self.0.map(|r| r[0]),
+            hi: self.0.map(|r| r[1] + 1),
+        })
+    }
+}
+
+impl std::fmt::Display for Crop {
+    /// As `--crop` takes it: `X0:X1,Y0:Y1,Z0:Z1`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let [x, y, z] = self.0;
+        write!(f, "{}:{},{}:{},{}:{}", x[0], x[1], y[0], y[1], z[0], z[1])
+    }
 }
 
 impl Scene {
@@ -162,7 +221,7 @@ impl Default for Scene {
     /// pixels seen from the front (VTK's azimuth, elevation and roll 0), zoom 1, orthographic,
     /// its default transfer function and window, emission shading, black background, linear
     /// 8-bit PNG, the paper's Gaussian (spread 1.6, 2.5 σ) with the robust map and the default
-    /// minimum radius, the opacity model (`tests/door.rs` checks it against the command line's).
+    /// minimum radius, the opacity model, uncropped (`tests/door.rs` checks it against the command line's).
     fn default() -> Scene {
         Scene {
             memory: None,
@@ -197,6 +256,7 @@ impl Default for Scene {
                 table_from_file: false,
             },
             absorption: Absorption::Opacity,
+            crop: None,
         }
     }
 }

@@ -201,6 +201,17 @@ impl Keywords for RenderArgs {
             "eye_distance" => self.eye_distance = Some(f32_checked(key, v, positive)?),
             "tf" => self.tf = Some(text(key, v)?.to_string()),
             "window" => self.window = Some(items::<2, f64>(key, v, f64s)?),
+            "crop" => {
+                self.crop = Some(match v {
+                    Value::Text(t) => super::parse_crop(t).map_err(err)?,
+                    _ => {
+                        let index = |x: &Value| whole(key, x).map(|n| n as usize);
+                        let pair = |x: &Value| items::<2, usize>(key, x, index);
+                        crate::scene::Crop::new(items::<3, [usize; 2]>(key, v, pair)?)
+                            .map_err(err)?
+                    }
+                })
+            }
             "shading" => self.shading = text(key, v)?.to_string(),
             "background" => self.background = parse_background(text(key, v)?).map_err(err)?,
             "gamma" => self.gamma = choice(key, v)?,

@@ -294,3 +294,19 @@ pub fn cull(e: f32) -> Result<Cull, String> {
         ))
     }
 }
+
+/// `--crop X0:X1,Y0:Y1,Z0:Z1`: three inclusive voxel-index ranges, each FIRST <= LAST (checked
+/// against the volume when it is loaded: `Crop::index_box`).
+pub fn parse_crop(s: &str) -> Result<crate::scene::Crop, String> {
+    let bad = || format!("expected X0:X1,Y0:Y1,Z0:Z1, inclusive voxel indices (got '{s}')");
+    let ranges: Vec<[usize; 2]> = s
+        .split(',')
+        .map(|r| {
+            let (lo, hi) = r.split_once(':').ok_or_else(bad)?;
+            let n = |x: &str| x.trim().parse::<usize>().map_err(|e| format!("'{x}': {e}"));
+            Ok([n(lo)?, n(hi)?])
+        })
+        .collect::<Result<_, String>>()?;
+    let ranges: [[usize; 2]; 3] = ranges.try_into().map_err(|_| bad())?;
+    crate::scene::Crop::new(ranges)
+}

@@ -303,6 +303,7 @@ pub fn scene(a: &RenderArgs) -> Result<Scene, CliError> {
         depth: a.depth,
         kernel: kernel_model(&a.footprint)?,
         absorption: a.absorption.into(),
+        crop: a.crop,
     })
 }
 

@@ -492,6 +492,12 @@ fn refuse(inputs: &Scene, plan: &Plan) -> Result<(), CliError> {
             )
         }
     }
+    if let Some(c) = inputs.crop {
+        return no(
+            &format!("--crop {c}"),
+            "the bricks are cut from the whole volume; render the crop with one process",
+        );
+    }
     if inputs.stream.is_some() {
         return no(
             "--stream",

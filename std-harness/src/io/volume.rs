@@ -217,6 +217,23 @@ impl Volume {
         }
     }
 
+    /// The sample at linear index `n` of the whole grid (`dims`, i fastest) as f32: [`Volume::value`]
+    /// for a whole volume; for a brick, its stored sample there, NaN (missing) outside the
+    /// stored box. What a reader indexing the whole grid (the refinement, a probe) calls.
+    #[inline]
+    pub fn value_in_grid(&self, n: usize) -> f32 {
+        let Some(b) = self.brick else {
+            return self.value(n);
+        };
+        let [nx, ny, _] = self.dims;
+        let g = [n % nx, (n / nx) % ny, n / (nx * ny)];
+        if !b.stored.contains(g) {
+            return f32::NAN;
+        }
+        let (sd, l) = (b.stored.dims(), [0, 1, 2].map(|c| g[c] - b.stored.lo[c]));
+        self.value(l[0] + sd[0] * (l[1] + sd[1] * l[2]))
+    }
+
     /// Number of voxels.
     pub fn len(&self) -> usize {
         self.dims.iter().product()

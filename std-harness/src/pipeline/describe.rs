@@ -38,6 +38,12 @@ pub fn describe(p: &Prepared, args: &Scene, plan: &Plan) -> Json {
         .str("shading", &args.shading.to_string())
         .str("tf", &p.tf_name)
         .arr_f64("window", &p.data_window())
+        .arr_usize(
+            "crop",
+            &args
+                .crop
+                .map_or(Vec::new(), |c| c.0.iter().flatten().copied().collect()),
+        )
         .str("sheet_axis", ["i", "j", "k"][f.sheet_axis])
         .str("slicing", plan.slicing())
         .str("classification", plan.classification())

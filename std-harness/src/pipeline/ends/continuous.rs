@@ -249,7 +249,9 @@ pub fn probes(
 ) -> Result<(Vec<Probe>, f64), CliError> {
     let start = Instant::now();
     let (volume, scene) = continuous_scene(p, Reconstruction::Kernel, model, DEFAULT_CAP)?;
-    if p.supersample != 1 || volume.brick.is_some() {
+    // A crop's brick stores only what it owns (no ghost voxel a split render's brick reads).
+    let ghosts = volume.brick.is_some_and(|b| b.stored != b.owned);
+    if p.supersample != 1 || ghosts {
         return Err(CliError::input(
             "depth: the frame must be rendered at its own size from the whole volume",
         ));
@@ -309,7 +311,7 @@ fn trilinear(volume: &crate::io::volume::Volume, g: [f64; 3]) -> f64 {
         }
         if w > 0.0 {
             let n = at[0] + d[0] * (at[1] + d[1] * at[2]);
-            sum += w * volume.values.to_data(volume.value(n));
+            sum += w * volume.values.to_data(volume.value_in_grid(n));
         }
     }
     sum

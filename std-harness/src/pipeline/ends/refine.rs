@@ -98,7 +98,7 @@ pub fn choose(
         shader.shade_with(
             &lighting,
             None,
-            volume.value(n),
+            volume.value_in_grid(n),
             || glam::Vec3::ZERO,
             [0; 3],
             [1; 3],
@@ -410,7 +410,7 @@ fn refined_bands<const N: usize>(
     let f = &p.frame;
     let volume = p.volume().expect("checked");
     let dims = volume.dims;
-    let value = |[i, j, k]: [usize; 3]| volume.value(i + dims[0] * (j + dims[1] * k));
+    let value = |[i, j, k]: [usize; 3]| volume.value_in_grid(i + dims[0] * (j + dims[1] * k));
     on_bands(
         crate::io::try_filled(f.size[0] * f.size[1], [0.0f32; 4], "the image")?,
         f.size,

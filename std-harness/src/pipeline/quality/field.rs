@@ -32,6 +32,12 @@ pub fn prepare_field(args: &Scene, plan: &Plan) -> Result<Prepared, CliError> {
              against --reference/--quality-reference continuous",
         ));
     }
+    if let Some(c) = args.crop {
+        return Err(CliError::input(format!(
+            "--crop {c} indexes the grid rendered, not the field's finer one: measure a crop \
+             against --reference/--quality-reference continuous"
+        )));
+    }
     if args.field_size <= args.scene_size {
         return Err(CliError::input(format!(
             "--field-size {} must be finer than the grid rendered (--scene-size {})",

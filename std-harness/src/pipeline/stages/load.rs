@@ -116,9 +116,19 @@ pub(crate) fn load_voxels(args: &Scene) -> Result<Loaded, CliError> {
         let range = v.brick.is_none().then(|| v.range());
         let (dims, grid) = (v.dims, v.grid_to_world());
         let sample = args.window.is_none().then(|| v.strided_sample());
+        let cropped = match args.crop {
+            Some(c) if v.brick.is_some() => {
+                return Err(CliError::input(format!(
+                    "--crop {c}: this volume is already a brick of a split render (crop the \
+                     volume before splitting it)"
+                )))
+            }
+            Some(c) => Arc::new(crop_volume(v, c)?),
+            None => Arc::clone(v),
+        };
         return Ok(Loaded {
             sample,
-            voxels: Voxels::Memory(Arc::clone(v)),
+            voxels: Voxels::Memory(cropped),
             name: m.name.clone(),
             dims,
             grid,
@@ -139,6 +149,12 @@ pub(crate) fn load_voxels(args: &Scene) -> Result<Loaded, CliError> {
         let (dims, grid, range) = (volume.dims, volume.grid_to_world(), Some(volume.range()));
         let sample =
             (args.window.is_none() && args.volume.is_some()).then(|| volume.strided_sample());
+        // The window and its warnings are the whole volume's (taken above): a crop hides
+        // voxels, it does not reclassify the rest.
+        let volume = match args.crop {
+            Some(c) => crop_volume(&volume, c)?,
+            None => volume,
+        };
         return Ok(Loaded {
             sample,
             voxels: Voxels::Memory(Arc::new(volume)),
@@ -149,6 +165,19 @@ pub(crate) fn load_voxels(args: &Scene) -> Result<Loaded, CliError> {
         });
     };
     load_stream(args, stream, raw)
+}
+
+/// `volume` cropped to `crop` ([`crate::scene::Crop`]): a brick owning and storing the box alone
+/// (no ghost layer: the voxels outside are missing, for gradients too).
+pub(crate) fn crop_volume(volume: &Volume, crop: crate::scene::Crop) -> Result<Volume, CliError> {
+    let b = crop.index_box(volume.dims)?;
+    io::cut::crop(
+        volume,
+        io::brick::BrickPlace {
+            stored: b,
+            owned: b,
+        },
+    )
 }
 
 /// The built-in scene's name in messages and the JSON's `volume`, sampled on an `n`³ grid.
@@ -174,6 +203,13 @@ fn load_stream(
     }
     let name = stream.display().to_string();
     if is_stdin(stream) {
+        if let Some(c) = args.crop {
+            return Err(CliError::input(format!(
+                "--crop {c}: standard input streams through once with these flags (no pilot holds \
+                 it) and a pipe's sheets are not cut; give the file as VOLUME or --stream FILE \
+                 (a file's box is read alone)"
+            )));
+        }
         let o = raw.ok_or_else(|| {
             CliError::input("--stream - (standard input) needs --dims and --type")
         })?;
@@ -215,6 +251,31 @@ fn load_stream(
         layout.values = stream_values(layout.ty, args.window);
         (None, None)
     };
+    if let Some(c) = args.crop {
+        // Only the box's samples are read (positioned reads) and held: the window above is the
+        // whole file's.
+        let b = c.index_box(layout.dims)?;
+        let (samples, _) = io::cut::read_box(&layout, b)?;
+        let volume = Volume {
+            dims: layout.dims,
+            spacing,
+            directions,
+            samples,
+            brick: Some(io::brick::BrickPlace {
+                stored: b,
+                owned: b,
+            }),
+            values: layout.values,
+        };
+        return Ok(Loaded {
+            sample,
+            dims: layout.dims,
+            voxels: Voxels::Memory(Arc::new(volume)),
+            name,
+            grid,
+            range,
+        });
+    }
     Ok(Loaded {
         sample,
         dims: layout.dims,
