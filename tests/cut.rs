@@ -192,6 +192,38 @@ fn a_crop_is_the_same_by_every_door() {
         std::fs::read(out).unwrap()
     };
     assert!(png(&[HEART], "a.png") == png(&["--stream", HEART], "b.png"));
+    // A program's pipe streamed through (nothing to choose: --window given), cropped as it
+    // streams (footprint::source::Cropped), against the file loaded whole and cropped.
+    let raw = std::fs::read(HEART.replace(".nhdr", ".raw")).unwrap();
+    let flags = [
+        "--stream",
+        "-",
+        "--dims",
+        "32,32,12",
+        "--type",
+        "f32",
+        "--spacing",
+        "1,1,4",
+        "--window",
+        "97.8,234",
+        "--crop",
+        "3:20,0:31,1:10",
+        "--slicing",
+        "object",
+        "--lod",
+        "0",
+        "--size",
+        "48x48",
+    ];
+    let mut piped = parse_args(&flags).unwrap();
+    piped.stdin = Some(footprint_harness::io::stream::Pipe::new(
+        std::io::Cursor::new(raw),
+    ));
+    let file = parse_args(&[&[HEART][..], &flags[8..]].concat()).unwrap();
+    let (a, b) = (frame_of(&piped), frame_of(&file));
+    assert!(a == b, "the pipe cropped as it streams is the file cropped");
+    let uncut = [&[HEART][..], &flags[8..10], &flags[12..]].concat();
+    assert!(a != frame(&uncut), "the crop cut nothing");
     let pair = |a: i64, b: i64| Value::List(vec![Value::Int(a), Value::Int(b)]);
     let nested = Value::List(vec![pair(3, 20), pair(0, 31), pair(1, 10)]);
     let by_list: RenderArgs = from_keywords([("crop", &nested)]).unwrap();

@@ -154,3 +154,156 @@ where
     }
     Ok(())
 }
+
+/// A sample that can be missing: the value the renderer treats as absent data (classified
+/// transparent, weight zero in the continuous model, no slope toward it in a neighbour's gradient).
+/// NaN for the float types.
+pub trait MaybeMissing: Sample {
+    /// The missing sample.
+    const MISSING: Self;
+}
+
+impl MaybeMissing for f32 {
+    const MISSING: f32 = f32::NAN;
+}
+
+impl MaybeMissing for f64 {
+    const MISSING: f64 = f64::NAN;
+}
+
+impl MaybeMissing for crate::lod::Coloured {
+    const MISSING: Self = crate::lod::Coloured {
+        value: f32::NAN,
+        colour: None,
+    };
+}
+
+/// A box of voxel indices along i, j, k, inclusive at both ends: `lo[c] ..= hi[c]`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CropBox {
+    /// The first index kept along each axis.
+    pub lo: [usize; 3],
+    /// The last index kept along each axis.
+    pub hi: [usize; 3],
+}
+
+impl CropBox {
+    /// Whether voxel `g` (i, j, k) lies in the box.
+    pub fn contains(&self, g: [usize; 3]) -> bool {
+        (0..3).all(|c| self.lo[c] <= g[c] && g[c] <= self.hi[c])
+    }
+}
+
+/// `source` cropped to `crop`: every sample outside the box is [`MaybeMissing::MISSING`], so the
+/// renderer splats only the box's voxels, in their places, and a voxel next to the cut takes its
+/// gradient from its kept neighbours. Every sheet is still read from the source (a sequential
+/// source must deliver them all; a sheet wholly outside the box is read and discarded), so the
+/// memory stays the driver's three sheets. `dims` are the source's grid (the whole volume's).
+pub struct Cropped<S> {
+    /// The source cropped.
+    pub source: S,
+    /// The voxels kept.
+    pub crop: CropBox,
+    /// The source's grid, voxels along i, j, k.
+    pub dims: [usize; 3],
+}
+
+impl<S: SheetSource> SheetSource for Cropped<S>
+where
+    S::Sample: MaybeMissing,
+{
+    type Sample = S::Sample;
+    type Error = S::Error;
+
+    fn read_sheet(
+        &mut self,
+        axis: usize,
+        index: usize,
+        out: &mut [Self::Sample],
+    ) -> Result<(), Self::Error> {
+        self.source.read_sheet(axis, index, out)?;
+        let missing = <S::Sample as MaybeMissing>::MISSING;
+        let (lo, hi) = (self.crop.lo, self.crop.hi);
+        if index < lo[axis] || index > hi[axis] {
+            out.fill(missing);
+            return Ok(());
+        }
+        let (a, b) = crate::geometry::in_sheet_axes(axis);
+        let na = self.dims[a].max(1);
+        for (v, row) in out.chunks_mut(na).enumerate() {
+            if v < lo[b] || v > hi[b] {
+                row.fill(missing);
+            } else {
+                let (start, end) = (lo[a].min(row.len()), (hi[a] + 1).min(row.len()));
+                row[..start].fill(missing);
+                row[end..].fill(missing);
+            }
+        }
+        Ok(())
+    }
+
+    fn sequential_axis(&self) -> Option<usize> {
+        self.source.sequential_axis()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A source whose sample at (i, j, k) is its linear index, with no error of its own.
+    struct Counting([usize; 3]);
+
+    impl SheetSource for Counting {
+        type Sample = f32;
+        type Error = RenderError;
+        fn read_sheet(
+            &mut self,
+            axis: usize,
+            s: usize,
+            out: &mut [f32],
+        ) -> Result<(), RenderError> {
+            let (a, b) = crate::geometry::in_sheet_axes(axis);
+            let d = self.0;
+            for (n, x) in out.iter_mut().enumerate() {
+                let mut g = [0; 3];
+                (g[axis], g[a], g[b]) = (s, n % d[a], n / d[a]);
+                *x = (g[0] + d[0] * (g[1] + d[1] * g[2])) as f32;
+            }
+            Ok(())
+        }
+    }
+
+    /// Every sheet of every axis, sample by sample against the box: kept inside, NaN outside.
+    #[test]
+    fn a_cropped_source_is_the_source_inside_the_box_and_missing_outside() {
+        let dims = [5, 4, 3];
+        let crop = CropBox {
+            lo: [1, 0, 1],
+            hi: [3, 2, 2],
+        };
+        let mut c = Cropped {
+            source: Counting(dims),
+            crop,
+            dims,
+        };
+        for axis in 0..3 {
+            let (a, b) = crate::geometry::in_sheet_axes(axis);
+            let mut out = [0.0f32; 20];
+            let len = dims[a] * dims[b];
+            for s in 0..dims[axis] {
+                c.read_sheet(axis, s, &mut out[..len]).unwrap();
+                for (n, x) in out[..len].iter().enumerate() {
+                    let mut g = [0; 3];
+                    (g[axis], g[a], g[b]) = (s, n % dims[a], n / dims[a]);
+                    let want = (g[0] + dims[0] * (g[1] + dims[1] * g[2])) as f32;
+                    if crop.contains(g) {
+                        assert_eq!(*x, want, "{g:?} along {axis}");
+                    } else {
+                        assert!(x.is_nan(), "{g:?} along {axis}: {x}");
+                    }
+                }
+            }
+        }
+    }
+}

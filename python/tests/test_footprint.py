@@ -294,6 +294,11 @@ def test_crop_is_the_volume_with_the_rest_missing():
     assert np.array_equal(cropped, footprint.render(masked, **kw))
     assert np.array_equal(cropped, footprint.render(v, crop="3:20,0:31,1:10", **kw))
     assert not np.array_equal(cropped, footprint.render(v, **kw))
+    # A generator streamed through is cropped as it streams: the array's picture.
+    streamed = footprint.render_stream(
+        (v[k] for k in range(v.shape[0])), (32, 32, 12), crop=((3, 20), (0, 31), (1, 10)), **kw
+    )
+    assert np.array_equal(streamed, cropped)
     with pytest.raises(ValueError, match="empty"):
         footprint.render(v, crop=((5, 4), (0, 31), (1, 10)), **kw)
     with pytest.raises(ValueError, match="reaches past the volume"):

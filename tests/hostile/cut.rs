@@ -1,5 +1,5 @@
 //! Crop boxes (issue 77): outside the volume, empty, malformed, past any index, and where a crop
-//! cannot be honoured (bricks, a pipe streamed through, the built-in field's finer grid): each a
+//! cannot be honoured (bricks, the built-in field's finer grid): each a
 //! one-line refusal. A box of one voxel renders that voxel's splat alone.
 
 use super::{args, png, refused, Case, Expect, HEART};
@@ -57,7 +57,7 @@ pub(super) fn cases(dir: &Path) -> Vec<Case> {
         dir,
     ));
     c.push(refused(
-        "--crop of a pipe streamed through",
+        "--crop past a pipe's volume, refused before it is read",
         &[
             "render",
             "--stream",
@@ -67,7 +67,7 @@ pub(super) fn cases(dir: &Path) -> Vec<Case> {
             "--type",
             "u8",
             "--crop",
-            "0:1,0:1,0:1",
+            "0:4,0:1,0:1",
             "--slicing",
             "object",
             "--lod",
@@ -77,7 +77,7 @@ pub(super) fn cases(dir: &Path) -> Vec<Case> {
             "--out",
             "out.png",
         ],
-        "a pipe's sheets are not cut",
+        "reaches past the volume",
         dir,
     ));
     c.push(refused(

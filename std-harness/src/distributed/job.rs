@@ -371,6 +371,7 @@ impl Job {
             big_endian: false,
             pipe: None,
             values: crate::io::volume::ValueMap::IDENTITY,
+            crop: None,
         };
         crate::pipeline::stages::window::default_window(
             &self.name,

@@ -385,6 +385,7 @@ fn run_sheets<P: Precision>(
             big_endian,
             pipe,
             values,
+            ..
         } => {
             let (reader, name): (Box<dyn std::io::Read>, _) = match pipe {
                 Some(pipe) => (
@@ -443,11 +444,24 @@ fn run_sheets<P: Precision>(
         Voxels::Memory(v) if v.is_coloured() => stream(r, s, &mut ColouredMemorySource(v))?,
         Voxels::Memory(v) => stream(r, s, &mut MemorySource(v))?,
         streamed => {
-            let (mut file, mut piped);
+            let (mut file, mut piped, mut cut);
             let src: &mut DynSource<'_> = match streamed {
                 Voxels::File(layout) => {
                     file = FileSource::open(layout.clone())?;
                     &mut file
+                }
+                Voxels::Stdin {
+                    crop: Some(crop),
+                    dims,
+                    ..
+                } => {
+                    piped = pipe.take().expect("made above for standard input");
+                    cut = footprint::source::Cropped {
+                        source: &mut piped as &mut DynSource<'_>,
+                        crop: *crop,
+                        dims: *dims,
+                    };
+                    &mut cut
                 }
                 _ => {
                     piped = pipe.take().expect("made above for standard input");

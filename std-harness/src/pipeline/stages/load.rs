@@ -28,6 +28,9 @@ pub enum Voxels {
         /// How wide samples become values: from the window a pipe must be given
         /// ([`stream_values`]).
         values: ValueMap,
+        /// `--crop`: the samples outside this box arrive and are made missing as they stream
+        /// ([`footprint::source::Cropped`]).
+        crop: Option<footprint::source::CropBox>,
     },
 }
 
@@ -203,13 +206,6 @@ fn load_stream(
     }
     let name = stream.display().to_string();
     if is_stdin(stream) {
-        if let Some(c) = args.crop {
-            return Err(CliError::input(format!(
-                "--crop {c}: standard input streams through once with these flags (no pilot holds \
-                 it) and a pipe's sheets are not cut; give the file as VOLUME or --stream FILE \
-                 (a file's box is read alone)"
-            )));
-        }
         let o = raw.ok_or_else(|| {
             CliError::input("--stream - (standard input) needs --dims and --type")
         })?;
@@ -224,6 +220,16 @@ fn load_stream(
             big_endian: o.big_endian,
             pipe: args.stdin.clone(),
             values: stream_values(o.ty, args.window),
+            crop: match args.crop {
+                Some(c) => {
+                    let b = c.index_box(o.dims)?;
+                    Some(footprint::source::CropBox {
+                        lo: b.lo,
+                        hi: b.hi.map(|h| h - 1),
+                    })
+                }
+                None => None,
+            },
         };
         return Ok(Loaded {
             voxels,
