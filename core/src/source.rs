@@ -171,13 +171,6 @@ impl MaybeMissing for f64 {
     const MISSING: f64 = f64::NAN;
 }
 
-impl MaybeMissing for crate::lod::Coloured {
-    const MISSING: Self = crate::lod::Coloured {
-        value: f32::NAN,
-        colour: None,
-    };
-}
-
 /// A box of voxel indices along i, j, k, inclusive at both ends: `lo[c] ..= hi[c]`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct CropBox {

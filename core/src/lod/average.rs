@@ -30,6 +30,14 @@ impl Sample for Coloured {
     }
 }
 
+/// A level's missing sample: NaN, with no colour (`crate::source::Cropped` crops a level's source).
+impl crate::source::MaybeMissing for Coloured {
+    const MISSING: Self = Coloured {
+        value: f32::NAN,
+        colour: None,
+    };
+}
+
 /// How a 2×2×2 block of samples becomes one.
 pub trait Averaging {
     /// The coarse sample of a block read from sheets along `axis`: `columns[i]` holds the two
