@@ -5,6 +5,7 @@
 mod bad_input;
 mod bricks;
 mod classify;
+mod clip;
 mod compact;
 mod continuous;
 mod cull;

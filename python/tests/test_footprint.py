@@ -304,6 +304,21 @@ def test_crop_is_the_volume_with_the_rest_missing():
     with pytest.raises(ValueError, match="reaches past the volume"):
         footprint.render(v, crop=((0, 32), (0, 31), (1, 10)), **kw)
 
+def test_clip_keywords_are_the_flags_planes():
+    """``clip`` takes one plane or a sequence of planes (or the flag's text) and renders what
+    the command line's ``--clip`` renders; a zero normal is refused."""
+    rng = np.random.default_rng(3)
+    v = rng.random((12, 32, 32), dtype=np.float32)
+    kw = dict(size=(48, 48), window=(0.2, 1.0), lod=0)
+    one = footprint.render(v, clip=(1, 0, 0, 2), **kw)
+    assert np.array_equal(one, footprint.render(v, clip=[(1, 0, 0, 2)], **kw))
+    assert np.array_equal(one, footprint.render(v, clip="1,0,0,2", **kw))
+    assert not np.array_equal(one, footprint.render(v, **kw))
+    two = footprint.render(v, clip=[(1, 0, 0, 2), (0, -1, 0, 3)], **kw)
+    assert not np.array_equal(one, two)
+    with pytest.raises(ValueError, match="normal"):
+        footprint.render(v, clip=(0, 0, 0, 1), **kw)
+
 
 def test_threads_release_the_gil():
     # While one thread renders, the main thread keeps running Python: the longest stretch in

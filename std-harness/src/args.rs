@@ -288,6 +288,11 @@ pub struct RenderArgs {
     /// model; the voxels keep their places, the window and the transfer function. See docs/cut.md.
     #[arg(help_heading = "Picture", long, value_name = "X0:X1,Y0:Y1,Z0:Z1", value_parser = parse_crop)]
     pub crop: Option<crate::scene::Crop>,
+    /// Keep the world points x with NX·x + NY·y + NZ·z ≤ D (world units, the volume's centre at
+    /// the origin); repeatable, every plane kept. Kernels a plane crosses are cut where it
+    /// crosses each ray; renders with image-aligned slabs. See docs/cut.md.
+    #[arg(help_heading = "Picture", long, value_name = "NX,NY,NZ,D", value_parser = parse_clip, allow_hyphen_values = true, action = clap::ArgAction::Append)]
+    pub clip: Vec<crate::scene::ClipPlane>,
     /// Shading: emission, phong, iso:VALUE (Levoy iso-surface at VALUE, data units), texture.
     #[arg(help_heading = "Picture", long, default_value = "emission")]
     pub shading: String,

@@ -141,6 +141,65 @@ pub struct Scene {
     pub absorption: Absorption,
     /// `--crop`: only the voxels of this box are rendered (the rest are missing samples).
     pub crop: Option<Crop>,
+    /// `--clip`: the half-spaces kept (every one of them), world units.
+    pub clip: Vec<ClipPlane>,
+}
+
+/// `--clip NX,NY,NZ,D`: the world points x with n·x ≤ D are kept, in world units with the
+/// volume's centre (the centre of its voxel-centre box) at the origin. The continuous model is
+/// multiplied by the kept region's indicator; a kernel a plane crosses is cut where the plane
+/// crosses each ray (`footprint::render::clip`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ClipPlane {
+    /// n (any length but zero).
+    pub normal: [f64; 3],
+    /// D, world units times |n|.
+    pub offset: f64,
+}
+
+impl ClipPlane {
+    /// The plane n·x ≤ D, refused unless n is finite and not zero and D finite.
+    pub fn new(normal: [f64; 3], offset: f64) -> Result<ClipPlane, String> {
+        if !normal.iter().chain([&offset]).all(|x| x.is_finite()) {
+            return Err(format!("{normal:?}, {offset}: every number must be finite"));
+        }
+        if normal.iter().all(|&x| x == 0.0) {
+            return Err("the normal NX,NY,NZ is zero: it must give a direction".into());
+        }
+        Ok(ClipPlane { normal, offset })
+    }
+
+    /// The plane in `frame`'s grid (voxel index units): (m, e) with m·g ≤ e kept, m = Gᵀn and
+    /// e = D + m·c (G grid to world, c the centre of the frame's voxel-centre box).
+    pub fn in_grid(&self, frame: &footprint::frame::FrameSetup) -> ([f64; 3], f64) {
+        let g = frame
+            .grid_inverse_transpose
+            .as_dmat3()
+            .inverse()
+            .transpose();
+        let m = g.transpose() * glam::DVec3::from_array(self.normal);
+        let c = glam::DVec3::from_array(frame.dims.map(|n| (n as f64 - 1.0) / 2.0));
+        (m.to_array(), self.offset + m.dot(c))
+    }
+
+    /// The plane in `frame`'s screen space (pixels; z the depth along the view): [a, b, c, d]
+    /// with a·x + b·y + c·z ≤ d kept, for `footprint::render::clip::ClipPlanes` (orthographic frames:
+    /// screen = origin + M·g, so (a, b, c) = M⁻ᵀm and d = e + (a, b, c)·origin).
+    pub fn in_screen(&self, frame: &footprint::frame::FrameSetup) -> [f32; 4] {
+        let (m, e) = self.in_grid(frame);
+        let inv_t = frame.grid_to_screen.as_dmat3().inverse().transpose();
+        let n = inv_t * glam::DVec3::from_array(m);
+        let d = e + n.dot(frame.origin.as_dvec3());
+        [n.x as f32, n.y as f32, n.z as f32, d as f32]
+    }
+}
+
+impl std::fmt::Display for ClipPlane {
+    /// As `--clip` takes it: `NX,NY,NZ,D`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let [x, y, z] = self.normal;
+        write!(f, "{x},{y},{z},{}", self.offset)
+    }
 }
 
 /// `--crop X0:X1,Y0:Y1,Z0:Z1`: a box of voxel indices, inclusive at both ends, along i, j, k.
@@ -221,7 +280,7 @@ impl Default for Scene {
     /// pixels seen from the front (VTK's azimuth, elevation and roll 0), zoom 1, orthographic,
     /// its default transfer function and window, emission shading, black background, linear
     /// 8-bit PNG, the paper's Gaussian (spread 1.6, 2.5 σ) with the robust map and the default
-    /// minimum radius, the opacity model, uncropped (`tests/door.rs` checks it against the command line's).
+    /// minimum radius, the opacity model, uncropped and unclipped (`tests/door.rs` checks it against the command line's).
     fn default() -> Scene {
         Scene {
             memory: None,
@@ -257,6 +316,7 @@ impl Default for Scene {
             },
             absorption: Absorption::Opacity,
             crop: None,
+            clip: Vec::new(),
         }
     }
 }

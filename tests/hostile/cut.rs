@@ -86,6 +86,88 @@ pub(super) fn cases(dir: &Path) -> Vec<Case> {
         "indexes the grid rendered",
         dir,
     ));
+    // Clipping planes.
+    let clip = |planes: &[&'static str], more: &[&'static str]| {
+        let mut a = vec!["render", HEART];
+        for p in planes {
+            a.extend_from_slice(&["--clip", p]);
+        }
+        a.extend_from_slice(more);
+        a.extend_from_slice(&out);
+        a
+    };
+    c.push(refused(
+        "--clip with a NaN",
+        &clip(&["nan,0,0,1"], &[]),
+        "is not finite",
+        dir,
+    ));
+    c.push(refused(
+        "--clip with a zero normal",
+        &clip(&["0,0,0,1"], &[]),
+        "the normal NX,NY,NZ is zero",
+        dir,
+    ));
+    c.push(refused(
+        "--clip with three numbers",
+        &clip(&["1,0,0"], &[]),
+        "expected 4 comma-separated numbers",
+        dir,
+    ));
+    c.push(refused(
+        "--clip, nine planes",
+        &clip(&["1,0,0,1"; 9], &[]),
+        "at most 8 clip one frame",
+        dir,
+    ));
+    c.push(refused(
+        "--clip with --slicing object",
+        &clip(&["1,0,0,1"], &["--slicing", "object"]),
+        "--clip does not render with --slicing object",
+        dir,
+    ));
+    c.push(refused(
+        "--clip with --perspective",
+        &clip(&["1,0,0,1"], &["--perspective", "30"]),
+        "--clip does not render with --perspective",
+        dir,
+    ));
+    c.push(refused(
+        "--clip with --bricks",
+        &clip(&["1,0,0,1"], &["--bricks", "2,1,1"]),
+        "--clip does not render in bricks",
+        dir,
+    ));
+    c.push(refused(
+        "--clip, verify against the sheet reference",
+        &["verify", HEART, "--clip", "1,0,0,1"],
+        "measure a clipped frame against its cut model with --reference continuous",
+        dir,
+    ));
+    c.push(
+        Case::new(
+            "--clip keeping nothing: an empty picture",
+            args(&[
+                "render",
+                HEART,
+                "--clip",
+                "1,0,0,-1e6",
+                "--size",
+                "32x32",
+                "--out",
+                "none.png",
+            ]),
+            Expect::Renders,
+            vec![],
+        )
+        .checked(|dir| {
+            let (_, _, px) = png(dir, "none.png")?;
+            match px.iter().all(|p| p[..3] == [0.0; 3]) {
+                true => Ok("none.png: nothing drawn".into()),
+                false => Err("none.png has something on it".into()),
+            }
+        }),
+    );
     // The built-in scene's corner voxel alone: one splat, a small blob in a clear picture.
     c.push(
         Case::new(

@@ -22,6 +22,7 @@
 
 pub mod absorption;
 mod band;
+pub mod clip;
 mod error;
 mod occlusion;
 mod perspective;

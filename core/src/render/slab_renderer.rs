@@ -3,6 +3,7 @@
 //! [`SlabBuffers`], slabs composited in order, optionally culling occluded voxels.
 
 use super::band::{check_band, start_image, SlabQueue};
+use super::clip::{ClipPlanes, ClipSide};
 use super::occlusion::Occlusion;
 use super::precision::{float_opacity_pixel, float_over_row, float_reaches};
 use super::slabs::{centres_within, SlabSetup, SlabVoxel, MAX_RING};
@@ -10,7 +11,7 @@ use super::{RenderError, RenderStats};
 use crate::composite::{over, RowSpan};
 use crate::frame::Order;
 use crate::math;
-use crate::table::SectionTable;
+use crate::table::{SectionRay, SectionTable};
 
 /// The caller-owned buffers of a slab render over a band of `rows` image rows of width `w`, for a
 /// setup whose kernels span at most `ring` = [`SlabSetup::ring`] slabs.
@@ -49,6 +50,7 @@ pub struct SlabRenderer<'a, const R: usize, const T: usize> {
     background: Option<&'a [[f32; 4]]>,
     queue: SlabQueue,
     occlusion: Option<Occlusion<'a, [f32; 4]>>,
+    clip: Option<&'a ClipPlanes>,
     stats: RenderStats,
 }
 
@@ -86,6 +88,7 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
             background,
             queue: SlabQueue::new(setup.count, order),
             occlusion: None,
+            clip: None,
             stats: RenderStats::default(),
         };
         start_image(&mut r.buffers.image[..n], background, order, [0.0; 4]);
@@ -111,6 +114,15 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
         Ok(self)
     }
 
+    /// Clips the frame by `planes` ([`super::clip`]): a voxel whose kernel lies outside one is
+    /// skipped, one that straddles one has each pixel's section cut to the depths the planes keep
+    /// on that pixel's ray, and the rest are splatted as without planes, bit for bit. `planes`
+    /// must be made for this renderer's frame.
+    pub fn with_clip(mut self, planes: &'a ClipPlanes) -> Self {
+        self.clip = (!planes.is_empty()).then_some(planes);
+        self
+    }
+
     /// Counts so far (`sheets` counts slabs composited).
     pub fn stats(&self) -> RenderStats {
         self.stats
@@ -128,6 +140,9 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
         let [cx, cy, cz] = voxel.position;
         let (first, last) = s.slabs_of(cz);
         self.queue.admit(first, last)?;
+        let Some(cut) = straddled(self.clip, voxel.position) else {
+            return Ok(());
+        };
         let rows = s.rows_of(cy);
         let (b0, bn) = self.band;
         let (y0, y1) = (rows.start.max(b0), rows.end.min(b0 + bn));
@@ -151,11 +166,7 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
         let (ka, kb) = (s.kappa * s.shear[0], s.kappa * s.shear[1]);
         let slabs = last - first + 1;
         // Each slab's slot in the ring, so the pixel loop does no modular arithmetic.
-        let mut slots = [0usize; MAX_RING];
-        for (k, slot) in slots.iter_mut().enumerate().take(slabs) {
-            *slot = (first + k) % ring;
-        }
-        let slots = &slots[..slabs];
+        let slots = &ring_slots(first, slabs, ring)[..slabs];
         // Without shear every pixel's chord meets slab boundary k at the same chord position
         // t0 + k·dt: the depth integral there is read once per voxel, not per pixel.
         let mut ends = [0.0f32; MAX_RING + 1];
@@ -196,6 +207,13 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
             for (x, px) in row.chunks_exact_mut(ring).enumerate() {
                 let dx = (x + x0) as f32 + 0.5 - cx;
                 let rho2 = (qxx * dx + 2.0 * qxy * dy) * dx + qyy * dy * dy;
+                if let Some(c) = cut {
+                    let at = ((x + x0) as f32 + 0.5, y as f32 + 0.5, t_row - ka * dx);
+                    let chord = (dt, s.kappa, s.front(first), slots.len());
+                    let add = |k: usize, g: f32| add(px, slots[k], g, &mut touched[k]);
+                    updates += cut_sections(c, self.table.ray(rho2), at, chord, add);
+                    continue;
+                }
                 // Every slab the kernel spans, with no branch per slab (outside the chord
                 // [−c, c] a section is exactly zero and adds nothing).
                 if let Some(ends) = &boundaries {
@@ -293,4 +311,61 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
         }
         self.stats
     }
+}
+
+/// Each of the `slabs` slabs from `first` on, its slot in a ring of `ring` (so the pixel loop
+/// does no modular arithmetic); the entries past `slabs` are 0.
+#[inline]
+fn ring_slots(first: usize, slabs: usize, ring: usize) -> [usize; MAX_RING] {
+    let mut slots = [0usize; MAX_RING];
+    for (k, slot) in slots.iter_mut().enumerate().take(slabs) {
+        *slot = (first + k) % ring;
+    }
+    slots
+}
+
+/// How the clipping planes take the kernel centred at screen point `c`: `None` when it lies
+/// outside one (nothing of it is kept), `Some(None)` when it lies inside every one (or there is
+/// none), `Some(Some(planes))` when one crosses it.
+#[inline]
+fn straddled(clip: Option<&ClipPlanes>, c: [f32; 3]) -> Option<Option<&ClipPlanes>> {
+    match clip.map(|p| (p, p.side(c))) {
+        Some((_, ClipSide::Outside)) => None,
+        Some((p, ClipSide::Straddles)) => Some(Some(p)),
+        _ => Some(None),
+    }
+}
+
+/// The sections of a kernel a clipping plane crosses, on the ray `ray` (`None`: the ray misses
+/// the kernel) through pixel centre (x, y): each slab's share read at its ends clamped to the
+/// depths the planes keep on that ray, [z_lo, z_hi] as chord positions. `at` is (x, y, t_front),
+/// t_front the chord position of the first slab's front on this ray; `chord` is (dt, κ,
+/// front_z, slabs): a slab's chord length, chord units per pixel of depth, the first slab's
+/// front (screen depth) and the slabs the kernel spans. `add(k, section)` takes slab k's
+/// (counted from the first). Returns 1 when the ray met the kernel, else 0 (a pixel update).
+#[inline]
+fn cut_sections<const T: usize>(
+    clip: &ClipPlanes,
+    ray: Option<SectionRay<'_, T>>,
+    (x, y, t_front): (f32, f32, f32),
+    (dt, kappa, front_z, slabs): (f32, f32, f32, usize),
+    mut add: impl FnMut(usize, f32),
+) -> u64 {
+    let Some(ray) = ray else {
+        return 0;
+    };
+    let (z_lo, z_hi) = clip.depths(x, y);
+    if !(z_lo < z_hi) {
+        return 1;
+    }
+    let base = t_front - kappa * front_z;
+    let (t_lo, t_hi) = (base + kappa * z_lo, base + kappa * z_hi);
+    let at = |t: f32| ray.at(t.max(t_lo).min(t_hi));
+    let mut before = at(t_front);
+    for k in 0..slabs {
+        let after = at(t_front + (k + 1) as f32 * dt);
+        add(k, after - before);
+        before = after;
+    }
+    1
 }

@@ -201,6 +201,20 @@ impl Keywords for RenderArgs {
             "eye_distance" => self.eye_distance = Some(f32_checked(key, v, positive)?),
             "tf" => self.tf = Some(text(key, v)?.to_string()),
             "window" => self.window = Some(items::<2, f64>(key, v, f64s)?),
+            "clip" => {
+                // One plane (four numbers) or a sequence of planes.
+                let plane = |x: &Value| {
+                    let [a, b, c, d] = items::<4, f64>(key, x, f64s)?;
+                    crate::scene::ClipPlane::new([a, b, c], d).map_err(err)
+                };
+                self.clip = match v {
+                    Value::Text(t) => vec![super::parse_clip(t).map_err(err)?],
+                    Value::List(l) if l.iter().all(|x| matches!(x, Value::List(_))) => {
+                        l.iter().map(plane).collect::<Result<_, _>>()?
+                    }
+                    _ => vec![plane(v)?],
+                }
+            }
             "crop" => {
                 self.crop = Some(match v {
                     Value::Text(t) => super::parse_crop(t).map_err(err)?,

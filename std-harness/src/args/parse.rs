@@ -310,3 +310,9 @@ pub fn parse_crop(s: &str) -> Result<crate::scene::Crop, String> {
     let ranges: [[usize; 2]; 3] = ranges.try_into().map_err(|_| bad())?;
     crate::scene::Crop::new(ranges)
 }
+
+/// `--clip NX,NY,NZ,D`: keep the world points x with n·x ≤ D (four finite numbers, n not zero).
+pub fn parse_clip(s: &str) -> Result<crate::scene::ClipPlane, String> {
+    let v: [f64; 4] = parse_list_f64::<4>(s)?;
+    crate::scene::ClipPlane::new([v[0], v[1], v[2]], v[3])
+}

@@ -32,12 +32,16 @@ pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
     request_rules(args)?;
     let fa = &args.footprint;
     let precision = Precision::from(args.accum);
+    clip_rules(args)?;
     if args.classification == ClassificationArg::Post {
         return post_plan(args, precision);
     }
     no_post_flags(args)?;
+    // Clipping planes cut kernels between image-aligned slabs: a clipped frame is slabs
+    // (`--slab` thick) unless object slicing is asked for, which `clip_rules` refused.
     let slicing = match args.slicing {
         Some(SlicingArg::Image) => SlicingArg::Image,
+        None | Some(SlicingArg::Auto) if !args.clip.is_empty() => SlicingArg::Image,
         _ => SlicingArg::Object,
     };
     let end = match (fa.method, args.refine, slicing) {
@@ -125,6 +129,41 @@ pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
     };
     check_levels(&scene(args)?, &plan.resolution())?;
     Ok(plan)
+}
+
+/// What `--clip` cannot be drawn with: each kernel is cut between image-aligned slabs
+/// (`footprint::render::clip`), so object slicing, post-classification's slabs, refinement,
+/// the f64 sheet reference and perspective views are refused with the reason.
+fn clip_rules(args: &RenderArgs) -> Result<(), CliError> {
+    if args.clip.is_empty() {
+        return Ok(());
+    }
+    if args.clip.len() > footprint::render::clip::MAX_CLIP_PLANES {
+        return Err(CliError::input(format!(
+            "--clip: {} planes; at most {} clip one frame",
+            args.clip.len(),
+            footprint::render::clip::MAX_CLIP_PLANES
+        )));
+    }
+    let why = if args.slicing == Some(SlicingArg::Object) {
+        Some("--slicing object (a sheet composites each kernel whole; the planes cut kernels between image-aligned slabs: drop it)")
+    } else if args.classification == ClassificationArg::Post {
+        Some("--classification post (its slabs do not cut kernels yet)")
+    } else if args.refine.is_some() {
+        Some("--refine (refinement renders the paper's sheets)")
+    } else if args.footprint.method == MethodArg::Reference {
+        Some("--method reference (the f64 sheet reference does not cut kernels)")
+    } else if args.perspective.is_some() {
+        Some("--perspective (image-aligned slabs are orthographic)")
+    } else if args.accum == AccumArg::Fixed {
+        Some("--accum fixed (there is no fixed-point slab path)")
+    } else {
+        None
+    };
+    match why {
+        Some(w) => Err(CliError::input(format!("--clip does not render with {w}"))),
+        None => Ok(()),
+    }
 }
 
 /// The rules between fields that hold for any request, whether flags or keywords built it: a flag
@@ -304,6 +343,7 @@ pub fn scene(a: &RenderArgs) -> Result<Scene, CliError> {
         kernel: kernel_model(&a.footprint)?,
         absorption: a.absorption.into(),
         crop: a.crop,
+        clip: a.clip.clone(),
     })
 }
 

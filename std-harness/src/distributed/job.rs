@@ -499,6 +499,13 @@ fn refuse(inputs: &Scene, plan: &Plan) -> Result<(), CliError> {
             "the bricks are cut from the whole volume; render the crop with one process",
         );
     }
+    if !inputs.clip.is_empty() {
+        return no(
+            "--clip",
+            "the bricks composite whole slabs of their own; render a clipped frame with one \
+             process",
+        );
+    }
     if inputs.stream.is_some() {
         return no(
             "--stream",

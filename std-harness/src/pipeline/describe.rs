@@ -44,6 +44,17 @@ pub fn describe(p: &Prepared, args: &Scene, plan: &Plan) -> Json {
                 .crop
                 .map_or(Vec::new(), |c| c.0.iter().flatten().copied().collect()),
         )
+        .arr_obj(
+            "clip",
+            p.clip
+                .iter()
+                .map(|c| {
+                    Json::object()
+                        .arr_f64("normal", &c.normal)
+                        .num("offset", c.offset)
+                })
+                .collect(),
+        )
         .str("sheet_axis", ["i", "j", "k"][f.sheet_axis])
         .str("slicing", plan.slicing())
         .str("classification", plan.classification())

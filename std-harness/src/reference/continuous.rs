@@ -125,6 +125,7 @@ fn march(
     let grid = f.grid_inverse_transpose.as_dmat3().inverse().transpose();
     let camera = f.camera().copied();
     let (lo, hi) = field.bounds();
+    let clip = &scene.clip;
     let threads = scene.threads.max(1);
     let count = rays.count(f);
     let mut image = vec![[0.0f64; 4]; count];
@@ -166,18 +167,7 @@ fn march(
                     // In grid coordinates: g(t) = g0 + t·dg.
                     let g0 = inv * (p0 - origin);
                     let dg = inv * d;
-                    let (mut t0, mut t1) = (f64::NEG_INFINITY, f64::INFINITY);
-                    for a in 0..3 {
-                        if dg[a].abs() < 1e-15 {
-                            if g0[a] < lo[a] || g0[a] > hi[a] {
-                                t1 = f64::NEG_INFINITY;
-                            }
-                            continue;
-                        }
-                        let (u, v) = ((lo[a] - g0[a]) / dg[a], (hi[a] - g0[a]) / dg[a]);
-                        t0 = t0.max(u.min(v));
-                        t1 = t1.min(u.max(v));
-                    }
+                    let (mut t0, t1) = ray_interval(g0, dg, (lo, hi), clip);
                     if camera.is_some() {
                         t0 = t0.max(0.0);
                     }
@@ -228,6 +218,41 @@ fn march(
         }
     });
     (image, thirds, crossings)
+}
+
+/// The part [t0, t1] of the ray g0 + t·dg (grid units) inside the box `bounds` (lo, hi) and
+/// every clipping plane's kept half-space m·g ≤ e: one interval, the region being convex; empty
+/// when t1 ≤ t0.
+fn ray_interval(
+    g0: DVec3,
+    dg: DVec3,
+    (lo, hi): (DVec3, DVec3),
+    clip: &[([f64; 3], f64)],
+) -> (f64, f64) {
+    let (mut t0, mut t1) = (f64::NEG_INFINITY, f64::INFINITY);
+    for a in 0..3 {
+        if dg[a].abs() < 1e-15 {
+            if g0[a] < lo[a] || g0[a] > hi[a] {
+                t1 = f64::NEG_INFINITY;
+            }
+            continue;
+        }
+        let (u, v) = ((lo[a] - g0[a]) / dg[a], (hi[a] - g0[a]) / dg[a]);
+        t0 = t0.max(u.min(v));
+        t1 = t1.min(u.max(v));
+    }
+    for (m, e) in clip {
+        let m = DVec3::from_array(*m);
+        let (along, room) = (m.dot(dg), e - m.dot(g0));
+        if along > 0.0 {
+            t1 = t1.min(room / along);
+        } else if along < 0.0 {
+            t0 = t0.max(room / along);
+        } else if room < 0.0 {
+            t1 = f64::NEG_INFINITY;
+        }
+    }
+    (t0, t1)
 }
 
 /// What [`march`] returns: the image, the nested thirds' image (empty unless nested) and the

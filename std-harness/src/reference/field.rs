@@ -63,6 +63,10 @@ pub struct ContinuousScene<'a> {
     /// Worker threads the march spreads its rays over (at least 1; each ray is marched by one
     /// thread alone, so the image is the same for every count).
     pub threads: usize,
+    /// `--clip`: the field is integrated inside every plane's half-space only (one interval of
+    /// each ray: the kept region is convex); each plane in the frame's grid, (m, e) with
+    /// m·g ≤ e kept (`crate::scene::ClipPlane::in_grid`).
+    pub clip: Vec<([f64; 3], f64)>,
 }
 
 /// [`ContinuousScene::cap`] as the renderer takes it: 1 − `SlabVoxel::MAX_UNIT_ALPHA` = 10⁻⁶.

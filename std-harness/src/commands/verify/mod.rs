@@ -115,6 +115,12 @@ fn check(args: &VerifyArgs) -> Result<(), CliError> {
             "verify compares a table method with the reference: choose robust, paper or direct",
         ));
     }
+    if !r.clip.is_empty() && args.reference != ReferenceArg::Continuous {
+        return Err(CliError::input(
+            "--clip: the f64 sheet reference and the field reference do not cut kernels; \
+             measure a clipped frame against its cut model with --reference continuous",
+        ));
+    }
     if r.refine.is_some() && args.reference != ReferenceArg::Field {
         return Err(CliError::input(
             "verify's sheet and continuous references render the grid as given, so they would \

@@ -37,6 +37,7 @@ fn continuous_scene(
         reconstruction,
         model,
         cap,
+        clip: p.clip.iter().map(|c| c.in_grid(&p.frame)).collect(),
         // A reference: every core (at most 16) unless the caller says otherwise.
         threads: std::thread::available_parallelism()
             .map_or(1, |n| n.get())

@@ -70,6 +70,14 @@ pub fn render_frame(
 /// size when supersampled), with no resolution decorator; what [`render_frame`] wraps and a
 /// brick of a split frame draws (`crate::distributed`).
 pub fn end_frame(p: &Prepared, plan: &Plan, cache: &mut FrameCache) -> Result<CoreFrame, CliError> {
+    // Only slabs cut kernels: any other end would draw the clipped region whole (a plan a
+    // chart derives, say), so it is refused, not drawn wrong.
+    if !p.clip.is_empty() && !matches!(plan.end, End::Slabs { .. }) {
+        return Err(CliError::input(
+            "--clip: only image-aligned slabs (--slicing image) cut kernels; this frame's end \
+             composites each kernel whole",
+        ));
+    }
     match plan.end {
         End::Refined { threshold, sheets } => {
             super::refine::render_refined(p, plan, threshold, sheets)

@@ -368,8 +368,10 @@ fn render_band(
         image,
         rows: &mut spans,
     };
+    let clip = p.clip_planes()?;
     let mut renderer =
-        SlabRenderer::with_band(setup, table, p.order, buffers, background, rows.clone())?;
+        SlabRenderer::with_band(setup, table, p.order, buffers, background, rows.clone())?
+            .with_clip(&clip);
     if let Some(eps) = cull {
         renderer = renderer.with_occlusion(&mut occluded, eps)?;
     }

@@ -38,6 +38,12 @@ pub fn prepare_field(args: &Scene, plan: &Plan) -> Result<Prepared, CliError> {
              against --reference/--quality-reference continuous"
         )));
     }
+    if !args.clip.is_empty() {
+        return Err(CliError::input(
+            "--clip: the field reference does not cut kernels; measure a clipped frame against \
+             --reference/--quality-reference continuous",
+        ));
+    }
     if args.field_size <= args.scene_size {
         return Err(CliError::input(format!(
             "--field-size {} must be finer than the grid rendered (--scene-size {})",

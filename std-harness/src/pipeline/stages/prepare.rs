@@ -60,9 +60,19 @@ pub struct Prepared {
     /// The view at the output size (`--view`, `--zoom`, `--view-matrix`): what a subsampled
     /// frame scales.
     pub view: View,
+    /// `--clip`: the half-spaces kept, world units (see [`Prepared::clip_planes`]).
+    pub clip: Vec<crate::scene::ClipPlane>,
 }
 
 impl Prepared {
+    /// The clipping planes in this frame's screen space, with its kernel's reach (empty without
+    /// `--clip`); refused for a perspective frame or more planes than the core takes.
+    pub fn clip_planes(&self) -> Result<footprint::render::clip::ClipPlanes, CliError> {
+        let planes: Vec<[f32; 4]> = self.clip.iter().map(|c| c.in_screen(&self.frame)).collect();
+        footprint::render::clip::ClipPlanes::new(&self.frame, self.kernel.spread(), &planes)
+            .map_err(|e| CliError::input(format!("--clip: {e}")))
+    }
+
     /// The window in the data's own units (as `--window` takes it and the JSON and the legend
     /// report it).
     pub fn data_window(&self) -> [f64; 2] {
@@ -166,6 +176,7 @@ impl Prepared {
             resolution: self.resolution,
             absorption: self.absorption,
             view: self.view,
+            clip: self.clip.clone(),
         })
     }
 
@@ -502,6 +513,7 @@ pub fn prepare_as_asked(args: &Scene, plan: &Plan) -> Result<Prepared, CliError>
         resolution,
         absorption: args.absorption,
         view: view_for(args, dims, &grid)?,
+        clip: args.clip.clone(),
     })
 }
 
