@@ -4,7 +4,7 @@
 use super::BrickLayout;
 use crate::args::Lod;
 use crate::io::brick::{BrickPlace, IndexBox};
-use crate::io::cut::{crop, read_box};
+use crate::io::cut::{crop, read_brick};
 use crate::io::stream::{InMemory, Layout};
 use crate::io::volume::Volume;
 use crate::pipeline::ends::run::end_frame;
@@ -289,21 +289,13 @@ impl Job {
                 layout,
                 spacing,
                 directions,
-            } => {
-                let (samples, bytes) = read_box(layout, place.stored)?;
-                Ok((
-                    Volume {
-                        dims: self.dims,
-                        spacing: *spacing,
-                        directions: *directions,
-                        samples,
-                        brick: Some(place),
-                        // Wide samples get the map all bricks agree on (`agreed_values`).
-                        values: crate::io::volume::ValueMap::IDENTITY,
-                    },
-                    bytes,
-                ))
-            }
+            } => read_brick(
+                layout,
+                place,
+                (*spacing, *directions),
+                // Wide samples get the map all bricks agree on (`agreed_values`).
+                crate::io::volume::ValueMap::IDENTITY,
+            ),
             Source::Whole { volume, bytes } => Ok((crop(volume, place)?, *bytes)),
             Source::Elsewhere(_) => Err(CliError::input(
                 "this rank's brick comes from the rank that loads the volume",

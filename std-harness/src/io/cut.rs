@@ -7,6 +7,27 @@ use super::volume::{decode, Samples, Volume};
 use crate::CliError;
 use std::os::unix::fs::FileExt;
 
+/// The brick `place` of the whole volume whose raw samples `layout` describes, on the grid
+/// `spacing` and `directions`, its values through `values`: only its stored box is read
+/// ([`read_box`]). Returned with the bytes read.
+pub fn read_brick(
+    layout: &Layout,
+    place: BrickPlace,
+    (spacing, directions): ([f32; 3], [[f32; 3]; 3]),
+    values: super::volume::ValueMap,
+) -> Result<(Volume, u64), CliError> {
+    let (samples, bytes) = read_box(layout, place.stored)?;
+    let volume = Volume {
+        dims: layout.dims,
+        spacing,
+        directions,
+        samples,
+        brick: Some(place),
+        values,
+    };
+    Ok((volume, bytes))
+}
+
 /// The samples of box `b` of the raw samples `layout` describes, read with positioned reads (a
 /// row of the box at a time, or whole z-slice runs where the box spans full rows), and the bytes
 /// read.

@@ -230,7 +230,13 @@ impl Volume {
         if !b.stored.contains(g) {
             return f32::NAN;
         }
-        let (sd, l) = (b.stored.dims(), [0, 1, 2].map(|c| g[c] - b.stored.lo[c]));
+        self.stored_value(b.stored, g)
+    }
+
+    /// A brick's sample at whole-grid voxel `g`, which must lie in its stored box `stored`.
+    #[inline]
+    fn stored_value(&self, stored: super::brick::IndexBox, g: [usize; 3]) -> f32 {
+        let (sd, l) = (stored.dims(), [0, 1, 2].map(|c| g[c] - stored.lo[c]));
         self.value(l[0] + sd[0] * (l[1] + sd[1] * l[2]))
     }
 
@@ -274,15 +280,11 @@ impl Volume {
                 .collect(),
             Some(b) => {
                 let [nx, ny, _] = self.dims;
-                let sd = b.stored.dims();
                 (0..n)
                     .step_by(sample_stride(n))
                     .map(|i| [i % nx, (i / nx) % ny, i / (nx * ny)])
                     .filter(|&g| b.owned.contains(g))
-                    .map(|g| {
-                        let l = [0, 1, 2].map(|c| g[c] - b.stored.lo[c]);
-                        self.value(l[0] + sd[0] * (l[1] + sd[1] * l[2]))
-                    })
+                    .map(|g| self.stored_value(b.stored, g))
                     .filter(|x| x.is_finite())
                     .collect()
             }

@@ -261,18 +261,12 @@ fn load_stream(
         // Only the box's samples are read (positioned reads) and held: the window above is the
         // whole file's.
         let b = c.index_box(layout.dims)?;
-        let (samples, _) = io::cut::read_box(&layout, b)?;
-        let volume = Volume {
-            dims: layout.dims,
-            spacing,
-            directions,
-            samples,
-            brick: Some(io::brick::BrickPlace {
-                stored: b,
-                owned: b,
-            }),
-            values: layout.values,
+        let place = io::brick::BrickPlace {
+            stored: b,
+            owned: b,
         };
+        let (volume, _) =
+            io::cut::read_brick(&layout, place, (spacing, directions), layout.values)?;
         return Ok(Loaded {
             sample,
             dims: layout.dims,
