@@ -675,9 +675,12 @@ fn cases(dir: &Path) -> Vec<Case> {
     c.extend(second_campaign(dir));
     c.extend(third::cases(dir));
     c.extend(cut::cases(dir));
+    c.extend(blend::cases(dir));
     c
 }
 
+#[path = "hostile/blend.rs"]
+mod blend;
 #[path = "hostile/cut.rs"]
 mod cut;
 #[path = "hostile/third.rs"]

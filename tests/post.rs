@@ -79,6 +79,10 @@ impl Classify for Ramp {
         self.layer_f64(f64::from(value), gradient.as_dvec3(), f64::from(fraction))
             .map(|c| c as f32)
     }
+    fn projection(&self, value: f32) -> [f32; 4] {
+        let a = ((value - 0.25) * 1.2).clamp(0.0, 1.0);
+        [value * a, 0.5 * a, 0.3 * a, a]
+    }
 }
 
 fn ramp(setup: &PostSetup, expect: Option<f32>) -> Ramp {

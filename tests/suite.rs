@@ -3,6 +3,7 @@
 //! disk. Each file beside this one is a module; run one with `cargo test --test suite MODULE::`.
 //! `hostile.rs` stays its own executable: it runs its cases as child processes under limits.
 mod bad_input;
+mod blend;
 mod bricks;
 mod classify;
 mod clip;

@@ -31,6 +31,7 @@ view-+y.png|render $data/headsq_64x64x93_int16_le.nhdr --tf ct-bone-skin --shadi
 view--y.png|render $data/headsq_64x64x93_int16_le.nhdr --tf ct-bone-skin --shading phong --size 160x160 --view -y
 view-+z.png|render $data/headsq_64x64x93_int16_le.nhdr --tf ct-bone-skin --shading phong --size 160x160 --view +z
 view--z.png|render $data/headsq_64x64x93_int16_le.nhdr --tf ct-bone-skin --shading phong --size 160x160 --view -z
+headsq-mip.png|render $data/headsq_64x64x93_int16_le.nhdr --view 180,-90,0 -s 256x256 --blend mip
 headsq-crop.png|render $data/headsq_64x64x93_int16_le.nhdr --tf ct-bone-skin --shading phong --view 150,-70,0 --size 256x256 --crop 0:63,0:63,0:60
 headsq-crop-clip.png|render $data/headsq_64x64x93_int16_le.nhdr --tf ct-bone-skin --shading phong --view 150,-70,0 --size 256x256 --crop 0:63,0:63,0:60 --clip 0,1,0,0
 paraview-preset.png|render $data/headsq_64x64x93_int16_le.nhdr --tf docs/presets/ct-warm.json --shading phong --view 180,-90,0 --size 256x256

@@ -320,6 +320,21 @@ def test_clip_keywords_are_the_flags_planes():
         footprint.render(v, clip=(0, 0, 0, 1), **kw)
 
 
+def test_blend_projects_the_values():
+    """``blend`` projects the reconstructed values along each ray: under a rising grey ramp the
+    maximum is at least the average at every pixel, and the average at least the minimum; an
+    unknown blend is refused."""
+    rng = np.random.default_rng(5)
+    v = rng.random((12, 32, 32), dtype=np.float32)
+    kw = dict(size=(48, 48), window=(0.0, 1.0), tf="grey")
+    mip, avg, minip = (footprint.render(v, blend=b, **kw) for b in ("mip", "average", "minip"))
+    assert not np.array_equal(mip, avg)
+    assert (mip[..., 3] >= avg[..., 3] - 1e-6).all()
+    assert (avg[..., 3] >= minip[..., 3] - 1e-6).all()
+    with pytest.raises(ValueError, match="sum"):
+        footprint.render(v, blend="sum", **kw)
+
+
 def test_threads_release_the_gil():
     # While one thread renders, the main thread keeps running Python: the longest stretch in
     # which it could not run is a small part of the render (with the GIL held it would be all of

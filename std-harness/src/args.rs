@@ -382,6 +382,11 @@ pub struct RenderArgs {
     /// memory) and renders slabs of --slab-post spacings.
     #[arg(help_heading = "Method", long, value_enum, default_value_t = ClassificationArg::Pre)]
     pub classification: ClassificationArg,
+    /// `composite` (the emission-absorption integral), or project the reconstructed value along
+    /// each ray and classify the projection: `mip` (maximum), `minip` (minimum), `average`.
+    /// Projections render post-classified slabs (docs/blend.md has the model).
+    #[arg(help_heading = "Method", long, value_enum, default_value_t = BlendArg::Composite)]
+    pub blend: BlendArg,
     /// With --classification post: slab thickness along the view ray, in voxel spacings (the
     /// smallest of the grid's three spacings): the step of the post-classified integral.
     /// [default: 0.7 for emission, 0.4 for lit shading (docs/post-classification.md)]

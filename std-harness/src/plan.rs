@@ -114,6 +114,8 @@ pub enum End {
         thickness: f32,
         /// The values' subsampling (`--value-subsample`).
         values: Supersample,
+        /// Composited, or projected (`--blend`).
+        blend: footprint::render::Blend,
     },
     /// Sheets on a grid refined wherever samples differ by more than `threshold` (float, robust
     /// method, orthographic, volume in memory); `sheets` also refines across sheets.

@@ -41,7 +41,7 @@ pub use error::RenderError;
 pub use occlusion::{occlusion_len, OcclusionError, OCCLUSION_TILE};
 pub use perspective::PerVoxel;
 pub use post::{
-    Classify, PostBuffers, PostRenderer, PostSample, PostSetup, PostVoxel, ShadedLayers,
+    Blend, Classify, PostBuffers, PostRenderer, PostSample, PostSetup, PostVoxel, ShadedLayers,
     WeightTable,
 };
 pub use precision::{CompactPath, FixedPath, FloatPath, Precision, VoxelSplat};

@@ -278,6 +278,7 @@ impl RenderArgs {
             "slab" => self.slab = f32_checked(key, v, positive)?,
             "absorption" => self.absorption = choice(key, v)?,
             "classification" => self.classification = choice(key, v)?,
+            "blend" => self.blend = choice(key, v)?,
             "slab_post" => self.slab_post = Some(f32_checked(key, v, positive)?),
             "value_subsample" => self.value_subsample = supersample(v)?,
             "phases" => self.phases = whole(key, v)? as usize,

@@ -48,6 +48,28 @@ impl ClassificationArg {
     }
 }
 
+/// `--blend`: how a ray's samples become a pixel (`footprint::render::post`'s `blend`).
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum BlendArg {
+    #[default]
+    Composite,
+    Mip,
+    Minip,
+    Average,
+}
+
+impl From<BlendArg> for footprint::render::Blend {
+    fn from(b: BlendArg) -> Self {
+        use footprint::render::Blend;
+        match b {
+            BlendArg::Composite => Blend::Composite,
+            BlendArg::Mip => Blend::Maximum,
+            BlendArg::Minip => Blend::Minimum,
+            BlendArg::Average => Blend::Average,
+        }
+    }
+}
+
 /// `--absorption`: the continuous model both slicings render and the continuous reference
 /// integrates (`footprint::render::absorption`).
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]

@@ -6,7 +6,7 @@
 //! flag's clap type: the pipeline reads the typed values only (`tests/layering.rs`).
 
 use super::{
-    AccumArg, ClassificationArg, FootprintArgs, Lod, LookupArg, MethodArg, OrderArg,
+    AccumArg, BlendArg, ClassificationArg, FootprintArgs, Lod, LookupArg, MethodArg, OrderArg,
     QualityReferenceArg, RenderArgs, SlicingArg, SplatArgs, Supersample,
 };
 use crate::pipeline::ends::single::{compose_view, Single};
@@ -33,7 +33,7 @@ pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
     let fa = &args.footprint;
     let precision = Precision::from(args.accum);
     clip_rules(args)?;
-    if args.classification == ClassificationArg::Post {
+    if args.classification == ClassificationArg::Post || args.blend != BlendArg::Composite {
         return post_plan(args, precision);
     }
     no_post_flags(args)?;

@@ -47,6 +47,12 @@ pub struct ChartArgs {
 }
 
 pub fn run(args: &ChartArgs) -> Result<(), CliError> {
+    if args.render.blend != crate::args::BlendArg::Composite {
+        return Err(CliError::input(
+            "chart --blend: the charts sweep composited configurations against composited \
+             models; measure a projection with verify --blend ... --reference continuous",
+        ));
+    }
     if args.model_only {
         let r = crate::charts::open(&args.render)?;
         let p = r.prepared();

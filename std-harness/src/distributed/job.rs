@@ -468,9 +468,13 @@ fn refuse(inputs: &Scene, plan: &Plan) -> Result<(), CliError> {
     };
     match plan.end {
         End::Sheets(_) | End::Slabs { .. } => {}
-        End::Post { .. } => {
+        End::Post { blend, .. } => {
             return no(
-                "--classification post",
+                if blend.projects() {
+                    "--blend"
+                } else {
+                    "--classification post"
+                },
                 "its values are reconstructed across voxels before they are classified, so a \
                  brick's pixels need its neighbours' values, not their colours",
             )

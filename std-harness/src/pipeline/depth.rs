@@ -27,6 +27,13 @@ pub fn probes(
     pixels: Option<&[[usize; 2]]>,
 ) -> Result<(Vec<Probe>, f64), CliError> {
     let model = match asked.end {
+        End::Post { blend, .. } if blend.projects() => {
+            return Err(CliError::input(format!(
+                "--blend {}: a projection has no depth (no opacity accumulates along a ray): \
+                 probe and --depth-map measure composited frames",
+                blend.name()
+            )))
+        }
         End::Post { .. } => Model::Post,
         _ => Model::Pre(scene.absorption),
     };

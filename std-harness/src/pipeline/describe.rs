@@ -68,10 +68,10 @@ pub fn describe(p: &Prepared, args: &Scene, plan: &Plan) -> Json {
         .num(
             "value_subsample",
             match plan.end {
-                End::Post { thickness, values } => {
-                    crate::pipeline::ends::post::value_scale(p, thickness, values)
-                        .map_or(f64::NAN, |s| s as f64)
-                }
+                End::Post {
+                    thickness, values, ..
+                } => crate::pipeline::ends::post::value_scale(p, thickness, values)
+                    .map_or(f64::NAN, |s| s as f64),
                 _ => f64::NAN,
             },
         )
@@ -114,7 +114,7 @@ pub fn describe(p: &Prepared, args: &Scene, plan: &Plan) -> Json {
 
 /// What drew the frame, resolved (defaults and `auto`s decided): `end` (`sheets`, `slabs`,
 /// `post`, `refined` or `reference`), `precision`, `slab` (voxel spacings; null but for slabs),
-/// `subsample` and `supersample` (factors), `lod` (level), `cull` (ε; null when off), `order`,
+/// `blend` (`composite`, `mip`, `minip`, `average`), `subsample` and `supersample` (factors), `lod` (level), `cull` (ε; null when off), `order`,
 /// `phase_lookup` (`blend` or `nearest`: how sheets, float or fixed, read the phase stencils).
 pub fn plan_json(p: &Prepared, plan: &Plan) -> Json {
     let (end, slab) = match plan.end {
@@ -134,6 +134,13 @@ pub fn plan_json(p: &Prepared, plan: &Plan) -> Json {
             },
         )
         .num("slab", slab)
+        .str(
+            "blend",
+            match plan.end {
+                End::Post { blend, .. } => blend.name(),
+                _ => "composite",
+            },
+        )
         .num("subsample", p.subsample_factor(plan).unwrap_or(1) as f64)
         .num("supersample", p.supersample as f64)
         .num("lod", f64::from(p.level))

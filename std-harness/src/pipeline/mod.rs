@@ -49,7 +49,7 @@ pub mod stages;
 
 pub use describe::describe;
 pub use door::{render, Renderer};
-pub use ends::continuous::render_continuous_ref;
+pub use ends::continuous::{render_continuous_as, render_continuous_ref};
 pub use ends::run::{render_core, render_frame, render_ref, CoreFrame};
 pub use entry::prepare;
 pub use stages::prepare::Prepared;

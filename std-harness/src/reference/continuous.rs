@@ -54,6 +54,7 @@
 
 use super::field::Field;
 pub use super::field::{Absorption, ContinuousScene, Model, Reconstruction, DEFAULT_CAP};
+use super::projection::pixel;
 use crate::CliError;
 use footprint::frame::FrameSetup;
 use glam::{DMat3, DVec3};
@@ -174,6 +175,19 @@ fn march(
                     let mut coarse = Ray::default();
                     let mut fine = Ray::default();
                     let per_t = (grid * dg).length();
+                    let bg = scene
+                        .background
+                        .map_or([0.0; 4], |b| b[y * w + x].map(f64::from));
+                    if let Some(blend) = field.projection() {
+                        let ray = ((g0, dg), (t0, t1), per_t);
+                        let mut pixel =
+                            |h| pixel(field, &scene.shader, blend, ray, h, &mut taps, bg);
+                        *px = pixel(h);
+                        if let Some(f) = fine_chunk.as_deref_mut() {
+                            f[i] = pixel(h / 3.0);
+                        }
+                        continue;
+                    }
                     if t1 > t0 {
                         let world = (t1 - t0) * per_t;
                         let steps = ((world / h).ceil() as usize).max(1);
@@ -203,9 +217,6 @@ fn march(
                             }
                         }
                     }
-                    let bg = scene
-                        .background
-                        .map_or([0.0; 4], |b| b[y * w + x].map(f64::from));
                     *px = coarse.over(bg);
                     if let Some(f) = fine_chunk.as_deref_mut() {
                         f[i] = fine.over(bg);

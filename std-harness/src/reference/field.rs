@@ -19,7 +19,7 @@
 use super::sparse::SparseGrid;
 use crate::CliError;
 use footprint::frame::FrameSetup;
-use footprint::render::{gradient, ShadeCache, ShadeCacheEntry, SheetRing, SHADE_CACHE_LEN};
+use footprint::render::{gradient, Blend, ShadeCache, ShadeCacheEntry, SheetRing, SHADE_CACHE_LEN};
 use footprint::shade::{Lighting, Shader};
 use footprint::Kernel;
 use glam::{DVec3, Vec3};
@@ -67,6 +67,9 @@ pub struct ContinuousScene<'a> {
     /// each ray: the kept region is convex); each plane in the frame's grid, (m, e) with
     /// m·g ≤ e kept (`crate::scene::ClipPlane::in_grid`).
     pub clip: Vec<([f64; 3], f64)>,
+    /// Post-classified and projected: samples exist among voxels `first..=last` per axis (a
+    /// crop; `footprint::render::post::sample_box_of`), or the whole grid's (`None`).
+    pub samples: Option<([usize; 3], [usize; 3])>,
 }
 
 /// [`ContinuousScene::cap`] as the renderer takes it: 1 − `SlabVoxel::MAX_UNIT_ALPHA` = 10⁻⁶.
@@ -82,6 +85,9 @@ pub enum Model {
     Pre(Absorption),
     /// Values and gradients reconstructed, then classified per sample.
     Post,
+    /// Values reconstructed as for [`Model::Post`], projected along each ray and the projection
+    /// classified (`footprint::render::post::Blend`, never `Composite`; `super::projection`).
+    Projection(Blend),
 }
 
 impl Model {
@@ -90,6 +96,7 @@ impl Model {
         match self {
             Model::Pre(a) => a.name(),
             Model::Post => "post-classified",
+            Model::Projection(b) => b.name(),
         }
     }
 }
@@ -119,6 +126,8 @@ pub(super) struct Field<'s> {
     /// The kernel's (R, k = sigmas² / (2R²), exp(−2k), 1 / (R³ ∫h)): its factor at offset d
     /// is exp(−k·d²).
     kernel: Option<(f64, f64, f64, f64)>,
+    /// Post-classified and projected: the box samples exist in, grid coordinates.
+    sample_box: ([f32; 3], [f32; 3]),
 }
 
 impl<'s> Field<'s> {
@@ -152,6 +161,7 @@ impl<'s> Field<'s> {
         let seen = |v: &[f32; 4]| match scene.model {
             Model::Pre(_) => v[0] > 0.0,
             Model::Post => !(v[0] <= clear),
+            Model::Projection(_) => v[0].is_finite(),
         };
         // The blocks holding a voxel that can be seen (dilated below by the reconstruction's
         // reach into the blocks it can be seen from).
@@ -196,6 +206,7 @@ impl<'s> Field<'s> {
                             let g = gradient(f, &window, u, v);
                             Some([value, g.x, g.y, g.z])
                         }
+                        Model::Projection(_) => Some([value, 0.0, 0.0, 0.0]),
                     };
                     if let Some(v) = stored {
                         voxels.set(idx, v);
@@ -233,6 +244,10 @@ impl<'s> Field<'s> {
             blocks,
             reach,
             kernel,
+            sample_box: match scene.samples {
+                Some((first, last)) => footprint::render::post::sample_box_of(first, last),
+                None => footprint::render::post::sample_box(dims),
+            },
         })
     }
 
@@ -247,8 +262,8 @@ impl<'s> Field<'s> {
                 DVec3::splat(-self.reach),
                 DVec3::from_array(self.dims.map(|d| (d - 1) as f64 + self.reach)),
             ),
-            Model::Post => {
-                let (lo, hi) = footprint::render::post::sample_box(self.dims);
+            Model::Post | Model::Projection(_) => {
+                let (lo, hi) = self.sample_box;
                 (
                     DVec3::from_array(lo.map(f64::from)),
                     DVec3::from_array(hi.map(f64::from)),
@@ -261,8 +276,44 @@ impl<'s> Field<'s> {
     pub(super) fn absorption(&self) -> Absorption {
         match self.model {
             Model::Pre(a) => a,
-            Model::Post => Absorption::Opacity,
+            Model::Post | Model::Projection(_) => Absorption::Opacity,
         }
+    }
+
+    /// The projection this field's rays take, if it is one ([`Model::Projection`]).
+    pub(super) fn projection(&self) -> Option<Blend> {
+        match self.model {
+            Model::Projection(b) => Some(b),
+            _ => None,
+        }
+    }
+
+    /// Whether the block of grid point `g` can hold a non-zero field (its neighbourhood holds a
+    /// voxel that can be seen).
+    #[inline]
+    fn active_at(&self, g: DVec3) -> bool {
+        let b = [g.x, g.y, g.z].map(|c| (c.max(0.0) as usize) / BLOCK);
+        let bi = (b[2].min(self.blocks[2] - 1) * self.blocks[1] + b[1].min(self.blocks[1] - 1))
+            * self.blocks[0]
+            + b[0].min(self.blocks[0] - 1);
+        self.active[bi]
+    }
+
+    /// The normalised reconstruction of the values at grid point `g`: Σw·f / Σw over the finite
+    /// samples, a convex combination of them; `None` where no finite sample has a weight.
+    #[inline]
+    pub(super) fn value_at(&self, g: DVec3, taps: &mut Taps) -> Option<f64> {
+        if !self.active_at(g) {
+            return None;
+        }
+        let (mut total, mut sum) = (0.0f64, 0.0f64);
+        self.weights(g, taps, |v, w| {
+            if v[0].is_finite() {
+                total += w;
+                sum += w * f64::from(v[0]);
+            }
+        });
+        (total > 0.0).then(|| sum / total)
     }
 
     /// Scratch for [`Field::at`]'s per-axis kernel factors, sized for this field's kernel (one
@@ -281,11 +332,7 @@ impl<'s> Field<'s> {
     /// `g` (continuous index coordinates).
     #[inline]
     pub(super) fn at(&self, g: DVec3, taps: &mut Taps) -> [f64; 4] {
-        let b = [g.x, g.y, g.z].map(|c| (c.max(0.0) as usize) / BLOCK);
-        let bi = (b[2].min(self.blocks[2] - 1) * self.blocks[1] + b[1].min(self.blocks[1] - 1))
-            * self.blocks[0]
-            + b[0].min(self.blocks[0] - 1);
-        if !self.active[bi] {
+        if !self.active_at(g) {
             return [0.0; 4];
         }
         let mut out = [0.0f64; 4];

@@ -16,6 +16,7 @@
 pub mod continuous;
 pub mod field;
 pub mod perspective;
+mod projection;
 pub mod render;
 mod sparse;
 

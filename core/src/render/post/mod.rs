@@ -60,11 +60,14 @@ use crate::frame::Order;
 use crate::math;
 use glam::Vec3;
 
+mod blend;
 mod setup;
 
+pub use blend::{vertex, Blend};
 use setup::{cell_of, pixels_of_cell};
 pub use setup::{
-    sample_box, Classify, PostSetup, ShadedLayers, WeightTable, MAX_VALUE_SCALE, WEIGHT_NODES,
+    sample_box, sample_box_of, Classify, PostSetup, ShadedLayers, WeightTable, MAX_VALUE_SCALE,
+    WEIGHT_NODES,
 };
 
 /// One voxel to splat: where it lands, its value and its world gradient.
@@ -124,6 +127,7 @@ pub struct PostRenderer<'a, C: Classify, const N: usize> {
     buffers: PostBuffers<'a>,
     background: Option<&'a [[f32; 4]]>,
     queue: SlabQueue,
+    blend: Blend,
     stats: RenderStats,
 }
 
@@ -165,11 +169,26 @@ impl<'a, C: Classify, const N: usize> PostRenderer<'a, C, N> {
             buffers,
             background,
             queue: SlabQueue::new(setup.full.count, order),
+            blend: Blend::Composite,
             stats: RenderStats::default(),
         };
         start_image(&mut r.buffers.image[..n], background, order, [0.0; 4]);
         r.buffers.rows[..ring * vr.len()].fill(RowSpan::EMPTY);
         Ok(r)
+    }
+
+    /// Projects the samples instead of compositing them ([`Blend`]): each image pixel then holds
+    /// its projection so far while the frame renders, and [`PostRenderer::finish`] classifies
+    /// the projected value ([`Classify::projection`]) and puts it over the background, whichever
+    /// the order. Every sample is folded (no value is transparent to a projection, no pixel
+    /// opaque), so give the renderer every finite voxel. Call before the first splat.
+    pub fn with_blend(mut self, blend: Blend) -> Self {
+        self.blend = blend;
+        if blend.projects() {
+            let n = self.setup.full.size[0] * self.band.1;
+            self.buffers.image[..n].fill(blend.start());
+        }
+        self
     }
 
     /// Counts so far (`sheets` counts slabs composited; `pixel_updates` the (value pixel, slab)
@@ -240,7 +259,8 @@ impl<'a, C: Classify, const N: usize> PostRenderer<'a, C, N> {
         let t0 = s.kappa * (s.front(run.first) + 0.5 * s.thickness - cz);
         let (ka, kb) = (s.kappa * s.shear[0], s.kappa * s.shear[1]);
         let a2 = qxx + ka * ka;
-        let opaque_skip = self.setup.scale == 1 && self.order == Order::FrontToBack;
+        let opaque_skip =
+            self.setup.scale == 1 && self.order == Order::FrontToBack && !self.blend.projects();
         let mut updates = 0u64;
         for k in 0..run.slabs.min(ring) {
             let slot = (run.first + k) % ring;
@@ -297,8 +317,8 @@ impl<'a, C: Classify, const N: usize> PostRenderer<'a, C, N> {
         let (w, vw) = (self.setup.full.size[0], self.setup.low.size[0]);
         let (ring, (b0, bn), (v0, vn)) = (self.ring, self.band, self.values);
         let slot = slab % ring;
-        let order = self.order;
-        let clear = self.classify.transparent_at_or_below();
+        let (order, blend) = (self.order, self.blend);
+        let clear = blend.transparent_bound(self.classify.transparent_at_or_below());
         let channels = if self.gradients { 5 } else { 2 };
         let spans = &self.buffers.rows[slot * vn..(slot + 1) * vn];
         let acc = &*self.buffers.accumulators;
@@ -319,13 +339,13 @@ impl<'a, C: Classify, const N: usize> PostRenderer<'a, C, N> {
         };
         let transparent = |c: &PostSample| !(c[0] > 0.0) || c[1] <= clear * c[0];
         let (setup, classify) = (self.setup, self.classify);
-        // One pixel's sums `a` classified and composited (nothing where it is transparent or
-        // outside the voxel box).
+        // One pixel's sums `a` classified and composited, or folded into its projection (nothing
+        // where it is transparent or outside the voxel box).
         let shade = |pixel: &mut [f32; 4], a: &PostSample, x: usize, y: usize| {
             if transparent(a) {
                 return;
             }
-            if order == Order::FrontToBack && pixel[3] >= 1.0 {
+            if order == Order::FrontToBack && pixel[3] >= 1.0 && !blend.projects() {
                 return;
             }
             let (fraction, index) = setup.inside(x, y, slab);
@@ -333,6 +353,10 @@ impl<'a, C: Classify, const N: usize> PostRenderer<'a, C, N> {
                 return;
             }
             let inv = 1.0 / a[0];
+            if blend.projects() {
+                blend.fold(pixel, a[1] * inv, fraction);
+                return;
+            }
             let gradient = Vec3::new(a[2] * inv, a[3] * inv, a[4] * inv);
             let layer = classify.layer(a[1] * inv, gradient, index, fraction);
             if layer[3] > 0.0 {
@@ -406,14 +430,26 @@ impl<'a, C: Classify, const N: usize> PostRenderer<'a, C, N> {
     }
 
     /// Ends the frame: composites the slabs not yet composited, then (front to back) the
-    /// background under the result; returns the counts.
+    /// background under the result; returns the counts. A projection ([`Self::with_blend`])
+    /// classifies each pixel's projected value and puts it over the background, either order.
     pub fn finish(mut self) -> RenderStats {
         while self.next_slab().is_some() {
             self.composite_next();
         }
-        if let (Order::FrontToBack, Some(bg)) = (self.order, self.background) {
-            let n = self.setup.full.size[0] * self.band.1;
-            float_over_row(&mut self.buffers.image[..n], &bg[..n]);
+        let n = self.setup.full.size[0] * self.band.1;
+        let image = &mut self.buffers.image[..n];
+        if self.blend.projects() {
+            for p in image.iter_mut() {
+                *p = match self.blend.projected(*p) {
+                    Some(v) => self.classify.projection(v),
+                    None => [0.0; 4],
+                };
+            }
+            if let Some(bg) = self.background {
+                float_over_row(image, &bg[..n]);
+            }
+        } else if let (Order::FrontToBack, Some(bg)) = (self.order, self.background) {
+            float_over_row(image, &bg[..n]);
         }
         self.stats
     }

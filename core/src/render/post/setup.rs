@@ -65,6 +65,9 @@ pub trait Classify {
     /// over `fraction` ∈ (0, 1] of the slab's chord (one except where the ray enters or leaves
     /// the voxel box inside the slab); `index` is the grid voxel nearest the sample.
     fn layer(&self, value: f32, gradient: Vec3, index: [usize; 3], fraction: f32) -> [f32; 4];
+    /// The premultiplied RGBA of a pixel whose ray projects to `value` (a [`super::Blend`] other
+    /// than compositing): one classification for the whole ray, unshaded.
+    fn projection(&self, value: f32) -> [f32; 4];
 }
 
 /// The renderer's classifier: a [`Shader`] at opacity per world unit, held over the slab's chord
@@ -126,6 +129,14 @@ impl Classify for ShadedLayers<'_> {
         self.shader
             .shade_with(&lighting, table, value, || gradient, index, self.dims)
     }
+
+    /// The transfer function's colour and opacity at `value` (its opacity as the pixel's,
+    /// as VTK's projections take it), premultiplied.
+    fn projection(&self, value: f32) -> [f32; 4] {
+        let [r, g, b, a] = self.shader.tf.lookup(value);
+        let a = a.clamp(0.0, 1.0);
+        [r * a, g * a, b * a, a]
+    }
 }
 
 /// One orthographic frame's post-classified slabs: [`SlabSetup`]'s geometry at the image's size
@@ -153,11 +164,20 @@ pub struct PostSetup {
 /// deep, as deep as two voxels' extent (and as much as a pre-classified voxel's footprint
 /// integrates). The continuous reference uses the same box.
 pub fn sample_box(dims: [usize; 3]) -> ([f32; 3], [f32; 3]) {
-    let thin = |d: usize| d <= 1;
-    (
-        dims.map(|d| if thin(d) { -0.5 } else { 0.0 }),
-        dims.map(|d| if thin(d) { 0.5 } else { (d - 1) as f32 }),
-    )
+    sample_box_of([0; 3], dims.map(|d| d.saturating_sub(1)))
+}
+
+/// [`sample_box`] of the voxels `first..=last` along each axis (a crop of the grid, whole-grid
+/// indices): [first, last], or the voxel's own cell [first − ½, first + ½] along an axis one
+/// voxel thick.
+pub fn sample_box_of(first: [usize; 3], last: [usize; 3]) -> ([f32; 3], [f32; 3]) {
+    let mut lo = [0.0f32; 3];
+    let mut hi = [0.0f32; 3];
+    for a in 0..3 {
+        let (f, l) = (first[a] as f32, last[a].max(first[a]) as f32);
+        (lo[a], hi[a]) = if l > f { (f, l) } else { (f - 0.5, f + 0.5) };
+    }
+    (lo, hi)
 }
 
 impl PostSetup {
@@ -188,6 +208,18 @@ impl PostSetup {
             top: sample_box(frame.dims).1,
             last: frame.dims.map(|d| d.saturating_sub(1)),
         })
+    }
+
+    /// The same slabs with samples only inside the box of voxels `first..=last` (whole-grid
+    /// indices, [`sample_box_of`]) instead of the whole grid's: what a cropped volume's samples
+    /// are (the rest of the grid is missing).
+    pub fn with_sample_box(self, first: [usize; 3], last: [usize; 3]) -> Self {
+        let (bottom, top) = sample_box_of(first, last);
+        PostSetup {
+            bottom,
+            top,
+            ..self
+        }
     }
 
     /// The same slabs with the values (and gradients) splatted at 1/`scale` of the image size

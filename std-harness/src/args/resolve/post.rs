@@ -2,7 +2,9 @@
 //! post's own flags refused without it.
 
 use super::plan;
-use crate::args::{ClassificationArg, Lod, MethodArg, RenderArgs, SlicingArg, Supersample};
+use crate::args::{
+    BlendArg, ClassificationArg, Lod, MethodArg, RenderArgs, SlicingArg, Supersample,
+};
 use crate::plan::{End, Plan, Precision};
 use crate::CliError;
 use footprint::frame::Order;
@@ -19,12 +21,47 @@ pub(super) fn no_post_flags(args: &RenderArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-/// `--classification post`'s plan: post-classified slabs, after the rules that the flags alone
-/// decide (what image slicing needs, and what post-classification cannot be combined with).
-pub(super) fn post_plan(args: &RenderArgs, precision: Precision) -> Result<Plan, CliError> {
+/// What a projection (`--blend` other than `composite`) cannot be combined with: shading (one
+/// value per ray is classified, with no gradient) and clipping planes (post-classified slabs do
+/// not cut yet).
+fn blend_rules(args: &RenderArgs) -> Result<(), CliError> {
+    let blend = footprint::render::Blend::from(args.blend);
     let refuse = |flag: &str, why: &str| {
         Err(CliError::input(format!(
-            "--classification post with {flag}: {why}"
+            "--blend {} with {flag}: {why}",
+            blend.name()
+        )))
+    };
+    if !blend.projects() {
+        return Ok(());
+    }
+    if args.shading != "emission" {
+        return refuse(
+            &format!("--shading {}", args.shading),
+            "a projection classifies one value per ray, which has no surface to light: drop --shading",
+        );
+    }
+    if !args.clip.is_empty() {
+        return refuse(
+            "--clip",
+            "post-classified slabs do not cut kernels yet (crop with --crop instead)",
+        );
+    }
+    Ok(())
+}
+
+/// `--classification post`'s plan (and a projection's, `--blend`): post-classified slabs, after
+/// the rules that the flags alone decide (what image slicing needs, and what
+/// post-classification cannot be combined with).
+pub(super) fn post_plan(args: &RenderArgs, precision: Precision) -> Result<Plan, CliError> {
+    blend_rules(args)?;
+    let refuse = |flag: &str, why: &str| {
+        Err(CliError::input(format!(
+            "--{} with {flag}: {why}",
+            match footprint::render::Blend::from(args.blend) {
+                footprint::render::Blend::Composite => "classification post".to_string(),
+                b => format!("blend {}", b.name()),
+            }
         )))
     };
     let fa = &args.footprint;
@@ -91,6 +128,7 @@ pub(super) fn post_plan(args: &RenderArgs, precision: Precision) -> Result<Plan,
     }
     let mut plan = plan(&RenderArgs {
         classification: ClassificationArg::Pre,
+        blend: BlendArg::Composite,
         slicing: Some(SlicingArg::Image),
         slab_post: None,
         value_subsample: Supersample::Auto,
@@ -101,6 +139,7 @@ pub(super) fn post_plan(args: &RenderArgs, precision: Precision) -> Result<Plan,
             .slab_post
             .unwrap_or_else(|| crate::args::default_post_slab(&args.shading)),
         values: args.value_subsample,
+        blend: args.blend.into(),
     };
     // Post-classification composites front to back unless told: opaque pixels then take
     // nothing more (exact), where back to front must classify every slab.

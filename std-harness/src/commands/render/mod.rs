@@ -77,6 +77,11 @@ pub fn run(command: &RenderCommandArgs) -> Result<(), CliError> {
     if command.orbit.is_some() {
         check_orbit(args, &out, command.depth_map.is_some())?;
     }
+    if command.depth_map.is_some() && args.blend != crate::args::BlendArg::Composite {
+        return Err(CliError::input(
+            "--depth-map with --blend: a projection has no depth (no opacity accumulates)",
+        ));
+    }
     if command.depth_map.is_some() && args.stream.is_some() {
         return Err(CliError::input(
             "--depth-map marches the volume in memory: drop --stream (the volume is loaded)",

@@ -121,6 +121,12 @@ fn check(args: &VerifyArgs) -> Result<(), CliError> {
              measure a clipped frame against its cut model with --reference continuous",
         ));
     }
+    if r.blend != crate::args::BlendArg::Composite && args.reference != ReferenceArg::Continuous {
+        return Err(CliError::input(
+            "--blend: the f64 sheet reference and the field reference composite; measure a \
+             projection against its own model with --reference continuous",
+        ));
+    }
     if r.refine.is_some() && args.reference != ReferenceArg::Field {
         return Err(CliError::input(
             "verify's sheet and continuous references render the grid as given, so they would \
@@ -209,6 +215,7 @@ fn measure(args: &VerifyArgs, r: &RenderArgs) -> Result<Measured, CliError> {
             };
             let over = fine.as_ref().unwrap_or(&p);
             let model = match plan.end {
+                End::Post { blend, .. } if blend.projects() => Model::Projection(blend),
                 End::Post { .. } => Model::Post,
                 _ => Model::Pre(p.absorption),
             };

@@ -38,6 +38,7 @@ fn continuous_scene(
         model,
         cap,
         clip: p.clip.iter().map(|c| c.in_grid(&p.frame)).collect(),
+        samples: super::post::sample_range(volume),
         // A reference: every core (at most 16) unless the caller says otherwise.
         threads: std::thread::available_parallelism()
             .map_or(1, |n| n.get())
@@ -76,11 +77,15 @@ pub fn continuous_models(
         chosen_model,
         crate::metrics::compare(core, &chosen.image).1.psnr_db,
     )];
-    let all = [
-        Model::Pre(Absorption::Opacity),
-        Model::Pre(Absorption::Extinction),
-        Model::Post,
-    ];
+    // A projection is compared with its own model only: the composited ones are other pictures.
+    let all = match chosen_model {
+        Model::Projection(_) => vec![],
+        _ => vec![
+            Model::Pre(Absorption::Opacity),
+            Model::Pre(Absorption::Extinction),
+            Model::Post,
+        ],
+    };
     for other in all.into_iter().filter(|&m| m != chosen_model) {
         let (c, _) = render_continuous_as(p, reconstruction, other, DEFAULT_CAP)?;
         figures.push((other, crate::metrics::compare(core, &c.image).1.psnr_db));

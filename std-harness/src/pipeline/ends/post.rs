@@ -33,7 +33,7 @@ use footprint::composite::RowSpan;
 use footprint::frame::Order;
 use footprint::render::post::{MAX_VALUE_SCALE, WEIGHT_NODES};
 use footprint::render::{
-    gradient, PostBuffers, PostRenderer, PostSetup, PostVoxel, RenderStats, ShadedLayers,
+    gradient, Blend, PostBuffers, PostRenderer, PostSetup, PostVoxel, RenderStats, ShadedLayers,
     SheetRing, WeightTable,
 };
 use footprint::shade::OPACITY_TABLE_LEN;
@@ -46,8 +46,7 @@ const BYTES_PER_SAMPLE: usize = 28;
 /// `threads` bands.
 pub fn render_post(
     p: &Prepared,
-    thickness: f32,
-    values: Supersample,
+    (thickness, values, blend): (f32, Supersample, Blend),
     threads: usize,
     cache: &mut FrameCache,
 ) -> Result<CoreFrame, CliError> {
@@ -70,6 +69,11 @@ pub fn render_post(
     let setup = setup
         .with_value_scale(scale)
         .map_err(|e| refuse(&e.to_string()))?;
+    // A crop's samples exist inside its box only (the rest of the grid is missing).
+    let setup = match sample_range(volume) {
+        Some((first, last)) => setup.with_sample_box(first, last),
+        None => setup,
+    };
     let start = Instant::now();
     let weights =
         Box::new(WeightTable::<WEIGHT_NODES>::new(&p.kernel).map_err(|e| refuse(&e.to_string()))?);
@@ -81,7 +85,12 @@ pub fn render_post(
     let t0 = Instant::now();
     let fresh = cache.post.is_none();
     if fresh {
-        cache.post = Some(post_samples(p, volume, cache.list_budget_for(volume))?);
+        cache.post = Some(post_samples(
+            p,
+            volume,
+            blend,
+            cache.list_budget_for(volume),
+        )?);
     }
     let samples = cache.post.as_ref().expect("just made");
     let classify_samples = t0.elapsed().as_secs_f64();
@@ -107,10 +116,20 @@ pub fn render_post(
                 size,
                 equal_bands_for(size[1], bands),
                 p.background.as_deref(),
-                |rows, band, bg| render_band(p, setup, weights, classify, sv, bg, band, rows),
+                |rows, band, bg| {
+                    render_band(p, setup, (weights, classify, blend), sv, bg, band, rows)
+                },
             )
         },
     )
+}
+
+/// The voxels a volume's samples exist among, `first..=last` per axis in whole-grid indices: a
+/// crop's box (the volume is a brick owning it); `None` for the whole grid.
+pub(crate) fn sample_range(volume: &crate::io::volume::Volume) -> Option<([usize; 3], [usize; 3])> {
+    volume
+        .brick
+        .map(|b| (b.owned.lo, b.owned.hi.map(|h| h.saturating_sub(1))))
 }
 
 /// `--value-subsample auto`'s bound: the kernel's shorter semi-axis, in value pixels, stays at or
@@ -147,12 +166,18 @@ pub fn value_scale(p: &Prepared, thickness: f32, values: Supersample) -> Option<
 fn post_samples(
     p: &Prepared,
     volume: &crate::io::volume::Volume,
+    blend: Blend,
     budget: usize,
 ) -> Result<PostSamples, CliError> {
     let f = &p.frame;
     let dims = f.dims;
     let shader = p.shader();
-    let clear = shader.transparent_at_or_below();
+    // A projection reads every finite sample: none is transparent to it.
+    let clear = if blend.projects() {
+        f32::NEG_INFINITY
+    } else {
+        shader.transparent_at_or_below()
+    };
     let needs_gradient = shader.shading.needs_gradient();
     let (len, na, nb) = f.sheet_shape();
     let axis = f.sheet_axis;
@@ -410,8 +435,7 @@ fn place(p: &Prepared, setup: &PostSetup, s: &PostSamples) -> Result<Placed, Cli
 fn render_band(
     p: &Prepared,
     setup: &PostSetup,
-    weights: &WeightTable<WEIGHT_NODES>,
-    classify: &ShadedLayers<'_>,
+    (weights, classify, blend): (&WeightTable<WEIGHT_NODES>, &ShadedLayers<'_>, Blend),
     sv: &Placed,
     background: Option<&[[f32; 4]]>,
     image: &mut [[f32; 4]],
@@ -444,7 +468,8 @@ fn render_band(
         buffers,
         background,
         rows.clone(),
-    )?;
+    )?
+    .with_blend(blend);
     let mut phases = Phases::default();
     for k in 0..slabs.slab_count() {
         crate::cancel::check()?;

@@ -85,9 +85,11 @@ pub fn end_frame(p: &Prepared, plan: &Plan, cache: &mut FrameCache) -> Result<Co
         End::Slabs { thickness } => {
             super::slabs::render_slabs(p, thickness, Bands::of(plan), cache)
         }
-        End::Post { thickness, values } => {
-            super::post::render_post(p, thickness, values, plan.threads, cache)
-        }
+        End::Post {
+            thickness,
+            values,
+            blend,
+        } => super::post::render_post(p, (thickness, values, blend), plan.threads, cache),
         End::Sheets(precision) => render_sheets(p, plan, precision, cache),
         End::Reference => reference_frame(p),
     }
