@@ -4,7 +4,7 @@
 //! (an f64 march of the same field), threads and compositing orders give the same picture, and
 //! the projections order as they must (maximum ≥ average ≥ minimum under a rising ramp).
 
-use super::cut::{HEADSQ, HEART};
+use super::cut::{frame, HEADSQ, HEART};
 use footprint::render::Blend;
 use footprint_harness::args::{parse_args, plan, scene};
 use footprint_harness::metrics::compare;
@@ -32,13 +32,7 @@ fn against_model(a: &[&str], blend: Blend) -> (Vec<[f32; 4]>, f64) {
 fn projections_meet_the_target_against_their_models() {
     for volume in [HEADSQ, HEART] {
         for view in ["0,0,0", "30,20,0"] {
-            let composite = {
-                let args = parse_args(&[volume, "--size", "96x96", "--view", view]).unwrap();
-                render(&scene(&args).unwrap(), &plan(&args).unwrap())
-                    .unwrap()
-                    .0
-                    .image
-            };
+            let composite = frame(&[volume, "--size", "96x96", "--view", view]);
             for blend in [Blend::Maximum, Blend::Minimum, Blend::Average] {
                 let a = [
                     volume,
@@ -73,14 +67,9 @@ fn projections_meet_the_target_against_their_models() {
 #[test]
 fn maximum_average_minimum_order_under_a_rising_ramp() {
     let frame = |blend: &str| {
-        let a = [
+        frame(&[
             HEADSQ, "--size", "64x64", "--view", "30,20,0", "--tf", "grey", "--blend", blend,
-        ];
-        let args = parse_args(&a).unwrap();
-        render(&scene(&args).unwrap(), &plan(&args).unwrap())
-            .unwrap()
-            .0
-            .image
+        ])
     };
     let (max, avg, min) = (frame("mip"), frame("average"), frame("minip"));
     let lit = max.iter().filter(|p| p[3] > 0.0).count();
@@ -99,15 +88,10 @@ fn maximum_average_minimum_order_under_a_rising_ramp() {
 fn projections_are_the_same_for_every_thread_count_and_order() {
     for blend in ["mip", "minip", "average"] {
         let frame = |more: &[&str]| {
-            let mut a = vec![
+            let base = [
                 HEADSQ, "--size", "80x64", "--view", "30,20,0", "--blend", blend,
             ];
-            a.extend_from_slice(more);
-            let args = parse_args(&a).unwrap();
-            render(&scene(&args).unwrap(), &plan(&args).unwrap())
-                .unwrap()
-                .0
-                .image
+            frame(&[&base[..], more].concat())
         };
         let one = frame(&["--threads", "1"]);
         assert_eq!(one, frame(&["--threads", "3"]), "{blend}: threads");

@@ -163,6 +163,16 @@ impl TransferFunction<'_> {
         Some((low, f32::MAX))
     }
 
+    /// The premultiplied RGBA of a pixel shown as `value` alone (a projection's pixel:
+    /// `crate::render::post::Blend`): [`Self::lookup`]'s colour times its opacity, the opacity
+    /// clamped to [0, 1] and taken as the pixel's, as VTK's projections take it.
+    #[inline]
+    pub fn pixel(&self, value: f32) -> [f32; 4] {
+        let [r, g, b, a] = self.lookup(value);
+        let a = a.clamp(0.0, 1.0);
+        [r * a, g * a, b * a, a]
+    }
+
     /// Straight RGBA for `value`; transparent for a non-finite value.
     #[inline]
     pub fn lookup(&self, value: f32) -> [f32; 4] {

@@ -149,6 +149,8 @@ fn clip_rules(args: &RenderArgs) -> Result<(), CliError> {
         Some("--slicing object (a sheet composites each kernel whole; the planes cut kernels between image-aligned slabs: drop it)")
     } else if args.classification == ClassificationArg::Post {
         Some("--classification post (its slabs do not cut kernels yet)")
+    } else if args.blend != BlendArg::Composite {
+        Some("--blend (a projection renders post-classified slabs, which do not cut kernels yet; crop with --crop instead)")
     } else if args.refine.is_some() {
         Some("--refine (refinement renders the paper's sheets)")
     } else if args.footprint.method == MethodArg::Reference {

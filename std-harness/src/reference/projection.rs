@@ -112,11 +112,8 @@ pub(super) fn pixel(
     taps: &mut Taps,
     bg: [f64; 4],
 ) -> [f64; 4] {
-    let p = project(field, blend, line, span, per_t, h, taps).map_or([0.0; 4], |v| {
-        let [r, g, b, a] = shader.tf.lookup(v as f32).map(f64::from);
-        let a = a.clamp(0.0, 1.0);
-        [r * a, g * a, b * a, a]
-    });
+    let p = project(field, blend, line, span, per_t, h, taps)
+        .map_or([0.0; 4], |v| shader.tf.pixel(v as f32).map(f64::from));
     let t = 1.0 - p[3];
     [0, 1, 2, 3].map(|c| p[c] + t * bg[c])
 }

@@ -130,12 +130,10 @@ impl Classify for ShadedLayers<'_> {
             .shade_with(&lighting, table, value, || gradient, index, self.dims)
     }
 
-    /// The transfer function's colour and opacity at `value` (its opacity as the pixel's,
-    /// as VTK's projections take it), premultiplied.
+    /// The transfer function's colour and opacity at `value`, premultiplied
+    /// ([`crate::shade::TransferFunction::pixel`]).
     fn projection(&self, value: f32) -> [f32; 4] {
-        let [r, g, b, a] = self.shader.tf.lookup(value);
-        let a = a.clamp(0.0, 1.0);
-        [r * a, g * a, b * a, a]
+        self.shader.tf.pixel(value)
     }
 }
 

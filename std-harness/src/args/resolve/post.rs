@@ -22,8 +22,8 @@ pub(super) fn no_post_flags(args: &RenderArgs) -> Result<(), CliError> {
 }
 
 /// What a projection (`--blend` other than `composite`) cannot be combined with: shading (one
-/// value per ray is classified, with no gradient) and clipping planes (post-classified slabs do
-/// not cut yet).
+/// value per ray is classified, with no gradient). Clipping planes are refused with the other
+/// clip rules (`clip_rules`).
 fn blend_rules(args: &RenderArgs) -> Result<(), CliError> {
     let blend = footprint::render::Blend::from(args.blend);
     let refuse = |flag: &str, why: &str| {
@@ -39,12 +39,6 @@ fn blend_rules(args: &RenderArgs) -> Result<(), CliError> {
         return refuse(
             &format!("--shading {}", args.shading),
             "a projection classifies one value per ray, which has no surface to light: drop --shading",
-        );
-    }
-    if !args.clip.is_empty() {
-        return refuse(
-            "--clip",
-            "post-classified slabs do not cut kernels yet (crop with --crop instead)",
         );
     }
     Ok(())
