@@ -73,6 +73,7 @@ const PHONG: Phong = Phong {
 /// An iso-surface at `value` over `tf` (opacity from the distance to it, not from `tf`).
 fn iso_at(tf: TransferFunction<'_>, value: f32) -> Shader<'_> {
     Shader {
+        labels: None,
         tf,
         shading: Shading::Iso {
             value,
@@ -166,6 +167,7 @@ fn no_interval_where_visibility_is_not_one() {
     let iso = iso_at(tf, 1.0);
     assert!(iso.visible_interval().is_none());
     let emission = Shader {
+        labels: None,
         tf,
         shading: Shading::Emission,
     };
@@ -202,7 +204,11 @@ fn the_classifier_keeps_what_the_lookup_keeps() {
             lo: 10.0,
             hi: 20.0,
         };
-        let shader = Shader { tf, shading };
+        let shader = Shader {
+            labels: None,
+            tf,
+            shading,
+        };
         let (low, high) = tf.visible_interval().unwrap_or((13.0, 20.0));
         let special = [
             low,
@@ -296,6 +302,7 @@ fn the_ends_and_the_iso_surface() {
     assert_eq!(tf.lookup(bound)[3], 0.0);
     assert!(tf.lookup(next_up(bound))[3] > 0.0);
     let emission = Shader {
+        labels: None,
         tf,
         shading: Shading::Emission,
     };

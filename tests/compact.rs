@@ -111,6 +111,7 @@ fn banded(
     let st = CompactStencils::build(f, &sampler, 4, &mut buf).unwrap();
     let lut = [[0.0f32; 4], [1.0; 4]];
     let shader = Shader {
+        labels: None,
         tf: TransferFunction {
             lut: &lut,
             lo: 0.0,

@@ -676,6 +676,7 @@ fn cases(dir: &Path) -> Vec<Case> {
     c.extend(third::cases(dir));
     c.extend(cut::cases(dir));
     c.extend(blend::cases(dir));
+    c.extend(labels::cases(dir));
     c
 }
 
@@ -683,6 +684,8 @@ fn cases(dir: &Path) -> Vec<Case> {
 mod blend;
 #[path = "hostile/cut.rs"]
 mod cut;
+#[path = "hostile/labels.rs"]
+mod labels;
 #[path = "hostile/third.rs"]
 mod third;
 

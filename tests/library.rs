@@ -353,6 +353,7 @@ fn ring_render_ordered(
         Lookup::Bilinear,
     );
     let shader = Shader {
+        labels: None,
         tf: TransferFunction { lut, lo, hi },
         shading: Shading::Emission,
     };

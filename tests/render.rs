@@ -131,6 +131,7 @@ fn render_cached(
         vec![RowSpan::EMPTY; size],
     );
     let shader = Shader {
+        labels: None,
         tf: TransferFunction {
             lut,
             lo: 0.0,
@@ -409,6 +410,7 @@ fn renderer_errors_are_typed() {
         Lookup::Bilinear,
     );
     let shader = Shader {
+        labels: None,
         tf: TransferFunction {
             lut: &lut,
             lo: 0.0,
@@ -515,6 +517,7 @@ fn pre_shaded_sheets_match_classified_sheets() {
     );
     let frame = classified.frame;
     let shader = Shader {
+        labels: None,
         tf: TransferFunction {
             lut: &lut,
             lo: 0.0,

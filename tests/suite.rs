@@ -25,6 +25,7 @@ mod freestanding_scene;
 mod harness_render;
 mod kernels;
 mod keywords;
+mod labels;
 mod layering;
 mod library;
 mod lod;

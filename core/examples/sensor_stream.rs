@@ -108,6 +108,7 @@ fn run() -> Result<(), SensorError> {
     );
     let lut: [[f32; 4]; 2] = [[0.0, 0.0, 0.0, 0.0], [1.0, 1.0, 1.0, 0.35]];
     let shader = Shader {
+        labels: None,
         tf: TransferFunction {
             lut: &lut,
             lo: 0.0,

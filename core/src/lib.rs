@@ -87,7 +87,7 @@
 //! let order = order_for(&source, &frame, Order::BackToFront).unwrap();
 //! let generic = GenericTable::<33>::build(Kernel::PAPER_GAUSSIAN);
 //! let table = ViewTable::<33>::build(&frame.footprint, &generic, Lookup::Bilinear, Lookup::Bilinear);
-//! let shader = Shader { tf: TransferFunction { lut: Preset::Grey.lut(), lo: 0.0, hi: 255.0 }, shading: Shading::Emission };
+//! let shader = Shader { labels: None, tf: TransferFunction { lut: Preset::Grey.lut(), lo: 0.0, hi: 255.0 }, shading: Shading::Emission };
 //! let (mut acc, mut image, mut rows) = (vec![[0.0; 4]; 48 * 48], vec![[0.0; 4]; 48 * 48], vec![RowSpan::EMPTY; 48]);
 //! let buffers = RenderBuffers { accumulator: &mut acc, image: &mut image, rows: &mut rows };
 //! let mut renderer = SheetRenderer::new(&frame, &table, shader, order, buffers, None).unwrap();
@@ -114,7 +114,7 @@
 //! let generic = GenericTable::<33>::build(Kernel::PAPER_GAUSSIAN);
 //! let mut table = FixedTable::<33>::zeroed();
 //! table.build_view(&frame, &generic, Lookup::Bilinear, Lookup::Bilinear).unwrap();
-//! let shader = Shader { tf: TransferFunction { lut: Preset::Grey.lut(), lo: 0.0, hi: 255.0 }, shading: Shading::Emission };
+//! let shader = Shader { labels: None, tf: TransferFunction { lut: Preset::Grey.lut(), lo: 0.0, hi: 255.0 }, shading: Shading::Emission };
 //! let (mut acc, mut image, mut rows) = (vec![[0i64; 4]; 48 * 48], vec![[0u32; 4]; 48 * 48], vec![RowSpan::EMPTY; 48]);
 //! let buffers = RenderBuffers { accumulator: &mut acc, image: &mut image, rows: &mut rows };
 //! let path = FixedPath::new(&frame, &table).unwrap();

@@ -190,6 +190,7 @@ pub fn render_volume<T: Sample, const N: usize>(
     let mut volume = MemoryVolume::new(data, dims)?;
     let frame = settings.frame(dims)?;
     let shader = Shader {
+        labels: None,
         tf: TransferFunction {
             lut: settings.lut,
             lo: settings.window[0],

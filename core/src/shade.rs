@@ -13,9 +13,11 @@ use crate::math;
 use crate::splat::BufferError;
 use glam::Vec3;
 
+mod labels;
 pub mod presets;
 mod transfer;
 
+pub use labels::{Label, Labels};
 pub use presets::{Preset, LUT_SIZE};
 pub use transfer::{TransferFunction, TransferFunctionError, RAMP_MIN_OPACITY};
 
@@ -76,11 +78,14 @@ impl Shading {
     }
 }
 
-/// A transfer function with a shading mode.
+/// A classification (a transfer function, or a label table) with a shading mode.
 #[derive(Clone, Copy, Debug)]
 pub struct Shader<'a> {
-    /// Classification.
+    /// Classification by value (unused where `labels` is given).
     pub tf: TransferFunction<'a>,
+    /// Classification by label ([`Labels`]): each sample's exact value looked up in the table
+    /// instead of the transfer function. `None` for a volume of measurements.
+    pub labels: Option<Labels<'a>>,
     /// Lighting and opacity mode.
     pub shading: Shading,
 }
@@ -124,7 +129,64 @@ impl Lighting {
     }
 }
 
+impl<'a> Shader<'a> {
+    /// A shader of `tf` under `shading`, classifying by value.
+    pub fn new(tf: TransferFunction<'a>, shading: Shading) -> Self {
+        Shader {
+            tf,
+            labels: None,
+            shading,
+        }
+    }
+
+    /// A shader classifying a label volume by `labels`, unlit ([`Shading::Emission`]): the
+    /// picture holds the labels' colours and their composites only (see [`Labels`]).
+    pub fn labelled(labels: Labels<'a>) -> Self {
+        Shader {
+            tf: TransferFunction {
+                lut: &labels::CLEAR,
+                lo: 0.0,
+                hi: 1.0,
+            },
+            labels: Some(labels),
+            shading: Shading::Emission,
+        }
+    }
+}
+
 impl Shader<'_> {
+    /// Checks that the classification can classify: the transfer function, and the label table
+    /// where there is one.
+    pub fn check(&self) -> Result<(), TransferFunctionError> {
+        self.tf.check()?;
+        match self.labels {
+            Some(l) => l.check(),
+            None => Ok(()),
+        }
+    }
+
+    /// Straight RGBA the classification gives `value`: its label's, or the transfer function's.
+    #[inline]
+    pub fn lookup(&self, value: f32) -> [f32; 4] {
+        match &self.labels {
+            Some(l) => l.lookup(value),
+            None => self.tf.lookup(value),
+        }
+    }
+
+    /// The premultiplied RGBA of a pixel shown as `value` alone (a projection's pixel):
+    /// [`TransferFunction::pixel`], or the label's colour times its opacity.
+    #[inline]
+    pub fn pixel(&self, value: f32) -> [f32; 4] {
+        match &self.labels {
+            Some(l) => {
+                let [r, g, b, a] = l.lookup(value);
+                [r * a, g * a, b * a, a]
+            }
+            None => self.tf.pixel(value),
+        }
+    }
+
     /// Premultiplied RGBA for one voxel, opacity-corrected. `value` is the sample; `gradient` is
     /// called only when the mode needs it and the voxel is not already transparent, and returns the
     /// world-space gradient (value units per world unit); `index` is the voxel's grid index and
@@ -208,6 +270,8 @@ impl Shader<'_> {
     /// lookups: call it once per sheet or frame, not per voxel.
     pub fn visible_interval(&self) -> Option<(f32, f32)> {
         match self.shading {
+            // Values between labels are transparent: not one interval.
+            _ if self.labels.is_some() => None,
             Shading::Emission | Shading::Phong(_) | Shading::Texture(_) => {
                 self.tf.visible_interval()
             }
@@ -223,9 +287,10 @@ impl Shader<'_> {
     /// lookups: call it once per sheet or frame, not per voxel.
     pub fn transparent_at_or_below(&self) -> f32 {
         match self.shading {
-            Shading::Emission | Shading::Phong(_) | Shading::Texture(_) => {
-                self.tf.transparent_at_or_below()
-            }
+            Shading::Emission | Shading::Phong(_) | Shading::Texture(_) => match &self.labels {
+                Some(l) => l.transparent_at_or_below(),
+                None => self.tf.transparent_at_or_below(),
+            },
             Shading::Iso { .. } => f32::NEG_INFINITY,
         }
     }
@@ -250,18 +315,18 @@ impl Shader<'_> {
     ) -> Option<([f32; 3], f32, Option<Phong>, Vec3)> {
         let (rgb, alpha, phong, g) = match self.shading {
             Shading::Emission => {
-                let c = self.tf.lookup(value);
+                let c = self.lookup(value);
                 ([c[0], c[1], c[2]], c[3], None, Vec3::ZERO)
             }
             Shading::Phong(p) => {
-                let c = self.tf.lookup(value);
+                let c = self.lookup(value);
                 if !(c[3] > 0.0) {
                     return None;
                 }
                 ([c[0], c[1], c[2]], c[3], Some(p), gradient())
             }
             Shading::Texture(p) => {
-                let c = self.tf.lookup(value);
+                let c = self.lookup(value);
                 if !(c[3] > 0.0) {
                     return None;
                 }
@@ -280,7 +345,7 @@ impl Shader<'_> {
                 thickness,
                 phong,
             } => {
-                let c = self.tf.lookup(iso);
+                let c = self.lookup(iso);
                 let g = gradient();
                 let mag = g.length();
                 let alpha = if mag > 0.0 {

@@ -30,7 +30,7 @@ from __future__ import annotations
 import json
 import os
 import tempfile
-from typing import Any, Iterable, Optional, Sequence, Tuple
+from typing import Any, Iterable, Mapping, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -65,7 +65,14 @@ SAMPLE_TYPES = (
 
 def _common(size, view, tf, window, flags: dict) -> dict:
     """The keywords of a request: the camera and picture arguments every function names, and the
-    rest as given (typed values; the extension checks them as the flags are checked)."""
+    rest as given (typed values; the extension checks them as the flags are checked). ``labels``
+    may be a mapping of label to (r, g, b, a), passed as the flag's JSON."""
+    labels = flags.get("labels")
+    if isinstance(labels, Mapping):
+        flags = dict(
+            flags,
+            labels=json.dumps({str(int(k)): [float(c) for c in v] for k, v in labels.items()}),
+        )
     return dict(
         flags,
         size=tuple(size),
@@ -126,7 +133,8 @@ def render(
     from the data (Otsu threshold to the 99.5th percentile; ``footprint info`` prints it). ``tf``
     None: ``ct-bone-skin``, as ``footprint render`` on a file.
     Any other ``footprint render`` flag is a keyword (``shading="phong"``, ``threads=2``,
-    ``slicing="image"``, ``accum="fixed"``, ``lod=0``, ...). ``out="x.png"`` (or ``.pfm``) and
+    ``slicing="image"``, ``accum="fixed"``, ``lod=0``, ...). ``labels={1: (1, 0, 0, 0.5), ...}``
+    (or a path, or the JSON text) renders an integer label volume in the labels' colours. ``out="x.png"`` (or ``.pfm``) and
     ``json="x.json"`` also write the image and the summary as ``footprint render`` does (both or
     neither; the paths are checked before rendering).
     Ctrl-C interrupts the render within a sheet or slab and raises ``KeyboardInterrupt``.

@@ -494,3 +494,22 @@ def test_ctrl_c_interrupts_a_long_render():
     assert lines[0] == "interrupted", out.stdout
     assert float(lines[1]) < 3.0, f"KeyboardInterrupt came {lines[1]} s after the render began"
     assert lines[-1] == "again"
+
+
+def test_labels_colour_a_label_volume():
+    """``labels`` (a mapping, or the flag's JSON) renders an integer label volume in the labels'
+    colours only: two touching labels red and blue with green in the table show no green; a
+    table of labels the volume does not hold renders nothing; lit shading is refused."""
+    v = np.zeros((24, 24, 24), dtype=np.uint8)
+    v[6:18, 6:18, 4:12] = 1
+    v[6:18, 6:18, 12:20] = 3
+    table = {1: (1, 0, 0, 0.5), 2: (0, 1, 0, 1), 3: (0, 0, 1, 0.5)}
+    kw = dict(size=(48, 48), view=(30, 20, 0))
+    image = footprint.render(v, labels=table, **kw)
+    assert image[..., 0].max() > 0.1 and image[..., 2].max() > 0.1
+    assert image[..., 1].max() == 0.0
+    text = '{"1": [1, 0, 0, 0.5], "2": [0, 1, 0, 1], "3": [0, 0, 1, 0.5]}'
+    assert np.array_equal(image, footprint.render(v, labels=text, **kw))
+    assert not footprint.render(v, labels={9: (1, 1, 1, 1)}, **kw).any()
+    with pytest.raises(ValueError, match="unlit"):
+        footprint.render(v, labels=table, shading="phong", **kw)

@@ -293,6 +293,11 @@ pub struct RenderArgs {
     /// crosses each ray; renders with image-aligned slabs. See docs/cut.md.
     #[arg(help_heading = "Picture", long, value_name = "NX,NY,NZ,D", value_parser = parse_clip, allow_hyphen_values = true, action = clap::ArgAction::Append)]
     pub clip: Vec<crate::scene::ClipPlane>,
+    /// A label volume's colours: JSON `{"1": [r, g, b, a], …}` (a file, or the text itself), or
+    /// ITK-SNAP's label description file. Samples are classified by label before reconstruction;
+    /// unlisted labels are transparent. See docs/labels.md.
+    #[arg(help_heading = "Picture", long, value_name = "FILE|JSON")]
+    pub labels: Option<String>,
     /// Shading: emission, phong, iso:VALUE (Levoy iso-surface at VALUE, data units), texture.
     #[arg(help_heading = "Picture", long, default_value = "emission")]
     pub shading: String,

@@ -131,6 +131,8 @@ pub struct Scene {
     pub tf: Option<String>,
     pub window: Option<[f64; 2]>,
     pub shading: ShadingSpec,
+    /// `--labels`: a label volume's table (samples classified by label instead of `tf`).
+    pub labels: Option<crate::tf::labels::LabelTable>,
     /// Picture: background, gamma, PNG depth.
     pub background: Background,
     pub gamma: Gamma,
@@ -303,6 +305,7 @@ impl Default for Scene {
             tf: None,
             window: None,
             shading: ShadingSpec::Emission,
+            labels: None,
             background: Background::Black,
             gamma: Gamma::Linear,
             depth: 8,

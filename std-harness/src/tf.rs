@@ -2,6 +2,7 @@
 //! reads. Control points are `t r g b a` with t ∈ [0, 1] the position in the value window, colour
 //! straight (not premultiplied), a the opacity of a slab one reference distance thick.
 
+pub mod labels;
 pub mod paraview;
 
 use crate::CliError;

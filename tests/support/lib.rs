@@ -202,6 +202,7 @@ pub fn try_render_with<P: footprint::render::Precision>(
     use footprint::render::{RenderBuffers, SheetRenderer};
     use footprint::shade::{Shader, Shading, TransferFunction};
     let shader = Shader {
+        labels: None,
         tf: TransferFunction {
             lut: &UNIT_LUT,
             lo: 0.0,

@@ -185,7 +185,7 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
                 (buffers.rows.len(), band_rows),
             ],
         )?;
-        shader.tf.check()?;
+        shader.check()?;
         if frame.camera().is_some() && !P::PERSPECTIVE {
             return Err(RenderError::Projection);
         }

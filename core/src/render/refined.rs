@@ -397,6 +397,7 @@ mod tests {
             let generic = GenericTable::<65>::build(K);
             let base = table(&f, f.grid_to_screen, &generic);
             let shader = Shader {
+                labels: None,
                 tf: TransferFunction {
                     lut: &lut,
                     lo: 0.0,

@@ -127,7 +127,7 @@ pub fn classify_sheet<T: Sample>(
                     // A sample of a coloured type without a colour of its own takes the transfer
                     // function's, as the renderer would give it.
                     colours[n] = sample.colour().unwrap_or_else(|| {
-                        let c = shader.tf.lookup(value);
+                        let c = shader.lookup(value);
                         [c[0], c[1], c[2]]
                     });
                 }

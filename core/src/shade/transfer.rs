@@ -38,6 +38,19 @@ pub enum TransferFunctionError {
         /// Index of the entry.
         index: usize,
     },
+    /// A label table ([`super::Labels`]) with no label.
+    NoLabels,
+    /// A label whose value is not finite or not above the one before it (labels must be sorted
+    /// by strictly increasing value).
+    LabelOrder {
+        /// Index of the label.
+        index: usize,
+    },
+    /// A label with a channel outside [0, 1] or not finite.
+    LabelEntry {
+        /// Index of the label.
+        index: usize,
+    },
 }
 
 impl core::fmt::Display for TransferFunctionError {
@@ -55,6 +68,15 @@ impl core::fmt::Display for TransferFunctionError {
                 f,
                 "transfer function entry {index} has a channel outside [0, 1]"
             ),
+            Self::NoLabels => write!(f, "the label table has no label"),
+            Self::LabelOrder { index } => write!(
+                f,
+                "label {index} is not finite or not above the label before it (labels must be \
+                 sorted by increasing value, each once)"
+            ),
+            Self::LabelEntry { index } => {
+                write!(f, "label {index} has a channel outside [0, 1]")
+            }
         }
     }
 }

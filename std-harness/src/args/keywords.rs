@@ -200,6 +200,7 @@ impl Keywords for RenderArgs {
             "perspective" => self.perspective = Some(f32_checked(key, v, fov)?),
             "eye_distance" => self.eye_distance = Some(f32_checked(key, v, positive)?),
             "tf" => self.tf = Some(text(key, v)?.to_string()),
+            "labels" => self.labels = Some(text(key, v)?.to_string()),
             "window" => self.window = Some(items::<2, f64>(key, v, f64s)?),
             "clip" => {
                 // One plane (four numbers) or a sequence of planes.

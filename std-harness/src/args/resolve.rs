@@ -22,6 +22,7 @@ use footprint::render::Absorption;
 use footprint::{Grid, Lookup, View};
 
 mod auto;
+mod labels;
 mod phase;
 mod post;
 use phase::phase_lookup_rules;
@@ -30,6 +31,7 @@ use post::{no_post_flags, post_plan};
 /// `args`' plan, with every rule the flags alone decide (see the module docs).
 pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
     request_rules(args)?;
+    labels::label_rules(args)?;
     let fa = &args.footprint;
     let precision = Precision::from(args.accum);
     clip_rules(args)?;
@@ -117,7 +119,11 @@ pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
         }),
         auto_slicing,
         auto_subsample: args.subsample.is_none() && auto_slicing.is_some(),
-        lod: args.lod,
+        // A label volume renders level 0 (an average of labels names none): `auto` means it.
+        lod: match args.lod {
+            Lod::Auto if args.labels.is_some() => Lod::Level(0),
+            lod => lod,
+        },
         supersample: args.supersample,
         // Culling needs what is in front first.
         order: match args.order {
@@ -339,6 +345,11 @@ pub fn scene(a: &RenderArgs) -> Result<Scene, CliError> {
         tf: a.tf.clone(),
         window: a.window,
         shading: ShadingSpec::parse(&a.shading)?,
+        labels: a
+            .labels
+            .as_deref()
+            .map(crate::tf::labels::LabelTable::load)
+            .transpose()?,
         background: a.background.clone(),
         gamma: a.gamma.curve(),
         depth: a.depth,

@@ -78,8 +78,8 @@ pub fn agree_frame(
 ) -> Result<(), CliError> {
     let i = &job.inputs;
     let description = format!(
-        "size {:?} view {:?} zoom {:?} matrix {:?} perspective {:?} eye {:?} tf {:?} window {:?} \
-         shading {:?} background {:?} gamma {:?} depth {} kernel {:?} absorption {:?} \
+        "size {:?} view {:?} zoom {:?} matrix {:?} perspective {:?} eye {:?} tf {:?} labels {:?} \
+         window {:?} shading {:?} background {:?} gamma {:?} depth {} kernel {:?} absorption {:?} \
          plan {:?} grid {} bricks {:?}",
         i.size,
         i.view,
@@ -88,6 +88,7 @@ pub fn agree_frame(
         i.perspective,
         i.eye_distance,
         i.tf,
+        i.labels,
         i.window,
         i.shading,
         i.background,

@@ -38,6 +38,11 @@ pub fn describe(p: &Prepared, args: &Scene, plan: &Plan) -> Json {
         .str("shading", &args.shading.to_string())
         .str("tf", &p.tf_name)
         .arr_f64("window", &p.data_window())
+        // `--labels`: how many labels classify the samples (null: the transfer function does).
+        .num(
+            "labels",
+            p.labels.as_ref().map_or(f64::NAN, |l| l.len() as f64),
+        )
         .arr_usize(
             "crop",
             &args

@@ -22,7 +22,7 @@ use std::path::PathBuf;
 
 /// Emission through `lut` (straight RGBA over sample values 0..=255).
 fn emission(lut: &[[f32; 4]]) -> Shader<'_> {
-    Shader {
+    Shader { labels: None,
         tf: TransferFunction {
             lut,
             lo: 0.0,

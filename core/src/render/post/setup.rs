@@ -133,7 +133,7 @@ impl Classify for ShadedLayers<'_> {
     /// The transfer function's colour and opacity at `value`, premultiplied
     /// ([`crate::shade::TransferFunction::pixel`]).
     fn projection(&self, value: f32) -> [f32; 4] {
-        self.shader.tf.pixel(value)
+        self.shader.pixel(value)
     }
 }
 

@@ -18,7 +18,7 @@ use crate::{tf, CliError};
 use footprint::frame::{FrameSetup, Order};
 use footprint::geometry::FootprintOptions;
 use footprint::lod::{level_frame, level_kernel};
-use footprint::shade::{Shader, Shading, TransferFunction};
+use footprint::shade::{Labels, Shader, Shading, TransferFunction};
 use footprint::{Grid, Kernel, View};
 use std::sync::Arc;
 
@@ -42,6 +42,8 @@ pub struct Prepared {
     /// own units but for rebased wide samples; [`Prepared::data_window`] gives it in those).
     pub window: [f32; 2],
     pub shading: Shading,
+    /// `--labels` in the renderer's values: the shader classifies by them instead of `lut`.
+    pub labels: Option<Arc<[footprint::shade::Label]>>,
     pub tf_name: String,
     /// The background at the frame's (internal) size (shared with `background_out` when the
     /// frame is not supersampled).
@@ -167,6 +169,7 @@ impl Prepared {
             lut: self.lut.clone(),
             window: self.window,
             shading,
+            labels: self.labels.clone(),
             tf_name: self.tf_name.clone(),
             background: at_frame(self.background_out.as_ref(), args.size, supersample),
             background_out: self.background_out.clone(),
@@ -230,6 +233,7 @@ impl Prepared {
     /// The shader over this render's lookup table.
     pub fn shader(&self) -> Shader<'_> {
         Shader {
+            labels: self.labels.as_deref().map(|entries| Labels { entries }),
             tf: TransferFunction {
                 lut: &self.lut,
                 lo: self.window[0],
@@ -453,6 +457,10 @@ pub fn prepare_as_asked(args: &Scene, plan: &Plan) -> Result<Prepared, CliError>
     let tf_name = tf_name(args);
     let lut = tf::lut(&tf::load(&tf_name)?);
     let values = voxels.values();
+    let labels = match &args.labels {
+        Some(t) => Some(t.in_values(values)?.into()),
+        None => None,
+    };
     let window = match args.window {
         Some(w) => super::window::check_given(w, values)?,
         None => super::window::default_window(&name, range, &voxels, sample.as_deref())?,
@@ -504,6 +512,7 @@ pub fn prepare_as_asked(args: &Scene, plan: &Plan) -> Result<Prepared, CliError>
         lut,
         window,
         shading,
+        labels,
         tf_name,
         background,
         background_out,
