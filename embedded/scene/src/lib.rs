@@ -147,7 +147,8 @@ pub fn frame_at(side: usize, step: usize) -> Result<FrameSetup, footprint::Error
 }
 
 fn shader() -> Shader<'static> {
-    Shader { labels: None,
+    Shader {
+        labels: None,
         tf: TransferFunction {
             lut: &TF,
             lo: 0.0,
