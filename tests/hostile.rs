@@ -1122,10 +1122,12 @@ fn second_campaign(dir: &Path) -> Vec<Case> {
     );
     let mut mha = b"ObjectType = Image\nNDims = 3\nDimSize = 4 4 4\nElementType = MET_UCHAR\nElementNumberOfChannels = 3\nElementDataFile = LOCAL\n".to_vec();
     mha.extend([7u8; 192]);
+    // Three components are read (docs/components.md), each through the transfer function over
+    // its own window: constant data have none.
     c.push(refused(
-        "MetaImage with ElementNumberOfChannels = 3",
+        "MetaImage with ElementNumberOfChannels = 3, constant data",
         &["render", &write("rgb.mha", &mha), "--out", "out.png"],
-        "ElementNumberOfChannels",
+        "component 0: the data are constant (7); give --window",
     ));
     // An NRRD whose header holds a 100 KiB comment before its fields: streamed equals loaded
     // (with `--slicing object --lod 0`, which leave a pilot nothing to choose, so the stream is

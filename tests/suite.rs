@@ -8,6 +8,7 @@ mod bricks;
 mod classify;
 mod clip;
 mod compact;
+mod components;
 mod continuous;
 mod cull;
 mod cut;

@@ -274,10 +274,10 @@ pub struct RenderArgs {
     pub eye_distance: Option<f32>,
     /// Transfer function: a preset (grey, ct-bone-skin, density; ParaView's Grayscale, Cool to
     /// Warm, Viridis, X Ray), a ParaView preset file (`.json`, `FILE.json#NAME` for one of
-    /// several) or a file of `t r g b a` lines. Default: density for the built-in scene,
-    /// ct-bone-skin for a volume (transparent over the window's first 18 %).
-    #[arg(help_heading = "Picture", long)]
-    pub tf: Option<String>,
+    /// several) or a file of `t r g b a` lines. Default: density (built-in scene), ct-bone-skin
+    /// (a volume). Repeatable: one per component of a multi-component volume (docs/components.md).
+    #[arg(help_heading = "Picture", long, action = clap::ArgAction::Append)]
+    pub tf: Vec<String>,
     /// Value window LO,HI mapped onto the transfer function. Default for a volume: Otsu's
     /// threshold between background and foreground to the 99.5th percentile, from at most 2^20
     /// strided samples (`footprint info` prints it); the built-in scene: the data's range. Data units, f64.
@@ -293,9 +293,8 @@ pub struct RenderArgs {
     /// crosses each ray; renders with image-aligned slabs. See docs/cut.md.
     #[arg(help_heading = "Picture", long, value_name = "NX,NY,NZ,D", value_parser = parse_clip, allow_hyphen_values = true, action = clap::ArgAction::Append)]
     pub clip: Vec<crate::scene::ClipPlane>,
-    /// A label volume's colours: JSON `{"1": [r, g, b, a], …}` (a file, or the text itself), or
-    /// ITK-SNAP's label description file. Samples are classified by label before reconstruction;
-    /// unlisted labels are transparent. See docs/labels.md.
+    /// A label volume's colours: JSON `{"1": [r, g, b, a], …}` (a file, or the text) or ITK-SNAP's
+    /// label file; unlisted labels are transparent (docs/labels.md).
     #[arg(help_heading = "Picture", long, value_name = "FILE|JSON")]
     pub labels: Option<String>,
     /// Shading: emission, phong, iso:VALUE (Levoy iso-surface at VALUE, data units), texture.
@@ -524,11 +523,15 @@ impl RenderArgs {
         let named = [
             self.volume.as_deref(),
             self.stream.as_deref(),
-            self.tf.as_deref().map(std::path::Path::new),
+            self.labels.as_deref().map(std::path::Path::new),
             self.background.file(),
             self.footprint.table_file.as_deref(),
         ];
-        for path in named.into_iter().flatten() {
+        let tfs = self
+            .tf
+            .iter()
+            .map(|t| Some(std::path::Path::new(t.as_str())));
+        for path in named.into_iter().chain(tfs).flatten() {
             crate::io::note_input_path(path);
         }
     }

@@ -129,6 +129,8 @@ pub struct Scene {
     /// Classification: `--tf` (a built-in name or a file, read when the volume is prepared;
     /// `None`: the default for the source), `--window` (data units), `--shading`.
     pub tf: Option<String>,
+    /// Every `--tf` given: one per component of a multi-component volume.
+    pub tfs: Vec<String>,
     pub window: Option<[f64; 2]>,
     pub shading: ShadingSpec,
     /// `--labels`: a label volume's table (samples classified by label instead of `tf`).
@@ -303,6 +305,7 @@ impl Default for Scene {
             perspective: None,
             eye_distance: None,
             tf: None,
+            tfs: Vec::new(),
             window: None,
             shading: ShadingSpec::Emission,
             labels: None,

@@ -199,7 +199,16 @@ impl Keywords for RenderArgs {
             "view_matrix" => self.view_matrix = Some(items::<9, f32>(key, v, f32s)?),
             "perspective" => self.perspective = Some(f32_checked(key, v, fov)?),
             "eye_distance" => self.eye_distance = Some(f32_checked(key, v, positive)?),
-            "tf" => self.tf = Some(text(key, v)?.to_string()),
+            // One transfer function, or one per component.
+            "tf" => {
+                self.tf = match v {
+                    Value::List(l) => l
+                        .iter()
+                        .map(|x| text(key, x).map(str::to_string))
+                        .collect::<Result<_, _>>()?,
+                    _ => vec![text(key, v)?.to_string()],
+                }
+            }
             "labels" => self.labels = Some(text(key, v)?.to_string()),
             "window" => self.window = Some(items::<2, f64>(key, v, f64s)?),
             "clip" => {

@@ -143,6 +143,7 @@ impl Job {
         let builtin = inputs.volume.is_none() && inputs.memory.is_none();
         // Bricks reach the pipeline as volumes in memory: the one-process choice, made here.
         inputs.tf = Some(crate::pipeline::stages::prepare::tf_name(&inputs));
+        inputs.tfs = vec![crate::pipeline::stages::prepare::tf_name(&inputs)];
         let mut plan = plan.clone();
         if plan.lod == Lod::Auto {
             // A level of detail is built from the whole volume; bricks render level 0.

@@ -51,5 +51,11 @@ pub fn prepare_scene(mut args: Scene, plan: &Plan) -> Result<Prepared, CliError>
         }
         return Ok(p);
     }
-    validated_auto(prepare_as_asked(&args, &plan.at_level_0())?, &args, plan)
+    let p = prepare_as_asked(&args, &plan.at_level_0())?;
+    if p.labels.is_some() {
+        // A label volume (or a multi-component one's palette) renders level 0: an average of
+        // labels names none.
+        return Ok(p);
+    }
+    validated_auto(p, &args, plan)
 }

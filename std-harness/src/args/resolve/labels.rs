@@ -15,7 +15,7 @@ pub(super) fn label_rules(args: &RenderArgs) -> Result<(), CliError> {
         Lod::Level(n @ 1..) => Some(format!("--lod {n}")),
         _ => None,
     };
-    let why = if args.tf.is_some() {
+    let why = if !args.tf.is_empty() {
         Some(("--tf", "the labels give each voxel its colour: drop --tf"))
     } else if args.window.is_some() {
         Some((

@@ -1,8 +1,9 @@
 //! MetaImage (`.mhd` with a detached data file, `.mha` with `ElementDataFile = LOCAL`): `NDims = 3`,
 //! `DimSize`, `ElementType` (`MET_UCHAR` … `MET_DOUBLE`), `ElementSpacing` (or `ElementSize`),
 //! `ElementByteOrderMSB` / `BinaryDataByteOrderMSB`, `CompressedData` (zlib), `HeaderSize`,
-//! `TransformMatrix` (row i is grid axis i's direction). `ElementNumberOfChannels` other than 1
-//! (interleaved components) is refused.
+//! `TransformMatrix` (row i is grid axis i's direction). `ElementNumberOfChannels` 2 to 4
+//! (interleaved components) are read by [`load_components`] alone; [`load`] and streaming refuse
+//! them.
 
 use super::{compress, numbers, Fields};
 use crate::io::volume::{at, byte_len, check_spacing, decode, SampleType, Volume, AXIS_ALIGNED};
@@ -24,6 +25,8 @@ pub struct Header {
     pub header_size: i64,
     /// Bytes of header text (where LOCAL data start).
     pub header_len: usize,
+    /// `ElementNumberOfChannels`: components per voxel, interleaved (1 to 4).
+    pub components: usize,
 }
 
 fn is_true(v: &str) -> bool {
@@ -47,19 +50,17 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
     let d: Vec<usize> = numbers(ds, 3, "DimSize")?;
     let dims = [d[0], d[1], d[2]];
     let ty = element_type(need("ElementType")?)?;
-    byte_len(dims, ty)?;
-    // Several components per voxel lie interleaved in the data (RGB, a vector field): read as
-    // scalars they would render a wrong image, so they are refused, as VTI and legacy VTK
-    // refuse multi-component arrays.
-    if let Some(c) = get(&["ElementNumberOfChannels"]) {
-        if c != "1" {
+    // Several components per voxel lie interleaved in the data (RGBA, channels): 1 to 4.
+    let components = match get(&["ElementNumberOfChannels"]).unwrap_or("1") {
+        c @ ("1" | "2" | "3" | "4") => c.parse::<usize>().unwrap_or(1),
+        c => {
             return Err(format!(
-                "ElementNumberOfChannels = {}: only one component per voxel (a scalar volume) \
-                 is supported",
+                "ElementNumberOfChannels = {}: 1 to 4 components per voxel are supported",
                 c.chars().take(20).collect::<String>()
-            ));
+            ))
         }
-    }
+    };
+    byte_len(super::interleaved(dims, components)?, ty)?;
     let (spacing, directions) = orientation(&fields)?;
     let big_endian = get(&["ElementByteOrderMSB", "BinaryDataByteOrderMSB"]).is_some_and(is_true);
     if get(&["BinaryData"]).is_some_and(|v| !is_true(v)) {
@@ -90,6 +91,7 @@ pub fn parse_header(bytes: &[u8]) -> Result<Header, String> {
         data_file,
         header_size,
         header_len,
+        components,
     })
 }
 
@@ -171,13 +173,35 @@ fn orientation(fields: &Fields) -> Result<([f32; 3], [[f32; 3]; 3]), String> {
     Ok((spacing, directions))
 }
 
-/// Loads a MetaImage volume.
+/// Loads a MetaImage volume of one component per voxel (more are refused: see
+/// [`load_components`]).
+pub fn load(path: &Path) -> Result<Volume, CliError> {
+    super::scalar(path, load_all(path)?)
+}
+
+/// The components of a MetaImage of 2 to 4 components per voxel, each a volume of its own;
+/// `None` for one component.
+pub fn load_components(path: &Path) -> Result<Option<Vec<Volume>>, CliError> {
+    Ok(Some(load_all(path)?).filter(|parts| parts.len() > 1))
+}
+
+/// A MetaImage's volumes, one per component.
+fn load_all(path: &Path) -> Result<Vec<Volume>, CliError> {
+    let (h, samples) = read(path)?;
+    Ok(super::grid_volumes(
+        (h.dims, h.spacing, h.directions),
+        samples,
+        h.components,
+    ))
+}
+
+/// Reads a MetaImage's header and every sample (components interleaved).
 ///
 /// The data (after the header, or in `ElementDataFile`) are read as a stream for exactly the
 /// bytes the header declares (`HeaderSize` bytes skipped, then the samples, or a zlib stream
 /// inflated to exactly them); what follows is never read, so a larger or endless data file costs
 /// only the volume. `HeaderSize = -1` (the data are the file's last bytes) needs a regular file.
-pub fn load(path: &Path) -> Result<Volume, CliError> {
+fn read(path: &Path) -> Result<(Header, crate::io::volume::Samples), CliError> {
     let bytes = crate::io::read_file(path)?;
     let h = parse_header(&bytes).map_err(|e| at(path, e))?;
     let (source, mut reader, len): (PathBuf, Box<dyn std::io::BufRead>, Option<u64>) =
@@ -193,7 +217,9 @@ pub fn load(path: &Path) -> Result<Volume, CliError> {
             }
         };
     let err = |e: String| at(&source, e);
-    let need = byte_len(h.dims, h.ty).map_err(err)?;
+    let need = super::interleaved(h.dims, h.components)
+        .and_then(|d| byte_len(d, h.ty))
+        .map_err(err)?;
     let short = |found: u64| {
         err(format!(
             "expected {need} bytes of {}x{}x{} {:?}, found {found}",
@@ -229,14 +255,7 @@ pub fn load(path: &Path) -> Result<Volume, CliError> {
         })?
     };
     let samples = decode(&body, h.ty, h.big_endian).map_err(err)?;
-    Ok(Volume {
-        dims: h.dims,
-        spacing: h.spacing,
-        directions: h.directions,
-        values: crate::io::volume::ValueMap::for_samples(&samples),
-        samples,
-        brick: None,
-    })
+    Ok((h, samples))
 }
 
 /// Where the samples of an uncompressed MetaImage are, and its grid, for streaming.
@@ -253,6 +272,9 @@ pub fn raw_layout(path: &Path) -> Result<super::Streamable, CliError> {
             path,
             "streaming needs uncompressed data (CompressedData = False)",
         ));
+    }
+    if h.components != 1 {
+        return Err(at(path, super::several_components(h.components)));
     }
     super::raw_data_at(
         path,

@@ -20,7 +20,7 @@ pub mod vti;
 pub mod vtk;
 
 use crate::io::stream::Layout;
-use crate::io::volume::{at, byte_len, SampleType, Volume};
+use crate::io::volume::{at, byte_len, Data, SampleType, Samples, Volume};
 use crate::CliError;
 use std::path::Path;
 
@@ -63,6 +63,81 @@ pub struct Streamable {
     pub layout: Layout,
     pub spacing: [f32; 3],
     pub directions: [[f32; 3]; 3],
+}
+
+/// The dims of a volume of `components` interleaved components per voxel read as scalars (the
+/// first axis `components` times longer), for the byte count; an error if that overflows.
+pub fn interleaved(dims: [usize; 3], components: usize) -> Result<[usize; 3], String> {
+    let wide = dims[0]
+        .checked_mul(components)
+        .ok_or("the data are too large to address")?;
+    Ok([wide, dims[1], dims[2]])
+}
+
+/// Why a file of several components per voxel is refused where one is read as a scalar volume.
+pub fn several_components(n: usize) -> String {
+    format!(
+        "{n} components per voxel: `footprint render` classifies them (one --tf per component, or \
+         4 as RGBA; docs/components.md), loaded whole; read as one scalar they would render a \
+         wrong image"
+    )
+}
+
+/// Splits samples holding `n` interleaved components per voxel into `n` arrays of one.
+pub fn split_components(samples: &Samples, n: usize) -> Vec<Samples> {
+    macro_rules! split {
+        ($($v:ident),*) => {
+            match samples {
+                $(Samples::$v(d) => (0..n)
+                    .map(|c| Samples::$v(Data::from(
+                        d.iter().skip(c).step_by(n).copied().collect::<Vec<_>>(),
+                    )))
+                    .collect(),)*
+                // Never read from a file.
+                Samples::Coloured(_) => Vec::new(),
+            }
+        };
+    }
+    split!(U8, I8, U16, I16, U32, I32, F32, F64)
+}
+
+/// A file's samples of `components` per voxel as volumes on one grid (dims, spacing,
+/// directions): one volume, or one per component.
+pub fn grid_volumes(
+    (dims, spacing, directions): ([usize; 3], [f32; 3], [[f32; 3]; 3]),
+    samples: Samples,
+    components: usize,
+) -> Vec<Volume> {
+    let parts = match components {
+        1 => vec![samples],
+        n => split_components(&samples, n),
+    };
+    parts
+        .into_iter()
+        .map(|s| {
+            let mut v = Volume::new(dims, spacing, s);
+            v.directions = directions;
+            v
+        })
+        .collect()
+}
+
+/// A file's one volume, refusing several components (`load_components` reads those).
+pub fn scalar(path: &Path, mut parts: Vec<Volume>) -> Result<Volume, CliError> {
+    if parts.len() != 1 {
+        return Err(at(path, several_components(parts.len())));
+    }
+    Ok(parts.remove(0))
+}
+
+/// The components of a file of 2 to 4 components per voxel (MetaImage, VTK XML image data),
+/// each a volume of its own; `None` for a file of one component, or of another format.
+pub fn load_components(path: &Path, array: Option<&str>) -> Result<Option<Vec<Volume>>, CliError> {
+    match header_format(path) {
+        Some("MetaImage") => metaimage::load_components(path),
+        Some("VTK XML image data") => vti::load_components(path, array),
+        _ => Ok(None),
+    }
 }
 
 /// Splits a grid axis's world step into (spacing, unit direction); `None` if it is zero or not

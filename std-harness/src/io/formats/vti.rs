@@ -54,6 +54,8 @@ pub struct Header {
     pub header64: bool,
     pub compressor: Compressor,
     pub format: Format,
+    /// `NumberOfComponents`: components per point, interleaved (1 to 4).
+    pub components: usize,
 }
 
 /// How each data block is compressed (the `compressor` attribute of `VTKFile`).
@@ -201,8 +203,8 @@ pub fn parse_header_array<'a>(
         .find(|n| n.has_tag_name("ImageData"))
         .ok_or("no ImageData element")?;
     let (dims, spacing, directions) = geometry(image)?;
-    let (ty, format) = data_array(choose_array(image, array)?)?;
-    byte_len(dims, ty)?;
+    let (ty, format, components) = data_array(choose_array(image, array)?)?;
+    byte_len(super::interleaved(dims, components)?, ty)?;
     if matches!(format, Format::Appended { .. }) && appended.is_none() {
         return Err("appended DataArray but no AppendedData section".into());
     }
@@ -216,6 +218,7 @@ pub fn parse_header_array<'a>(
             header64,
             compressor,
             format,
+            components,
         },
         appended,
     ))
@@ -342,14 +345,17 @@ fn choose_array<'a, 'input>(
     Ok(*found)
 }
 
-/// A `DataArray`'s sample type and where its values are.
-fn data_array(array: Node<'_, '_>) -> Result<(SampleType, Format), String> {
-    let comps = array.attribute("NumberOfComponents").unwrap_or("1");
-    if comps != "1" {
-        return Err(format!(
-            "NumberOfComponents: {comps} (only scalar data are supported)"
-        ));
-    }
+/// A `DataArray`'s sample type, where its values are, and its components per point (1 to 4).
+fn data_array(array: Node<'_, '_>) -> Result<(SampleType, Format, usize), String> {
+    let components = match array.attribute("NumberOfComponents").unwrap_or("1") {
+        c @ ("1" | "2" | "3" | "4") => c.parse::<usize>().unwrap_or(1),
+        c => {
+            return Err(format!(
+                "NumberOfComponents: {} (1 to 4 components are supported)",
+                c.chars().take(20).collect::<String>()
+            ))
+        }
+    };
     let tyname = array.attribute("type").ok_or("DataArray has no type")?;
     let ty = match tyname {
         "Int8" => SampleType::I8,
@@ -383,7 +389,7 @@ fn data_array(array: Node<'_, '_>) -> Result<(SampleType, Format), String> {
             ))
         }
     };
-    Ok((ty, format))
+    Ok((ty, format, components))
 }
 
 /// Reads header words (UInt32 or UInt64) from `b` at word index `i`.
@@ -461,9 +467,35 @@ fn block_stream(b: &[u8], h: &Header, need: usize) -> Result<Vec<u8>, String> {
 /// Loads a `.vti` volume: the point-data array named `array`, or the default (see
 /// [`parse_header_array`]).
 pub fn load(path: &Path, array: Option<&str>) -> Result<Volume, CliError> {
+    super::scalar(path, load_all(path, array)?)
+}
+
+/// The components of a `.vti` array of 2 to 4 components per point, each a volume of its own;
+/// `None` for one component.
+pub fn load_components(path: &Path, array: Option<&str>) -> Result<Option<Vec<Volume>>, CliError> {
+    Ok(Some(load_all(path, array)?).filter(|parts| parts.len() > 1))
+}
+
+/// A `.vti` array's volumes, one per component.
+fn load_all(path: &Path, array: Option<&str>) -> Result<Vec<Volume>, CliError> {
+    let (h, samples) = read(path, array)?;
+    Ok(super::grid_volumes(
+        (h.dims, h.spacing, h.directions),
+        samples,
+        h.components,
+    ))
+}
+
+/// Reads a `.vti`'s header and every sample of its array (components interleaved).
+fn read(
+    path: &Path,
+    array: Option<&str>,
+) -> Result<(Header, crate::io::volume::Samples), CliError> {
     let bytes = crate::io::read_file(path)?;
     let (h, appended) = parse_header_array(&bytes, array).map_err(|e| at(path, e))?;
-    let need = byte_len(h.dims, h.ty).map_err(|e| at(path, e))?;
+    let need = super::interleaved(h.dims, h.components)
+        .and_then(|d| byte_len(d, h.ty))
+        .map_err(|e| at(path, e))?;
     let err = |e: String| at(path, e);
     let samples = match &h.format {
         Format::Ascii(text) => decode_ascii(text, h.ty, need / h.ty.size()).map_err(err)?,
@@ -491,12 +523,5 @@ pub fn load(path: &Path, array: Option<&str>) -> Result<Volume, CliError> {
             decode(&bytes, h.ty, h.big_endian).map_err(err)?
         }
     };
-    Ok(Volume {
-        dims: h.dims,
-        spacing: h.spacing,
-        directions: h.directions,
-        values: crate::io::volume::ValueMap::for_samples(&samples),
-        samples,
-        brick: None,
-    })
+    Ok((h, samples))
 }

@@ -99,6 +99,8 @@ pub(crate) struct Loaded {
     /// A user's volume (not the built-in scene, not a pipe) with no `--window`: its strided
     /// sample, for the default window (`super::window`).
     pub(crate) sample: Option<Vec<f32>>,
+    /// A multi-component volume's palette (`super::components`): the volume holds its indices.
+    pub(crate) labels: Option<crate::tf::labels::LabelTable>,
 }
 
 pub(crate) fn load_voxels(args: &Scene) -> Result<Loaded, CliError> {
@@ -136,14 +138,24 @@ pub(crate) fn load_voxels(args: &Scene) -> Result<Loaded, CliError> {
             dims,
             grid,
             range,
+            labels: None,
         });
     }
     let Some(stream) = &args.stream else {
+        let mut labels = None;
         let (volume, name) = match &args.volume {
-            Some(path) => (
-                formats::load_array(path, raw.as_ref(), args.array.as_deref())?,
-                path.display().to_string(),
-            ),
+            Some(path) => {
+                let name = path.display().to_string();
+                let volume = match formats::load_components(path, args.array.as_deref())? {
+                    Some(parts) => {
+                        let (v, table) = super::components::classify(&parts, args, &name)?;
+                        labels = Some(table);
+                        v
+                    }
+                    None => formats::load_array(path, raw.as_ref(), args.array.as_deref())?,
+                };
+                (volume, name)
+            }
             None => (
                 builtin::volume(args.scene_size)?,
                 scene_name(args.scene_size),
@@ -165,6 +177,7 @@ pub(crate) fn load_voxels(args: &Scene) -> Result<Loaded, CliError> {
             dims,
             grid,
             range,
+            labels,
         });
     };
     load_stream(args, stream, raw)
@@ -238,6 +251,7 @@ fn load_stream(
             grid,
             range: None,
             sample: None,
+            labels: None,
         });
     }
     let formats::Streamable {
@@ -274,6 +288,7 @@ fn load_stream(
             name,
             grid,
             range,
+            labels: None,
         });
     }
     Ok(Loaded {
@@ -283,6 +298,7 @@ fn load_stream(
         name,
         grid,
         range,
+        labels: None,
     })
 }
 

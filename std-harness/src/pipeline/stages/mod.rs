@@ -2,6 +2,7 @@
 
 pub mod bands;
 pub mod blocks;
+pub mod components;
 pub mod decorators;
 pub mod hold;
 pub mod load;

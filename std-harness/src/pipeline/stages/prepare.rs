@@ -120,6 +120,12 @@ impl Prepared {
                 ))
             }
         };
+        if self.labels.is_some() {
+            return Err(CliError::input(format!(
+                "{}: a label volume renders level 0 alone (an average of labels names none)",
+                self.name
+            )));
+        }
         if self.level != 0 || level == 0 {
             return Err(CliError::input(format!(
                 "level {level} is built from level 0 (this is level {})",
@@ -440,6 +446,7 @@ pub fn prepare_as_asked(args: &Scene, plan: &Plan) -> Result<Prepared, CliError>
         grid,
         range,
         sample,
+        labels: classified,
     } = load_voxels(args)?;
     let grid = Grid::from_matrix(grid).map_err(|e| CliError::input(format!("{name}: {e}")))?;
     let options = args.kernel.options;
@@ -457,11 +464,10 @@ pub fn prepare_as_asked(args: &Scene, plan: &Plan) -> Result<Prepared, CliError>
     let tf_name = tf_name(args);
     let lut = tf::lut(&tf::load(&tf_name)?);
     let values = voxels.values();
-    let labels = match &args.labels {
-        Some(t) => Some(t.in_values(values)?.into()),
-        None => None,
-    };
+    let labels = super::components::labels_of(classified.as_ref(), args, plan, &name, values)?;
     let window = match args.window {
+        // A multi-component volume's windows are its components' (`super::components`).
+        _ if classified.is_some() => [0.0, 1.0],
         Some(w) => super::window::check_given(w, values)?,
         None => super::window::default_window(&name, range, &voxels, sample.as_deref())?,
     };
