@@ -174,17 +174,11 @@ impl Shader<'_> {
         }
     }
 
-    /// The premultiplied RGBA of a pixel shown as `value` alone (a projection's pixel):
-    /// [`TransferFunction::pixel`], or the label's colour times its opacity.
+    /// The premultiplied RGBA of a pixel shown as `value` alone (a projection's pixel): the
+    /// classification's colour times its opacity, as [`TransferFunction::pixel`] gives it.
     #[inline]
     pub fn pixel(&self, value: f32) -> [f32; 4] {
-        match &self.labels {
-            Some(l) => {
-                let [r, g, b, a] = l.lookup(value);
-                [r * a, g * a, b * a, a]
-            }
-            None => self.tf.pixel(value),
-        }
+        transfer::premultiplied(self.lookup(value))
     }
 
     /// Premultiplied RGBA for one voxel, opacity-corrected. `value` is the sample; `gradient` is

@@ -126,10 +126,9 @@ pub struct Scene {
     pub view_matrix: Option<[f32; 9]>,
     pub perspective: Option<f32>,
     pub eye_distance: Option<f32>,
-    /// Classification: `--tf` (a built-in name or a file, read when the volume is prepared;
-    /// `None`: the default for the source), `--window` (data units), `--shading`.
-    pub tf: Option<String>,
-    /// Every `--tf` given: one per component of a multi-component volume.
+    /// Classification: every `--tf` (a built-in name or a file, read when the volume is
+    /// prepared; one per component of a multi-component volume; none: the default for the
+    /// source), `--window` (data units), `--shading`.
     pub tfs: Vec<String>,
     pub window: Option<[f64; 2]>,
     pub shading: ShadingSpec,
@@ -304,7 +303,6 @@ impl Default for Scene {
             view_matrix: None,
             perspective: None,
             eye_distance: None,
-            tf: None,
             tfs: Vec::new(),
             window: None,
             shading: ShadingSpec::Emission,

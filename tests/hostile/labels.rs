@@ -190,6 +190,15 @@ fn components(dir: &Path) -> Vec<Case> {
         two(),
     ));
     c.push(refused(
+        "one component, 2 --tf, in bricks",
+        &[
+            "render", HEART, "--tf", "grey", "--tf", "density", "--bricks", "2,1,1", "--out",
+            "out.png",
+        ],
+        "this one has one component",
+        dir,
+    ));
+    c.push(refused(
         "one component, 2 --tf",
         &[
             "render", HEART, "--tf", "grey", "--tf", "density", "--out", "out.png",

@@ -190,9 +190,7 @@ impl TransferFunction<'_> {
     /// clamped to [0, 1] and taken as the pixel's, as VTK's projections take it.
     #[inline]
     pub fn pixel(&self, value: f32) -> [f32; 4] {
-        let [r, g, b, a] = self.lookup(value);
-        let a = a.clamp(0.0, 1.0);
-        [r * a, g * a, b * a, a]
+        premultiplied(self.lookup(value))
     }
 
     /// Straight RGBA for `value`; transparent for a non-finite value.
@@ -214,6 +212,15 @@ impl TransferFunction<'_> {
             a[3] + f * (b[3] - a[3]),
         ]
     }
+}
+
+/// Straight RGBA as a pixel's premultiplied RGBA: the colour times the opacity, the opacity
+/// clamped to [0, 1] (a projection's pixel, [`TransferFunction::pixel`] and
+/// [`super::Shader::pixel`]).
+#[inline]
+pub(crate) fn premultiplied([r, g, b, a]: [f32; 4]) -> [f32; 4] {
+    let a = a.clamp(0.0, 1.0);
+    [r * a, g * a, b * a, a]
 }
 
 /// The lowest opacity [`TransferFunction::visible_interval`] accepts for the entries from the

@@ -342,7 +342,6 @@ pub fn scene(a: &RenderArgs) -> Result<Scene, CliError> {
         view_matrix: a.view_matrix,
         perspective: a.perspective,
         eye_distance: a.eye_distance,
-        tf: a.tf.first().cloned(),
         tfs: a.tf.clone(),
         window: a.window,
         shading: ShadingSpec::parse(&a.shading)?,

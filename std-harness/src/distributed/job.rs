@@ -142,8 +142,12 @@ impl Job {
         let mut inputs = inputs.clone();
         let builtin = inputs.volume.is_none() && inputs.memory.is_none();
         // Bricks reach the pipeline as volumes in memory: the one-process choice, made here.
-        inputs.tf = Some(crate::pipeline::stages::prepare::tf_name(&inputs));
-        inputs.tfs = vec![crate::pipeline::stages::prepare::tf_name(&inputs)];
+        // (Any further --tf stay, for the rule that a one-component volume takes one.)
+        if inputs.tfs.is_empty() {
+            inputs
+                .tfs
+                .push(crate::pipeline::stages::prepare::tf_name(&inputs));
+        }
         let mut plan = plan.clone();
         if plan.lod == Lod::Auto {
             // A level of detail is built from the whole volume; bricks render level 0.

@@ -87,7 +87,7 @@ pub fn agree_frame(
         i.view_matrix,
         i.perspective,
         i.eye_distance,
-        i.tf,
+        i.tfs,
         i.labels,
         i.window,
         i.shading,

@@ -113,7 +113,7 @@ pub(super) fn pixel(
     bg: [f64; 4],
 ) -> [f64; 4] {
     let p = project(field, blend, line, span, per_t, h, taps)
-        .map_or([0.0; 4], |v| shader.tf.pixel(v as f32).map(f64::from));
+        .map_or([0.0; 4], |v| shader.pixel(v as f32).map(f64::from));
     let t = 1.0 - p[3];
     [0, 1, 2, 3].map(|c| p[c] + t * bg[c])
 }

@@ -142,23 +142,24 @@ pub(crate) fn load_voxels(args: &Scene) -> Result<Loaded, CliError> {
         });
     }
     let Some(stream) = &args.stream else {
-        let mut labels = None;
-        let (volume, name) = match &args.volume {
+        let (volume, name, labels) = match &args.volume {
             Some(path) => {
                 let name = path.display().to_string();
-                let volume = match formats::load_components(path, args.array.as_deref())? {
+                match formats::load_components(path, args.array.as_deref())? {
                     Some(parts) => {
                         let (v, table) = super::components::classify(&parts, args, &name)?;
-                        labels = Some(table);
-                        v
+                        (v, name, Some(table))
                     }
-                    None => formats::load_array(path, raw.as_ref(), args.array.as_deref())?,
-                };
-                (volume, name)
+                    None => {
+                        let v = formats::load_array(path, raw.as_ref(), args.array.as_deref())?;
+                        (v, name, None)
+                    }
+                }
             }
             None => (
                 builtin::volume(args.scene_size)?,
                 scene_name(args.scene_size),
+                None,
             ),
         };
         let (dims, grid, range) = (volume.dims, volume.grid_to_world(), Some(volume.range()));

@@ -536,7 +536,7 @@ pub fn prepare_as_asked(args: &Scene, plan: &Plan) -> Result<Prepared, CliError>
 /// `ct-bone-skin` for a user's volume (transparent below the default window's first 18 %: see
 /// `super::window`).
 pub fn tf_name(args: &Scene) -> String {
-    args.tf.clone().unwrap_or_else(|| {
+    args.tfs.first().cloned().unwrap_or_else(|| {
         if args.volume.is_none() && args.stream.is_none() && args.memory.is_none() {
             "density"
         } else {
