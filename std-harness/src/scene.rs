@@ -278,6 +278,22 @@ impl Scene {
     }
 }
 
+impl Scene {
+    /// The transfer function this scene renders with: the first `--tf`, else `density` for the
+    /// built-in scene and `ct-bone-skin` for a user's volume (transparent below the default
+    /// window's first 18 %: see `crate::pipeline::stages::window`).
+    pub fn tf_name(&self) -> String {
+        self.tfs.first().cloned().unwrap_or_else(|| {
+            if self.volume.is_none() && self.stream.is_none() && self.memory.is_none() {
+                "density"
+            } else {
+                "ct-bone-skin"
+            }
+            .into()
+        })
+    }
+}
+
 impl Default for Scene {
     /// The scene `footprint render` resolves with no flags: the built-in volume (64³), 512 × 512
     /// pixels seen from the front (VTK's azimuth, elevation and roll 0), zoom 1, orthographic,

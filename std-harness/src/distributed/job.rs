@@ -9,7 +9,6 @@ use crate::io::stream::{InMemory, Layout};
 use crate::io::volume::Volume;
 use crate::pipeline::ends::run::end_frame;
 use crate::pipeline::stages::decorators::{self, Resample};
-use crate::pipeline::stages::load::Voxels;
 use crate::pipeline::stages::visible::FrameCache;
 use crate::pipeline::Renderer;
 use crate::plan::{End, Plan};
@@ -144,9 +143,7 @@ impl Job {
         // Bricks reach the pipeline as volumes in memory: the one-process choice, made here.
         // (Any further --tf stay, for the rule that a one-component volume takes one.)
         if inputs.tfs.is_empty() {
-            inputs
-                .tfs
-                .push(crate::pipeline::stages::prepare::tf_name(&inputs));
+            inputs.tfs.push(inputs.tf_name());
         }
         let mut plan = plan.clone();
         if plan.lod == Lod::Auto {
@@ -362,18 +359,10 @@ impl Job {
             });
         let mut sample: Vec<f32> = parts.into_iter().flat_map(|p| p.sample).collect();
         sample.sort_by(f32::total_cmp);
-        let voxels = Voxels::Stdin {
-            dims: self.dims,
-            ty: crate::io::volume::SampleType::F32,
-            big_endian: false,
-            pipe: None,
-            values: crate::io::volume::ValueMap::IDENTITY,
-            crop: None,
-        };
         crate::pipeline::stages::window::default_window(
             &self.name,
             Some(range),
-            &voxels,
+            None,
             self.sampled.then_some(sample.as_slice()),
         )
     }

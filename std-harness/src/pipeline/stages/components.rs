@@ -44,21 +44,17 @@ pub fn classify(
             for (c, v) in parts.iter().enumerate() {
                 let spec = match args.tfs.get(c).or(args.tfs.first()) {
                     Some(t) => t.clone(),
-                    None => super::prepare::tf_name(args),
+                    None => args.tf_name(),
                 };
                 let lut = crate::tf::lut(&crate::tf::load(&spec)?);
                 let window = match args.window {
                     Some(w) => super::window::check_given(w, v.values)?,
-                    None => {
-                        let (lo, hi) = v.range();
-                        super::window::auto_window(&v.strided_sample())
-                            .or((hi > lo).then_some([lo, hi]))
-                            .ok_or_else(|| {
-                                refuse(format!(
-                                    "component {c}: the data are constant ({lo}); give --window"
-                                ))
-                            })?
-                    }
+                    None => super::window::default_window(
+                        &format!("{name}: {} components: component {c}", parts.len()),
+                        Some(v.range()),
+                        None,
+                        Some(&v.strided_sample()),
+                    )?,
                 };
                 each.push((lut, window));
             }

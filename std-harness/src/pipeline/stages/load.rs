@@ -35,6 +35,14 @@ pub enum Voxels {
 }
 
 impl Voxels {
+    /// The sample type of a pipe (`--stream -`), which cannot be read twice; `None` otherwise.
+    pub fn piped(&self) -> Option<SampleType> {
+        match self {
+            Voxels::Stdin { ty, .. } => Some(*ty),
+            _ => None,
+        }
+    }
+
     /// How the samples become the renderer's values ([`ValueMap`]), whatever carries them.
     pub fn values(&self) -> ValueMap {
         match self {

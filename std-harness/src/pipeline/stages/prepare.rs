@@ -461,7 +461,7 @@ pub fn prepare_as_asked(args: &Scene, plan: &Plan) -> Result<Prepared, CliError>
     let kernel = kernel_at(args, &kernel, level);
 
     let order = compositing_order(plan.order, &voxels, &frame)?;
-    let tf_name = tf_name(args);
+    let tf_name = args.tf_name();
     let lut = tf::lut(&tf::load(&tf_name)?);
     let values = voxels.values();
     let labels = super::components::labels_of(classified.as_ref(), args, plan, &name, values)?;
@@ -469,7 +469,7 @@ pub fn prepare_as_asked(args: &Scene, plan: &Plan) -> Result<Prepared, CliError>
         // A multi-component volume's windows are its components' (`super::components`).
         _ if classified.is_some() => [0.0, 1.0],
         Some(w) => super::window::check_given(w, values)?,
-        None => super::window::default_window(&name, range, &voxels, sample.as_deref())?,
+        None => super::window::default_window(&name, range, voxels.piped(), sample.as_deref())?,
     };
     let shading = values_shading(
         args.shading
@@ -529,20 +529,6 @@ pub fn prepare_as_asked(args: &Scene, plan: &Plan) -> Result<Prepared, CliError>
         absorption: args.absorption,
         view: view_for(args, dims, &grid)?,
         clip: args.clip.clone(),
-    })
-}
-
-/// The transfer function `args` render with: `--tf`, else `density` for the built-in scene and
-/// `ct-bone-skin` for a user's volume (transparent below the default window's first 18 %: see
-/// `super::window`).
-pub fn tf_name(args: &Scene) -> String {
-    args.tfs.first().cloned().unwrap_or_else(|| {
-        if args.volume.is_none() && args.stream.is_none() && args.memory.is_none() {
-            "density"
-        } else {
-            "ct-bone-skin"
-        }
-        .into()
     })
 }
 

@@ -12,7 +12,6 @@
 //! The built-in scene keeps its own range, and a stream from a pipe, which cannot be read twice,
 //! its type's range; `footprint info` prints the window this picks.
 
-use super::load::Voxels;
 use crate::io::volume::SampleType;
 use crate::io::volume::ValueMap;
 use crate::scene::ShadingSpec;
@@ -21,30 +20,21 @@ use footprint::shade::Shading;
 
 /// The window for a render without `--window`: [`auto_window`] of a user's volume's `sample`;
 /// else (the built-in scene, or no sample spans a range) the data's `range`; for a pipe, which
-/// cannot be read twice, an 8-bit type's range, or an error asking for `--window`.
+/// cannot be read twice (`piped`: its sample type), an 8-bit type's range, or an error asking
+/// for `--window`.
 pub(crate) fn default_window(
     name: &str,
     range: Option<(f32, f32)>,
-    voxels: &Voxels,
+    piped: Option<SampleType>,
     sample: Option<&[f32]>,
 ) -> Result<[f32; 2], CliError> {
     if let Some(w) = sample.and_then(auto_window) {
         return Ok(w);
     }
-    let (lo, hi) = match (range, voxels) {
+    let (lo, hi) = match (range, piped) {
         (Some(r), _) => r,
-        (
-            None,
-            Voxels::Stdin {
-                ty: SampleType::U8, ..
-            },
-        ) => (0.0, 255.0),
-        (
-            None,
-            Voxels::Stdin {
-                ty: SampleType::I8, ..
-            },
-        ) => (-128.0, 127.0),
+        (None, Some(SampleType::U8)) => (0.0, 255.0),
+        (None, Some(SampleType::I8)) => (-128.0, 127.0),
         (None, _) => {
             return Err(CliError::input(
                 "standard input cannot be read twice: give --window LO,HI",
