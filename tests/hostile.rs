@@ -677,6 +677,7 @@ fn cases(dir: &Path) -> Vec<Case> {
     c.extend(cut::cases(dir));
     c.extend(blend::cases(dir));
     c.extend(labels::cases(dir));
+    c.extend(grid::cases(dir));
     c
 }
 
@@ -684,6 +685,8 @@ fn cases(dir: &Path) -> Vec<Case> {
 mod blend;
 #[path = "hostile/cut.rs"]
 mod cut;
+#[path = "hostile/grid.rs"]
+mod grid;
 #[path = "hostile/labels.rs"]
 mod labels;
 #[path = "hostile/third.rs"]

@@ -39,6 +39,7 @@ mod post;
 mod quality_continuous;
 mod quality_lod;
 mod real_writers;
+mod rectilinear;
 mod refine;
 mod render;
 mod rotation_45;

@@ -11,6 +11,17 @@
 //! paper's asymmetric case ("the scale factor may be 4.0 for positive i and 2.0 for negative i"),
 //! [`RefinedSample::spacing`].
 //!
+//! # Rectilinear grids
+//! The same axes carry a *rectilinear* grid, whose samples stand at given positions
+//! ([`RefinedAxis::rectilinear`]: strictly increasing, in the frame's grid steps) instead of one
+//! step apart: each sample's spacings are its distances to its neighbours, the kernel of each
+//! sample is scaled per side to them (the asymmetric case above, for any scale), and an interval
+//! may still be split into 1, 2 or 4 equal steps. The field such a grid stands for is the uniform
+//! grid's composed with the piecewise-linear map from position to sample index (per axis), so
+//! the kernels still sum to what the uniform lattice's do (a partition of unity): each kernel is
+//! the uniform one scaled, interval by interval, to the length of the interval it lies over, and
+//! the per-side scaling is exact out to the sample's neighbours.
+//!
 //! # Interpolation
 //! New values come from the tensor-product Catmull–Rom cubic through the 4 × 4 × 4 nearest coarse
 //! samples ([`catmull_rom`]). It passes through the samples, reproduces quadratics (third-order
@@ -57,6 +68,15 @@ pub enum RefineError {
         /// The threshold given.
         value: f32,
     },
+    /// A rectilinear position that is not finite or not above the one before it.
+    Position {
+        /// Grid axis.
+        axis: usize,
+        /// The sample.
+        index: usize,
+        /// Its position.
+        value: f32,
+    },
 }
 
 impl fmt::Display for RefineError {
@@ -82,6 +102,11 @@ impl fmt::Display for RefineError {
                 f,
                 "refinement threshold {value} is not a non-negative finite number"
             ),
+            Self::Position { axis, index, value } => write!(
+                f,
+                "axis {axis}, coordinate {index}: {value} is not finite and above the one before \
+                 (coordinates must increase strictly)"
+            ),
         }
     }
 }
@@ -95,15 +120,24 @@ pub struct RefinedSample {
     pub coarse: usize,
     /// Its offset from `coarse`, coarse steps, in [0, 1).
     pub frac: f32,
-    /// Distance to the previous and to the next sample, coarse steps (at an end of the axis, the
-    /// one neighbour's distance on both sides; 1 for an axis one sample long).
+    /// Distance to the previous and to the next sample, the frame's grid steps (at an end of the
+    /// axis, the one neighbour's distance on both sides; 1 for an axis one sample long).
     pub spacing: [f32; 2],
+    /// Position along the axis, the frame's grid steps: `coarse + frac` on a uniform grid; on a
+    /// rectilinear one, `frac` of the way along the coarse interval.
+    pub at: f32,
+    /// Coarse (index) steps per grid step here, which turns a derivative per coarse step into
+    /// one per grid step: 1 on a uniform grid; on a rectilinear one the inverse of the interval's
+    /// length inside it, and at a coarse sample 2 / (the sum of its two intervals), so that the
+    /// Catmull–Rom slope there (the central difference) becomes the non-uniform central
+    /// difference (one-sided at an end).
+    pub rate: f32,
 }
 
 impl RefinedSample {
-    /// Position along the axis, coarse grid steps.
+    /// Position along the axis, the frame's grid steps.
     pub fn position(&self) -> f32 {
-        self.coarse as f32 + self.frac
+        self.at
     }
 
     /// The mean of the two spacings: the share of the axis this sample stands for.
@@ -117,6 +151,9 @@ impl RefinedSample {
 pub struct RefinedAxis<'a> {
     n: usize,
     factors: &'a [u8],
+    /// A rectilinear axis's sample positions (grid steps, strictly increasing); `None`: one step
+    /// apart from 0.
+    positions: Option<&'a [f32]>,
 }
 
 impl<'a> RefinedAxis<'a> {
@@ -142,7 +179,39 @@ impl<'a> RefinedAxis<'a> {
                 factor,
             });
         }
-        Ok(RefinedAxis { n, factors })
+        Ok(RefinedAxis {
+            n,
+            factors,
+            positions: None,
+        })
+    }
+
+    /// Axis `axis` of a rectilinear grid: its samples at `positions` (the frame's grid steps,
+    /// finite and strictly increasing), each interval split into `factors[i]` steps as for
+    /// [`RefinedAxis::new`] (all ones: the grid as it is).
+    pub fn rectilinear(
+        axis: usize,
+        positions: &'a [f32],
+        factors: &'a [u8],
+    ) -> Result<Self, RefineError> {
+        let n = positions.len();
+        let mut previous = f32::NEG_INFINITY;
+        for (index, &value) in positions.iter().enumerate() {
+            if !(value.is_finite() && value > previous) {
+                return Err(RefineError::Position { axis, index, value });
+            }
+            previous = value;
+        }
+        let uniform = Self::new(axis, n, factors)?;
+        Ok(RefinedAxis {
+            positions: Some(positions),
+            ..uniform
+        })
+    }
+
+    /// Whether the samples stand at given positions ([`RefinedAxis::rectilinear`]).
+    pub fn is_rectilinear(&self) -> bool {
+        self.positions.is_some()
     }
 
     /// Coarse samples.
@@ -165,7 +234,9 @@ impl<'a> RefinedAxis<'a> {
 
     /// The refined sample `m` steps past coarse sample `i` (m < `factors[i]`; m = 0 for the last).
     pub fn sample(&self, i: usize, m: usize) -> RefinedSample {
-        let step = |k: usize| 1.0 / f32::from(self.factors[k]);
+        // Interval k's length and its refined step, grid steps.
+        let length = |k: usize| self.positions.map_or(1.0, |p| p[k + 1] - p[k]);
+        let step = |k: usize| length(k) / f32::from(self.factors[k]);
         let right = (i + 1 < self.n).then(|| step(i));
         let left = if m > 0 {
             right
@@ -178,10 +249,30 @@ impl<'a> RefinedAxis<'a> {
             (None, Some(r)) => (r, r),
             (None, None) => (1.0, 1.0),
         };
+        let frac = match right {
+            Some(_) => m as f32 / f32::from(self.factors[i]),
+            None => 0.0,
+        };
+        let (at, rate) = match self.positions {
+            None => (i as f32 + frac, 1.0),
+            Some(p) => {
+                let inside = (i + 1 < self.n).then(|| length(i));
+                let rate = match (m, i.checked_sub(1).map(length), inside) {
+                    (1.., _, Some(li)) => 1.0 / li,
+                    (_, Some(lp), Some(li)) => 2.0 / (lp + li),
+                    (_, Some(lp), None) => 1.0 / lp,
+                    (_, None, Some(li)) => 1.0 / li,
+                    _ => 1.0,
+                };
+                (p[i] + frac * inside.unwrap_or(0.0), rate)
+            }
+        };
         RefinedSample {
             coarse: i,
-            frac: right.map_or(0.0, |s| m as f32 * s),
+            frac,
             spacing: [l, r],
+            at,
+            rate,
         }
     }
 
@@ -301,6 +392,68 @@ mod tests {
         .unwrap();
         back.reverse();
         assert_eq!(back, got.map(|g| g.0));
+    }
+
+    #[test]
+    fn rectilinear_positions_spacings_and_rates() {
+        let p = [0.0f32, 1.0, 3.0, 3.5];
+        let axis = RefinedAxis::rectilinear(1, &p, &[1, 2, 1]).unwrap();
+        assert!(axis.is_rectilinear());
+        assert_eq!(axis.len(), 5);
+        let mut got = [(0.0f32, [0.0f32; 2], 0.0f32, 0usize, 0.0f32); 5];
+        let mut n = 0;
+        axis.for_each::<()>(true, |s| {
+            got[n] = (s.position(), s.spacing, s.rate, s.coarse, s.frac);
+            n += 1;
+            Ok(())
+        })
+        .unwrap();
+        let want = [
+            (0.0, [1.0, 1.0], 1.0, 0, 0.0),
+            // Between intervals of 1 and 2: the non-uniform central difference's 2 / 3.
+            (1.0, [1.0, 1.0], 2.0 / 3.0, 1, 0.0),
+            // Inside the split interval: half of it on each side, 1 / its length.
+            (2.0, [1.0, 1.0], 0.5, 1, 0.5),
+            (3.0, [1.0, 0.5], 2.0 / 2.5, 2, 0.0),
+            (3.5, [0.5, 0.5], 2.0, 3, 0.0),
+        ];
+        assert_eq!(got, want);
+        for k in 1..5 {
+            assert_eq!(got[k].0 - got[k - 1].0, got[k].1[0]);
+            assert_eq!(got[k].0 - got[k - 1].0, got[k - 1].1[1]);
+        }
+        // A uniform axis is the rectilinear one at 0, 1, 2, ...
+        let uniform = RefinedAxis::new(0, 4, &[1, 2, 4]).unwrap();
+        let at = RefinedAxis::rectilinear(0, &[0.0, 1.0, 2.0, 3.0], &[1, 2, 4]).unwrap();
+        let every = |axis: &RefinedAxis| {
+            let mut out = [None; 8];
+            let mut n = 0;
+            axis.for_each::<()>(true, |s| {
+                out[n] = Some(s);
+                n += 1;
+                Ok(())
+            })
+            .unwrap();
+            out
+        };
+        let (a, b) = (every(&uniform), every(&at));
+        assert_eq!(a, b);
+        // Refused: a coordinate that repeats, goes back, or is NaN; a count that is not the
+        // samples'.
+        for bad in [[0.0, 1.0, 1.0], [0.0, 2.0, 1.0], [0.0, f32::NAN, 2.0]] {
+            assert!(matches!(
+                RefinedAxis::rectilinear(2, &bad, &[1, 1]),
+                Err(RefineError::Position {
+                    axis: 2,
+                    index: 2 | 1,
+                    ..
+                })
+            ));
+        }
+        assert!(matches!(
+            RefinedAxis::rectilinear(0, &[0.0, 1.0], &[1, 1]),
+            Err(RefineError::Length { .. })
+        ));
     }
 
     #[test]

@@ -55,6 +55,14 @@ pub fn rgb_psnr(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
     compare(a, &b).1.psnr_db
 }
 
+/// The largest channel difference between two RGBA images of the same size.
+pub fn max_abs_diff(a: &[[f32; 4]], b: &[[f32; 4]]) -> f32 {
+    a.iter()
+        .zip(b)
+        .flat_map(|(p, q)| (0..4).map(move |k| (p[k] - q[k]).abs()))
+        .fold(0.0f32, f32::max)
+}
+
 /// Composite Simpson's rule for ∫ₐᵇ f, with `steps` (even) intervals.
 pub fn simpson(f: impl Fn(f64) -> f64, a: f64, b: f64, steps: usize) -> f64 {
     let h = (b - a) / steps as f64;

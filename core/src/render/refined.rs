@@ -1,6 +1,7 @@
 //! Rendering a refined grid ([`crate::refine`]) with the paper's sheets: every refined sample
 //! along the sheet axis is a sheet, composited in order; every refined sample in it is splatted
-//! with a footprint for its local spacing ([`super::scaled`] derives them).
+//! with a footprint for its local spacing ([`super::scaled`] derives them). A rectilinear grid
+//! (samples at given positions, [`crate::refine`]'s "Rectilinear grids") renders the same way.
 //!
 //! # Which footprint
 //! A sample's spacings (previous and next along each in-sheet axis, its sheet's width along the
@@ -198,10 +199,11 @@ impl<'a, S: Splatter + ?Sized> SheetRenderer<'a, FloatPath<'a, S>> {
                 idx[a] = ua.coarse;
                 idx[b] = vb.coarse;
                 let gradient = || {
+                    // Per coarse step, then per grid step (`RefinedSample::rate`).
                     let mut g = [0.0f32; 3];
-                    g[a] = ga;
-                    g[b] = gb;
-                    g[k] = gz;
+                    g[a] = ga * ua.rate;
+                    g[b] = gb * vb.rate;
+                    g[k] = gz * zs.rate;
                     f.grid_inverse_transpose * Vec3::from_array(g)
                 };
                 let mut rgba =
@@ -221,7 +223,16 @@ impl<'a, S: Splatter + ?Sized> SheetRenderer<'a, FloatPath<'a, S>> {
                 pos[b] = vb.position();
                 let p = f.affine_position(pos);
                 let key = spacing_key(ua.spacing, vb.spacing, thickness);
-                let s = if let Some(Some(splatter)) = tables.splatters.get(key) {
+                // A key's splatter is the footprint of exactly its in-sheet spacings (its sheet
+                // width rounded, as the rates are): a sample whose spacings are otherwise (on a
+                // rectilinear grid) reads its rate's table at its own.
+                let (ka, kb, _) = key_spacings(key);
+                let own = tables
+                    .splatters
+                    .get(key)
+                    .and_then(Option::as_ref)
+                    .filter(|_| ka == ua.spacing && kb == vb.spacing);
+                let s = if let Some(splatter) = own {
                     // Its own footprint: the area it stands for is in the weights (a symmetric
                     // spacing's footprint integrates to one over its own, smaller, cell; a
                     // scaled one to the share its sides give it), so the value carries the
@@ -432,6 +443,43 @@ mod tests {
                 .flat_map(|(a, b)| (0..4).map(move |c| (a[c] - b[c]).abs()))
                 .fold(0.0f32, f32::max);
             assert!(d < 2e-3, "{angles:?}: unrefined grid differs by {d}");
+            // A rectilinear grid at 0, 1, 2, ... is the uniform one, bit for bit; positions
+            // stretched along i move the picture.
+            let rectilinear = |stretch: f32| {
+                let pos: [std::vec::Vec<f32>; 3] = core::array::from_fn(|a| {
+                    (0..dims[a])
+                        .map(|i| {
+                            if a == 0 {
+                                i as f32 * (1.0 + stretch * i as f32)
+                            } else {
+                                i as f32
+                            }
+                        })
+                        .collect()
+                });
+                render_with(&f, &base, shader, |r| {
+                    let grid = RefinedGrid {
+                        axes: [0, 1, 2]
+                            .map(|a| RefinedAxis::rectilinear(a, &pos[a], ones[a]).unwrap()),
+                    };
+                    let tables: RefineTables<'_, ViewTable<65>, ViewTable<65>> = RefineTables {
+                        rates: [&base; 5],
+                        splatters: &[],
+                    };
+                    let mut scratch = std::vec![0.0f32; 2 * f.sheet_shape().0];
+                    r.render_refined(&grid, &tables, at, &mut scratch).unwrap();
+                })
+            };
+            assert!(rectilinear(0.0) == refined, "{angles:?}: uniform positions");
+            let moved = rectilinear(0.1)
+                .iter()
+                .zip(&refined)
+                .map(|(a, b)| (a[3] - b[3]).abs())
+                .fold(0.0f32, f32::max);
+            assert!(
+                moved > 0.05,
+                "{angles:?}: stretched positions moved by {moved}"
+            );
             let more = render([&[1, 2, 4, 2, 1][..], &[4u8; 6][..], &[2, 1, 1, 2][..]]);
             assert!(more
                 .iter()

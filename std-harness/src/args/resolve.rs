@@ -25,6 +25,7 @@ mod auto;
 mod labels;
 mod phase;
 mod post;
+mod rectilinear;
 use phase::phase_lookup_rules;
 use post::{no_post_flags, post_plan};
 
@@ -32,6 +33,7 @@ use post::{no_post_flags, post_plan};
 pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
     request_rules(args)?;
     labels::label_rules(args)?;
+    let rectilinear = rectilinear::rectilinear_rules(args)?;
     let fa = &args.footprint;
     let precision = Precision::from(args.accum);
     clip_rules(args)?;
@@ -96,7 +98,8 @@ pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
         }
     }
     subsample_rules(args)?;
-    let auto_slicing = auto::slicing_target(&end, args);
+    // A rectilinear grid renders sheets (`rectilinear`): the pilot has no slabs to offer it.
+    let auto_slicing = auto::slicing_target(&end, args).filter(|_| !rectilinear);
     let plan = Plan {
         end,
         table: Table {
@@ -119,9 +122,10 @@ pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
         }),
         auto_slicing,
         auto_subsample: args.subsample.is_none() && auto_slicing.is_some(),
-        // A label volume renders level 0 (an average of labels names none): `auto` means it.
+        // A label volume renders level 0 (an average of labels names none), and so does a
+        // rectilinear grid (one of uneven spacing): `auto` means it.
         lod: match args.lod {
-            Lod::Auto if args.labels.is_some() => Lod::Level(0),
+            Lod::Auto if args.labels.is_some() || rectilinear => Lod::Level(0),
             lod => lod,
         },
         supersample: args.supersample,

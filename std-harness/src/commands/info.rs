@@ -103,12 +103,16 @@ impl Report {
             v.bytes()
         );
         let s = v.spacing;
+        let mean = if v.grid.is_some() { " (the mean)" } else { "" };
         crate::say!(
-            "spacing: {} x {} x {} world units per voxel (i, j, k)",
+            "spacing: {} x {} x {} world units per voxel (i, j, k){mean}",
             s[0],
             s[1],
             s[2]
         );
+        if let Some(g) = &v.grid {
+            crate::say!("grid: {} world units between neighbours", g.describe());
+        }
         let d = v.directions;
         crate::say!(
             "orientation: i -> {:?}, j -> {:?}, k -> {:?} (world directions)",
@@ -174,6 +178,18 @@ impl Report {
         let json = match &self.held {
             Some(note) => json.str("precision", note),
             None => json,
+        };
+        // A rectilinear grid: its coordinates' spread (gaps per axis, world units).
+        let json = match &v.grid {
+            Some(g) => json.obj(
+                "rectilinear",
+                (0..3).fold(Json::object(), |o, a| {
+                    let (lo, hi) = g.gaps()[a];
+                    let c = g.axis(a);
+                    o.arr_f64(["x", "y", "z"][a], &[c[0], c[c.len() - 1], lo, hi])
+                }),
+            ),
+            None => json.null("rectilinear"),
         };
         match &self.window {
             Ok((w, rule)) => json

@@ -460,6 +460,16 @@ fn refuse(inputs: &Scene, plan: &Plan) -> Result<(), CliError> {
             "{what} does not render in bricks: {why}"
         )))
     };
+    let rectilinear = inputs
+        .volume
+        .as_deref()
+        .is_some_and(crate::io::formats::is_rectilinear);
+    if rectilinear {
+        return no(
+            "a rectilinear grid (.vtr)",
+            "its samples' footprints are drawn by the refined renderer, which reads the whole grid",
+        );
+    }
     match plan.end {
         End::Sheets(_) | End::Slabs { .. } => {}
         End::Post { blend, .. } => {

@@ -207,6 +207,7 @@ pub fn render(
                 directions: h.directions,
                 samples,
                 brick: Some(place),
+                grid: None,
                 // Set from the whole volume's range with the others' (`render_brick`).
                 values: crate::io::volume::ValueMap::IDENTITY,
             };
@@ -297,6 +298,7 @@ pub fn render_in_situ(
         directions: crate::io::volume::AXIS_ALIGNED,
         samples,
         brick: Some(BrickPlace { stored, owned }),
+        grid: None,
         values: crate::io::volume::ValueMap::IDENTITY,
     };
     inputs.memory = Some(crate::io::stream::InMemory {

@@ -23,6 +23,7 @@ pub fn read_brick(
         directions,
         samples,
         brick: Some(place),
+        grid: None,
         values,
     };
     Ok((volume, bytes))
@@ -99,6 +100,8 @@ pub fn crop(volume: &Volume, place: BrickPlace) -> Result<Volume, CliError> {
         directions: volume.directions,
         samples,
         brick: Some(place),
+        // The whole volume's, as `dims` are.
+        grid: volume.grid.clone(),
         // The whole volume's: a brick's values are the volume's.
         values: volume.values,
     })

@@ -4,6 +4,7 @@
 pub mod brick;
 pub mod cut;
 pub mod formats;
+pub mod grid;
 pub mod image;
 pub mod json;
 pub mod outputs;

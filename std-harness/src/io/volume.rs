@@ -156,6 +156,8 @@ pub struct Volume {
     /// samples need rebasing ([`ValueMap::for_samples`], set by the loaders and
     /// [`Volume::new`]).
     pub values: ValueMap,
+    /// A rectilinear grid's coordinates (`.vtr`): `spacing` is then their mean ([`super::grid`]).
+    pub grid: Option<std::sync::Arc<super::grid::Coordinates>>,
 }
 
 /// The identity orientation.
@@ -171,6 +173,7 @@ impl Volume {
             values: ValueMap::for_samples(&samples),
             samples,
             brick: None,
+            grid: None,
         }
     }
 

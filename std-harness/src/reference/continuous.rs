@@ -125,7 +125,12 @@ fn march(
     // Grid steps to world: G = ((G⁻ᵀ)⁻¹)ᵀ.
     let grid = f.grid_inverse_transpose.as_dmat3().inverse().transpose();
     let camera = f.camera().copied();
-    let (lo, hi) = field.bounds();
+    // A rectilinear grid: the field's box in the frame's grid, and its argument warped.
+    let (lo, hi) = match &scene.grid {
+        Some(w) => (w.grid(field.bounds().0), w.grid(field.bounds().1)),
+        None => field.bounds(),
+    };
+    let warp = |g: DVec3| scene.grid.as_ref().map_or(g, |w| w.index(g));
     let clip = &scene.clip;
     let threads = scene.threads.max(1);
     let count = rays.count(f);
@@ -147,24 +152,7 @@ fn march(
                 for (i, px) in chunk.iter_mut().enumerate() {
                     let (x, y) = rays.pixel(f, t * band + i);
                     let (xc, yc) = (x as f64 + 0.5, y as f64 + 0.5);
-                    // The ray in affine screen units: P(t) = p0 + t·d, |d| = 1.
-                    let (p0, d) = match camera {
-                        None => (DVec3::new(xc, yc, 0.0), DVec3::Z),
-                        Some(c) => {
-                            let eye = DVec3::new(
-                                f64::from(c.centre[0]),
-                                f64::from(c.centre[1]),
-                                -f64::from(c.focal_px),
-                            );
-                            let d = DVec3::new(
-                                xc - f64::from(c.centre[0]),
-                                yc - f64::from(c.centre[1]),
-                                f64::from(c.focal_px),
-                            )
-                            .normalize();
-                            (eye, d)
-                        }
-                    };
+                    let (p0, d) = ray_of(camera.as_ref(), xc, yc);
                     // In grid coordinates: g(t) = g0 + t·dg.
                     let g0 = inv * (p0 - origin);
                     let dg = inv * d;
@@ -197,14 +185,18 @@ fn march(
                         for k in 0..steps {
                             if !nested {
                                 let tm = t0 + (k as f64 + 0.5) * step;
-                                if coarse.add(field.at(g0 + dg * tm, &mut taps), hw, absorption) {
+                                if coarse.add(
+                                    field.at(warp(g0 + dg * tm), &mut taps),
+                                    hw,
+                                    absorption,
+                                ) {
                                     break;
                                 }
                                 continue;
                             }
                             for j in 0..3 {
                                 let tm = t0 + (k as f64 + (2 * j + 1) as f64 / 6.0) * step;
-                                let v = field.at(g0 + dg * tm, &mut taps);
+                                let v = field.at(warp(g0 + dg * tm), &mut taps);
                                 if j == 1 && !coarse.done() {
                                     coarse.add(v, hw, absorption);
                                 }
@@ -229,6 +221,27 @@ fn march(
         }
     });
     (image, thirds, crossings)
+}
+
+/// The ray through the pixel centre (`xc`, `yc`) in affine screen units: P(t) = p0 + t·d,
+/// |d| = 1; parallel to the view without a `camera`, from its eye with one.
+fn ray_of(camera: Option<&footprint::geometry::Perspective>, xc: f64, yc: f64) -> (DVec3, DVec3) {
+    match camera {
+        None => (DVec3::new(xc, yc, 0.0), DVec3::Z),
+        Some(c) => {
+            let eye = DVec3::new(
+                f64::from(c.centre[0]),
+                f64::from(c.centre[1]),
+                -f64::from(c.focal_px),
+            );
+            let d = DVec3::new(
+                xc - f64::from(c.centre[0]),
+                yc - f64::from(c.centre[1]),
+                f64::from(c.focal_px),
+            );
+            (eye, d.normalize())
+        }
+    }
 }
 
 /// The part [t0, t1] of the ray g0 + t·dg (grid units) inside the box `bounds` (lo, hi) and
@@ -460,7 +473,11 @@ fn converge_on(
         .iter()
         .copied()
         .fold(f32::INFINITY, f32::min);
-    let mut h = 0.5 * f64::from(smallest);
+    // A rectilinear grid's: its shortest gap.
+    let smallest = (scene.grid.as_ref())
+        .and_then(|w| w.smallest_gap(scene.frame.spacing))
+        .unwrap_or(f64::from(smallest));
+    let mut h = 0.5 * smallest;
     let (mut image, mut crossings, mut passes, mut change, halvings) = if nested {
         // The first two passes from one march: steps of 3/4 of the smallest spacing and their
         // thirds (1/4 of it, the second pass's step without nesting), 2 samples per 1/2

@@ -13,10 +13,11 @@
 //!   keeps (1 − α)^dl). This is what ray casters such as VTK's compute (they interpolate
 //!   gradients the same way). Samples only exist inside the voxel box (the grid's own extent:
 //!   nothing is extrapolated past its faces; along an axis one voxel thick, that voxel's cell,
-//!   one grid step deep); a NaN value is a missing sample (weight zero) and a
-//!   sample whose weights are all missing is transparent.
+//!   one grid step deep); a NaN value is a missing sample (weight zero) and a sample whose
+//!   weights are all missing is transparent. A rectilinear grid warps the field's argument
+//!   (`super::warp`, which the march applies): the field itself is the uniform one's.
 
-use super::sparse::SparseGrid;
+use super::sparse::{dilate, SparseGrid};
 use crate::CliError;
 use footprint::frame::FrameSetup;
 use footprint::render::{gradient, Blend, ShadeCache, ShadeCacheEntry, SheetRing, SHADE_CACHE_LEN};
@@ -70,6 +71,8 @@ pub struct ContinuousScene<'a> {
     /// Post-classified and projected: samples exist among voxels `first..=last` per axis (a
     /// crop; `footprint::render::post::sample_box_of`), or the whole grid's (`None`).
     pub samples: Option<([usize; 3], [usize; 3])>,
+    /// A rectilinear grid's map from the frame's grid to sample indices.
+    pub grid: Option<super::warp::Warp>,
 }
 
 /// [`ContinuousScene::cap`] as the renderer takes it: 1 − `SlabVoxel::MAX_UNIT_ALPHA` = 10⁻⁶.
@@ -189,21 +192,22 @@ impl<'s> Field<'s> {
                         continue;
                     }
                     let idx = f.grid_index(s, u, v);
+                    // Central differences; a rectilinear grid's non-uniform ones.
+                    let grad = |u, v, idx| {
+                        let g = gradient(f, &window, u, v);
+                        scene.grid.as_ref().map_or(g, |w| w.gradient(f, g, idx))
+                    };
                     let stored = match scene.model {
                         Model::Pre(absorption) => {
                             let rgba = ShadeCache::shade(memo.as_mut(), value, false, || {
-                                scene.shader.shade(
-                                    &lighting,
-                                    value,
-                                    || gradient(f, &window, u, v),
-                                    idx,
-                                    dims,
-                                )
+                                scene
+                                    .shader
+                                    .shade(&lighting, value, || grad(u, v, idx), idx, dims)
                             });
                             pre_classified(rgba, absorption, scene.cap)
                         }
                         Model::Post => {
-                            let g = gradient(f, &window, u, v);
+                            let g = grad(u, v, idx);
                             Some([value, g.x, g.y, g.z])
                         }
                         Model::Projection(_) => Some([value, 0.0, 0.0, 0.0]),
@@ -476,30 +480,6 @@ fn reconstruction(scene: &ContinuousScene<'_>) -> Result<KernelFactors, CliError
     })
 }
 
-/// The blocks of a `blocks`-sized map (x fastest) within `r` blocks along every axis of one set
-/// in `holds`.
-fn dilate(holds: &[bool], blocks: [usize; 3], r: usize) -> Vec<bool> {
-    let mut out = vec![false; holds.len()];
-    let span = |c: usize, a: usize| c.saturating_sub(r)..=(c + r).min(blocks[a] - 1);
-    for z in 0..blocks[2] {
-        for y in 0..blocks[1] {
-            for x in 0..blocks[0] {
-                if !holds[(z * blocks[1] + y) * blocks[0] + x] {
-                    continue;
-                }
-                for bz in span(z, 2) {
-                    for by in span(y, 1) {
-                        for bx in span(x, 0) {
-                            out[(bz * blocks[1] + by) * blocks[0] + bx] = true;
-                        }
-                    }
-                }
-            }
-        }
-    }
-    out
-}
-
 /// The squared offsets d² and Gaussian factors exp(−k·d²) of the taps d = `d0`, `d0` − 1, …
 /// along one axis (as many as `d2` holds; `e` the same length), with `fall` = exp(−2k). The
 /// offset falls by one per tap, so two exponentials give them all: e(d − 1) = e(d)·q with
@@ -539,7 +519,8 @@ fn pre_classified(rgba: [f32; 4], absorption: Absorption, cap: f64) -> Option<[f
 
 #[cfg(test)]
 mod tests {
-    use super::{dilate, gaussian_taps, BLOCK};
+    use super::super::sparse::dilate;
+    use super::{gaussian_taps, BLOCK};
 
     #[test]
     fn dilated_blocks_cover_every_block_a_voxel_can_be_seen_from() {

@@ -19,6 +19,7 @@ pub mod perspective;
 mod projection;
 pub mod render;
 mod sparse;
+pub mod warp;
 
 use footprint::geometry::{in_sheet_axes, sheet_axis, RENORMALISE_BELOW_PX};
 use footprint::{GeometryError, Kernel};

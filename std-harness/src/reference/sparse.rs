@@ -145,6 +145,30 @@ fn local(idx: [usize; 3]) -> usize {
     ((idx[2] % SIDE) * SIDE + idx[1] % SIDE) * SIDE + idx[0] % SIDE
 }
 
+/// The blocks of a `blocks`-sized map (x fastest) within `r` blocks along every axis of one set
+/// in `holds`.
+pub(super) fn dilate(holds: &[bool], blocks: [usize; 3], r: usize) -> Vec<bool> {
+    let mut out = vec![false; holds.len()];
+    let span = |c: usize, a: usize| c.saturating_sub(r)..=(c + r).min(blocks[a] - 1);
+    for z in 0..blocks[2] {
+        for y in 0..blocks[1] {
+            for x in 0..blocks[0] {
+                if !holds[(z * blocks[1] + y) * blocks[0] + x] {
+                    continue;
+                }
+                for bz in span(z, 2) {
+                    for by in span(y, 1) {
+                        for bx in span(x, 0) {
+                            out[(bz * blocks[1] + by) * blocks[0] + bx] = true;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::SparseGrid;

@@ -8,8 +8,8 @@ use footprint_harness::io::formats::{self, raw::RawOptions};
 use libfuzzer_sys::fuzz_target;
 use std::sync::OnceLock;
 
-const EXTENSIONS: [&str; 9] = [
-    "nrrd", "nhdr", "vti", "vtk", "mhd", "mha", "nii", "nii.gz", "raw",
+const EXTENSIONS: [&str; 10] = [
+    "nrrd", "nhdr", "vti", "vtk", "mhd", "mha", "nii", "nii.gz", "raw", "vtr",
 ];
 
 fuzz_target!(|data: &[u8]| {

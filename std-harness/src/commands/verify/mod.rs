@@ -127,6 +127,17 @@ fn check(args: &VerifyArgs) -> Result<(), CliError> {
              projection against its own model with --reference continuous",
         ));
     }
+    let rectilinear = r
+        .volume
+        .as_deref()
+        .is_some_and(crate::io::formats::is_rectilinear);
+    if rectilinear && args.reference != ReferenceArg::Continuous {
+        return Err(CliError::input(
+            "a rectilinear grid (.vtr): the f64 sheet reference and the field reference place \
+             voxels on a uniform grid; measure it against its continuous model with \
+             --reference continuous",
+        ));
+    }
     if r.refine.is_some() && args.reference != ReferenceArg::Field {
         return Err(CliError::input(
             "verify's sheet and continuous references render the grid as given, so they would \

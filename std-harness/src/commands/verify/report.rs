@@ -58,6 +58,13 @@ impl Measured {
                  sampling)"
             );
         }
+        if self.p.volume().is_some_and(|v| v.grid.is_some()) {
+            crate::say!(
+                "(a rectilinear grid: the sheet reference renders its values on the uniform grid \
+                 of its mean spacing, so `overall` above is what the uneven spacing changes; the \
+                 continuous line below measures the grid)"
+            );
+        }
         if matches!(self.plan.end, End::Slabs { .. }) {
             crate::say!(
                 "(--slicing image: the sheet reference renders the paper's object-aligned sheets, \

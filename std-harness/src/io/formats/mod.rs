@@ -6,6 +6,7 @@
 //! |---|---|
 //! | `.nrrd`, `.nhdr` | [`nrrd`] |
 //! | `.vti` | [`vti`] |
+//! | `.vtr` (a rectilinear grid: per-axis coordinates, [`crate::io::grid`]) | [`vtr`] |
 //! | `.vtk` | [`vtk`] |
 //! | `.mhd`, `.mha` | [`metaimage`] |
 //! | `.nii`, `.nii.gz`, `.hdr` + `.img` / `.img.gz` | [`nifti`] (NIfTI-1, NIfTI-2, Analyze 7.5) |
@@ -18,6 +19,7 @@ pub mod nrrd;
 pub mod raw;
 pub mod vti;
 pub mod vtk;
+pub mod vtr;
 
 use crate::io::stream::Layout;
 use crate::io::volume::{at, byte_len, Data, SampleType, Samples, Volume};
@@ -212,8 +214,19 @@ pub fn raw_data_at(path: &Path, h: RawHeader<'_>) -> Result<Streamable, CliError
     })
 }
 
+/// What [`header_format`] calls a `.vtr`: a rectilinear grid, which renders through per-sample
+/// footprints (`args::resolve` has its rules).
+pub const RECTILINEAR: &str = "VTK XML rectilinear grid";
+
+/// Whether `path` names a rectilinear grid (a `.vtr`): what the plan's rules read before the
+/// file is.
+pub fn is_rectilinear(path: &Path) -> bool {
+    header_format(path) == Some(RECTILINEAR)
+}
+
 /// The formats by extension, for messages.
-pub const EXTENSIONS: &str = ".nrrd, .nhdr, .vti, .vtk, .mhd, .mha, .nii, .nii.gz, .hdr/.img \
+pub const EXTENSIONS: &str =
+    ".nrrd, .nhdr, .vti, .vtr, .vtk, .mhd, .mha, .nii, .nii.gz, .hdr/.img \
      (NIfTI or Analyze pair, either half may be .gz), or raw with --dims and --type";
 
 /// The format `path`'s extension names, if it is one with a header (NRRD, VTK XML image data,
@@ -227,6 +240,7 @@ pub fn header_format(path: &Path) -> Option<&'static str> {
     match name.rsplit('.').next().unwrap_or("") {
         "nrrd" | "nhdr" => Some("NRRD"),
         "vti" => Some("VTK XML image data"),
+        "vtr" => Some(RECTILINEAR),
         "vtk" => Some("legacy VTK"),
         "mhd" | "mha" => Some("MetaImage"),
         "nii" | "hdr" => Some("NIfTI"),
@@ -258,13 +272,16 @@ pub fn load_array(
 ) -> Result<Volume, CliError> {
     // Before the extension decides anything: a directory or a special file is named as such.
     crate::io::regular_file_len(path)?;
-    let vtk = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("vtk") || e.eq_ignore_ascii_case("vti"));
+    let vtk = path.extension().is_some_and(|e| {
+        ["vtk", "vti", "vtr"]
+            .iter()
+            .any(|x| e.eq_ignore_ascii_case(x))
+    });
     if array.is_some() && (raw.is_some() || !vtk) {
         return Err(at(
             path,
-            "--array picks one of several arrays in a VTK file (.vtk, .vti); this format holds one",
+            "--array picks one of several arrays in a VTK file (.vtk, .vti, .vtr); this format \
+             holds one",
         ));
     }
     if let Some(o) = raw {
@@ -279,6 +296,7 @@ pub fn load_array(
     match ext {
         "nrrd" | "nhdr" => nrrd::load(path),
         "vti" => vti::load(path, array),
+        "vtr" => vtr::load(path, array),
         "vtk" => vtk::load(path, array),
         "mhd" | "mha" => metaimage::load(path),
         "nii" | "hdr" => nifti::load(path),

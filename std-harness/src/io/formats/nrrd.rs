@@ -313,6 +313,7 @@ pub fn load(path: &Path) -> Result<Volume, CliError> {
         values: crate::io::volume::ValueMap::for_samples(&samples),
         samples,
         brick: None,
+        grid: None,
     })
 }
 

@@ -56,6 +56,8 @@ pub struct Header {
     pub format: Format,
     /// `NumberOfComponents`: components per point, interleaved (1 to 4).
     pub components: usize,
+    /// A `RectilinearGrid`'s coordinate arrays (x, y, z: type and where), empty for an image.
+    pub coordinates: Vec<(SampleType, Format)>,
 }
 
 /// How each data block is compressed (the `compressor` attribute of `VTKFile`).
@@ -190,20 +192,38 @@ pub fn parse_header_array<'a>(
     bytes: &'a [u8],
     array: Option<&str>,
 ) -> Result<(Header, Option<Appended<'a>>), String> {
+    parse_dataset(bytes, array, "ImageData")
+}
+
+/// [`parse_header_array`] of a VTK XML file of dataset `kind`: `ImageData`, or
+/// `RectilinearGrid` (`super::vtr`; its coordinate arrays in [`Header::coordinates`], its
+/// spacing 1).
+pub(super) fn parse_dataset<'a>(
+    bytes: &'a [u8],
+    array: Option<&str>,
+    kind: &str,
+) -> Result<(Header, Option<Appended<'a>>), String> {
     let (xml, appended) = split_appended(bytes)?;
     check_depth(&xml, MAX_XML_DEPTH)?;
     let doc = roxmltree::Document::parse(&xml).map_err(|e| format!("not valid XML: {e}"))?;
     let root = doc.root_element();
-    if root.tag_name().name() != "VTKFile" || root.attribute("type") != Some("ImageData") {
-        return Err("not a VTK XML ImageData file (VTKFile type=\"ImageData\")".into());
+    if root.tag_name().name() != "VTKFile" || root.attribute("type") != Some(kind) {
+        return Err(format!(
+            "not a VTK XML {kind} file (VTKFile type=\"{kind}\")"
+        ));
     }
     let (big_endian, header64, compressor) = encoding(root)?;
     let image = root
         .children()
-        .find(|n| n.has_tag_name("ImageData"))
-        .ok_or("no ImageData element")?;
+        .find(|n| n.has_tag_name(kind))
+        .ok_or_else(|| format!("no {kind} element"))?;
     let (dims, spacing, directions) = geometry(image)?;
     let (ty, format, components) = data_array(choose_array(image, array)?)?;
+    let coordinates = if kind == "RectilinearGrid" {
+        coordinate_arrays(image)?
+    } else {
+        Vec::new()
+    };
     byte_len(super::interleaved(dims, components)?, ty)?;
     if matches!(format, Format::Appended { .. }) && appended.is_none() {
         return Err("appended DataArray but no AppendedData section".into());
@@ -219,6 +239,7 @@ pub fn parse_header_array<'a>(
             compressor,
             format,
             components,
+            coordinates,
         },
         appended,
     ))
@@ -263,9 +284,7 @@ type Geometry = ([usize; 3], [f32; 3], [[f32; 3]; 3]);
 /// The `ImageData` element's dimensions (from `WholeExtent`), spacing and axis directions.
 fn geometry(image: Node<'_, '_>) -> Result<Geometry, String> {
     let extent: Vec<i64> = numbers(
-        image
-            .attribute("WholeExtent")
-            .ok_or("ImageData has no WholeExtent")?,
+        image.attribute("WholeExtent").ok_or("no WholeExtent")?,
         6,
         "WholeExtent",
     )?;
@@ -318,14 +337,7 @@ fn choose_array<'a, 'input>(
     if pieces.len() != 1 {
         return Err(format!("expected one Piece, found {}", pieces.len()));
     }
-    let point_data = pieces[0]
-        .children()
-        .find(|n| n.has_tag_name("PointData"))
-        .ok_or("Piece has no PointData")?;
-    let arrays: Vec<_> = point_data
-        .children()
-        .filter(|n| n.has_tag_name("DataArray"))
-        .collect();
+    let (point_data, arrays) = arrays_in(pieces[0], "PointData", "Piece has no PointData")?;
     let names = || {
         arrays
             .iter()
@@ -343,6 +355,58 @@ fn choose_array<'a, 'input>(
         (None, None) => arrays.first().ok_or("PointData has no scalar DataArray")?,
     };
     Ok(*found)
+}
+
+/// An element and the `DataArray`s in it.
+type Arrays<'a, 'input> = (Node<'a, 'input>, Vec<Node<'a, 'input>>);
+/// `piece`'s child element `tag` and the `DataArray`s in it; `missing` where it has none.
+fn arrays_in<'a, 'input>(
+    piece: Node<'a, 'input>,
+    tag: &str,
+    missing: &str,
+) -> Result<Arrays<'a, 'input>, String> {
+    let holder = piece
+        .children()
+        .find(|n| n.has_tag_name(tag))
+        .ok_or(missing)?;
+    let arrays = holder
+        .children()
+        .filter(|n| n.has_tag_name("DataArray"))
+        .collect();
+    Ok((holder, arrays))
+}
+
+/// The `RectilinearGrid` element's coordinate arrays: its one piece's `Coordinates`, exactly
+/// three `DataArray`s of one component (x, y, z), each's type and where its values are.
+fn coordinate_arrays(grid: Node<'_, '_>) -> Result<Vec<(SampleType, Format)>, String> {
+    let piece = grid
+        .children()
+        .find(|n| n.has_tag_name("Piece"))
+        .ok_or("no Piece")?;
+    let (_, arrays) = arrays_in(
+        piece,
+        "Coordinates",
+        "Piece has no Coordinates (a RectilinearGrid needs its x, y and z coordinates)",
+    )?;
+    if arrays.len() != 3 {
+        return Err(format!(
+            "Coordinates hold {} DataArrays, expected 3 (x, y, z)",
+            arrays.len()
+        ));
+    }
+    arrays
+        .iter()
+        .zip(["x", "y", "z"])
+        .map(|(a, name)| {
+            let (ty, format, components) = data_array(*a)?;
+            if components != 1 {
+                return Err(format!(
+                    "{name} coordinates have {components} components, expected 1"
+                ));
+            }
+            Ok((ty, format))
+        })
+        .collect()
 }
 
 /// A `DataArray`'s sample type, where its values are, and its components per point (1 to 4).
@@ -496,32 +560,41 @@ fn read(
     let need = super::interleaved(h.dims, h.components)
         .and_then(|d| byte_len(d, h.ty))
         .map_err(|e| at(path, e))?;
-    let err = |e: String| at(path, e);
-    let samples = match &h.format {
-        Format::Ascii(text) => decode_ascii(text, h.ty, need / h.ty.size()).map_err(err)?,
+    let samples = array_samples(&h, appended, (h.ty, &h.format), need).map_err(|e| at(path, e))?;
+    Ok((h, samples))
+}
+
+/// The `need` bytes of one array of type `ty` stored as `format` (ascii, base64, or in the
+/// `appended` section), decoded; the file's encoding (byte order, header words, compressor) is
+/// `h`'s.
+pub(super) fn array_samples(
+    h: &Header,
+    appended: Option<Appended<'_>>,
+    (ty, format): (SampleType, &Format),
+    need: usize,
+) -> Result<crate::io::volume::Samples, String> {
+    Ok(match format {
+        Format::Ascii(text) => decode_ascii(text, ty, need / ty.size())?,
         Format::Binary(text) => decode(
-            &block_stream(&base64_segments(text).map_err(err)?, &h, need).map_err(err)?,
-            h.ty,
+            &block_stream(&base64_segments(text)?, h, need)?,
+            ty,
             h.big_endian,
-        )
-        .map_err(err)?,
+        )?,
         Format::Appended { offset } => {
             let Appended {
                 bytes: section,
                 raw,
-            } = appended.expect("checked by parse_header");
+            } = appended.ok_or("appended DataArray but no AppendedData section")?;
             let start = section
                 .get(*offset..)
-                .ok_or_else(|| err(format!("appended offset {offset} is past the end")))?;
+                .ok_or_else(|| format!("appended offset {offset} is past the end"))?;
             let bytes = if raw {
-                block_stream(start, &h, need).map_err(err)?
+                block_stream(start, h, need)?
             } else {
                 let end = start.iter().position(|&b| b == b'<').unwrap_or(start.len());
-                block_stream(&base64_segments(&start[..end]).map_err(err)?, &h, need)
-                    .map_err(err)?
+                block_stream(&base64_segments(&start[..end])?, h, need)?
             };
-            decode(&bytes, h.ty, h.big_endian).map_err(err)?
+            decode(&bytes, ty, h.big_endian)?
         }
-    };
-    Ok((h, samples))
+    })
 }

@@ -39,6 +39,10 @@ fn continuous_scene(
         cap,
         clip: p.clip.iter().map(|c| c.in_grid(&p.frame)).collect(),
         samples: super::post::sample_range(volume),
+        grid: volume
+            .grid
+            .as_deref()
+            .map(|c| crate::reference::warp::Warp::new(c.positions())),
         // A reference: every core (at most 16) unless the caller says otherwise.
         threads: std::thread::available_parallelism()
             .map_or(1, |n| n.get())
@@ -283,7 +287,8 @@ pub fn probes(
         Probe {
             depth: world.dot(away),
             world: world.to_array(),
-            value: trilinear(volume, *g),
+            // At the sample indices a rectilinear grid's crossing falls between.
+            value: trilinear(volume, scene_grid_index(&scene, *g)),
         }
     };
     Ok((
@@ -321,4 +326,11 @@ fn trilinear(volume: &crate::io::volume::Volume, g: [f64; 3]) -> f64 {
         }
     }
     sum
+}
+
+/// Sample-index coordinates of the frame's grid point `g` in `scene` (warped on a rectilinear
+/// grid, `crate::reference::warp`).
+fn scene_grid_index(scene: &ContinuousScene<'_>, g: [f64; 3]) -> [f64; 3] {
+    let g = glam::DVec3::from_array(g);
+    scene.grid.as_ref().map_or(g, |w| w.index(g)).to_array()
 }

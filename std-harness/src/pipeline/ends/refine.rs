@@ -182,49 +182,82 @@ pub fn render_refined(
     let start = Instant::now();
     let refinement = choose(p, volume, threshold, sheets)?;
     let classify = start.elapsed().as_secs_f64();
+    grid_frame(p, plan, Some(refinement), start, classify)
+}
+
+/// A rectilinear grid's sheets as they are (every factor 1; `footprint::refine`, "Rectilinear
+/// grids"): what [`End::Sheets`] draws for a volume with coordinates (`crate::io::grid`).
+pub fn render_rectilinear(p: &Prepared, plan: &Plan) -> Result<CoreFrame, CliError> {
+    check(p).map_err(|e| CliError::input(format!("a rectilinear grid: {e}")))?;
+    grid_frame(p, plan, None, Instant::now(), 0.0)
+}
+
+/// The frame of `p`'s grid (rectilinear where the volume has coordinates) split as
+/// `refinement` says (unsplit for `None`), chosen at `start` in `classify` seconds, through
+/// `plan`'s tables.
+fn grid_frame(
+    p: &Prepared,
+    plan: &Plan,
+    refinement: Option<Refinement>,
+    start: Instant,
+    classify: f64,
+) -> Result<CoreFrame, CliError> {
     /// The refined frame through tables of side N.
     struct Refined<'a> {
         p: &'a Prepared,
         plan: &'a Plan,
-        refinement: Refinement,
-        start: Instant,
-        classify: f64,
+        chosen: Chosen,
     }
     impl crate::dispatch::TableSize for Refined<'_> {
         type Output = CoreFrame;
         fn run<const N: usize>(self) -> Result<CoreFrame, CliError> {
-            refined_at::<N>(
-                self.p,
-                self.plan,
-                self.refinement,
-                self.start,
-                self.classify,
-            )
+            refined_at::<N>(self.p, self.plan, self.chosen)
         }
     }
-    let work = Refined {
-        p,
-        plan,
+    let chosen = Chosen {
         refinement,
         start,
         classify,
     };
-    crate::dispatch::with_size(plan.table.size, work)
+    crate::dispatch::with_size(plan.table.size, Refined { p, plan, chosen })
 }
 
-/// [`render_refined`] with tables of side `N`, its refinement chosen at `start` in `classify`
-/// seconds.
+/// What a refined frame was split by: the refinement (none: the grid as it is), when the frame
+/// began and the seconds choosing it took.
+struct Chosen {
+    refinement: Option<Refinement>,
+    start: Instant,
+    classify: f64,
+}
+
+/// [`grid_frame`] with tables of side `N`. A rectilinear grid's samples have spacings of
+/// their own, which no spacing key's footprint is built for: they read the rate tables at their
+/// own scales.
 fn refined_at<const N: usize>(
     p: &Prepared,
     plan: &Plan,
-    refinement: Refinement,
-    start: Instant,
-    classify: f64,
+    chosen: Chosen,
 ) -> Result<CoreFrame, CliError> {
+    let Chosen {
+        refinement,
+        start,
+        classify,
+    } = chosen;
     let f = &p.frame;
+    let ones: [Vec<u8>; 3] = f.dims.map(|n| vec![1u8; n.saturating_sub(1)]);
+    let factors = refinement.as_ref().map_or(&ones, |r| &r.factors);
+    let coordinates = p.volume().and_then(|v| v.grid.as_deref());
+    let positions: Option<[Vec<f32>; 3]> =
+        coordinates.map(|c| c.positions().map(|a| a.iter().map(|&x| x as f32).collect()));
     let axis = |a: usize| {
-        RefinedAxis::new(a, f.dims[a], &refinement.factors[a])
-            .map_err(|e| CliError::input(format!("--refine: {e}")))
+        match &positions {
+            Some(at) => RefinedAxis::rectilinear(a, &at[a], &factors[a]),
+            None => RefinedAxis::new(a, f.dims[a], &factors[a]),
+        }
+        .map_err(|e| match positions {
+            Some(_) => CliError::input(format!("a rectilinear grid, in f32 grid steps: {e}")),
+            None => CliError::input(format!("--refine: {e}")),
+        })
     };
     let grid = RefinedGrid {
         axes: [axis(0)?, axis(1)?, axis(2)?],
@@ -235,8 +268,11 @@ fn refined_at<const N: usize>(
     // Refined footprints are many and small: their stencils get at most REFINE_PHASES
     // phases per pixel (a 1/16-px placement), which keeps building them cheap.
     let phases = plan.phases.min(REFINE_PHASES);
-    let keys = spacing_keys(&grid, f);
-    let rate_tables = rate_tables::<N>(p, &refinement, &keys, &generic, lookup)?;
+    let keys = match positions {
+        Some(_) => Vec::new(),
+        None => spacing_keys(&grid, f),
+    };
+    let rate_tables = rate_tables::<N>(p, &grid, &keys, &generic, lookup)?;
     let base = &*rate_tables.iter().find(|(r, _)| *r == 2).expect("built").1;
     let rates = [0, 1, 2, 3, 4].map(|r| {
         rate_tables
@@ -273,7 +309,7 @@ fn refined_at<const N: usize>(
         },
         threads: plan.threads.clamp(1, f.size[1]),
         visible: None,
-        refine: Some(refinement),
+        refine: refinement,
     })
 }
 
@@ -318,14 +354,14 @@ fn local_footprint(p: &Prepared, m: &glam::Mat3) -> Result<Footprint, CliError> 
 /// by rate index; rate 1 (index 2) always.
 fn rate_tables<const N: usize>(
     p: &Prepared,
-    refinement: &Refinement,
+    grid: &RefinedGrid,
     keys: &[(usize, usize)],
     generic: &GenericTable<N>,
     lookup: Lookup,
 ) -> Result<Vec<(usize, Box<ViewTable<N>>)>, CliError> {
     let f = &p.frame;
     let (k, (a, b)) = (f.sheet_axis, f.in_sheet);
-    let mut needed = rates_needed(refinement, k, (a, b));
+    let mut needed = rates_needed(grid, k, (a, b));
     for &(key, _) in keys.iter().filter(|&&(key, _)| !symmetric(key)) {
         let (sa, sb, w) = key_spacings(key);
         needed[rate_index(sa, sb, w)] = true;
@@ -470,32 +506,30 @@ impl<const N: usize> Splatter for Exact<'_, N> {
     }
 }
 
-/// The distinct widths (mean of the two spacings, coarse steps) of an axis's refined samples.
-fn widths(factors: &[u8]) -> Vec<f32> {
-    let mut w: Vec<f32> = vec![1.0];
-    let step = |f: u8| 1.0 / f32::from(f);
-    for (i, &f) in factors.iter().enumerate() {
-        w.push(step(f));
-        if let Some(&g) = factors.get(i + 1) {
-            w.push(0.5 * (step(f) + step(g)));
-        }
-    }
-    w.sort_by(f32::total_cmp);
-    w.dedup();
-    w
+/// The least and greatest width (mean of the two spacings, grid steps) of an axis's samples.
+fn widths(axis: &RefinedAxis) -> (f32, f32) {
+    let (mut lo, mut hi) = (f32::INFINITY, 0.0f32);
+    let _ = axis.for_each::<()>(true, |s| {
+        (lo, hi) = (lo.min(s.width()), hi.max(s.width()));
+        Ok(())
+    });
+    (lo.min(hi), hi)
 }
 
-/// Which rates ([`RefineTables::rate_index`]) some sample of `r` can ask for.
-fn rates_needed(r: &Refinement, sheet: usize, (a, b): (usize, usize)) -> [bool; 5] {
-    let mut needed = [false; 5];
-    for wz in widths(&r.factors[sheet]) {
-        for wa in widths(&r.factors[a]) {
-            for wb in widths(&r.factors[b]) {
-                needed[rate_index([wa; 2], [wb; 2], wz)] = true;
-            }
-        }
-    }
-    needed
+/// Which rates ([`RefineTables::rate_index`]) some sample of `grid` can ask for: every one
+/// between the least and the greatest (the rate grows with the sheet's width and falls with the
+/// in-sheet widths).
+fn rates_needed(grid: &RefinedGrid, sheet: usize, (a, b): (usize, usize)) -> [bool; 5] {
+    let ((za, zb), (aa, ab), (ba, bb)) = (
+        widths(&grid.axes[sheet]),
+        widths(&grid.axes[a]),
+        widths(&grid.axes[b]),
+    );
+    let (least, most) = (
+        rate_index([ab; 2], [bb; 2], za),
+        rate_index([aa; 2], [ba; 2], zb),
+    );
+    std::array::from_fn(|r| (least..=most).contains(&r))
 }
 
 /// Stencil floats for a footprint that `samples` samples share, if stencils pay: they cost

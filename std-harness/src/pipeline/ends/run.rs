@@ -78,6 +78,20 @@ pub fn end_frame(p: &Prepared, plan: &Plan, cache: &mut FrameCache) -> Result<Co
              composites each kernel whole",
         ));
     }
+    // A rectilinear grid's samples each have their own footprint: the refined renderer's
+    // sheets draw them (`super::refine::render_rectilinear`), and no other end can.
+    if p.volume().is_some_and(|v| v.grid.is_some()) {
+        return match plan.end {
+            End::Refined { threshold, sheets } => {
+                super::refine::render_refined(p, plan, threshold, sheets)
+            }
+            End::Sheets(PlanPrecision::Float) => super::refine::render_rectilinear(p, plan),
+            _ => Err(CliError::input(
+                "a rectilinear grid (.vtr) renders float sheets with a footprint per sample; \
+                 this frame's end places every kernel on one uniform grid",
+            )),
+        };
+    }
     match plan.end {
         End::Refined { threshold, sheets } => {
             super::refine::render_refined(p, plan, threshold, sheets)

@@ -220,6 +220,7 @@ pub fn coarsen_volume(
         directions: v.directions,
         samples: Samples::Coloured(out.into()),
         brick: None,
+        grid: None,
         // Coarsened from the values, already mapped.
         values: crate::io::volume::ValueMap::IDENTITY,
     })
