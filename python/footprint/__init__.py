@@ -94,7 +94,7 @@ def _volume_of(volume: Any, spacing):
         array = np.asarray(scalars)
         if array.ndim != 1:
             raise ValueError("the ImageData's active scalars have several components: render one")
-        return array.reshape(dims, order="F"), tuple(float(s) for s in volume.spacing)
+        return array.reshape(dims, order="F"), tuple(float(s) for s in getattr(volume, "spacing", spacing))
     array = np.asarray(volume)
     if array.dtype.byteorder not in ("=", "|") and array.dtype.byteorder != _NATIVE:
         # Another byte order (np.fromfile(f, ">u2"), how raw CT files are read): one copy in
@@ -134,11 +134,18 @@ def render(
     None: ``ct-bone-skin``, as ``footprint render`` on a file.
     Any other ``footprint render`` flag is a keyword (``shading="phong"``, ``threads=2``,
     ``slicing="image"``, ``accum="fixed"``, ``lod=0``, ...). ``labels={1: (1, 0, 0, 0.5), ...}``
-    (or a path, or the JSON text) renders an integer label volume in the labels' colours. ``out="x.png"`` (or ``.pfm``) and
+    (or a path, or the JSON text) renders an integer label volume in the labels' colours.
+    ``coordinates=(x, y, z)`` (each one coordinate per sample, world units, strictly increasing;
+    also taken from a ``pyvista.RectilinearGrid``) renders the array on that rectilinear grid,
+    each sample's footprint scaled to its own spacings (``spacing`` is then their mean; see
+    docs/rectilinear.md). ``out="x.png"`` (or ``.pfm``) and
     ``json="x.json"`` also write the image and the summary as ``footprint render`` does (both or
     neither; the paths are checked before rendering).
     Ctrl-C interrupts the render within a sheet or slab and raises ``KeyboardInterrupt``.
     """
+    if hasattr(volume, "x") and hasattr(volume, "z") and hasattr(volume, "point_data"):
+        # pyvista.RectilinearGrid: its coordinates, and its scalars as ImageData's are read.
+        flags = dict(flags, coordinates=(volume.x, volume.y, volume.z))
     array, spacing = _volume_of(volume, spacing)
     keywords = _common(size, view, tf, window, flags)
     image = _footprint.render_array(array, tuple(float(s) for s in spacing), keywords)

@@ -5,6 +5,8 @@
 use crate::py_err;
 use footprint_harness::args::keywords::{from_keywords, Keywords};
 use footprint_harness::args::Value;
+use footprint_harness::io::grid::Coordinates;
+use footprint_harness::io::volume::Volume;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyString};
@@ -58,4 +60,41 @@ pub fn request<T: Keywords>(keywords: &Bound<'_, PyDict>) -> PyResult<T> {
         }
     }
     from_keywords(pairs.iter().map(|(k, v)| (k.as_str(), v))).map_err(py_err)
+}
+
+/// Takes the `coordinates` keyword out of `keywords` (it is no flag: a `.vtr` carries them in
+/// the file): a rectilinear grid's (x, y, z) coordinates, three sequences of numbers in world
+/// units, one per sample along each axis; `None` where it is absent or None.
+pub fn take_coordinates(keywords: &Bound<'_, PyDict>) -> PyResult<Option<[Vec<f64>; 3]>> {
+    let Some(c) = keywords.get_item("coordinates")? else {
+        return Ok(None);
+    };
+    keywords.del_item("coordinates")?;
+    if c.is_none() {
+        return Ok(None);
+    }
+    let bad = || PyValueError::new_err("coordinates: give three sequences of numbers (x, y, z)");
+    let mut axes = Vec::new();
+    for axis in c.try_iter().map_err(|_| bad())? {
+        let numbers = axis?
+            .try_iter()
+            .map_err(|_| bad())?
+            .map(|x| x?.extract::<f64>().map_err(|_| bad()))
+            .collect::<PyResult<Vec<f64>>>()?;
+        axes.push(numbers);
+    }
+    let [x, y, z]: [Vec<f64>; 3] = axes.try_into().map_err(|_| bad())?;
+    Ok(Some([x, y, z]))
+}
+
+/// `volume` on the rectilinear grid of `coordinates` (checked against its dims: finite,
+/// strictly increasing; its spacing becomes their mean), or as it is for `None`.
+pub fn on_grid(mut volume: Volume, coordinates: Option<[Vec<f64>; 3]>) -> PyResult<Volume> {
+    if let Some(axes) = coordinates {
+        let grid = Coordinates::new(axes, volume.dims)
+            .map_err(|e| PyValueError::new_err(format!("coordinates: {e}")))?;
+        volume.spacing = grid.mean_spacing();
+        volume.grid = Some(std::sync::Arc::new(grid));
+    }
+    Ok(volume)
 }

@@ -296,8 +296,10 @@ fn render_array<'py>(
     spacing: (f64, f64, f64),
     keywords: &Bound<'py, PyDict>,
 ) -> PyResult<Bound<'py, PyArray3<f32>>> {
+    let coordinates = keywords::take_coordinates(keywords)?;
     let mut args: RenderArgs = request(keywords)?;
     let (image, size) = with_volume(volume, spacing3(spacing), |v, _| {
+        let v = keywords::on_grid(v, coordinates)?;
         if args.window.is_none() {
             // A constant volume (np.zeros) has no range to map: it renders as the transfer
             // function's low end, where the command line asks for --window.

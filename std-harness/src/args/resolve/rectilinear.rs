@@ -5,7 +5,8 @@
 //! `--clip`, post-classification and projections, the fixed-point path, perspective footprints,
 //! the f64 sheet reference and the other table methods, levels of detail, `--quality`'s choices,
 //! culling and nearest-phase stencils) or reads the file in parts (`--stream`, `--crop`) is
-//! refused with the reason. The format is known from the file's name before it is read.
+//! refused with the reason. The format is known from the file's name before it is read (or from
+//! a volume in memory, Python's `coordinates=`).
 
 use crate::args::{
     AccumArg, BlendArg, ClassificationArg, Lod, MethodArg, PhaseLookupArg, RenderArgs, SlicingArg,
@@ -16,7 +17,11 @@ use crate::CliError;
 /// Whether `args` render a rectilinear grid, after checking the flags it refuses.
 pub(super) fn rectilinear_rules(args: &RenderArgs) -> Result<bool, CliError> {
     let path = args.volume.as_deref().or(args.stream.as_deref());
-    if !path.is_some_and(is_rectilinear) {
+    let in_memory = args
+        .memory
+        .as_ref()
+        .is_some_and(|m| m.volume.grid.is_some());
+    if !(path.is_some_and(is_rectilinear) || in_memory) {
         return Ok(false);
     }
     let uniform = "kernels on one uniform grid, where a rectilinear grid's samples each have \
@@ -87,7 +92,7 @@ pub(super) fn rectilinear_rules(args: &RenderArgs) -> Result<bool, CliError> {
     };
     match why {
         Some((flag, why)) => Err(CliError::input(format!(
-            "a rectilinear grid (.vtr) with {flag}: {why}"
+            "a rectilinear grid with {flag}: {why}"
         ))),
         None => Ok(true),
     }
