@@ -21,14 +21,21 @@
 #  4. the worst-case stack from the compiler's stack sizes fits STACK_BUDGET and bounds what the
 #     painted stack measured;
 #  5. the float build's figures, and every build's instructions per frame under -icount, for the
-#     README's cost table.
+#     README's cost table;
+#  6. every compact board's estimated cycles per orbit frame, by instruction class, from QEMU's log
+#     of the blocks it executes (cycles.py: ARM's documented timings; its instruction count must
+#     equal the SysTick figure, and its count of the calibration loop a hand count), frames per
+#     second at the board's clock, and CI fails past each board's cycle ceiling (below); the
+#     M4F also renders 128×128 (`--features side128`, its own summary line `M4F 128x128`).
 # Needs: qemu-system-arm, rustup targets thumbv6m-none-eabi, thumbv7m-none-eabi,
 # thumbv7em-none-eabihf, and the llvm-tools component.
 set -euo pipefail
 cd "$(dirname "$0")"
 
-# The compact path's per-view stencil set-up keeps one box of float weights on the stack.
+# The compact path's per-view stencil set-up keeps one box of float weights on the stack (9×9 at
+# the M4F's 128², which has 4 MiB of RAM: its budget is larger).
 STACK_BUDGET=4608
+STACK_BUDGET_LARGE=6144
 # -icount shift=0: the virtual clock advances 1 ns per instruction, so the firmware's SysTick
 # count (calibrated against a loop of known length) is an instruction count, the same every run.
 QEMU_FLAGS=(-nographic -icount shift=0 -semihosting-config enable=on,target=native)
@@ -56,13 +63,27 @@ host_out=$out
 host_value() { sed -n "s/^$1$2 \(0x[0-9a-f]*\).*/\1/p" <<<"$host_out"; }
 host_orbit() { sed -n "s/^$1orbit checksums //p" <<<"$host_out"; }
 
-# run MACHINE CPU ELF: prints the firmware's output, fails on a non-zero exit or a timeout
-# (CPU "-": the machine's own).
+# run MACHINE CPU ELF [CORE CYCLES]: prints the firmware's output, fails on a non-zero exit or a
+# timeout (CPU "-": the machine's own). With CORE (m0, m3, m4), QEMU also logs every block it
+# executes into a FIFO that cycles.py reads as it is written, and each measured region's
+# instructions and estimated cycles by instruction class go to the file CYCLES.
 run() {
-  local cpu=(-cpu "$2")
+  local cpu=(-cpu "$2") log=() fifo="" pid="" limit=300
   [ "$2" = - ] && cpu=()
-  timeout 300 qemu-system-arm -machine "$1" "${cpu[@]}" "${QEMU_FLAGS[@]}" -kernel "$3" \
-    || fail "$3 on $1 exited with $?"
+  if [ $# -ge 5 ]; then
+    fifo=$(mktemp -u "${TMPDIR:-/tmp}/footprint-exec.XXXXXX")
+    mkfifo "$fifo"
+    timeout 1200 python3 cycles.py "$4" "$3" "$fifo" --selftest >"$5" 2>&1 &
+    pid=$!
+    log=(-d in_asm,exec,nochain -D "$fifo")
+    limit=1200
+  fi
+  timeout "$limit" qemu-system-arm -machine "$1" "${cpu[@]}" "${QEMU_FLAGS[@]}" "${log[@]}" -kernel "$3" \
+    || { [ -z "$pid" ] || kill "$pid" 2>/dev/null; fail "$3 on $1 exited with $?"; }
+  if [ -n "$pid" ]; then
+    wait "$pid" || fail "cycles.py on $3: $(cat "$5")"
+    rm -f "$fifo"
+  fi
 }
 images=target/embedded-images
 mkdir -p "$images"
@@ -79,7 +100,7 @@ field() { sed -n "s/^$1 \([0-9]*\) bytes/\1/p" <<<"$2"; }
 instr() { sed -n 's/^frame instructions \([0-9]*\).*/\1/p' <<<"$1"; }
 frame_sums() { sed -n 's/^frame [0-9]* checksum \(0x[0-9a-f]*\) .*/\1/p' <<<"$1" | paste -sd' '; }
 frame_instr() { sed -n 's/^frame [0-9]* checksum 0x[0-9a-f]* instructions \([0-9]*\)/\1/p' <<<"$1" | paste -sd' '; }
-# stack_bound TARGET DIR FEATURES: the worst-case stack of the render chain (the compiler's stack
+# stack_bound TARGET DIR FEATURES [BUDGET]: the worst-case stack of the render chain (the compiler's stack
 # sizes), printed; the bound in $bound.
 stack_bound() {
   RUSTC_BOOTSTRAP=1 RUSTFLAGS="-Z emit-stack-sizes ${LINK[*]}" \
@@ -89,7 +110,7 @@ stack_bound() {
   # high-water mark is taken).
   local b
   b=$(python3 elf_check.py stack-bound "$2/$1/release/footprint-firmware" \
-    "__stext>main>___cortex_m_rt_main>footprint_firmware6render" "$STACK_BUDGET")
+    "__stext>main>___cortex_m_rt_main>footprint_firmware6render" "${4:-$STACK_BUDGET}")
   echo "$b"
   bound=$(sed -n 's/^stack-bound: worst case from [^:]*: \([0-9]*\) bytes.*/\1/p' <<<"$b")
 }
@@ -97,15 +118,28 @@ stack_bound() {
 report=target/embedded-report.txt
 mkdir -p target
 : > "$report"
-# board NAME TARGET MACHINE CPU RAM PREFIX FEATURES: the compact firmware on one board.
+# Each board's worst orbit frame, estimated cycles (cycles.py: ARM's documented timings, upper
+# ends of ranges, no wait states). TARGET is the budget issue 78 set: the micro:bit a frame a
+# second at 16 MHz, the M4F's 128² ten frames a second at 168 MHz. CI fails past CEILING: the
+# TARGET where a board meets it, otherwise the worst frame measured when the ceiling was last set
+# plus 2 % (so a regression stops CI while the gap to the target is printed on every run).
+declare -A TARGET=([microbit]=16000000 [M4F-128]=16800000)
+declare -A CEILING=([microbit]=30240000 [M4F-128]=44690000 [M4F]=16920000 [M3]=22680000 [STM32F100]=23180000)
+# The clock each board's frames per second are given at, MHz: the micro:bit's nRF51822 16,
+# QEMU's MPS2 FPGA images 25 (the M3's), the STM32F100 24; the M4F's 168, a 168 MHz STM32F4-class
+# part, as the issue's budget (QEMU's mps2-an386 models its core, not a clock).
+declare -A CLOCK=([microbit]=16 [M4F-128]=168 [M4F]=168 [M3]=25 [STM32F100]=24)
+
+# board NAME TARGET MACHINE CPU CORE RAM PREFIX LABEL PSNR FEATURES: the compact firmware on one
+# board (LABEL starts its summary line; PSNR the least dB against float it must reach).
 board() {
-  local name=$1 target=$2 machine=$3 cpu=$4 ram=$5 prefix=$6 features=$7
+  local name=$1 target=$2 machine=$3 cpu=$4 core=$5 ram=$6 prefix=$7 label=$8 least=$9 features=${10}
   local dir=target/board-$name
-  echo "== $name compact ($target on $machine)"
+  echo "== $label compact ($target on $machine)"
   cargo build -q --release -p footprint-firmware --target "$target" --target-dir "$dir" $features
   local elf=$dir/$target/release/footprint-firmware
   local out
-  out=$(run "$machine" "$cpu" "$elf")
+  out=$(run "$machine" "$cpu" "$elf" "$core" "target/$name.cycles")
   grep -v '^row ' <<<"$out"
   printf '%s\n' "$out" > "target/$name.log"
   local sum shown sums want
@@ -121,25 +155,66 @@ board() {
   cmp_out=$(compare "$name" "target/$name.log")
   echo "$cmp_out"
   psnr=$(sed -n 's/.*psnr_vs_float \([0-9.]*\) dB.*/\1/p' <<<"$cmp_out")
-  python3 -c "import sys; sys.exit(0 if float('$psnr') >= 40 else 1)" || fail "$name: PSNR $psnr dB < 40"
+  python3 -c "import sys; sys.exit(0 if float('$psnr') >= $least else 1)" || fail "$name: PSNR $psnr dB < $least"
   python3 elf_check.py float-audit "$elf"
   local statics stack flash
   statics=$(field 'static RAM' "$out"); stack=$(field 'stack high-water' "$out"); flash=$(field flash "$out")
   [ -n "$statics" ] && [ -n "$stack" ] && [ -n "$flash" ] || fail "$name: missing figures"
   [ $((statics + stack)) -le "$ram" ] || fail "$name: static RAM $statics + stack $stack > $ram"
-  echo "== $name stack bound"
-  stack_bound "$target" "target/stack-$name" "$features"
+  echo "== $label stack bound"
+  local budget=$STACK_BUDGET
+  [ "$name" = M4F-128 ] && budget=$STACK_BUDGET_LARGE
+  stack_bound "$target" "target/stack-$name" "$features" "$budget"
   [ -n "$bound" ] && [ "$stack" -le "$bound" ] || fail "$name: painted stack $stack exceeds the computed bound $bound"
   local ins setup
   ins=$(frame_instr "$out")
   setup=$(sed -n 's/^setup instructions \([0-9]*\).*/\1/p' <<<"$out")
-  echo "$name compact: orbit instructions/frame $ins (set-up once: $setup); static RAM $statics + stack $stack (bound $bound) of $ram B; flash $flash B; checksum $sum; psnr_vs_float $psnr dB" >>"$report"
+  # Cycles: the exec log's count of each frame's instructions must be the SysTick figure (within
+  # 0.1 %: the two differ only by where the timer is read), and the calibration loop's cycles
+  # its hand count (cycles.py --selftest).
+  local cyc
+  cyc=$(python3 - "target/$name.cycles" "$ins" "$setup" "${CLOCK[$name]}" "${TARGET[$name]:-0}" "${CEILING[$name]}" <<'PY'
+import sys
+path, ins, setup, clock, target, ceiling = sys.argv[1:]
+regions = [l.split() for l in open(path) if l.startswith("region ")]
+text = open(path).read()
+if "selftest:" not in text or " ok" not in text.split("selftest:")[1].splitlines()[0]:
+    sys.exit(f"cycles.py selftest failed: {text}")
+get = lambda r: dict(zip(r[2::2], map(int, r[3::2])))
+frames = [get(r) for r in regions if r[1] == "render"]
+setups = [get(r) for r in regions if r[1] == "setup"]
+ins = [int(x) for x in ins.split()]
+if len(frames) != len(ins) or not setups:
+    sys.exit(f"cycles.py saw {len(frames)} frames, the firmware printed {len(ins)}")
+for f, n in zip(frames, ins):
+    if abs(f["instructions"] - n) > n / 1000:
+        sys.exit(f"exec log counted {f['instructions']} instructions, SysTick {n}")
+cycles = [f["cycles"] for f in frames]
+worst = max(cycles)
+f0 = frames[0]
+mix = ", ".join(f"{k} {f0[k]}" for k in ("loads", "stores", "multi", "multi_regs", "branches_taken",
+                                           "branches_not_taken", "calls", "mul", "div", "fpu"))
+target, ceiling = int(target), int(ceiling)
+if target:
+    budget = (f"budget {target / 1e6:g} M cycles met" if worst <= target else
+              f"budget {target / 1e6:g} M cycles NOT met ({worst / target:.2f}x; CI ceiling {ceiling / 1e6:g} M)")
+else:
+    budget = f"no cycle budget (CI ceiling {ceiling / 1e6:g} M)"
+print(f"estimated cycles/frame {' '.join(map(str, cycles))} (set-up once: {setups[0]['cycles']}); "
+      f"{int(clock) * 1e6 / worst:.2f} frames/s at {clock} MHz (worst frame); {budget}")
+print(f"frame 0 mix: {f0['instructions']} instructions: {mix}", file=sys.stderr)
+sys.exit(3 if worst > ceiling else 0)
+PY
+) || fail "$name: cycles: $cyc (ceiling ${CEILING[$name]})"
+  echo "$label cycles: $cyc"
+  echo "$label compact: orbit instructions/frame $ins (set-up once: $setup); $cyc; static RAM $statics + stack $stack (bound $bound) of $ram B; flash $flash B; checksum $sum; psnr_vs_float $psnr dB" >>"$report"
 }
 
-board M3 thumbv7m-none-eabi mps2-an385 cortex-m3 4194304 "" ""
-board M4F thumbv7em-none-eabihf mps2-an386 cortex-m4 4194304 "" ""
-board microbit thumbv6m-none-eabi microbit - 16384 "microbit " ""
-board STM32F100 thumbv7m-none-eabi stm32vldiscovery - 8192 "stm32 " "--features stm32f100"
+board M3 thumbv7m-none-eabi mps2-an385 cortex-m3 m3 4194304 "" M3 40 ""
+board M4F thumbv7em-none-eabihf mps2-an386 cortex-m4 m4 4194304 "" M4F 40 ""
+board M4F-128 thumbv7em-none-eabihf mps2-an386 cortex-m4 m4 4194304 "m4f128 " "M4F 128x128" 45 "--features side128"
+board microbit thumbv6m-none-eabi microbit - m0 16384 "microbit " microbit 40 ""
+board STM32F100 thumbv7m-none-eabi stm32vldiscovery - m3 8192 "stm32 " STM32F100 40 "--features stm32f100"
 # The README's pictures are the micro:bit's: a change is a reviewed decision (copy them to
 # docs/images).
 for f in microbit host-float; do

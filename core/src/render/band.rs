@@ -38,6 +38,36 @@ struct RowLine {
     step: i64,
 }
 
+/// One sheet row's counts, kept locally and added to the frame's 64-bit [`super::RenderStats`]
+/// once per row (on a 32-bit core a 64-bit add in memory per voxel is four instructions and two
+/// stores).
+pub(super) struct RowCounts {
+    visited: usize,
+    pub culled: usize,
+    pub splatted: usize,
+    pub updates: u64,
+}
+
+impl RowCounts {
+    /// A row of `visited` voxels (the culled ones are taken off when added).
+    fn visiting(visited: usize) -> Self {
+        RowCounts {
+            visited,
+            culled: 0,
+            splatted: 0,
+            updates: 0,
+        }
+    }
+
+    /// Adds the row to the frame's counts.
+    pub fn add_to(&self, stats: &mut super::RenderStats) {
+        stats.voxels += (self.visited - self.culled) as u64;
+        stats.culled_voxels += self.culled as u64;
+        stats.voxels_splatted += self.splatted as u64;
+        stats.pixel_updates += self.updates;
+    }
+}
+
 /// Fraction bits of [`RowLine`].
 const ROW_FRAC: u32 = 32;
 /// Widening of each end of a [`RowLine`]: 2⁻⁸ voxel, far above the rounding (f32 set-up to
@@ -110,6 +140,21 @@ impl BandReach {
         // floor + 2 ≥ ceil + 1: one voxel past the last that may reach.
         let last = (math::floor(b.min(na as f32)) as usize + 2).min(na);
         first.saturating_sub(1)..last
+    }
+
+    /// The voxels of sheet row `v` (of `na`) to visit: those of [`BandReach::row`] within `held`
+    /// (the source's non-empty ones), and a fresh count for the row.
+    #[inline(always)]
+    pub(super) fn row_within(
+        &self,
+        v: usize,
+        na: usize,
+        held: core::ops::Range<usize>,
+    ) -> (core::ops::Range<usize>, RowCounts) {
+        let reached = self.row(v, na);
+        let us = reached.start.max(held.start)..reached.end.min(held.end);
+        let n = RowCounts::visiting(us.len());
+        (us, n)
     }
 
     /// [`BandReach::row`] computed in floats, as before the integer lines (the reference the

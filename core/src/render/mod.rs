@@ -537,13 +537,12 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
         let rows = &mut *buffers.rows;
         let reach = BandReach::new(f, band, index);
         for v in 0..nb {
-            let (reached, held) = (reach.row(v, na), occupied(v));
-            for u in reached.start.max(held.start)..reached.end.min(held.end) {
+            let (us, mut n) = reach.row_within(v, na, occupied(v));
+            for u in us {
                 if occlusion.is_some_and(|o| o.hides(f, index, u, v, band.0)) {
-                    stats.culled_voxels += 1;
+                    n.culled += 1;
                     continue;
                 }
-                stats.voxels += 1;
                 let value = shade(u, v);
                 if P::is_transparent(&value) {
                     continue;
@@ -551,9 +550,10 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
                 let s = path.splat(f, index, (u, v), band.0, &value, &mut image, |y, x0, x1| {
                     rows[y].include(x0, x1)
                 })?;
-                stats.voxels_splatted += u64::from(s.pixels_visited > 0);
-                stats.pixel_updates += u64::from(s.pixels_updated);
+                n.splatted += usize::from(s.pixels_visited > 0);
+                n.updates += u64::from(s.pixels_updated);
             }
+            n.add_to(stats);
         }
         stats.sheets += 1;
         Ok(())

@@ -19,7 +19,7 @@
 //! The board follows the target and features: Cortex-M0 (`thumbv6m-none-eabi`) is the BBC
 //! micro:bit (16 KiB of RAM: 48×48 in bands of [`BAND`] rows); `--features stm32f100` the
 //! STM32VLDISCOVERY's STM32F100 (Cortex-M3, 8 KiB of RAM: 32×32); anything else QEMU's MPS2
-//! boards (64×64, one band). Build with `--features q24` for the Q24 fixed path (one frame,
+//! boards (64×64, one band; 128×128 with `--features side128`). Build with `--features q24` for the Q24 fixed path (one frame,
 //! bit-exact with the host's `footprint render --fixed`), or `--features float` for the float
 //! path (its checksum is informational).
 #![no_std]
@@ -44,8 +44,11 @@ const SIDE: usize = footprint_scene::SIDE_MICROBIT;
 #[cfg(stm32f100)]
 const SIDE: usize = footprint_scene::SIDE_STM32;
 /// Image side, pixels.
-#[cfg(not(any(microbit, stm32f100)))]
+#[cfg(not(any(microbit, stm32f100, feature = "side128")))]
 const SIDE: usize = footprint_scene::SIDE;
+/// Image side, pixels: the M4F's bigger picture.
+#[cfg(all(feature = "side128", not(any(microbit, stm32f100))))]
+const SIDE: usize = footprint_scene::SIDE_M4F_LARGE;
 /// Rows per band: the accumulator and working image hold this many rows (as many as the
 /// board's RAM leaves: README "Embedding").
 #[cfg(all(microbit, not(any(feature = "q24", feature = "float"))))]
@@ -263,13 +266,15 @@ fn spin(n: u32) {
 /// Instructions executed in `ticks`, from a calibration of (instructions, ticks). Under QEMU's
 /// `-icount shift=0` the virtual clock advances 1 ns per instruction and SysTick counts that
 /// clock, so this is an instruction count, deterministic from run to run. It is not a cycle
-/// count: QEMU models no pipeline, wait states or multi-cycle instructions. Without `-icount`
+/// count: QEMU models no pipeline, wait states or multi-cycle instructions (`embedded/cycles.py`
+/// estimates cycles from QEMU's log of the blocks executed). Without `-icount`
 /// the clock follows the host and the figure means little; with no clock at all, `None`.
 fn instructions(ticks: u64, (cal_instructions, cal_ticks): (u64, u64)) -> Option<u64> {
     (cal_ticks > 0).then(|| (ticks * cal_instructions + cal_ticks / 2) / cal_ticks)
 }
 
 /// Prints band rows as `row Y` and hex Q24 RGBA (float images are quantised to Q24 first).
+#[inline(never)]
 fn emit(first: usize, pixels: &[[u32; 4]]) {
     let t0 = ticks();
     print_rows(first, pixels);

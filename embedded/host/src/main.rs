@@ -18,7 +18,7 @@ use footprint::ViewTable;
 use footprint_scene::display::{send_band, send_band_q15, CrcDisplay};
 use footprint_scene::{compact_lut, compact_stencil_len, render_compact, CompactBuffers};
 use footprint_scene::{render_fixed, render_float, FixedBuffers, FloatBuffers, Report};
-use footprint_scene::{SIDE, SIDE_MICROBIT, SIDE_STM32};
+use footprint_scene::{SIDE, SIDE_M4F_LARGE, SIDE_MICROBIT, SIDE_STM32};
 
 /// Frames of the firmware's orbit (its `FRAMES`).
 const ORBIT_FRAMES: usize = 4;
@@ -118,6 +118,7 @@ fn checksums(threads: usize) -> Result<(), String> {
         ("", SIDE),
         ("microbit ", SIDE_MICROBIT),
         ("stm32 ", SIDE_STM32),
+        ("m4f128 ", SIDE_M4F_LARGE),
     ] {
         let (r, img) = compact_image(&lut, side, side, 0)?;
         for band in [1, 2, 5] {

@@ -43,6 +43,8 @@ pub const SIDE: usize = 64;
 pub const SIDE_MICROBIT: usize = 48;
 /// Image width and height on the STM32F100 (8 KiB of RAM), pixels.
 pub const SIDE_STM32: usize = 32;
+/// Image side of the M4F's bigger picture (QEMU mps2-an386, `--features side128`), pixels.
+pub const SIDE_M4F_LARGE: usize = 128;
 /// Generic and view table size (N×N nodes).
 pub const N: usize = 33;
 
@@ -105,11 +107,14 @@ pub fn view_matrix() -> Mat3 {
 }
 
 /// The view of orbit frame `step` at `side`² pixels: V = zoom · Rx(20°) · Ry(30° + step ·
-/// [`ORBIT_STEP_DEG`]), zoom 1.3 px per voxel from 48² up (the volume fits), scaled down with
-/// the image below that (32² on the 8 KiB board).
+/// [`ORBIT_STEP_DEG`]), zoom 1.3 px per voxel from 48² to 64² (the volume fits), scaled with
+/// the image below that (32² on the 8 KiB board) and above it (the M4F's 128²: 2.6 px per
+/// voxel, the 64² picture at twice the resolution).
 pub fn view_matrix_at(side: usize, step: usize) -> Mat3 {
     let turn = ORBIT_STEP_DEG * step as f32;
-    let zoom = if side >= SIDE_MICROBIT {
+    let zoom = if side > SIDE {
+        1.3 * side as f32 / SIDE as f32
+    } else if side >= SIDE_MICROBIT {
         1.3f32
     } else {
         1.3 * side as f32 / SIDE_MICROBIT as f32
@@ -331,9 +336,15 @@ pub const fn phases_for(side: usize) -> usize {
 
 /// `i16`s the compact stencils need at `side`² (for sizing a `static`; checked at run time).
 pub const fn compact_stencil_len(side: usize) -> usize {
-    // The footprint's box is 5×5 at 48² and 64² (half-extent 2.1 px), 4×4 at 32²: 31 or 21
-    // `i16`s per phase (see footprint::fixed::compact).
-    let per = if side >= SIDE_MICROBIT { 31 } else { 21 };
+    // The footprint's box is 5×5 at 48² and 64² (half-extent 2.1 px), 4×4 at 32², 9×9 at 128²
+    // (4.2 px): 31, 21 or 91 `i16`s per phase (see footprint::fixed::compact).
+    let per = if side > SIDE {
+        91
+    } else if side >= SIDE_MICROBIT {
+        31
+    } else {
+        21
+    };
     phases_for(side) * phases_for(side) * per
 }
 

@@ -218,37 +218,60 @@ impl<'a> CompactStencils<'a> {
             return stats;
         }
         // Values above one are clamped to it: the overflow proof assumes |value| ≤ 2¹⁵.
-        let [v0, v1, v2, v3] = value.map(|c| i32::from(c.min(ONE)));
+        let value = value.map(|c| i32::from(c.min(ONE)));
         let data = acc.data_mut();
         let width = self.bx + 1;
-        let mut rows = st[1 + r0 as usize * width..].chunks(width);
+        // The box's rows inside `acc`, without `chunks` (their length is a division, a library
+        // call on a Cortex-M0).
+        let rows = (r0 as usize..r1 as usize).map(|r| &st[1 + r * width..1 + (r + 1) * width]);
+        let first = (y0 + r0) as usize;
         let mut n = 0u32;
-        for y in (y0 + r0) as usize..(y0 + r1) as usize {
-            let Some(row) = rows.next() else { break };
-            let run = row[0] as u16;
-            let (lo, hi) = (i32::from(run & 0xff), i32::from(run >> 8));
-            let (xa, xb) = ((x0 + lo).max(0), (x0 + hi).min(w));
-            if xa >= xb {
-                continue;
+        if x0 >= 0 && x0 + self.bx as i32 <= w {
+            // The whole box lies inside the rows (most voxels): no clipping per row.
+            let mut at = first * stride + x0 as usize;
+            for (y, row) in (first..).zip(rows) {
+                let run = row[0] as u16;
+                let (lo, hi) = (usize::from(run & 0xff), usize::from(run >> 8));
+                if lo < hi {
+                    add_row(&mut data[at + lo..at + hi], &row[1 + lo..1 + hi], &value);
+                    n += (hi - lo) as u32;
+                    touched(y, x0 as usize + lo, x0 as usize + hi - 1);
+                }
+                at += stride;
             }
-            let at = y * stride;
-            let line = &mut data[at + xa as usize..at + xb as usize];
-            let weights = &row[1 + (xa - x0) as usize..];
-            for (px, &wt) in line.iter_mut().zip(weights) {
-                let wt = i32::from(wt);
-                // Cannot wrap ("Why the sums cannot overflow"); wrapping_add, not `+`, so that
-                // a broken proof would show as a wrong image rather than a panic.
-                px[0] = px[0].wrapping_add(v0 * wt);
-                px[1] = px[1].wrapping_add(v1 * wt);
-                px[2] = px[2].wrapping_add(v2 * wt);
-                px[3] = px[3].wrapping_add(v3 * wt);
+        } else {
+            for (y, row) in (first..).zip(rows) {
+                let run = row[0] as u16;
+                let (lo, hi) = (i32::from(run & 0xff), i32::from(run >> 8));
+                let (xa, xb) = ((x0 + lo).max(0), (x0 + hi).min(w));
+                if xa >= xb {
+                    continue;
+                }
+                let at = y * stride;
+                let line = &mut data[at + xa as usize..at + xb as usize];
+                let k = (xa - x0) as usize;
+                add_row(line, &row[1 + k..1 + k + line.len()], &value);
+                n += (xb - xa) as u32;
+                touched(y, xa as usize, xb as usize - 1);
             }
-            n += (xb - xa) as u32;
-            touched(y, xa as usize, xb as usize - 1);
         }
         stats.pixels_visited = n;
         stats.pixels_updated = n;
         stats
+    }
+}
+
+/// Adds `weights[i] · value` to `line[i]`, the two the same length. Cannot wrap ("Why the sums
+/// cannot overflow"); wrapping_add, not `+`, so that a broken proof would show as a wrong image
+/// rather than a panic.
+#[inline(always)]
+fn add_row(line: &mut [[i32; 4]], weights: &[i16], value: &[i32; 4]) {
+    for (px, &wt) in line.iter_mut().zip(weights) {
+        let wt = i32::from(wt);
+        px[0] = px[0].wrapping_add(value[0] * wt);
+        px[1] = px[1].wrapping_add(value[1] * wt);
+        px[2] = px[2].wrapping_add(value[2] * wt);
+        px[3] = px[3].wrapping_add(value[3] * wt);
     }
 }
 
@@ -311,13 +334,18 @@ pub fn over(front: [u16; 4], back: [u16; 4]) -> [u16; 4] {
 /// back) and clears the accumulator row. (Not inlined: audited by name, like the splat.)
 #[inline(never)]
 pub fn composite_row(acc: &mut [[i32; 4]], image: &mut [[u16; 4]], frac: u32, order: Order) {
+    let half = (1i32 << frac) >> 1;
     for (a, px) in acc.iter_mut().zip(image.iter_mut()) {
+        let [a0, a1, a2, a3] = *a;
         // An empty layer composites to the pixel itself, exactly (over and under by nothing).
-        if (a[0] | a[1] | a[2] | a[3]) == 0 {
+        if (a0 | a1 | a2 | a3) == 0 {
             continue;
         }
-        let layer = resolve(*a, frac);
         *a = [0; 4];
+        // [`resolve`] without its saturation: a sheet's sum is below 2¹⁵ · 65 535 in magnitude
+        // ("Why the sums cannot overflow"), so adding half of 2^W ≤ 2¹³ cannot wrap.
+        let r = |x: i32| (x.wrapping_add(half) >> frac).clamp(0, i32::from(ONE)) as u16;
+        let layer = [r(a0), r(a1), r(a2), r(a3)];
         *px = match order {
             Order::BackToFront => over(layer, *px),
             Order::FrontToBack => over(*px, layer),
