@@ -85,9 +85,9 @@ class Timing:
         pc = re.search(r"\bpc\b", ops) is not None
         if BRANCH.match(m):
             taken = 3 if m0 else 1 + self.p
-            return ("branch", 1, taken)
+            return ("branch" if m == "b" else "cond_branch", 1, taken)
         if m in ("cbz", "cbnz"):
-            return ("branch", 1, 1 + self.p)
+            return ("cond_branch", 1, 1 + self.p)
         if m == "bl":
             return ("call", 4 if m0 else 1 + self.p, 4 if m0 else 1 + self.p)
         if m in ("bx", "blx"):
@@ -163,9 +163,7 @@ class Block:
             cls = timing.cost(mnem, ops)
             kind, fall, taken = cls[0], cls[1], cls[2]
             self.fall = addr + size
-            control = kind in ("branch", "call", "multi_pc", "load_pc")
-            conditional = kind == "branch" and (BRANCH.match(mnem.split(".")[0]) and mnem.split(".")[0] != "b"
-                                                or mnem.split(".")[0] in ("cbz", "cbnz"))
+            control = kind in ("branch", "cond_branch", "call", "multi_pc", "load_pc")
             if kind in ("multi", "multi_pc"):
                 self.classes["multi"] += 1
                 self.classes["multi_regs"] += cls[3]
@@ -181,7 +179,7 @@ class Block:
                 self.classes["calls"] += 1
             self.costs.append((addr, taken if control else fall))
             self.call_last = i == last and kind == "call"
-            if i == last and conditional:
+            if i == last and kind == "cond_branch":
                 # Charged as not taken here; the taken case adds the refill when the next
                 # block shows it.
                 self.cond_last = True
@@ -189,8 +187,6 @@ class Block:
                 self.taken_extra = taken - fall
             else:
                 self.cycles += taken if control else fall
-        if not self.cond_last:
-            self.taken_extra = 0
 
 
 def symbols(elf):
@@ -226,12 +222,11 @@ def main(argv):
     main_lo, main_hi = sym["main"]
     entries = {sym[k][0]: k for k in ("spin", "setup", "render")}
     emit_entry = sym.get("emit", (None, None))[0]
-    emit_ret = None
     blocks = {}
     pending = []
-    pending_start = None
     regions = []
-    current = None  # {pc: [executions, times its last branch was taken]} of the open region
+    # {block's host address: [executions, times its last branch was taken]} of the open region
+    current = None
     prev, prev_entry = None, None
     symbol = ""
     # CYCLES_INCLUSIVE=N: each function's cycles with its callees, over region N (0 = spin, 1 =
@@ -248,8 +243,6 @@ def main(argv):
                 m = INSN.match(line)
                 if m:
                     addr = int(m.group(1), 16)
-                    if pending_start is None:
-                        pending_start = addr
                     pending.append((addr, 2 if len(m.group(2)) == 4 else 4, m.group(3), m.group(4)))
                 continue
             if c == "S" and line.startswith("Stopped execution"):
@@ -281,7 +274,7 @@ def main(argv):
             if pending:
                 blocks[host] = Block(pending, timing)
                 blocks[host].symbol = symbol
-                pending, pending_start = [], None
+                pending = []
             pc = int(line.split("/", 2)[1], 16)
             # Close the previous block's branch: taken unless this block is its fall-through.
             if prev_entry is not None:

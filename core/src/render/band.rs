@@ -50,7 +50,7 @@ pub(super) struct RowCounts {
 
 impl RowCounts {
     /// A row of `visited` voxels (the culled ones are taken off when added).
-    fn visiting(visited: usize) -> Self {
+    pub fn visiting(visited: usize) -> Self {
         RowCounts {
             visited,
             culled: 0,
@@ -143,18 +143,16 @@ impl BandReach {
     }
 
     /// The voxels of sheet row `v` (of `na`) to visit: those of [`BandReach::row`] within `held`
-    /// (the source's non-empty ones), and a fresh count for the row.
+    /// (the source's non-empty ones).
     #[inline(always)]
     pub(super) fn row_within(
         &self,
         v: usize,
         na: usize,
         held: core::ops::Range<usize>,
-    ) -> (core::ops::Range<usize>, RowCounts) {
+    ) -> core::ops::Range<usize> {
         let reached = self.row(v, na);
-        let us = reached.start.max(held.start)..reached.end.min(held.end);
-        let n = RowCounts::visiting(us.len());
-        (us, n)
+        reached.start.max(held.start)..reached.end.min(held.end)
     }
 
     /// [`BandReach::row`] computed in floats, as before the integer lines (the reference the

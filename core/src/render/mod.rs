@@ -57,7 +57,7 @@ use crate::composite::RowSpan;
 use crate::frame::{FrameSetup, Order};
 use crate::shade::{Lighting, OpacityTable, Sample, Shader};
 use crate::splat::{BufferError, ImageMut, Splatter};
-use band::{check_band, start_image, BandReach};
+use band::{check_band, start_image, BandReach, RowCounts};
 use occlusion::Occlusion;
 
 /// The caller-owned buffers of a render, each [`FrameSetup::image_len`] long except `rows`
@@ -91,8 +91,7 @@ pub struct RenderStats {
     pub culled_voxels: u64,
 }
 
-/// Renders sheets into caller-owned buffers, with float or fixed-point accumulation
-/// ([`Precision`]).
+/// Renders sheets into caller-owned buffers, with float or fixed accumulation ([`Precision`]).
 ///
 /// **Bands.** A renderer may own only a band of image rows ([`SheetRenderer::with_band`]): its
 /// buffers then hold just those rows, voxels are splatted only where they reach them, and every
@@ -537,7 +536,8 @@ impl<'a, P: Precision> SheetRenderer<'a, P> {
         let rows = &mut *buffers.rows;
         let reach = BandReach::new(f, band, index);
         for v in 0..nb {
-            let (us, mut n) = reach.row_within(v, na, occupied(v));
+            let us = reach.row_within(v, na, occupied(v));
+            let mut n = RowCounts::visiting(us.len());
             for u in us {
                 if occlusion.is_some_and(|o| o.hides(f, index, u, v, band.0)) {
                     n.culled += 1;
