@@ -360,18 +360,15 @@ pub struct RenderArgs {
     /// Accumulation: float, or fixed (integer splat, accumulator and compositing; bit-exact).
     #[arg(help_heading = "Method", long, value_enum, default_value_t = AccumArg::Float)]
     pub accum: AccumArg,
-    /// Slicing: `object`, the paper's sheets along the grid axis most parallel to the image (the
-    /// way to reproduce the paper; pops where that axis switches), `image`, slabs parallel to
-    /// the image plane (Mueller and Crawfis 1998; no popping), or `auto`: object slicing where a
-    /// pilot of sampled rays measures it at 44 dB or more against the continuous model, else the
-    /// thickest slabs that reach it (docs/modes.md, "The default plan"). Image slicing needs a
-    /// gaussian kernel, float accumulation, an orthographic view and the volume in memory; where
-    /// it cannot run, or with --accum fixed, --refine, --quality or a stream too large to hold,
-    /// `auto` is object slicing without a pilot. [default: auto]
+    /// Slicing: `object`, the paper's sheets along the grid axis most parallel to the image (pops
+    /// where that axis switches), `image`, slabs parallel to the image (Mueller and Crawfis 1998;
+    /// no popping), or `auto`: object slicing where a pilot of sampled rays measures it at 44 dB
+    /// against the continuous model, else the thickest slabs that reach it (docs/modes.md). Image
+    /// slicing needs a gaussian kernel, float, an orthographic view and the volume in memory;
+    /// else (or with --accum fixed, --refine, --quality) `auto` is object slicing. [default: auto]
     #[arg(help_heading = "Method", long, value_enum)]
     pub slicing: Option<SlicingArg>,
-    /// With --slicing image: slab thickness along the view ray, in voxel spacings (the smallest
-    /// of the grid's three spacings).
+    /// With --slicing image: slab thickness along the view ray, in smallest voxel spacings.
     #[arg(help_heading = "Method", long, value_name = "T", default_value_t = 1.0, value_parser = parse_positive)]
     pub slab: f32,
     /// The model both slicings render and `verify --reference continuous` integrates: `opacity`
@@ -403,11 +400,14 @@ pub struct RenderArgs {
     /// size. Measured cost in accuracy: docs/post-classification.md.
     #[arg(help_heading = "Method", long, value_name = "S", default_value = "auto", value_parser = parse_supersample)]
     pub value_subsample: Supersample,
-    /// View-table renders: sub-pixel phases per pixel (at most; wide footprints use fewer) of the
-    /// stencils that splat footprints up to 128 px across, the view table (float, `stencil`) or
-    /// integer table (fixed, `fixed::stencil`) sampled per phase; 0 walks the table per pixel.
+    /// Sub-pixel phases per pixel (at most; wide footprints use fewer) of the stencils that splat
+    /// footprints up to 128 px across (slab sections: at most 8); 0 walks the table per pixel.
     #[arg(help_heading = "Method", long, default_value_t = footprint::stencil::DEFAULT_PHASES)]
     pub phases: usize,
+    /// --slicing image: voxel depths snapped to N phases per slab (T/(2N) at most), sections
+    /// splatted by stencils built per view (docs/performance.md); 0: each kernel cut per pixel.
+    #[arg(help_heading = "Method", long, value_name = "N", default_value_t = 0, value_parser = parse_depth_phases)]
+    pub depth_phases: usize,
     /// Stencils (float or fixed) read at the nearest phase (up to 1/(2P) px off) or blended from
     /// four; `auto`: nearest where the default plan's pilot measures it at target, else blended.
     #[arg(help_heading = "Method", long, value_enum, default_value = "auto")]

@@ -171,6 +171,9 @@ pub struct Plan {
     pub table: Table,
     /// Sub-pixel phases of the stencils (0: walk the table).
     pub phases: usize,
+    /// Slab depth phases (`--depth-phases`): each voxel's depth snapped to one of these per slab
+    /// and its sections splatted through section stencils; 0: cut per pixel.
+    pub depth_phases: usize,
     /// How sheets (float, or the fixed path's integer stencils) read the stencils at a voxel's
     /// phase (`--phase-lookup`); `None` (`auto`): blended, unless the default plan's pilot chose
     /// the nearest (`pilot::choose_slicing`; the fixed path has no pilot, so it blends).
@@ -223,6 +226,7 @@ impl Default for Plan {
                 file: None,
             },
             phases: footprint::stencil::DEFAULT_PHASES,
+            depth_phases: 0,
             phase_lookup: None,
             threads: crate::threads::count(0),
             subsample: Supersample::Fixed(1),

@@ -277,6 +277,24 @@ pub fn cases(dir: &Path) -> Vec<Case> {
         vec![dir.join("out.png")],
         More::default(),
     ));
+    c.push(case(
+        "slabs: more depth phases than a setup holds are refused",
+        &[
+            "render",
+            HEART,
+            "--size",
+            "32x32",
+            "--slicing",
+            "image",
+            "--depth-phases",
+            "100000",
+            "--out",
+            "out.png",
+        ],
+        Expect::Refused("depth phases in 0..=256"),
+        vec![dir.join("out.png")],
+        More::default(),
+    ));
 
     // 6. Wide samples keep their values: u32 4 294 967 290 … 295 are not one value, f64 past
     // f32's range is not missing.

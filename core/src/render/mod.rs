@@ -50,7 +50,7 @@ pub use scaled::{sheet_map, splat_scaled, ScaledFootprint};
 pub use shade_cache::{ShadeCache, ShadeCacheEntry, SHADE_CACHE_LEN};
 pub use sheets::{gradient, SheetRing, SheetWindow};
 pub use slab_renderer::{SlabBuffers, SlabRenderer};
-pub use slabs::{SlabError, SlabSetup, SlabVoxel};
+pub use slabs::{SectionStencils, SlabError, SlabSetup, SlabVoxel};
 pub use visible::{classify_sheet, VisibleSheet, VisibleVoxel};
 
 use crate::composite::RowSpan;

@@ -2,11 +2,12 @@
 //! overlaps ([`super::slabs`] derives the sections), a ring of slab accumulators in caller-owned
 //! [`SlabBuffers`], slabs composited in order, optionally culling occluded voxels.
 
+use super::absorption::{Absorption, OpacityLayers};
 use super::band::{check_band, start_image, SlabQueue};
 use super::clip::{ClipPlanes, ClipSide};
 use super::occlusion::Occlusion;
 use super::precision::{float_opacity_pixel, float_over_row, float_reaches};
-use super::slabs::{centres_within, SlabSetup, SlabVoxel, MAX_RING};
+use super::slabs::{centres_within, SectionStencils, SlabError, SlabSetup, SlabVoxel, MAX_RING};
 use super::{RenderError, RenderStats};
 use crate::composite::{over, RowSpan};
 use crate::frame::Order;
@@ -17,8 +18,9 @@ use crate::table::{SectionRay, SectionTable};
 /// setup whose kernels span at most `ring` = [`SlabSetup::ring`] slabs.
 #[derive(Debug)]
 pub struct SlabBuffers<'a> {
-    /// The ring of slab accumulators, pixel-major: `accumulators[(y·w + x)·ring + slot]`, at least
-    /// `ring × w × rows` long, all zero at the start (left all zero).
+    /// The ring of slab accumulators, slab-major (one plane of the band's pixels per ring slot,
+    /// rows contiguous): `accumulators[(slot·rows + y)·w + x]`, at least `ring × w × rows` long,
+    /// all zero at the start (left all zero).
     pub accumulators: &'a mut [[f32; 4]],
     /// Working image, premultiplied RGBA, row-major, `w × rows`: the result.
     pub image: &'a mut [[f32; 4]],
@@ -51,6 +53,8 @@ pub struct SlabRenderer<'a, const R: usize, const T: usize> {
     queue: SlabQueue,
     occlusion: Option<Occlusion<'a, [f32; 4]>>,
     clip: Option<&'a ClipPlanes>,
+    stencils: Option<&'a SectionStencils<'a>>,
+    layers: Option<&'a OpacityLayers>,
     stats: RenderStats,
 }
 
@@ -89,6 +93,8 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
             queue: SlabQueue::new(setup.count, order),
             occlusion: None,
             clip: None,
+            stencils: None,
+            layers: None,
             stats: RenderStats::default(),
         };
         start_image(&mut r.buffers.image[..n], background, order, [0.0; 4]);
@@ -123,6 +129,28 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
         self
     }
 
+    /// Splats through `stencils` ([`SectionStencils`], built for this renderer's setup, which
+    /// has depth phases): each voxel's section in each slab is a few runs of stencil rows instead
+    /// of a table walk per pixel and slab. Kernels a clipping plane crosses are still cut per
+    /// pixel. Refused ([`SlabError::NoStencils`]) for stencils of another setup.
+    pub fn with_stencils(mut self, stencils: &'a SectionStencils<'a>) -> Result<Self, SlabError> {
+        if stencils.setup() != self.setup {
+            return Err(SlabError::NoStencils);
+        }
+        self.stencils = Some(stencils);
+        Ok(self)
+    }
+
+    /// Composites opacity-model slabs through `layers` (the tabulated [`OpacityLayers`], within
+    /// 10⁻⁵ of the exact layer) instead of a logarithm and an exponential per pixel. Ignored
+    /// for the extinction model or a table of another chord.
+    pub fn with_layers(mut self, layers: &'a OpacityLayers) -> Self {
+        let fits =
+            self.setup.absorption == Absorption::Opacity && layers.chord() == self.setup.chord;
+        self.layers = fits.then_some(layers);
+        self
+    }
+
     /// Counts so far (`sheets` counts slabs composited).
     pub fn stats(&self) -> RenderStats {
         self.stats
@@ -137,16 +165,15 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
     /// (nothing where it misses the band). Refused if it overlaps a slab already composited.
     pub fn splat_voxel(&mut self, voxel: &SlabVoxel) -> Result<(), RenderError> {
         let s = self.setup;
-        let [cx, cy, cz] = voxel.position;
-        let (first, last) = s.slabs_of(cz);
+        let [cx, cy, _] = voxel.position;
+        let (first, last) = s.slabs_of(voxel.position[2]);
         self.queue.admit(first, last)?;
         let Some(cut) = straddled(self.clip, voxel.position) else {
             return Ok(());
         };
         let rows = s.rows_of(cy);
         let (b0, bn) = self.band;
-        let (y0, y1) = (rows.start.max(b0), rows.end.min(b0 + bn));
-        if y0 >= y1 {
+        if rows.start.max(b0) >= rows.end.min(b0 + bn) {
             return Ok(());
         }
         if let Some(o) = &self.occlusion {
@@ -156,7 +183,58 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
             }
         }
         self.stats.voxels += 1;
+        let updates = match (self.stencils, cut) {
+            (Some(st), None) => self.splat_stencils(st, voxel, (first, last)),
+            _ => self.splat_pixels(voxel, (first, last), cut),
+        };
+        self.stats.pixel_updates += updates;
+        self.stats.voxels_splatted += u64::from(updates > 0);
+        Ok(())
+    }
+
+    /// [`SlabRenderer::splat_voxel`] through section stencils: each slab's section as runs of
+    /// stencil rows into that slab's plane. Returns the (pixel, slab) updates.
+    fn splat_stencils(
+        &mut self,
+        st: &SectionStencils<'_>,
+        voxel: &SlabVoxel,
+        slabs: (usize, usize),
+    ) -> u64 {
+        let (w, bn, b0) = (self.setup.size[0], self.band.1, self.band.0);
+        let (own, phase, _) = self.setup.place(voxel.position[2]);
+        // Subtracting a whole number of rows is exact here (|y| < 2²⁴), so every pixel of a band
+        // sees the offsets, and so the weights, of a whole-image render.
+        let center = [voxel.position[0], voxel.position[1] - b0 as f32];
+        let buffers = (
+            &mut *self.buffers.accumulators,
+            &mut *self.buffers.rows,
+            [w, bn, self.ring],
+        );
+        st.splat((own, phase), slabs, center, &voxel.value, buffers)
+    }
+
+    /// [`SlabRenderer::splat_voxel`] pixel by pixel: each pixel's chord read from the section
+    /// table at every slab boundary it crosses (cut where a clipping plane crosses the kernel).
+    /// Returns the pixels updated.
+    fn splat_pixels(
+        &mut self,
+        voxel: &SlabVoxel,
+        (first, last): (usize, usize),
+        cut: Option<&ClipPlanes>,
+    ) -> u64 {
+        let s = self.setup;
+        let [cx, cy, _] = voxel.position;
+        // The depth the voxel is placed at: snapped to its depth phase if the setup has them,
+        // else its own (bit for bit).
+        let cz = match s.place(voxel.position[2]) {
+            (own, _, delta) if s.depth_phases > 0 => s.z0 + (own as f32 + delta) * s.thickness,
+            _ => voxel.position[2],
+        };
+        let rows = s.rows_of(cy);
+        let (b0, bn) = self.band;
+        let (y0, y1) = (rows.start.max(b0), rows.end.min(b0 + bn));
         let (w, ring) = (s.size[0], self.ring);
+        let n = w * bn;
         let value = voxel.value.map(|c| c * s.scale);
         let [qxx, qxy, qyy] = s.q;
         // Chord coordinate of the first slab's front at the voxel's own pixel offset (0, 0), and
@@ -165,8 +243,10 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
         let dt = s.kappa * s.thickness;
         let (ka, kb) = (s.kappa * s.shear[0], s.kappa * s.shear[1]);
         let slabs = last - first + 1;
-        // Each slab's slot in the ring, so the pixel loop does no modular arithmetic.
-        let slots = &ring_slots(first, slabs, ring)[..slabs];
+        // Each slab's plane in the ring, so the pixel loop does no modular arithmetic.
+        let mut planes = ring_slots(first, slabs, ring);
+        planes.iter_mut().for_each(|p| *p *= n);
+        let planes = &planes[..slabs];
         // Without shear every pixel's chord meets slab boundary k at the same chord position
         // t0 + k·dt: the depth integral there is read once per voxel, not per pixel.
         let mut ends = [0.0f32; MAX_RING + 1];
@@ -176,9 +256,10 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
             }
             &ends[..slabs + 1]
         });
-        // A section g of the voxel into one slab's slot of a pixel's ring.
-        let add = |px: &mut [[f32; 4]], slot: usize, g: f32, hit: &mut bool| {
-            for (p, v) in px[slot].iter_mut().zip(&value) {
+        let acc = &mut *self.buffers.accumulators;
+        // A section g of the voxel into one slab's plane at pixel index `at`.
+        let mut add = |at: usize, g: f32, hit: &mut bool| {
+            for (p, v) in acc[at].iter_mut().zip(&value) {
                 *p += v * g;
             }
             *hit |= g != 0.0;
@@ -201,16 +282,16 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
                 continue;
             }
             let yl = y - b0;
-            let row = &mut self.buffers.accumulators[(yl * w + x0) * ring..(yl * w + x1) * ring];
             let t_row = t0 - kb * dy;
             let mut touched = [false; MAX_RING];
-            for (x, px) in row.chunks_exact_mut(ring).enumerate() {
-                let dx = (x + x0) as f32 + 0.5 - cx;
+            for x in x0..x1 {
+                let px = yl * w + x;
+                let dx = x as f32 + 0.5 - cx;
                 let rho2 = (qxx * dx + 2.0 * qxy * dy) * dx + qyy * dy * dy;
                 if let Some(c) = cut {
-                    let at = ((x + x0) as f32 + 0.5, y as f32 + 0.5, t_row - ka * dx);
-                    let chord = (dt, s.kappa, s.front(first), slots.len());
-                    let add = |k: usize, g: f32| add(px, slots[k], g, &mut touched[k]);
+                    let at = (x as f32 + 0.5, y as f32 + 0.5, t_row - ka * dx);
+                    let chord = (dt, s.kappa, s.front(first), planes.len());
+                    let add = |k: usize, g: f32| add(planes[k] + px, g, &mut touched[k]);
                     updates += cut_sections(c, self.table.ray(rho2), at, chord, add);
                     continue;
                 }
@@ -225,9 +306,9 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
                     };
                     let clamp = |e: f32| math::select_clamp(e, -hi, hi);
                     let mut before = clamp(ends[0]);
-                    for ((&slot, hit), &end) in slots.iter().zip(&mut touched).zip(&ends[1..]) {
+                    for ((&plane, hit), &end) in planes.iter().zip(&mut touched).zip(&ends[1..]) {
                         let after = clamp(end);
-                        add(px, slot, radial * (after - before), hit);
+                        add(plane + px, radial * (after - before), hit);
                         before = after;
                     }
                 } else {
@@ -236,21 +317,19 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
                     };
                     let t_front = t_row - ka * dx;
                     let mut before = ray.at(t_front);
-                    for (k, (&slot, hit)) in slots.iter().zip(&mut touched).enumerate() {
+                    for (k, (&plane, hit)) in planes.iter().zip(&mut touched).enumerate() {
                         let after = ray.at(t_front + (k + 1) as f32 * dt);
-                        add(px, slot, after - before, hit);
+                        add(plane + px, after - before, hit);
                         before = after;
                     }
                 }
                 updates += 1;
             }
-            for (&slot, _) in slots.iter().zip(&touched).filter(|(_, &t)| t) {
-                self.buffers.rows[slot * bn + yl].include(x0, x1 - 1);
+            for (&plane, _) in planes.iter().zip(&touched).filter(|(_, &t)| t) {
+                self.buffers.rows[plane / n * bn + yl].include(x0, x1 - 1);
             }
         }
-        self.stats.pixel_updates += updates;
-        self.stats.voxels_splatted += u64::from(updates > 0);
-        Ok(())
+        updates
     }
 
     /// Composites the next slab in compositing order (as one layer of the setup's model,
@@ -261,8 +340,9 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
             return;
         };
         let (w, ring, bn) = (self.setup.size[0], self.ring, self.band.1);
-        let slot = slab % ring;
+        let (slot, plane) = (slab % ring, w * bn);
         let (order, model, chord) = (self.order, self.setup.absorption, self.setup.chord);
+        let layers = self.layers;
         let (acc, img) = (&mut *self.buffers.accumulators, &mut *self.buffers.image);
         for (y, span) in self.buffers.rows[slot * bn..(slot + 1) * bn]
             .iter_mut()
@@ -274,9 +354,13 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
             let mut layer_row =
                 |px: core::ops::Range<usize>, closed: bool, img: &mut [[f32; 4]]| {
                     for p in px {
-                        let a = &mut acc[p * ring + slot];
+                        let a = &mut acc[slot * plane + p];
                         if !closed {
-                            let (layer, i) = (model.layer(*a, chord), &mut img[p]);
+                            let layer = match layers {
+                                Some(t) => t.layer(*a),
+                                None => model.layer(*a, chord),
+                            };
+                            let i = &mut img[p];
                             *i = match order {
                                 Order::BackToFront => over(layer, *i),
                                 Order::FrontToBack => over(*i, layer),

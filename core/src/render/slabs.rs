@@ -56,6 +56,9 @@ use crate::splat::pixel_range;
 use crate::table::SectionError;
 use core::fmt;
 
+mod sections;
+pub use sections::SectionStencils;
+
 /// The most slabs a frame may have.
 pub const MAX_SLABS: usize = 1 << 16;
 
@@ -70,6 +73,9 @@ pub const SHEAR_SNAP: f32 = 1e-6;
 /// renderer keeps): slabs thinner than about a twentieth of the kernel's depth along the ray are
 /// refused ([`SlabError::KernelTooDeep`]).
 pub const MAX_RING: usize = 40;
+
+/// The most depth phases per slab ([`SlabSetup::with_depth_phases`]).
+pub const MAX_DEPTH_PHASES: usize = 256;
 
 /// Why image-aligned slicing could not be set up.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -101,6 +107,21 @@ pub enum SlabError {
     ValueScale {
         /// The factor given.
         scale: usize,
+    },
+    /// More depth phases than [`MAX_DEPTH_PHASES`] ([`SlabSetup::with_depth_phases`]).
+    DepthPhases {
+        /// The phases asked for.
+        phases: usize,
+    },
+    /// Section stencils ([`SectionStencils`]) for a setup without depth phases, or for a
+    /// footprint they do not serve (one too wide to blend: the renderer cuts it per pixel).
+    NoStencils,
+    /// A section stencil buffer shorter than [`SectionStencils::len_for`].
+    StencilBuffer {
+        /// Floats needed.
+        needed: usize,
+        /// Floats given.
+        got: usize,
     },
     /// Post-classified slabs at least as deep as the volume's sample box along the view
     /// ([`super::post::PostSetup::new`]): a slab samples each ray once, at its mid-plane, and
@@ -136,6 +157,17 @@ impl fmt::Display for SlabError {
             ),
             Self::Singular => f.write_str("the view or grid is singular"),
             Self::ValueScale { scale } => write!(f, "value subsampling {scale} is outside 1..=64"),
+            Self::DepthPhases { phases } => write!(
+                f,
+                "{phases} depth phases per slab is more than {MAX_DEPTH_PHASES}"
+            ),
+            Self::NoStencils => f.write_str(
+                "section stencils need depth phases and a footprint narrow enough to blend",
+            ),
+            Self::StencilBuffer { needed, got } => write!(
+                f,
+                "section stencils need {needed} floats of storage, got {got}"
+            ),
             Self::ThickerThanVolume { thickness, depth } => write!(
                 f,
                 "post-classified slabs {thickness} spacings thick are at least as deep as the \
@@ -205,6 +237,8 @@ pub struct SlabSetup {
     /// The model the slabs composite, and a slab's chord along the ray, world units.
     pub(super) absorption: Absorption,
     pub(super) chord: f32,
+    /// Depth phases per slab (0: voxels at their own depth; see [`SlabSetup::with_depth_phases`]).
+    pub(super) depth_phases: usize,
 }
 
 impl SlabSetup {
@@ -289,12 +323,53 @@ impl SlabSetup {
             scale: world_per_z / (dl * r2),
             absorption: Absorption::default(),
             chord: thickness * min_spacing,
+            depth_phases: 0,
         })
     }
 
     /// The same slabs compositing `absorption`'s model (voxels made with [`SlabSetup::voxel`]).
     pub fn with_absorption(self, absorption: Absorption) -> Self {
         SlabSetup { absorption, ..self }
+    }
+
+    /// The same slabs with every voxel's depth snapped to the middle of its depth phase: a voxel
+    /// at depth z lies `u` = (z − z₀)/T slabs behind slab 0's front, in slab j = ⌊u⌋ at phase
+    /// δ = u − j, and is placed at j + (e + ½)/`phases` with e = ⌊δ·`phases`⌋: at most T/(2·`phases`)
+    /// from where it was, along the view. Then a kernel's share of each slab depends only on
+    /// (e, the slab's offset from j, the sub-pixel phase), so it can be precomputed once per view
+    /// ([`SectionStencils`]). Moving every kernel by a small depth moves mass between
+    /// neighbouring slabs only: each kernel still deposits all of itself. `phases` 0 (the
+    /// default) leaves voxels where they are; at most [`MAX_DEPTH_PHASES`].
+    pub fn with_depth_phases(self, phases: usize) -> Result<Self, SlabError> {
+        if phases > MAX_DEPTH_PHASES {
+            return Err(SlabError::DepthPhases { phases });
+        }
+        Ok(SlabSetup {
+            depth_phases: phases,
+            ..self
+        })
+    }
+
+    /// Depth phases per slab (0: voxels at their own depth).
+    pub fn depth_phases(&self) -> usize {
+        self.depth_phases
+    }
+
+    /// Where a voxel at screen depth `z` (pixels) is placed: its slab j (may lie outside the
+    /// frame's slabs), its depth phase e (0 without depth phases) and its depth within slab j as
+    /// a fraction δ ∈ [0, 1] of the slab (the middle of phase e, or exactly where it is without
+    /// phases).
+    #[inline]
+    pub(super) fn place(&self, z: f32) -> (i64, usize, f32) {
+        let u = (z - self.z0) / self.thickness;
+        let j = math::floor(u);
+        let delta = u - j;
+        let d = self.depth_phases;
+        if d == 0 {
+            return (j as i64, 0, delta);
+        }
+        let e = ((delta * d as f32) as usize).min(d - 1);
+        (j as i64, e, (e as f32 + 0.5) / d as f32)
     }
 
     /// The model the slabs composite.
@@ -350,9 +425,16 @@ impl SlabSetup {
 
     /// The first and last slab a kernel centred at depth `z` (pixels) overlaps, clamped to the
     /// frame's slabs.
+    /// With depth phases ([`SlabSetup::with_depth_phases`]), those of the snapped depth.
     #[inline]
     pub fn slabs_of(&self, z: f32) -> (usize, usize) {
         let last = (self.count - 1) as f32;
+        if self.depth_phases > 0 {
+            let (j, _, delta) = self.place(z);
+            let reach = self.z_reach / self.thickness;
+            let f = |m: f32| (j as f32 + math::floor(m)).max(0.0).min(last) as usize;
+            return (f(delta - reach), f(delta + reach));
+        }
         let f = |v: f32| {
             math::floor((v - self.z0) / self.thickness)
                 .max(0.0)

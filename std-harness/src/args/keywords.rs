@@ -292,6 +292,11 @@ impl RenderArgs {
             "slab_post" => self.slab_post = Some(f32_checked(key, v, positive)?),
             "value_subsample" => self.value_subsample = supersample(v)?,
             "phases" => self.phases = whole(key, v)? as usize,
+            "depth_phases" => {
+                let n = whole(key, v)?;
+                self.depth_phases = crate::args::parse_depth_phases(&n.to_string())
+                    .map_err(|e| CliError::input(format!("{key}: {e}")))?
+            }
             "phase_lookup" => self.phase_lookup = choice(key, v)?,
             "order" => self.order = Some(choice(key, v)?),
             "supersample" => self.supersample = supersample(v)?,

@@ -316,3 +316,14 @@ pub fn parse_clip(s: &str) -> Result<crate::scene::ClipPlane, String> {
     let v: [f64; 4] = parse_list_f64::<4>(s)?;
     crate::scene::ClipPlane::new([v[0], v[1], v[2]], v[3])
 }
+
+/// `--depth-phases`: 0 … [`footprint::render::slabs::MAX_DEPTH_PHASES`].
+pub fn parse_depth_phases(s: &str) -> Result<usize, String> {
+    let max = footprint::render::slabs::MAX_DEPTH_PHASES;
+    match s.trim().parse::<usize>() {
+        Ok(n) if n <= max => Ok(n),
+        _ => Err(format!(
+            "{s:?} is not a number of depth phases in 0..={max}"
+        )),
+    }
+}

@@ -112,6 +112,7 @@ pub fn plan(args: &RenderArgs) -> Result<Plan, CliError> {
             file: fa.table_file.clone(),
         },
         phases: args.phases,
+        depth_phases: args.depth_phases,
         phase_lookup: args.phase_lookup.fixed(),
         threads: args.thread_count(),
         subsample: args.subsample.unwrap_or(Supersample::Fixed(1)),

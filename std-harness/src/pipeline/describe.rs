@@ -119,7 +119,8 @@ pub fn describe(p: &Prepared, args: &Scene, plan: &Plan) -> Json {
 
 /// What drew the frame, resolved (defaults and `auto`s decided): `end` (`sheets`, `slabs`,
 /// `post`, `refined` or `reference`), `precision`, `slab` (voxel spacings; null but for slabs),
-/// `blend` (`composite`, `mip`, `minip`, `average`), `subsample` and `supersample` (factors), `lod` (level), `cull` (ε; null when off), `order`,
+/// `depth_phases` (slabs: 0 cuts each kernel per pixel, N snaps depths to N phases per slab and
+/// splats section stencils; null but for slabs), `blend` (`composite`, `mip`, `minip`, `average`), `subsample` and `supersample` (factors), `lod` (level), `cull` (ε; null when off), `order`,
 /// `phase_lookup` (`blend` or `nearest`: how sheets, float or fixed, read the phase stencils).
 pub fn plan_json(p: &Prepared, plan: &Plan) -> Json {
     let (end, slab) = match plan.end {
@@ -139,6 +140,13 @@ pub fn plan_json(p: &Prepared, plan: &Plan) -> Json {
             },
         )
         .num("slab", slab)
+        .num(
+            "depth_phases",
+            match plan.end {
+                End::Slabs { .. } => plan.depth_phases as f64,
+                _ => f64::NAN,
+            },
+        )
         .str(
             "blend",
             match plan.end {

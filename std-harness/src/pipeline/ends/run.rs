@@ -96,9 +96,7 @@ pub fn end_frame(p: &Prepared, plan: &Plan, cache: &mut FrameCache) -> Result<Co
         End::Refined { threshold, sheets } => {
             super::refine::render_refined(p, plan, threshold, sheets)
         }
-        End::Slabs { thickness } => {
-            super::slabs::render_slabs(p, thickness, Bands::of(plan), cache)
-        }
+        End::Slabs { thickness } => super::slabs::render_slabs(p, thickness, plan, cache),
         End::Post {
             thickness,
             values,

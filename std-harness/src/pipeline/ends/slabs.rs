@@ -12,7 +12,12 @@
 //!    ([`crate::pipeline::stages::blocks`]), each voxel listed in the blocks it reaches; threads
 //!    take blocks as they come free. A block walks the slabs in compositing order: the voxels
 //!    that reach slab j first (that reach the block) are splatted into every slab they overlap,
-//!    then slab j is composited (the core's ring of slab accumulators).
+//!    then slab j is composited (the core's ring of slab accumulators, one plane per slab).
+//! 3. With `--depth-phases N` each voxel's depth is snapped to one of N phases per slab and its
+//!    sections are splatted from section stencils built once per frame
+//!    (`footprint::render::SectionStencils`), shared read-only by every block; without, each
+//!    kernel is cut pixel by pixel. Opacity-model slabs are composited through a table of the
+//!    opacity correction (`footprint::render::absorption::OpacityLayers`, within 10⁻⁵).
 //!
 //! **Memory.** 28 bytes per visible voxel (its [`SlabVoxel`]; 76 while a run of sheets sorts
 //! them) on top of the visible lists, and 4 per voxel and block it reaches; the sort's keys, 8
@@ -31,8 +36,9 @@ use crate::pipeline::stages::visible::FrameCache;
 use crate::CliError;
 use footprint::composite::RowSpan;
 use footprint::frame::Order;
+use footprint::render::absorption::OpacityLayers;
 use footprint::render::{
-    occlusion_len, RenderStats, SlabBuffers, SlabRenderer, SlabSetup, SlabVoxel,
+    occlusion_len, RenderStats, SectionStencils, SlabBuffers, SlabRenderer, SlabSetup, SlabVoxel,
 };
 use footprint::shade::Lighting;
 use footprint::table::SectionTable;
@@ -43,14 +49,25 @@ use std::time::Instant;
 const ROWS: usize = 257;
 const COLUMNS: usize = 1025;
 
+/// The most sub-pixel phases of section stencils: D · K sets of them must stay in the cache (at
+/// 8 phases, 8 depth phases and the 256×256×113 CT phantom's 9 slab offsets at 512²: 1.1 MiB).
+const SECTION_PHASES: usize = 8;
+
+/// The most floats of section stencils a frame builds (32 MiB); past it the renderer cuts each
+/// kernel per pixel.
+const MAX_SECTION_FLOATS: usize = 1 << 23;
+
 /// Renders one frame of `p` with image-aligned slabs `thickness` voxel spacings thick on
-/// `bands` (float: the plan refuses fixed-point slabs), culling occluded voxels if they say so.
+/// `plan`'s bands (float: the plan refuses fixed-point slabs), culling occluded voxels if it says
+/// so, through section stencils where it has depth phases (and phases, at most
+/// `SECTION_PHASES`, read by its phase lookup) and they fit `MAX_SECTION_FLOATS`.
 pub fn render_slabs(
     p: &Prepared,
     thickness: f32,
-    bands: Bands,
+    plan: &crate::plan::Plan,
     cache: &mut FrameCache,
 ) -> Result<CoreFrame, CliError> {
+    let bands = Bands::of(plan);
     let refuse = |why: &str| CliError::input(format!("{}: --slicing image: {why}", p.name));
     let volume = p.volume().ok_or_else(|| {
         refuse(
@@ -58,7 +75,14 @@ pub fn render_slabs(
              streamed sheets: drop --stream (the volume is loaded) or use --slicing object",
         )
     })?;
+    let section_phases = plan.phases.min(SECTION_PHASES);
+    let depth_phases = if section_phases > 0 {
+        plan.depth_phases
+    } else {
+        0
+    };
     let setup = SlabSetup::new(&p.frame, &p.kernel, thickness)
+        .and_then(|s| s.with_depth_phases(depth_phases))
         .map_err(|e| refuse(&e.to_string()))?
         .with_absorption(p.absorption);
     let start = Instant::now();
@@ -66,6 +90,17 @@ pub fn render_slabs(
     table
         .build_into(p.kernel)
         .map_err(|e| refuse(&e.to_string()))?;
+    let len = SectionStencils::len_for(&setup, section_phases).filter(|&n| n <= MAX_SECTION_FLOATS);
+    let mut store = crate::io::try_filled(len.unwrap_or(0), 0.0f32, "the section stencils")?;
+    let stencils = match len {
+        Some(_) => Some(
+            SectionStencils::build(&setup, &table, section_phases, &mut store)
+                .map_err(|e| refuse(&e.to_string()))?
+                .with_phase_lookup(plan.phase_lookup.unwrap_or_default()),
+        ),
+        _ => None,
+    };
+    let layers = OpacityLayers::new(setup.chord());
     let tables = start.elapsed().as_secs_f64();
 
     let t0 = Instant::now();
@@ -82,7 +117,7 @@ pub fn render_slabs(
     let voxels = slab_voxels(p, &setup, lists, bands.threads, rows)?;
     let classify = classify_lists + t1.elapsed().as_secs_f64();
 
-    let (setup, table, sv) = (&setup, &*table, &voxels);
+    let (setup, table, sv, stencils) = (&setup, &*table, &voxels, stencils.as_ref());
     let threads = bands.threads.clamp(1, ranges.len().max(1));
     let timing = (start, classify, tables);
     banded_frame(p, threads, timing, voxels.len(), |image| {
@@ -92,7 +127,10 @@ pub fn render_slabs(
             &ranges,
             threads,
             p.background.as_deref(),
-            |b, rows, band, bg| render_band(p, setup, table, sv, b, bg, band, rows, bands.cull),
+            |b, rows, band, bg| {
+                let tables = (table, stencils, &layers);
+                render_band(p, setup, tables, sv, b, bg, band, rows, bands.cull)
+            },
         )
     })
 }
@@ -345,7 +383,11 @@ pub(crate) fn counting_sort<T: Copy>(
 fn render_band(
     p: &Prepared,
     setup: &SlabSetup,
-    table: &SectionTable<ROWS, COLUMNS>,
+    (table, stencils, layers): (
+        &SectionTable<ROWS, COLUMNS>,
+        Option<&SectionStencils>,
+        &OpacityLayers,
+    ),
     sv: &SlabVoxels,
     block: usize,
     background: Option<&[[f32; 4]]>,
@@ -371,9 +413,15 @@ fn render_band(
     let clip = p.clip_planes()?;
     let mut renderer =
         SlabRenderer::with_band(setup, table, p.order, buffers, background, rows.clone())?
-            .with_clip(&clip);
+            .with_clip(&clip)
+            .with_layers(layers);
     if let Some(eps) = cull {
         renderer = renderer.with_occlusion(&mut occluded, eps)?;
+    }
+    if let Some(st) = stencils {
+        renderer = renderer
+            .with_stencils(st)
+            .map_err(|e| CliError::input(e.to_string()))?;
     }
     let mut phases = Phases::default();
     // Each chunk's voxels reaching the block, in the chunk's order.
