@@ -9,7 +9,9 @@
 # 512x512, azimuth 30 / elevation 20, orthographic, emission, grey ramp, on:
 #   - the 256^3 blobs of ../shared/peers/make_volumes.py;
 #   - ../shared/data/walnut and headsq, quantised once to u8 over their full range (VolPack reads u8
-#     only, so all three renderers get the same u8 file).
+#     only, so all three renderers get the same u8 file);
+#   - the real-size CT phantom of benches/ct_phantom.py (256x256x113, spacing 1:1:2, dense bone;
+#     issue 74), quantised to u8 over CT numbers 0..3071 (its ramp 100..200 is 1200..2400).
 # The camera is VTK's (Azimuth, Elevation, the bounding sphere fitted to the image height): the
 # script reads it from VTK's JSON and hands Footprint the same world-to-screen matrix
 # (--view-matrix), so coverage matches; a side-by-side picture per volume goes to
@@ -80,12 +82,20 @@ for name, path, dt, dims in [
     u8 = np.round(255 * (v - v.min()) / (v.max() - v.min())).astype(np.uint8)
     u8.tofile(f"{work}/{name}_u8.raw")
 PY
+[ -s "$work/ct.raw" ] || "$py" benches/ct_phantom.py "$work/ct" >/dev/null
+"$py" - "$work" <<'PY'
+import sys, numpy as np
+work = sys.argv[1]
+v = np.fromfile(f"{work}/ct.raw", "<u2").astype(np.float64)
+np.round(np.clip(v, 0, 3071) * 255 / 3071).astype(np.uint8).tofile(f"{work}/ctphantom_u8.raw")
+PY
 
 # name | dims (x y z) | spacing | ramp LO HI (u8 units)
 volumes=(
   "blobs|256 256 256|1 1 1|80 255"
   "walnut|128 96 114|1 1 1|40 255"
   "headsq|64 64 93|3.2 3.2 1.5|60 255"
+  "ctphantom|256 256 113|1 1 2|100 200"
 )
 [ "$quick" = 1 ] && volumes=("${volumes[1]}")
 
