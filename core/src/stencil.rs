@@ -271,6 +271,41 @@ pub(crate) fn corner_offsets(ka: usize, kb: usize, phases: usize, cells: usize) 
     [s00, s00 + cells, s01, s01 + cells]
 }
 
+/// The phase cell k (0 … P − 1) and the fraction f ∈ [0, 1] within it of a centre coordinate `c`
+/// (pixels) whose pixel is `i`, at `p` phases: (c − i)·P split into its floor and remainder.
+#[inline(always)]
+pub(crate) fn phase_cell(c: f32, i: i64, p: usize) -> (usize, f32) {
+    let t = (c - i as f32) * p as f32;
+    let k = (t.max(0.0) as usize).min(p - 1);
+    (k, (t - k as f32).clamp(0.0, 1.0))
+}
+
+/// Where and how a splat reads phase cell (`ka`, `kb`) at fraction (`fx`, `fy`), for stencils of
+/// `cells` weights at `phases` phases: the four corner stencils' offsets ([`corner_offsets`]) and
+/// their bilinear weights; `nearest`: the corner (a + [fx ≥ ½], b + [fy ≥ ½]) alone, first and
+/// weighed 1 (the others are read by no loop: their weight is never formed).
+#[inline(always)]
+pub(crate) fn cell_read(
+    (ka, kb): (usize, usize),
+    (fx, fy): (f32, f32),
+    phases: usize,
+    cells: usize,
+    nearest: bool,
+) -> ([usize; 4], [f32; 4]) {
+    let corners = corner_offsets(ka, kb, phases, cells);
+    if nearest {
+        let c = corners[usize::from(fx >= 0.5) + 2 * usize::from(fy >= 0.5)];
+        return ([c; 4], [1.0, 0.0, 0.0, 0.0]);
+    }
+    let blend = [
+        (1.0 - fx) * (1.0 - fy),
+        fx * (1.0 - fy),
+        (1.0 - fx) * fy,
+        fx * fy,
+    ];
+    (corners, blend)
+}
+
 /// The first and last index of a non-zero weight in `row`, if any.
 pub(crate) fn nonzero_run<W: PartialEq + Default>(row: &[W]) -> Option<(usize, usize)> {
     let zero = W::default();
@@ -469,36 +504,17 @@ impl<'a, S: Sampler + ?Sized> Stencils<'a, S> {
         let Some(walk) = SpanWalk::new([ix, iy], self.side, image.width(), image.height()) else {
             return Ok(stats);
         };
-        let phase = |c: f32, i: i64| {
-            let t = (c - i as f32) * p as f32;
-            let k = (t.max(0.0) as usize).min(p - 1);
-            (k, (t - k as f32).clamp(0.0, 1.0))
-        };
         let ((ka, fx), (kb, fy)) = match scaled {
             Some((_, t, j)) if walk.inside => {
                 let cell =
                     |t: f32, j: i64| ((j as usize) & (p - 1), (t - j as f32).clamp(0.0, 1.0));
                 (cell(t[0], j[0]), cell(t[1], j[1]))
             }
-            _ => (phase(center[0], ix), phase(center[1], iy)),
+            _ => (phase_cell(center[0], ix, p), phase_cell(center[1], iy, p)),
         };
         let side = self.side;
-        let corners = corner_offsets(ka, kb, p, side * side);
-        let blend = [
-            (1.0 - fx) * (1.0 - fy),
-            fx * (1.0 - fy),
-            (1.0 - fx) * fy,
-            fx * fy,
-        ];
         let nearest = !self.wide && self.lookup == PhaseLookup::Nearest;
-        // Nearest: the corner (a + [fx ≥ ½], b + [fy ≥ ½]) first, weighed 1 (the others are read
-        // by no loop below: their weight is never formed).
-        let (corners, blend) = if nearest {
-            let c = corners[usize::from(fx >= 0.5) + 2 * usize::from(fy >= 0.5)];
-            ([c; 4], [1.0, 0.0, 0.0, 0.0])
-        } else {
-            (corners, blend)
-        };
+        let (corners, blend) = cell_read((ka, kb), (fx, fy), p, side * side, nearest);
         let spans = &self.data[self.ranges + (kb * p + ka) * side..][..side];
         let stride = image.stride();
         let w = image.width() as i64;

@@ -243,10 +243,10 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
         let dt = s.kappa * s.thickness;
         let (ka, kb) = (s.kappa * s.shear[0], s.kappa * s.shear[1]);
         let slabs = last - first + 1;
-        // Each slab's plane in the ring, so the pixel loop does no modular arithmetic.
-        let mut planes = ring_slots(first, slabs, ring);
-        planes.iter_mut().for_each(|p| *p *= n);
-        let planes = &planes[..slabs];
+        // Each slab's slot and plane in the ring, so the pixel loop does no modular arithmetic.
+        let slots = ring_slots(first, slabs, ring);
+        let planes = slots.map(|slot| slot * n);
+        let (slots, planes) = (&slots[..slabs], &planes[..slabs]);
         // Without shear every pixel's chord meets slab boundary k at the same chord position
         // t0 + k·dt: the depth integral there is read once per voxel, not per pixel.
         let mut ends = [0.0f32; MAX_RING + 1];
@@ -325,8 +325,8 @@ impl<'a, const R: usize, const T: usize> SlabRenderer<'a, R, T> {
                 }
                 updates += 1;
             }
-            for (&plane, _) in planes.iter().zip(&touched).filter(|(_, &t)| t) {
-                self.buffers.rows[plane / n * bn + yl].include(x0, x1 - 1);
+            for (&slot, _) in slots.iter().zip(&touched).filter(|(_, &t)| t) {
+                self.buffers.rows[slot * bn + yl].include(x0, x1 - 1);
             }
         }
         updates

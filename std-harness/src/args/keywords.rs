@@ -11,9 +11,9 @@
 //! defaults for an empty command line), so a keyword left out means what a flag left out means.
 
 use super::{
-    factor, finite_f32, fov, grid_side, level, min_radius, parse_background, parse_cull, parse_lod,
-    parse_sample_type, parse_supersample, parse_view, positive, size, spacing, threshold,
-    RenderArgs,
+    depth_phases, factor, finite_f32, fov, grid_side, level, min_radius, parse_background,
+    parse_cull, parse_lod, parse_sample_type, parse_supersample, parse_view, positive, size,
+    spacing, threshold, RenderArgs,
 };
 use crate::CliError;
 use clap::ValueEnum;
@@ -292,11 +292,7 @@ impl RenderArgs {
             "slab_post" => self.slab_post = Some(f32_checked(key, v, positive)?),
             "value_subsample" => self.value_subsample = supersample(v)?,
             "phases" => self.phases = whole(key, v)? as usize,
-            "depth_phases" => {
-                let n = whole(key, v)?;
-                self.depth_phases = crate::args::parse_depth_phases(&n.to_string())
-                    .map_err(|e| CliError::input(format!("{key}: {e}")))?
-            }
+            "depth_phases" => self.depth_phases = depth_phases(whole(key, v)?).map_err(err)?,
             "phase_lookup" => self.phase_lookup = choice(key, v)?,
             "order" => self.order = Some(choice(key, v)?),
             "supersample" => self.supersample = supersample(v)?,

@@ -320,10 +320,21 @@ pub fn parse_clip(s: &str) -> Result<crate::scene::ClipPlane, String> {
 /// `--depth-phases`: 0 … [`footprint::render::slabs::MAX_DEPTH_PHASES`].
 pub fn parse_depth_phases(s: &str) -> Result<usize, String> {
     let max = footprint::render::slabs::MAX_DEPTH_PHASES;
-    match s.trim().parse::<usize>() {
-        Ok(n) if n <= max => Ok(n),
+    match s.trim().parse::<u64>() {
+        Ok(n) => depth_phases(n)
+            .map_err(|_| format!("{s:?} is not a number of depth phases in 0..={max}")),
         _ => Err(format!(
             "{s:?} is not a number of depth phases in 0..={max}"
         )),
+    }
+}
+
+/// `n` if it is a number of depth phases, 0 … [`footprint::render::slabs::MAX_DEPTH_PHASES`]
+/// (the typed check [`parse_depth_phases`] makes).
+pub fn depth_phases(n: u64) -> Result<usize, String> {
+    let max = footprint::render::slabs::MAX_DEPTH_PHASES;
+    match usize::try_from(n) {
+        Ok(n) if n <= max => Ok(n),
+        _ => Err(format!("{n} is not a number of depth phases in 0..={max}")),
     }
 }

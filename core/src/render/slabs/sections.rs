@@ -36,7 +36,7 @@ use crate::geometry::{Footprint, Sampler};
 use crate::math;
 use crate::splat::floor_i64;
 use crate::stencil::walk::{corner_rows, SpanWalk};
-use crate::stencil::{corner_offsets, plan_for, PhaseLookup, Plan, Stencils};
+use crate::stencil::{cell_read, phase_cell, plan_for, PhaseLookup, Plan, Stencils};
 use crate::table::SectionTable;
 
 /// A view's section stencils in caller storage (see the module docs).
@@ -102,7 +102,11 @@ impl<'a> SectionStencils<'a> {
     /// phases; `None` when the setup has no depth phases, the footprint is too wide to blend, or
     /// the size overflows.
     pub fn len_for(setup: &SlabSetup, max_phases: usize) -> Option<usize> {
-        let plan = Self::plan(setup, max_phases)?;
+        Self::len(setup, Self::plan(setup, max_phases)?)
+    }
+
+    /// Floats the sets and their row ranges take for `setup` laid out by `plan`.
+    fn len(setup: &SlabSetup, plan: Plan) -> Option<usize> {
         let sets = setup.depth_phases.checked_mul(offsets_of(setup).1)?;
         let cells = plan.phases.checked_mul(plan.phases)?;
         sets.checked_mul(plan.floats())?
@@ -126,9 +130,8 @@ impl<'a> SectionStencils<'a> {
         max_phases: usize,
         buffer: &'a mut [f32],
     ) -> Result<Self, SlabError> {
-        let (plan, len) = Self::plan(setup, max_phases)
-            .zip(Self::len_for(setup, max_phases))
-            .ok_or(SlabError::NoStencils)?;
+        let plan = Self::plan(setup, max_phases).ok_or(SlabError::NoStencils)?;
+        let len = Self::len(setup, plan).ok_or(SlabError::NoStencils)?;
         if buffer.len() < len {
             return Err(SlabError::StencilBuffer {
                 needed: len,
@@ -187,11 +190,6 @@ impl<'a> SectionStencils<'a> {
         &self.setup
     }
 
-    /// Sub-pixel phases P and box side B.
-    pub fn phases_and_side(&self) -> (usize, usize) {
-        (self.plan.phases, self.plan.side)
-    }
-
     /// Adds a voxel's sections to the slabs `first..=last` it reaches: the voxel of `value` at
     /// screen `center` (pixels; y relative to the band's first row), placed in slab `own` at
     /// depth phase `phase` ([`SlabSetup::place`]), into the ring `acc` of `ring` slab planes of
@@ -215,31 +213,13 @@ impl<'a> SectionStencils<'a> {
         let Some(walk) = SpanWalk::new([ix, iy], side, w, bn) else {
             return 0;
         };
-        let cell = |c: f32, i: i64| {
-            let t = (c - i as f32) * p as f32;
-            let k = (t.max(0.0) as usize).min(p - 1);
-            (k, (t - k as f32).clamp(0.0, 1.0))
-        };
-        let ((ka, fx), (kb, fy)) = (cell(center[0], ix), cell(center[1], iy));
-        let blend = [
-            (1.0 - fx) * (1.0 - fy),
-            fx * (1.0 - fy),
-            (1.0 - fx) * fy,
-            fx * fy,
-        ];
+        let ((ka, fx), (kb, fy)) = (phase_cell(center[0], ix, p), phase_cell(center[1], iy, p));
         // A copy the compiler knows no accumulator store can change (kept in registers).
         let value = *value;
         let value = &value;
         let cells = side * side;
-        let corners = corner_offsets(ka, kb, p, cells);
         let nearest = self.lookup == PhaseLookup::Nearest;
-        // Nearest: the corner (a + [fx ≥ ½], b + [fy ≥ ½]) alone, weighed 1.
-        let (corners, blend) = if nearest {
-            let c = corners[usize::from(fx >= 0.5) + 2 * usize::from(fy >= 0.5)];
-            ([c; 4], [1.0, 0.0, 0.0, 0.0])
-        } else {
-            (corners, blend)
-        };
+        let (corners, blend) = cell_read((ka, kb), (fx, fy), p, cells, nearest);
         let ranges = (p + 1) * (p + 1) * cells + (kb * p + ka) * side;
         let ranges_at = self.set_len * self.setup.depth_phases * self.offsets;
         let cell = kb * p + ka;
