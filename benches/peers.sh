@@ -108,7 +108,7 @@ cull=0.004
 acsv=docs/perf/subsample.csv
 echo "volume,subsample,factor,psnr_f64_db,psnr_continuous_db" > "$acsv"
 pcsv=docs/perf/post.csv
-echo "volume,slab,value_subsample,post_db,pre_db,vtk_db,vtk_trilinear_db,post_trilinear_db" > "$pcsv"
+echo "volume,slab,value_subsample,post_db,pre_db,vtk_db,vtk_trilinear_db,post_trilinear_db,trilinear_slab,trilinear_post_trilinear_db,trilinear_post_kernel_db" > "$pcsv"
 fcsv=docs/perf/floor.csv
 echo "volume,rep,pixel,pixel_updates,composites,voxels,sheets,box_px,accumulate_ms,composite_ms,floor_ms" > "$fcsv"
 for spec in "${volumes[@]}"; do
@@ -122,17 +122,7 @@ for spec in "${volumes[@]}"; do
   }
   vtk 1
   # VTK's camera as Footprint's world-to-screen matrix (rows right, down, away; pixels per unit).
-  vm=$("$py" - "$work/out/vtk-$name.json" <<'PY'
-import json, sys, numpy as np
-v = json.load(open(sys.argv[1]))["view"]
-pos, foc, up = (np.array(v[k], float) for k in ("camera_position", "focal_point", "view_up"))
-d = foc - pos; d /= np.linalg.norm(d)
-right = np.cross(d, up); right /= np.linalg.norm(right)
-upo = np.cross(right, d)
-s = 512 / (2 * v["parallel_scale"])
-print(",".join(f"{x:.9g}" for x in (s * np.array([right, -upo, d])).ravel()))
-PY
-)
+  vm=$("$py" benches/vtk_view_matrix.py "$work/out/vtk-$name.json" 512)
   common=("$raw" --dims "$nx,$ny,$nz" --type u8 --spacing "$sx,$sy,$sz" --window "$lo,$hi" --tf grey
           --size 512x512 --view-matrix "$vm" --frames "$frames" --orbit 2)
   "$fp" render "$raw" --dims "$nx,$ny,$nz" --type u8 --spacing "$sx,$sy,$sz" --window "$lo,$hi" --tf grey \
@@ -160,32 +150,30 @@ PY
       --size 512x512 --view-matrix "$vm" $flags --threads 1 --out "$work/m.png" --json "$work/mr.json" >/dev/null
     "$py" -c "import json; j=json.load(open('$work/m.json')); r=json.load(open('$work/mr.json')); print(f'$name,$label,{j[\"continuous\"][\"psnr_db\"]:.2f},{j[\"overall\"][\"psnr_db\"]:.2f},{int(r[\"voxels\"])},{int(r[\"culled_voxels\"])},{int(r[\"pixel_updates\"])}')" >> "$mcsv"
   done
-  # Post-classification (issue 47): Footprint's post-classified default and its pre-classified
-  # default against the post-classified integral (the kernel's reconstruction, the default, and
-  # trilinear, VTK's own), and VTK's image (from its first run above) against the same integrals.
+  # Post-classification (issues 47, 75): Footprint's post-classified defaults with each
+  # reconstruction (the kernel's, the default, and trilinear, VTK's own) and its pre-classified
+  # default against both post-classified integrals, and VTK's image (from its first run above)
+  # against the same integrals.
   for recon in kernel trilinear; do
     "$fp" verify "$raw" --dims "$nx,$ny,$nz" --type u8 --spacing "$sx,$sy,$sz" --window "$lo,$hi" --tf grey \
       --size 512x512 --view-matrix "$vm" --classification post --reference continuous --reconstruction "$recon" \
-      --json "$work/post-$recon.json" --reference-out "$work/out/post-ref-$name-$recon.pfm" >/dev/null
+      --json "$work/post-$recon.json" --reference-out "$work/out/post-ref-$name-$recon.pfm" \
+      --out "$work/out/post-$name-$recon.pfm" >/dev/null
   done
   "$py" - "$work" "$name" "$pcsv" <<'PY'
 import json, sys, numpy as np
+sys.path.insert(0, "benches")
+from images import pfm, psnr
 work, name, out = sys.argv[1:]
-def pfm(path):
-    with open(path, "rb") as f:
-        assert f.readline().strip() == b"PF"
-        w, h = map(int, f.readline().split())
-        scale = float(f.readline())
-        a = np.frombuffer(f.read(), "<f4" if scale < 0 else ">f4").reshape(h, w, 3)
-    return a[::-1]  # PFM rows run bottom to top
-def psnr(a, b):
-    return 10 * np.log10(1 / max(1e-20, float(((a - b) ** 2).mean())))
 vtk = np.fromfile(f"{work}/out/vtk-{name}.rgba.f32.raw", np.float32).reshape(512, 512, 4)[..., :3]
 k, t = (json.load(open(f"{work}/post-{r}.json")) for r in ("kernel", "trilinear"))
 ref = {r: pfm(f"{work}/out/post-ref-{name}-{r}.pfm") for r in ("kernel", "trilinear")}
 pre = json.load(open(f"{work}/v1.json"))["continuous"]["models"]["post-classified"]
+# Each reconstruction's frame (`verify --reconstruction R` renders it) against both integrals.
+img = {r: pfm(f"{work}/out/post-{name}-{r}.pfm") for r in ("kernel", "trilinear")}
 row = [name, f"{k['slab']:.2g}", str(int(k["value_subsample"])), k["continuous"]["psnr_db"], pre,
-       psnr(vtk, ref["kernel"]), psnr(vtk, ref["trilinear"]), t["continuous"]["psnr_db"]]
+       psnr(vtk, ref["kernel"]), psnr(vtk, ref["trilinear"]), psnr(img["kernel"], ref["trilinear"]),
+       f"{t['slab']:.2g}", t["continuous"]["psnr_db"], psnr(img["trilinear"], ref["kernel"])]
 open(out, "a").write(",".join(str(x) if isinstance(x, str) else f"{x:.2f}" for x in row) + "\n")
 PY
   "$work/vp_bench" "$raw" "$nx" "$ny" "$nz" "$sx" "$sy" "$sz" 512 512 30 20 "$lo" "$hi" 3 "$work/out/vp-$name" classified grey >/dev/null
@@ -213,8 +201,12 @@ PY
       "$py" -c "import json,sys; j=json.load(open('$work/b.json')); print(f'$name,$rep,footprint,$th,$label,{j[\"first_ms\"]:.3f},{j[\"median_ms\"]:.3f},{int(j[\"culled_voxels\"])}')" >> "$csv"
     done
     # Post-classified (issue 47), one thread: beside VTK's ray caster, which post-classifies.
-    "$fp" bench "${common[@]}" --threads 1 --classification post --json "$work/b.json" >/dev/null
-    "$py" -c "import json,sys; j=json.load(open('$work/b.json')); print(f'$name,$rep,footprint,1,float-post,{j[\"first_ms\"]:.3f},{j[\"median_ms\"]:.3f},0')" >> "$csv"
+    # Both reconstructions (issue 75): the kernel's and trilinear, VTK's own model.
+    for recon in kernel trilinear; do
+      "$fp" bench "${common[@]}" --threads 1 --classification post --reconstruction "$recon" --json "$work/b.json" >/dev/null
+      label=float-post; [ "$recon" = trilinear ] && label=float-post-trilinear
+      "$py" -c "import json,sys; j=json.load(open('$work/b.json')); print(f'$name,$rep,footprint,1,$label,{j[\"first_ms\"]:.3f},{j[\"median_ms\"]:.3f},0')" >> "$csv"
+    done
     for th in 1 2; do
       vtk "$th"
       "$py" -c "import json; j=json.load(open('$work/out/vtk-$name.json'))['seconds']; print(f'$name,$rep,vtk,$th,-,{j[\"warmup_total\"]*1e3:.3f},{j[\"frame\"][\"median\"]*1e3:.3f},0')" >> "$csv"

@@ -235,6 +235,38 @@ if any(r["accum"] == "float-post" for r in rows):
         slab, vs = (a["slab"], a["value_subsample"]) if a else ("?", "?")
         lines.append(f"| {v} | {slab} | {vs} | {p1:.1f} ms | {q1:.1f} ms | {t1:.1f} ms | {t1 / q1:.2f}× | "
                      f"{acc_[0]} | {acc_[1]} | {acc_[2]} |")
+        # Trilinear reconstruction (issue 75), where this run measured it.
+        p3, q3 = (med(v, "footprint", 1, "float-post-trilinear", k) for k in ("first_ms", "median_ms"))
+        if a and a.get("trilinear_post_trilinear_db") and q3 == q3:
+            lines.append(f"| {v}, `--reconstruction trilinear` | {a['trilinear_slab']} | {vs} | {p3:.1f} ms | "
+                         f"{q3:.1f} ms | {t1:.1f} ms | {t1 / q3:.2f}× | {a['trilinear_post_kernel_db']} / "
+                         f"{a['trilinear_post_trilinear_db']} dB | – | – |")
+
+# Post-classification's two reconstructions (issue 75): benches/post_reconstruction.sh, if run.
+recon_csv = os.path.join(os.path.dirname(out_md), "perf", "post-reconstruction.csv")
+if os.path.exists(recon_csv):
+    rr = list(csv.DictReader(open(recon_csv)))
+    lines += [
+        "",
+        "## Post-classification, kernel and trilinear reconstruction",
+        "",
+        "`--classification post --reconstruction kernel|trilinear` at their default slabs (kernel 0.7 "
+        "for emission, 0.4 Phong; trilinear 0.5 and 0.3), 512², each against the post-classified "
+        "continuous integral *of its own reconstruction* (`verify --reference continuous`); time at "
+        "30,20,0, emission, one thread, `bench --frames 3 --orbit 2`, the two run alternately "
+        f"(medians). `benches/post_reconstruction.sh`, {rr[0]['date'] if rr else ''} on "
+        f"{rr[0]['cpu'] if rr else ''}. Data: `docs/perf/post-reconstruction.csv`.",
+        "",
+        "| volume | view | shading | reconstruction | slab | values at 1/s | vs its integral | fresh | re-render |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
+    for r in rr:
+        t = (f"{float(r['first_ms']):.0f} ms | {float(r['median_ms']):.0f} ms" if r["first_ms"] else "– | –")
+        lines.append(f"| {r['volume']} | {r['view']} | {r['shading']} | {r['reconstruction']} | {r['slab']} | "
+                     f"{r['value_subsample']} | {r['psnr_own_db']} dB | {t} |")
+    low = [float(r["psnr_own_db"]) for r in rr if r["reconstruction"] == "trilinear"]
+    if low:
+        lines += ["", f"Trilinear: {min(low):.2f}–{max(low):.2f} dB against its integral over these cases."]
 
 # The real-size CT (issue 74): benches/real_size.sh's medians, if it has run.
 real_csv = os.path.join(os.path.dirname(out_md), "perf", "real-size.csv")

@@ -12,12 +12,8 @@
 # --phases 8). Writes docs/perf/real-size.csv (medians) for benches/peers_report.py, which puts it
 # in docs/performance.md.
 set -euo pipefail
-root=$(cd "$(dirname "$0")/.." && pwd)
-cd "$root"
-reps=3
-if [ "${1:-}" = --reps ]; then reps=$2; shift 2; fi
-fp=${1:-$root/target/release/footprint}
-[ -x "$fp" ] || cargo build -q --release -p footprint-harness
+# shellcheck source=benches/bench_common.sh
+source "$(dirname "$0")/bench_common.sh"
 work=$root/target/real-size
 mkdir -p "$work" docs/perf
 # numpy for the phantom: benches/peers.sh's venv if it is there, else one of its own.

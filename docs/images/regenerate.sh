@@ -39,6 +39,7 @@ cool-to-warm.png|render $data/headsq_64x64x93_int16_le.nhdr --tf 'Cool to Warm' 
 transparent-srgb.png|render $data/headsq_64x64x93_int16_le.nhdr --tf Grayscale --window 1200,4000 --view +x --size 192x192 --background transparent --gamma srgb
 perspective-headsq-ortho.png|render $data/headsq_64x64x93_int16_le.nhdr --tf ct-bone-skin --shading phong --view 30,20,0 --size 256x256
 post-headsq.png|render $data/headsq_64x64x93_int16_le.nhdr --tf ct-bone-skin --shading phong --view 30,20,0 --size 256x256 --classification post
+post-trilinear-headsq.png|render $data/headsq_64x64x93_int16_le.nhdr --tf ct-bone-skin --shading phong --view 30,20,0 --size 256x256 --classification post --reconstruction trilinear
 perspective-headsq-60.png|render $data/headsq_64x64x93_int16_le.nhdr --tf ct-bone-skin --shading phong --view 30,20,0 --size 256x256 --perspective 60
 splat-gaussian-60-30-30.png|splat --spacing 60,30,30 --rotate-z 30 --rotate-x 20 --table 65
 splat-bilinear-sheared.png|splat --kernel bilinear --spacing 40,40,40 --rotate-x 40 --rotate-y 35 --table 65

@@ -80,6 +80,7 @@ def test_the_issue_one_liner():
         {"shading": "phong", "view": (30, 20, 0)},
         {"view": (75, -40, 20), "accum": "fixed", "threads": 3},
         {"view": (30, 20, 0), "slicing": "image", "slab": 1},
+        {"view": (30, 20, 0), "classification": "post", "reconstruction": "trilinear"},
     ],
 )
 def test_render_is_byte_identical_to_the_command_line(tmp_path, flags):

@@ -376,11 +376,9 @@ pub struct RenderArgs {
     /// voxels capped at 1 − 10⁻⁶ per world unit). See docs/accuracy.md, "The model".
     #[arg(help_heading = "Method", long, value_enum, default_value_t = AbsorptionArg::Opacity)]
     pub absorption: AbsorptionArg,
-    /// Classification: `pre` (the paper's: each voxel shaded, the shaded volume reconstructed) or
-    /// `post` (values and gradients reconstructed into image-aligned slabs, then classified and
-    /// shaded per pixel: transfer-function edges stay sharp; what ray casters compute). Post
-    /// needs what --slicing image needs (a gaussian kernel, float, orthographic, the volume in
-    /// memory) and renders slabs of --slab-post spacings.
+    /// `pre` (the paper's: voxels shaded, then reconstructed) or `post` (values and gradients
+    /// reconstructed into image-aligned slabs of --slab-post spacings, then classified and shaded
+    /// per pixel, as ray casters do; float, orthographic, the volume in memory).
     #[arg(help_heading = "Method", long, value_enum, default_value_t = ClassificationArg::Pre)]
     pub classification: ClassificationArg,
     /// `composite` (the emission-absorption integral), or project the reconstructed value along
@@ -388,16 +386,18 @@ pub struct RenderArgs {
     /// Projections render post-classified slabs (docs/blend.md has the model).
     #[arg(help_heading = "Method", long, value_enum, default_value_t = BlendArg::Composite)]
     pub blend: BlendArg,
+    /// With --classification post: reconstruct values and gradients with the kernel (gaussian) or
+    /// `trilinear`ly, as VTK's ray casters do. `verify`: also the continuous model's.
+    #[arg(help_heading = "Method", long, value_enum, default_value_t = ReconstructionArg::Kernel)]
+    pub reconstruction: ReconstructionArg,
     /// With --classification post: slab thickness along the view ray, in voxel spacings (the
     /// smallest of the grid's three spacings): the step of the post-classified integral.
-    /// [default: 0.7 for emission, 0.4 for lit shading (docs/post-classification.md)]
+    /// [default: 0.7 for emission, 0.4 lit; trilinear 0.5 and 0.3 (docs/post-classification.md)]
     #[arg(help_heading = "Method", long, value_name = "T", value_parser = parse_positive)]
     pub slab_post: Option<f32>,
-    /// With --classification post: splat the values and gradients at 1/S of the image size and
-    /// interpolate them bilinearly at each pixel before classifying it (the transfer function
-    /// still acts per pixel). `auto` picks the largest S that keeps the kernel's shorter
-    /// semi-axis at least `footprint::render::post`'s bound in value pixels; 1 splats at full
-    /// size. Measured cost in accuracy: docs/post-classification.md.
+    /// With --classification post: splat values and gradients at 1/S of the image size, then
+    /// interpolate them bilinearly per pixel before classifying; `auto`: the largest S keeping
+    /// the kernel's shorter semi-axis ≥ 3 value pixels (docs/post-classification.md).
     #[arg(help_heading = "Method", long, value_name = "S", default_value = "auto", value_parser = parse_supersample)]
     pub value_subsample: Supersample,
     /// Sub-pixel phases per pixel (at most; wide footprints use fewer) of the stencils that splat

@@ -116,6 +116,8 @@ pub enum End {
         values: Supersample,
         /// Composited, or projected (`--blend`).
         blend: footprint::render::Blend,
+        /// How the values are reconstructed (`--reconstruction`).
+        reconstruction: crate::reference::continuous::Reconstruction,
     },
     /// Sheets on a grid refined wherever samples differ by more than `threshold` (float, robust
     /// method, orthographic, volume in memory); `sheets` also refines across sheets.
@@ -275,6 +277,15 @@ impl Plan {
         match self.end {
             End::Post { .. } => "post",
             _ => "pre",
+        }
+    }
+
+    /// How the frame reconstructs between voxels (`--reconstruction`): post-classified slabs
+    /// as asked; every pre-classified end with the kernel.
+    pub fn reconstruction(&self) -> crate::reference::continuous::Reconstruction {
+        match self.end {
+            End::Post { reconstruction, .. } => reconstruction,
+            _ => crate::reference::continuous::Reconstruction::Kernel,
         }
     }
 

@@ -289,6 +289,7 @@ impl RenderArgs {
             "absorption" => self.absorption = choice(key, v)?,
             "classification" => self.classification = choice(key, v)?,
             "blend" => self.blend = choice(key, v)?,
+            "reconstruction" => self.reconstruction = choice(key, v)?,
             "slab_post" => self.slab_post = Some(f32_checked(key, v, positive)?),
             "value_subsample" => self.value_subsample = supersample(v)?,
             "phases" => self.phases = whole(key, v)? as usize,

@@ -2,8 +2,8 @@
 //! `post.svg`/`.png`): the scene rendered post-classified at each slab thickness of
 //! [`SLABS`] and value subsampling of [`SCALES`], each point's frame time (median over the runs,
 //! the configurations timed in turn within each run so that drift hits them alike) and its PSNR
-//! (RGB) against the post-classified continuous integral (kernel reconstruction) of the same
-//! view: the speed a post-classified frame buys with accuracy. The pre-classified trade-off
+//! (RGB) against the post-classified continuous integral of the same view, in the reconstruction
+//! the sweep renders (`--reconstruction`: the kernel or trilinear): the speed a post-classified frame buys with accuracy. The pre-classified trade-off
 //! charts do not apply to this mode (they measure against the pre-classified models).
 
 use super::plot::{
@@ -42,7 +42,7 @@ pub fn sweep(base: &RenderArgs, runs: usize) -> Result<Vec<PostRow>, CliError> {
     let mut r = super::open(&base)?;
     let (truth, _) = render_continuous_as(
         r.prepared(),
-        Reconstruction::Kernel,
+        Reconstruction::from(base.reconstruction),
         Model::Post,
         DEFAULT_CAP,
     )?;

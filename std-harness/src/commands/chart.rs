@@ -96,8 +96,10 @@ pub fn run(args: &ChartArgs) -> Result<(), CliError> {
         let rows = post::sweep(&base, args.runs)?;
         out.add("post.csv", post::csv(&rows));
         let title = format!(
-            "{name}, {}x{}: post-classified frame time against error",
-            base.size.0, base.size.1
+            "{name}, {}x{}: post-classified ({}) frame time against error",
+            base.size.0,
+            base.size.1,
+            crate::reference::continuous::Reconstruction::from(base.reconstruction).name()
         );
         post::write_chart(&mut out, &rows, &title)?;
     } else if args.refine_only {

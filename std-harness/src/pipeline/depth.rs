@@ -20,7 +20,7 @@ pub const DEPTH_EXTENSIONS: [&str; 2] = ["pfm", "npy"];
 /// The [`Probe`]s of the frame of `scene` and `asked` at the listed pixels ((x, y); every pixel,
 /// row-major, for None), and their seconds: the scene at level 0 and the output size (no
 /// supersampling or subsampling), in the frame's model (the scene's absorption, or
-/// post-classified where the plan's end is).
+/// post-classified where the plan's end is) and reconstruction.
 pub fn probes(
     scene: &Scene,
     asked: &Plan,
@@ -48,7 +48,7 @@ pub fn probes(
         ..asked.clone()
     };
     let r = Renderer::prepare(scene, &plan)?;
-    model_probes(r.prepared(), model, pixels)
+    model_probes(r.prepared(), (model, asked.reconstruction()), pixels)
 }
 
 /// The depth map of the frame of `scene` and `asked` encoded for `path` ([`DEPTH_EXTENSIONS`]):

@@ -63,6 +63,7 @@ pub fn describe(p: &Prepared, args: &Scene, plan: &Plan) -> Json {
         .str("sheet_axis", ["i", "j", "k"][f.sheet_axis])
         .str("slicing", plan.slicing())
         .str("classification", plan.classification())
+        .str("reconstruction", plan.reconstruction().name())
         .num(
             "slab",
             match plan.end {
@@ -74,9 +75,14 @@ pub fn describe(p: &Prepared, args: &Scene, plan: &Plan) -> Json {
             "value_subsample",
             match plan.end {
                 End::Post {
-                    thickness, values, ..
-                } => crate::pipeline::ends::post::value_scale(p, thickness, values)
-                    .map_or(f64::NAN, |s| s as f64),
+                    thickness,
+                    values,
+                    reconstruction,
+                    ..
+                } => {
+                    crate::pipeline::ends::post::value_scale(p, (thickness, values, reconstruction))
+                        .map_or(f64::NAN, |s| s as f64)
+                }
                 _ => f64::NAN,
             },
         )
@@ -120,7 +126,8 @@ pub fn describe(p: &Prepared, args: &Scene, plan: &Plan) -> Json {
 /// What drew the frame, resolved (defaults and `auto`s decided): `end` (`sheets`, `slabs`,
 /// `post`, `refined` or `reference`), `precision`, `slab` (voxel spacings; null but for slabs),
 /// `depth_phases` (slabs: 0 cuts each kernel per pixel, N snaps depths to N phases per slab and
-/// splats section stencils; null but for slabs), `blend` (`composite`, `mip`, `minip`, `average`), `subsample` and `supersample` (factors), `lod` (level), `cull` (ε; null when off), `order`,
+/// splats section stencils; null but for slabs), `blend` (`composite`, `mip`, `minip`, `average`),
+/// `reconstruction` (`kernel`, or `trilinear` for post-classified slabs), `subsample` and `supersample` (factors), `lod` (level), `cull` (ε; null when off), `order`,
 /// `phase_lookup` (`blend` or `nearest`: how sheets, float or fixed, read the phase stencils).
 pub fn plan_json(p: &Prepared, plan: &Plan) -> Json {
     let (end, slab) = match plan.end {
@@ -154,6 +161,7 @@ pub fn plan_json(p: &Prepared, plan: &Plan) -> Json {
                 _ => "composite",
             },
         )
+        .str("reconstruction", plan.reconstruction().name())
         .num("subsample", p.subsample_factor(plan).unwrap_or(1) as f64)
         .num("supersample", p.supersample as f64)
         .num("lod", f64::from(p.level))

@@ -18,7 +18,10 @@
 //! The weight is the continuous reference's: the Gaussian w(q) ∝ exp(−s²|q|²/(2R²)) for
 //! |q| < R (grid steps; s = the kernel's `sigmas`), read from a [`WeightTable`] over
 //! r² = |q|²/R² = ρ² + t² (ρ the offset across the ray, t along it, both in kernel radii: see
-//! [`super::slabs`]). Its normalisation cancels in f̄.
+//! [`super::slabs`]). Its normalisation cancels in f̄. A [`PostSetup::trilinear`] frame weighs
+//! by each voxel's tent instead, Π(1 − |q_a|)₊ (its trilinear basis function), so the sample is
+//! the trilinear interpolant, as VTK's ray casters reconstruct ([`PostReconstruction`];
+//! `tent.rs` finds each row's support in closed form).
 //!
 //! # Classification and compositing
 //! Per pixel and slab, the caller's [`Classify`] turns (f̄, ∇̄f) into a premultiplied layer of
@@ -62,12 +65,13 @@ use glam::Vec3;
 
 mod blend;
 mod setup;
+mod tent;
 
 pub use blend::{vertex, Blend};
 use setup::{cell_of, pixels_of_cell};
 pub use setup::{
-    sample_box, sample_box_of, Classify, PostSetup, ShadedLayers, WeightTable, MAX_VALUE_SCALE,
-    WEIGHT_NODES,
+    sample_box, sample_box_of, tent_bound, Classify, PostReconstruction, PostSetup, ShadedLayers,
+    WeightTable, MAX_VALUE_SCALE, WEIGHT_NODES,
 };
 
 /// One voxel to splat: where it lands, its value and its world gradient.
@@ -228,10 +232,13 @@ impl<'a, C: Classify, const N: usize> PostRenderer<'a, C, N> {
             slabs: last - first + 1,
             rows: y0..y1,
         };
-        let updates = if self.gradients {
-            self.accumulate::<5>(&run, &add)
-        } else {
-            self.accumulate::<2>(&run, &[add[0], add[1]])
+        let updates = match (self.setup.reconstruction, self.gradients) {
+            (PostReconstruction::Kernel, true) => self.accumulate::<5>(&run, &add),
+            (PostReconstruction::Kernel, false) => self.accumulate::<2>(&run, &[add[0], add[1]]),
+            (PostReconstruction::Trilinear, true) => self.accumulate_tent::<5>(&run, &add),
+            (PostReconstruction::Trilinear, false) => {
+                self.accumulate_tent::<2>(&run, &[add[0], add[1]])
+            }
         };
         self.stats.pixel_updates += updates;
         self.stats.voxels_splatted += u64::from(updates > 0);

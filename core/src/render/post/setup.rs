@@ -146,7 +146,7 @@ pub struct PostSetup {
     pub(super) low: SlabSetup,
     pub(super) scale: usize,
     /// Screen (pixels, depth) → grid coordinates: g = to_grid·(s − origin).
-    to_grid: Mat3,
+    pub(super) to_grid: Mat3,
     origin: Vec3,
     /// The sample box per axis, grid coordinates: [0, dims − 1], or [−½, ½] along an axis one
     /// voxel thick (see [`sample_box`]).
@@ -154,6 +154,22 @@ pub struct PostSetup {
     top: [f32; 3],
     /// Largest grid index per axis (dims − 1).
     last: [usize; 3],
+    /// How values are reconstructed between voxels.
+    pub(super) reconstruction: PostReconstruction,
+}
+
+/// How a post-classified frame reconstructs the values (and gradients) between voxels.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PostReconstruction {
+    /// The Gaussian kernel, read from a [`WeightTable`] (the default; the continuous reference's
+    /// `kernel` reconstruction).
+    #[default]
+    Kernel,
+    /// Trilinear interpolation, as VTK's, ParaView's and 3D Slicer's ray casters reconstruct:
+    /// each voxel splats its tent Π(1 − |qₐ|)₊ (q its grid offset from the sample), which is its
+    /// trilinear basis function, so the samples are the trilinear interpolant exactly
+    /// (`core/src/render/post/tent.rs`).
+    Trilinear,
 }
 
 /// Where post-classified samples exist along each axis of a grid of `dims` voxels, grid
@@ -205,7 +221,26 @@ impl PostSetup {
             bottom: sample_box(frame.dims).0,
             top: sample_box(frame.dims).1,
             last: frame.dims.map(|d| d.saturating_sub(1)),
+            reconstruction: PostReconstruction::Kernel,
         })
+    }
+
+    /// Slabs `thickness` smallest grid spacings thick for `frame` (orthographic) whose values are
+    /// reconstructed trilinearly ([`PostReconstruction::Trilinear`]). The slab geometry (rows,
+    /// slabs and ring a voxel reaches) is that of the ball of radius √3 that holds the tent's
+    /// support, the cube |qₐ| < 1: a bound the renderer then cuts exactly, per slab and row.
+    /// Errors as [`PostSetup::new`].
+    pub fn trilinear(frame: &FrameSetup, thickness: f32) -> Result<Self, SlabError> {
+        let setup = PostSetup::new(frame, &tent_bound(), thickness)?;
+        Ok(PostSetup {
+            reconstruction: PostReconstruction::Trilinear,
+            ..setup
+        })
+    }
+
+    /// How this frame reconstructs its values.
+    pub fn reconstruction(&self) -> PostReconstruction {
+        self.reconstruction
     }
 
     /// The same slabs with samples only inside the box of voxels `first..=last` (whole-grid
@@ -307,6 +342,15 @@ impl PostSetup {
         // the non-negative value + ½ rounds.
         let near = |a: usize| ((mid[a] + 0.5).max(0.0) as usize).min(self.last[a]);
         (fraction.min(1.0), [near(0), near(1), near(2)])
+    }
+}
+
+/// A Gaussian whose support (the ball of radius √3·(1 + 10⁻⁴) grid steps) holds the tent's cube
+/// |qₐ| < 1 with room for rounding: the reach a trilinear frame's slabs and rows are found with.
+pub fn tent_bound() -> Kernel {
+    Kernel::Gaussian {
+        spread: 1.732_051 * 1.0001,
+        sigmas: 2.5,
     }
 }
 

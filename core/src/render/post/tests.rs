@@ -40,3 +40,51 @@ fn weight_table_follows_the_gaussian() {
     assert_eq!(t.at(1.0), 0.0);
     assert_eq!(t.at(f32::NAN), 0.0);
 }
+
+/// A tent's row (`tent.rs`): its support in closed form is exactly where the brute-force tent
+/// Π(1 − |q_a|)₊ of q = M·(dx, dy, dz) is non-zero, and its weight is that tent, for sheared
+/// and axis-aligned screen-to-grid maps (an axis with m_a = 0 keeps the whole row or none).
+#[test]
+fn tent_rows_are_the_tent_in_closed_form() {
+    use super::tent::TentRow;
+    use glam::Mat3;
+    let mut seed = 12345u64;
+    let mut rnd = || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((seed >> 33) as f64 / (1u64 << 31) as f64) as f32 * 2.0 - 1.0
+    };
+    let mut maps: std::vec::Vec<Mat3> = (0..40)
+        .map(|_| Mat3::from_cols_array(&core::array::from_fn(|_| 0.8 * rnd())))
+        .collect();
+    maps.push(Mat3::from_diagonal(glam::Vec3::new(0.5, 0.4, 0.7)));
+    let mut inside = 0;
+    for m in &maps {
+        for _ in 0..30 {
+            let (dy, dz) = (2.0 * rnd(), 2.0 * rnd());
+            let row = TentRow::new(m, dy, dz);
+            let support = row.support();
+            for i in 0..=2000 {
+                let dx = -6.0 + 12.0 * i as f32 / 2000.0;
+                let q = *m * glam::Vec3::new(dx, dy, dz);
+                let exact: f64 = q
+                    .to_array()
+                    .iter()
+                    .map(|&c| (1.0 - f64::from(c).abs()).max(0.0))
+                    .product();
+                let w = f64::from(row.weight(dx));
+                assert!((w - exact).abs() < 1e-5, "{m:?} dy {dy} dz {dz} dx {dx}");
+                match support {
+                    Some((lo, hi)) if dx > lo + 1e-4 && dx < hi - 1e-4 => {
+                        assert!(exact > 0.0, "inside the support at {dx}: {exact}");
+                        inside += 1;
+                    }
+                    Some((lo, hi)) if dx > lo - 1e-4 && dx < hi + 1e-4 => {}
+                    _ => assert!(exact < 1e-6, "outside the support at {dx}: {exact}"),
+                }
+            }
+        }
+    }
+    assert!(inside > 10_000, "the rows meet the tent ({inside})");
+}

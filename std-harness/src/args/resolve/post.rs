@@ -3,7 +3,8 @@
 
 use super::plan;
 use crate::args::{
-    BlendArg, ClassificationArg, Lod, MethodArg, RenderArgs, SlicingArg, Supersample,
+    BlendArg, ClassificationArg, Lod, MethodArg, ReconstructionArg, RenderArgs, SlicingArg,
+    Supersample,
 };
 use crate::plan::{End, Plan, Precision};
 use crate::CliError;
@@ -16,6 +17,14 @@ pub(super) fn no_post_flags(args: &RenderArgs) -> Result<(), CliError> {
         return Err(CliError::input(
             "--slab-post and --value-subsample set up post-classified slabs: add \
              --classification post (or drop them)",
+        ));
+    }
+    if args.reconstruction == ReconstructionArg::Trilinear {
+        return Err(CliError::input(
+            "--reconstruction trilinear reconstructs post-classified values: add \
+             --classification post (pre-classified voxels are reconstructed with the kernel; \
+             `verify --reference continuous --reconstruction trilinear` measures them against \
+             the trilinear model)",
         ));
     }
     Ok(())
@@ -123,6 +132,7 @@ pub(super) fn post_plan(args: &RenderArgs, precision: Precision) -> Result<Plan,
     let mut plan = plan(&RenderArgs {
         classification: ClassificationArg::Pre,
         blend: BlendArg::Composite,
+        reconstruction: ReconstructionArg::Kernel,
         slicing: Some(SlicingArg::Image),
         slab_post: None,
         value_subsample: Supersample::Auto,
@@ -131,9 +141,10 @@ pub(super) fn post_plan(args: &RenderArgs, precision: Precision) -> Result<Plan,
     plan.end = End::Post {
         thickness: args
             .slab_post
-            .unwrap_or_else(|| crate::args::default_post_slab(&args.shading)),
+            .unwrap_or_else(|| crate::args::default_post_slab(&args.shading, args.reconstruction)),
         values: args.value_subsample,
         blend: args.blend.into(),
+        reconstruction: args.reconstruction.into(),
     };
     // Post-classification composites front to back unless told: opaque pixels then take
     // nothing more (exact), where back to front must classify every slab.

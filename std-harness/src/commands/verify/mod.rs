@@ -7,7 +7,8 @@
 mod report;
 
 use crate::args::keywords::{self, Keywords, Value};
-use crate::args::{plan, Lod, MethodArg, ReconstructionArg, ReferenceArg, RenderArgs};
+use crate::args::{plan, BlendArg, ClassificationArg, Lod, MethodArg, ReconstructionArg};
+use crate::args::{ReferenceArg, RenderArgs};
 use crate::io::image::{check_style, RGB_EXTENSIONS};
 use crate::io::outputs::{self, Planned};
 use crate::metrics::{compare, ErrorStats};
@@ -48,21 +49,16 @@ pub struct VerifyArgs {
     /// (said so); give `--slicing object` to measure the sheets' table and precision error.
     #[arg(long, value_enum, default_value_t = ReferenceArg::Sheets)]
     pub reference: ReferenceArg,
-    /// With `--reference continuous` or `field`: reconstruct the field with the kernel (Gaussian) or
-    /// trilinearly (as VTK's ray casters do).
-    #[arg(long, value_enum, default_value_t = ReconstructionArg::Kernel)]
-    pub reconstruction: ReconstructionArg,
 }
 
-/// `verify`'s own keywords (`min_psnr`, `reference_out`, `reference`, `reconstruction`), then
-/// `render`'s.
+/// `verify`'s own keywords (`min_psnr`, `reference_out`, `reference`), then `render`'s (among
+/// them `reconstruction`, which also chooses the continuous model's).
 impl Keywords for VerifyArgs {
     fn set(&mut self, key: &str, v: &Value) -> Result<(), CliError> {
         match key {
             "min_psnr" => self.min_psnr = Some(keywords::finite(key, v)?),
             "reference_out" => self.reference_out = Some(keywords::text(key, v)?.into()),
             "reference" => self.reference = keywords::choice(key, v)?,
-            "reconstruction" => self.reconstruction = keywords::choice(key, v)?,
             _ => self.render.set(key, v)?,
         }
         Ok(())
@@ -106,10 +102,23 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
     }
 }
 
+/// `r`'s plan. `--reconstruction` also names the continuous model measured against: a
+/// pre-classified frame (which reconstructs shaded voxels with the kernel, whatever the model)
+/// is planned as if it were `kernel`, which is all `render` accepts there.
+fn planned(r: &RenderArgs) -> Result<Plan, CliError> {
+    if r.classification == ClassificationArg::Pre && r.blend == BlendArg::Composite {
+        return plan(&RenderArgs {
+            reconstruction: ReconstructionArg::Kernel,
+            ..r.clone()
+        });
+    }
+    plan(r)
+}
+
 /// Every rule the flags decide, and the outputs' paths and styles, before anything is loaded.
 fn check(args: &VerifyArgs) -> Result<(), CliError> {
     let r = &args.render;
-    plan(r)?;
+    planned(r)?;
     if r.footprint.method == MethodArg::Reference {
         return Err(CliError::input(
             "verify compares a table method with the reference: choose robust, paper or direct",
@@ -202,7 +211,7 @@ struct Measured {
 /// the fixed one.
 fn measure(args: &VerifyArgs, r: &RenderArgs) -> Result<Measured, CliError> {
     let inputs = crate::args::scene(r)?;
-    let (frame, renderer) = render(&inputs, &plan(r)?)?;
+    let (frame, renderer) = render(&inputs, &planned(r)?)?;
     let (core, stats, core_s) = (frame.image, frame.stats, frame.seconds);
     // The fixed path against the float path of the same table and method.
     let fixed_vs_float = if renderer.plan().precision() == Precision::Fixed {
@@ -230,7 +239,7 @@ fn measure(args: &VerifyArgs, r: &RenderArgs) -> Result<Measured, CliError> {
                 End::Post { .. } => Model::Post,
                 _ => Model::Pre(p.absorption),
             };
-            let recon = args.reconstruction.into();
+            let recon = args.render.reconstruction.into();
             let (integral, seconds, models) = continuous_models(over, recon, model, &core)?;
             let (_, error) = compare(&core, &integral.image);
             Some(AgainstContinuous {

@@ -86,7 +86,7 @@ impl Measured {
                     ReferenceArg::Field => format!(" of the field sampled {}^3", r.field_size),
                     _ => String::new(),
                 },
-                Reconstruction::from(args.reconstruction).name(),
+                Reconstruction::from(args.render.reconstruction).name(),
                 c.models[0].0.name(),
                 others(&c.models),
                 i.step,
@@ -162,7 +162,7 @@ impl Measured {
                 "continuous",
                 e.str(
                     "reconstruction",
-                    Reconstruction::from(args.reconstruction).name(),
+                    Reconstruction::from(args.render.reconstruction).name(),
                 )
                 .str("absorption", c.models[0].0.name())
                 .obj("models", models_json(&c.models))

@@ -249,16 +249,16 @@ pub struct Probe {
     pub value: f64,
 }
 
-/// [`Probe`]s of `p`'s frame in `model` with kernel reconstruction: every pixel's, row-major
+/// [`Probe`]s of `p`'s frame in `model` and `reconstruction`: every pixel's, row-major
 /// (`pixels` None), or those listed ((x, y), each inside the frame), with their seconds. `p` must
 /// be a level-0 volume in memory rendered without supersampling (the rays are the pixels').
 pub fn probes(
     p: &Prepared,
-    model: Model,
+    (model, reconstruction): (Model, Reconstruction),
     pixels: Option<&[[usize; 2]]>,
 ) -> Result<(Vec<Probe>, f64), CliError> {
     let start = Instant::now();
-    let (volume, scene) = continuous_scene(p, Reconstruction::Kernel, model, DEFAULT_CAP)?;
+    let (volume, scene) = continuous_scene(p, reconstruction, model, DEFAULT_CAP)?;
     // A crop's brick stores only what it owns (no ghost voxel a split render's brick reads).
     let ghosts = volume.brick.is_some_and(|b| b.stored != b.owned);
     if p.supersample != 1 || ghosts {

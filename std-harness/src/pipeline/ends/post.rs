@@ -28,15 +28,17 @@ use crate::pipeline::stages::bands::{CoreFrame, Phases};
 use crate::pipeline::stages::prepare::Prepared;
 use crate::pipeline::stages::visible::{FrameCache, PostSamples};
 use crate::plan::Supersample;
+use crate::reference::continuous::Reconstruction;
 use crate::CliError;
 use footprint::composite::RowSpan;
 use footprint::frame::Order;
-use footprint::render::post::{MAX_VALUE_SCALE, WEIGHT_NODES};
+use footprint::render::post::{tent_bound, MAX_VALUE_SCALE, WEIGHT_NODES};
 use footprint::render::{
     gradient, Blend, PostBuffers, PostRenderer, PostSetup, PostVoxel, RenderStats, ShadedLayers,
     SheetRing, WeightTable,
 };
 use footprint::shade::OPACITY_TABLE_LEN;
+use footprint::Kernel;
 use std::time::Instant;
 
 /// Bytes [`PostSamples`] keeps per voxel.
@@ -46,7 +48,7 @@ const BYTES_PER_SAMPLE: usize = 28;
 /// `threads` bands.
 pub fn render_post(
     p: &Prepared,
-    (thickness, values, blend): (f32, Supersample, Blend),
+    (thickness, values, blend, reconstruction): (f32, Supersample, Blend, Reconstruction),
     threads: usize,
     cache: &mut FrameCache,
 ) -> Result<CoreFrame, CliError> {
@@ -63,8 +65,7 @@ pub fn render_post(
             p.level
         )));
     }
-    let setup =
-        PostSetup::new(&p.frame, &p.kernel, thickness).map_err(|e| refuse(&e.to_string()))?;
+    let setup = post_setup(p, thickness, reconstruction).map_err(|e| refuse(&e.to_string()))?;
     let scale = scale_for(&setup, values);
     let setup = setup
         .with_value_scale(scale)
@@ -83,16 +84,12 @@ pub fn render_post(
     let tables = start.elapsed().as_secs_f64();
 
     let t0 = Instant::now();
-    let fresh = cache.post.is_none();
-    if fresh {
-        cache.post = Some(post_samples(
-            p,
-            volume,
-            blend,
-            cache.list_budget_for(volume),
-        )?);
+    let reach = 2.0 * reach_kernel(p, reconstruction).spread();
+    if cache.post.as_ref().is_none_or(|(kept, _)| *kept != reach) {
+        let budget = cache.list_budget_for(volume);
+        cache.post = Some((reach, post_samples(p, volume, (blend, reach), budget)?));
     }
-    let samples = cache.post.as_ref().expect("just made");
+    let samples = &cache.post.as_ref().expect("just made").1;
     let classify_samples = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
     let voxels = place(p, &setup, samples)?;
@@ -122,6 +119,27 @@ pub fn render_post(
             )
         },
     )
+}
+
+/// The kernel whose support bounds the reconstruction's: `p`'s own, or for trilinear the ball
+/// that holds the tent's cube ([`tent_bound`]).
+fn reach_kernel(p: &Prepared, reconstruction: Reconstruction) -> Kernel {
+    match reconstruction {
+        Reconstruction::Kernel => p.kernel,
+        Reconstruction::Trilinear => tent_bound(),
+    }
+}
+
+/// The post-classified slabs of `p`'s frame, `thickness` spacings thick, reconstructing as asked.
+pub fn post_setup(
+    p: &Prepared,
+    thickness: f32,
+    reconstruction: Reconstruction,
+) -> Result<PostSetup, footprint::render::SlabError> {
+    match reconstruction {
+        Reconstruction::Kernel => PostSetup::new(&p.frame, &p.kernel, thickness),
+        Reconstruction::Trilinear => PostSetup::trilinear(&p.frame, thickness),
+    }
 }
 
 /// The voxels a volume's samples exist among, `first..=last` per axis in whole-grid indices: a
@@ -157,16 +175,20 @@ fn scale_for(setup: &PostSetup, values: Supersample) -> usize {
 
 /// The value scale a post-classified frame of `p` with slabs `thickness` thick renders at
 /// (`None` where the slabs cannot be set up: the render says why).
-pub fn value_scale(p: &Prepared, thickness: f32, values: Supersample) -> Option<usize> {
-    let setup = PostSetup::new(&p.frame, &p.kernel, thickness).ok()?;
+pub fn value_scale(
+    p: &Prepared,
+    (thickness, values, reconstruction): (f32, Supersample, Reconstruction),
+) -> Option<usize> {
+    let setup = post_setup(p, thickness, reconstruction).ok()?;
     Some(scale_for(&setup, values))
 }
 
-/// The finite voxels less than 2R grid steps from a visible-valued one (see the module docs).
+/// The finite voxels less than `reach` (2R) grid steps from a visible-valued one (see the module
+/// docs).
 fn post_samples(
     p: &Prepared,
     volume: &crate::io::volume::Volume,
-    blend: Blend,
+    (blend, reach): (Blend, f32),
     budget: usize,
 ) -> Result<PostSamples, CliError> {
     let f = &p.frame;
@@ -187,7 +209,7 @@ fn post_samples(
     };
     // The voxels near a visible value, one bit each (no full-volume distance map: the third
     // campaign's abort).
-    let near = near_visible(volume, clear, 2.0 * p.kernel.spread())?;
+    let near = near_visible(volume, clear, reach)?;
     let count = near.count;
     if count.saturating_mul(BYTES_PER_SAMPLE) > budget {
         return Err(CliError::input(format!(

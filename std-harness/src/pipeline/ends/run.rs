@@ -49,8 +49,7 @@ pub fn render_frame(
     plan: &Plan,
     cache: &mut FrameCache,
 ) -> Result<CoreFrame, CliError> {
-    // The resolution decorator (subsample or supersample) off, the end, the decorator's
-    // resampling; timed as one frame (`crate::pipeline::stages::decorators`).
+    // Decorator (sub/supersample) off, the end, its resampling: one frame (`stages::decorators`).
     let start = Instant::now();
     let d = decorators::peel(p, plan)?;
     let mut f = end_frame(&d.prepared, &d.plan, cache)?;
@@ -101,7 +100,13 @@ pub fn end_frame(p: &Prepared, plan: &Plan, cache: &mut FrameCache) -> Result<Co
             thickness,
             values,
             blend,
-        } => super::post::render_post(p, (thickness, values, blend), plan.threads, cache),
+            reconstruction,
+        } => super::post::render_post(
+            p,
+            (thickness, values, blend, reconstruction),
+            plan.threads,
+            cache,
+        ),
         End::Sheets(precision) => render_sheets(p, plan, precision, cache),
         End::Reference => reference_frame(p),
     }
@@ -257,15 +262,13 @@ fn fixed_sheets<const N: usize>(
         table.build_view(&p.frame, generic, lookup, lookup)
     }
     .map_err(fixed_range)?;
-    // Shaded voxels never exceed opacity 1: the stencils may add unsaturated where
-    // that keeps every sum in range (the same bits).
+    // Shaded voxels never exceed opacity 1: stencils may add unsaturated (sums stay in range).
     let path = FixedPath::new(&p.frame, &*table)
         .map_err(fixed_range)?
         .with_value_bound(fixed::ONE);
-    // Footprints up to 128 px across: the integer table sampled once per phase (as
-    // the float path's stencils, with as many phases); wider ones, or --phases 0, walk
-    // the table.
-    // Blended to the edge where the float stencils are (the same phases), else edged.
+    // Footprints up to 128 px across: the integer table sampled once per phase (as the float
+    // stencils, as many phases; blended to the edge where they are, else edged); wider ones, or
+    // --phases 0, walk the table.
     let sp = stencil::plan_for(&p.frame.footprint, plan.phases);
     let blended = sp.is_some_and(|q| !q.edged);
     let phases = match sp {
@@ -293,8 +296,7 @@ fn fixed_sheets<const N: usize>(
         .background
         .as_ref()
         .map(|b| b.iter().map(|&c| fixed::quantise(c)).collect());
-    // A kept float image (a frame handed back) serves as this one's, its bits as
-    // they are: the renderer starts every pixel afresh.
+    // A kept float image (a frame handed back) serves as this one's: every pixel starts afresh.
     let [w, h] = p.frame.size;
     cache.reuse_image_as(w * h, |px: [f32; 4]| px.map(f32::to_bits));
     let (img, stats, phases, visible) = run_path(p, path, bg.as_deref(), cache, Bands::of(plan))?;

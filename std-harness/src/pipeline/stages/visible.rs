@@ -195,8 +195,8 @@ pub struct FrameCache {
     /// The lists' budget in bytes, where not [`list_budget`]'s.
     budget: Option<usize>,
     spares: Spares,
-    /// The voxels post-classified frames splat (`--classification post`), once made.
-    pub post: Option<PostSamples>,
+    /// The voxels post-classified frames splat, once made, and their reach (2R, grid steps).
+    pub post: Option<(f32, PostSamples)>,
     /// The generic table, built once ([`super::tables`]).
     pub tables: super::tables::TableCache,
 }
