@@ -267,6 +267,25 @@ if os.path.exists(recon_csv):
     low = [float(r["psnr_own_db"]) for r in rr if r["reconstruction"] == "trilinear"]
     if low:
         lines += ["", f"Trilinear: {min(low):.2f}–{max(low):.2f} dB against its integral over these cases."]
+    vtk_csv = os.path.join(os.path.dirname(out_md), "perf", "post-vtk.csv")
+    vr = list(csv.DictReader(open(vtk_csv))) if os.path.exists(vtk_csv) else []
+    vtk = next((r for r in vr if r["renderer"] == "vtk-fixedpoint"), None)
+    if vtk:
+        lines += [
+            "",
+            "Beside VTK on the real-size CT (`VTK_PYTHON=… benches/post_reconstruction.sh`: "
+            "`vtkFixedPointVolumeRayCastMapper`, one thread, azimuth 30 / elevation 20, Footprint at "
+            "VTK's exact camera, each run alternately; every image against both post-classified "
+            f"integrals; {vtk['date']}, {vtk['cpu']}; data `docs/perf/post-vtk.csv`):",
+            "",
+            "| renderer | slab | fresh | re-render | VTK ÷ it [target ≥ 1] | vs kernel integral | vs trilinear integral |",
+            "|---|---|---|---|---|---|---|",
+        ]
+        for r in vr:
+            ratio = float(vtk["median_ms"]) / float(r["median_ms"])
+            lines.append(f"| {r['renderer']} | {r['slab']} | {float(r['first_ms']):.0f} ms | "
+                         f"{float(r['median_ms']):.0f} ms | {ratio:.2f}× | {r['psnr_kernel_db']} dB | "
+                         f"{r['psnr_trilinear_db']} dB |")
 
 # The real-size CT (issue 74): benches/real_size.sh's medians, if it has run.
 real_csv = os.path.join(os.path.dirname(out_md), "perf", "real-size.csv")

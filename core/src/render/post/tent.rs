@@ -27,32 +27,44 @@ use glam::Mat3;
 pub(super) struct TentRow {
     m: [f32; 3],
     b: [f32; 3],
+    /// 1/m_a (infinite where m_a = 0).
+    inv: [f32; 3],
 }
 
 impl TentRow {
     /// The row at screen offset `dy` (rows) and `dz` (depth) from the voxel, for `to_grid`
     /// (screen at the values' scale → grid steps).
-    #[inline]
+    #[cfg(test)]
     pub(super) fn new(to_grid: &Mat3, dy: f32, dz: f32) -> Self {
+        let m = to_grid.col(0).to_array();
+        Self::with_inverse(to_grid, m.map(|m| 1.0 / m), dy, dz)
+    }
+
+    /// [`TentRow::new`] with 1/m_a given (the same for every row of a frame: the divisions are
+    /// done once, not per row).
+    #[inline]
+    pub(super) fn with_inverse(to_grid: &Mat3, inv: [f32; 3], dy: f32, dz: f32) -> Self {
         let b = to_grid.col(1) * dy + to_grid.col(2) * dz;
         TentRow {
             m: to_grid.col(0).to_array(),
             b: b.to_array(),
+            inv,
         }
     }
 
-    /// The open interval of dx where every |q_a| < 1 (`None` if empty).
+    /// The open interval of dx where every |q_a| < 1 (`None` if empty), to the rounding of
+    /// 1/m_a: a pixel at its very ends weighs (1 − |q_a|)₊ = 0 either way.
     #[inline]
     pub(super) fn support(&self) -> Option<(f32, f32)> {
         let (mut lo, mut hi) = (f32::NEG_INFINITY, f32::INFINITY);
-        for (&m, &b) in self.m.iter().zip(&self.b) {
+        for ((&m, &b), &inv) in self.m.iter().zip(&self.b).zip(&self.inv) {
             if m == 0.0 {
                 if !(b.abs() < 1.0) {
                     return None;
                 }
                 continue;
             }
-            let (u, v) = ((-1.0 - b) / m, (1.0 - b) / m);
+            let (u, v) = ((-1.0 - b) * inv, (1.0 - b) * inv);
             lo = lo.max(u.min(v));
             hi = hi.min(u.max(v));
         }
@@ -79,6 +91,7 @@ impl<C: Classify, const N: usize> PostRenderer<'_, C, N> {
         let [cx, cy, cz] = run.centre;
         // Value pixels are `scale` image pixels (and depth units) each.
         let to_grid = self.setup.to_grid * self.setup.scale as f32;
+        let inv = to_grid.col(0).to_array().map(|m| 1.0 / m);
         let opaque_skip =
             self.setup.scale == 1 && self.order == Order::FrontToBack && !self.blend.projects();
         let mut updates = 0u64;
@@ -87,7 +100,7 @@ impl<C: Classify, const N: usize> PostRenderer<'_, C, N> {
             let dz = s.front(run.first + k) + 0.5 * s.thickness - cz;
             for y in run.rows.clone() {
                 let dy = y as f32 + 0.5 - cy;
-                let row = TentRow::new(&to_grid, dy, dz);
+                let row = TentRow::with_inverse(&to_grid, inv, dy, dz);
                 let Some((lo, hi)) = row.support() else {
                     continue;
                 };
