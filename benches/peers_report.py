@@ -242,10 +242,15 @@ if any(r["accum"] == "float-post" for r in rows):
                          f"{q3:.1f} ms | {t1:.1f} ms | {t1 / q3:.2f}× | {a['trilinear_post_kernel_db']} / "
                          f"{a['trilinear_post_trilinear_db']} dB | – | – |")
 
+def perf_rows(name):
+    """The rows of docs/perf/NAME beside the page, or none if that run has not been made."""
+    path = os.path.join(os.path.dirname(out_md), "perf", name)
+    return list(csv.DictReader(open(path))) if os.path.exists(path) else []
+
+
 # Post-classification's two reconstructions (issue 75): benches/post_reconstruction.sh, if run.
-recon_csv = os.path.join(os.path.dirname(out_md), "perf", "post-reconstruction.csv")
-if os.path.exists(recon_csv):
-    rr = list(csv.DictReader(open(recon_csv)))
+rr = perf_rows("post-reconstruction.csv")
+if rr:
     lines += [
         "",
         "## Post-classification, kernel and trilinear reconstruction",
@@ -254,8 +259,8 @@ if os.path.exists(recon_csv):
         "for emission, 0.4 Phong; trilinear 0.5 and 0.3), 512², each against the post-classified "
         "continuous integral *of its own reconstruction* (`verify --reference continuous`); time at "
         "30,20,0, emission, one thread, `bench --frames 3 --orbit 2`, the two run alternately "
-        f"(medians). `benches/post_reconstruction.sh`, {rr[0]['date'] if rr else ''} on "
-        f"{rr[0]['cpu'] if rr else ''}. Data: `docs/perf/post-reconstruction.csv`.",
+        f"(medians). `benches/post_reconstruction.sh`, {rr[0]['date']} on "
+        f"{rr[0]['cpu']}. Data: `docs/perf/post-reconstruction.csv`.",
         "",
         "| volume | view | shading | reconstruction | slab | values at 1/s | vs its integral | fresh | re-render |",
         "|---|---|---|---|---|---|---|---|---|",
@@ -267,8 +272,7 @@ if os.path.exists(recon_csv):
     low = [float(r["psnr_own_db"]) for r in rr if r["reconstruction"] == "trilinear"]
     if low:
         lines += ["", f"Trilinear: {min(low):.2f}–{max(low):.2f} dB against its integral over these cases."]
-    vtk_csv = os.path.join(os.path.dirname(out_md), "perf", "post-vtk.csv")
-    vr = list(csv.DictReader(open(vtk_csv))) if os.path.exists(vtk_csv) else []
+    vr = perf_rows("post-vtk.csv")
     vtk = next((r for r in vr if r["renderer"] == "vtk-fixedpoint"), None)
     if vtk:
         lines += [
@@ -288,9 +292,8 @@ if os.path.exists(recon_csv):
                          f"{r['psnr_trilinear_db']} dB |")
 
 # The real-size CT (issue 74): benches/real_size.sh's medians, if it has run.
-real_csv = os.path.join(os.path.dirname(out_md), "perf", "real-size.csv")
-if os.path.exists(real_csv):
-    real = list(csv.DictReader(open(real_csv)))
+real = perf_rows("real-size.csv")
+if real:
     sheets = next((r for r in real if r["method"] == "object"), None)
     lines += [
         "",

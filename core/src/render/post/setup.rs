@@ -156,6 +156,8 @@ pub struct PostSetup {
     last: [usize; 3],
     /// How values are reconstructed between voxels.
     pub(super) reconstruction: PostReconstruction,
+    /// Radius of the ball holding the reconstruction's support, grid steps.
+    radius: f32,
 }
 
 /// How a post-classified frame reconstructs the values (and gradients) between voxels.
@@ -222,6 +224,7 @@ impl PostSetup {
             top: sample_box(frame.dims).1,
             last: frame.dims.map(|d| d.saturating_sub(1)),
             reconstruction: PostReconstruction::Kernel,
+            radius: kernel.spread(),
         })
     }
 
@@ -241,6 +244,12 @@ impl PostSetup {
     /// How this frame reconstructs its values.
     pub fn reconstruction(&self) -> PostReconstruction {
         self.reconstruction
+    }
+
+    /// Radius of the ball that holds the reconstruction's support, grid steps: the kernel's R,
+    /// or [`tent_bound`]'s for trilinear. A sample reads only voxels within it.
+    pub fn support_radius(&self) -> f32 {
+        self.radius
     }
 
     /// The same slabs with samples only inside the box of voxels `first..=last` (whole-grid

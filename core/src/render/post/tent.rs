@@ -33,15 +33,8 @@ pub(super) struct TentRow {
 
 impl TentRow {
     /// The row at screen offset `dy` (rows) and `dz` (depth) from the voxel, for `to_grid`
-    /// (screen at the values' scale → grid steps).
-    #[cfg(test)]
-    pub(super) fn new(to_grid: &Mat3, dy: f32, dz: f32) -> Self {
-        let m = to_grid.col(0).to_array();
-        Self::with_inverse(to_grid, m.map(|m| 1.0 / m), dy, dz)
-    }
-
-    /// [`TentRow::new`] with 1/m_a given (the same for every row of a frame: the divisions are
-    /// done once, not per row).
+    /// (screen at the values' scale → grid steps), with `inv` = 1/m_a, m_a its first column (the
+    /// same for every row of a frame: the divisions are done once, not per row).
     #[inline]
     pub(super) fn with_inverse(to_grid: &Mat3, inv: [f32; 3], dy: f32, dz: f32) -> Self {
         let b = to_grid.col(1) * dy + to_grid.col(2) * dz;

@@ -63,7 +63,8 @@ fn tent_rows_are_the_tent_in_closed_form() {
     for m in &maps {
         for _ in 0..30 {
             let (dy, dz) = (2.0 * rnd(), 2.0 * rnd());
-            let row = TentRow::new(m, dy, dz);
+            let inv = m.col(0).to_array().map(|c| 1.0 / c);
+            let row = TentRow::with_inverse(m, inv, dy, dz);
             let support = row.support();
             for i in 0..=2000 {
                 let dx = -6.0 + 12.0 * i as f32 / 2000.0;

@@ -32,13 +32,12 @@ use crate::reference::continuous::Reconstruction;
 use crate::CliError;
 use footprint::composite::RowSpan;
 use footprint::frame::Order;
-use footprint::render::post::{tent_bound, MAX_VALUE_SCALE, WEIGHT_NODES};
+use footprint::render::post::{MAX_VALUE_SCALE, WEIGHT_NODES};
 use footprint::render::{
     gradient, Blend, PostBuffers, PostRenderer, PostSetup, PostVoxel, RenderStats, ShadedLayers,
     SheetRing, WeightTable,
 };
 use footprint::shade::OPACITY_TABLE_LEN;
-use footprint::Kernel;
 use std::time::Instant;
 
 /// Bytes [`PostSamples`] keeps per voxel.
@@ -84,7 +83,7 @@ pub fn render_post(
     let tables = start.elapsed().as_secs_f64();
 
     let t0 = Instant::now();
-    let reach = 2.0 * reach_kernel(p, reconstruction).spread();
+    let reach = 2.0 * setup.support_radius();
     if cache.post.as_ref().is_none_or(|(kept, _)| *kept != reach) {
         let budget = cache.list_budget_for(volume);
         cache.post = Some((reach, post_samples(p, volume, (blend, reach), budget)?));
@@ -119,15 +118,6 @@ pub fn render_post(
             )
         },
     )
-}
-
-/// The kernel whose support bounds the reconstruction's: `p`'s own, or for trilinear the ball
-/// that holds the tent's cube ([`tent_bound`]).
-fn reach_kernel(p: &Prepared, reconstruction: Reconstruction) -> Kernel {
-    match reconstruction {
-        Reconstruction::Kernel => p.kernel,
-        Reconstruction::Trilinear => tent_bound(),
-    }
 }
 
 /// The post-classified slabs of `p`'s frame, `thickness` spacings thick, reconstructing as asked.
